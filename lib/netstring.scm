@@ -1,0 +1,66 @@
+;;;; Netstrings: the frames every Murdoch message travels in.
+;;
+;; A netstring is "LENGTH:PAYLOAD," with LENGTH in decimal (D. J. Bernstein).
+;; The reader is strict, because a frame comes from the network: digits
+;; only, no leading zero but for the empty payload, at most MAX bytes of
+;; payload, and the comma.  It reads the payload with one read-bytevector,
+;; not byte by byte, so a large frame costs one copy.
+
+;;> Raised when a peer sends something that is not a netstring; the
+;;> message says what was wrong, for the log.
+(define-record-type netstring-error
+  (make-netstring-error message)
+  netstring-error?
+  (message netstring-error-message))
+
+(define (netstring-fail . parts)
+  (raise (make-netstring-error (apply string-append parts))))
+
+(define (digit-byte? b) (and (>= b 48) (<= b 57)))
+
+;; The length prefix, read one byte at a time: it is a few bytes long, and
+;; reading no further than the colon keeps the payload for read-bytevector.
+(define (read-netstring-length in max)
+  (let ((max-digits (string-length (number->string max))))
+    (let loop ((n 0) (digits 0))
+      (let ((b (read-u8 in)))
+        (cond
+         ((eof-object? b)
+          (if (zero? digits) b (netstring-fail "truncated length")))
+         ((= b 58)                      ; #\:
+          (if (zero? digits) (netstring-fail "empty length") n))
+         ((not (digit-byte? b))
+          (netstring-fail "non-digit byte " (number->string b)
+                          " in length"))
+         ((and (= digits 1) (zero? n))
+          (netstring-fail "leading zero in length"))
+         ((>= digits max-digits)
+          (netstring-fail "length over " (number->string max) " bytes"))
+         (else (loop (+ (* n 10) (- b 48)) (+ digits 1))))))))
+
+;;> Reads one netstring from the binary port \var{in} and returns its
+;;> payload as a bytevector, or an eof object when the port ends cleanly
+;;> between frames.  Raises a \scheme{netstring-error} on anything else.
+(define (read-netstring in max)
+  (let ((n (read-netstring-length in max)))
+    (cond
+     ((eof-object? n) n)
+     ((> n max)
+      (netstring-fail "length " (number->string n) " over "
+                      (number->string max) " bytes"))
+     (else
+      (let ((payload (if (zero? n) (bytevector) (read-bytevector n in))))
+        (if (or (eof-object? payload) (< (bytevector-length payload) n))
+            (netstring-fail "truncated payload"))
+        (let ((comma (read-u8 in)))
+          (if (not (eqv? comma 44))
+              (netstring-fail "missing comma after payload")))
+        payload)))))
+
+;;> Writes \var{payload}, a bytevector, to \var{out} as one netstring.
+;;> Does not flush: the caller knows when a batch of frames is complete.
+(define (write-netstring payload out)
+  (write-string (number->string (bytevector-length payload)) out)
+  (write-u8 58 out)
+  (write-bytevector payload out)
+  (write-u8 44 out))
