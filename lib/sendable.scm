@@ -1,0 +1,254 @@
+;;;; Sendable procedures: closures that travel as S-expressions.
+;;
+;; Kali-Scheme copied closures between address spaces frame by frame.
+;; Chibi keeps no source for a compiled lambda, so Murdoch's own `lambda`
+;; keeps it: it compiles the ordinary lambda and lets the closure carry a
+;; `sendable-info` holding the lambda's source and a thunk that answers the
+;; current values of the local variables the body mentions.  Globals are
+;; not captured: they are looked up by name where the closure lands, which
+;; is what the thesis's var-ref relies on.
+;;
+;; A value travels as an S-expression written with `write`.  Data stands
+;; for itself; what `read` cannot rebuild is a tagged vector:
+;;
+;;   #(murdoch:global NAME)             a procedure bound to NAME in the
+;;                                      environment received code runs in
+;;   #(murdoch:closure SOURCE ((NAME . VALUE) ...))
+;;   #(murdoch:proxy UID ID)            a procedure made by encap
+;;   #(murdoch:vector ELEMENT ...)      a vector (vectors are encoded too,
+;;                                      so a user's vector is never a tag)
+;;   #(murdoch:void) #(murdoch:eof)
+;;
+;; Anything else (a port, a thread, a mutex, a record) stops at the sender
+;; with an error that names the variable or argument that held it.
+
+(define-record-type sendable-info
+  (make-sendable-info source+names values)
+  sendable-info?
+  (source+names sendable-info-source+names)
+  (values sendable-info-values))
+
+(define-record-type proxy-ref
+  (make-proxy-ref uid id)
+  proxy-ref?
+  (uid proxy-ref-uid)
+  (id proxy-ref-id))
+
+;;> Raised when a value cannot travel; the message names what held it.
+(define-record-type send-error
+  (make-send-error message)
+  send-error?
+  (message send-error-message))
+
+(define (send-fail . parts)
+  (raise (make-send-error (apply string-append parts))))
+
+;;; The lambda that keeps its source
+
+;; Every symbol of the body outside quote: a superset of the variables it
+;; references.  Over-approximating costs at most a captured value; a
+;; variable missed would be wrong.
+(define (body-symbols body)
+  (let walk ((x body) (acc '()))
+    (cond
+     ((pair? x)
+      (if (and (eq? (car x) 'quote) (pair? (cdr x)))
+          acc
+          (walk (cdr x) (walk (car x) acc))))
+     ((or (symbol? x) (syntactic-closure? x))
+      (if (memq x acc) acc (cons x acc)))
+     (else acc))))
+
+;; A variable is local when the innermost binding the expander sees for it
+;; is a lambda's parameter; Chibi marks those cells with the lambda.
+(define (local-variable? id env)
+  (let ((cell (env-cell env id)))
+    (and cell (lambda? (cdr cell)))))
+
+(define (formals->list formals)
+  (cond ((pair? formals) (cons (car formals) (formals->list (cdr formals))))
+        ((null? formals) '())
+        (else (list formals))))
+
+(define (expand-sendable-lambda expr use-env mac-env)
+  (let* ((formals (cadr expr))
+         (body (cddr expr))
+         (locals (filter (lambda (id) (local-variable? id use-env))
+                         (body-symbols body))))
+    (define (close x) (make-syntactic-closure use-env '() x))
+    (define (close-body x) (make-syntactic-closure use-env params x))
+    (define params (formals->list formals))
+    (make-syntactic-closure
+     mac-env '()
+     `(let ((info (make-sendable-info
+                   ',(cons (strip-syntactic-closures expr)
+                           (map strip-syntactic-closures locals))
+                   (%lambda () (list ,@(map close locals))))))
+        (%lambda ,formals
+          ;; The test keeps `info` among the closure's variables, where
+          ;; closure-info finds it; Chibi drops a reference with no use.
+          (if info (let () ,@(map close-body body)) #f))))))
+
+;;> Murdoch's \scheme{lambda}: an ordinary lambda whose closures can be
+;;> sent to another address space.
+(define-syntax sendable-lambda
+  (lambda (expr use-env mac-env)
+    (expand-sendable-lambda expr use-env mac-env)))
+
+;;> Murdoch's \scheme{define}: as usual, but a procedure it defines is made
+;;> by the sendable lambda and carries its name.
+(define-syntax sendable-define
+  (er-macro-transformer
+   (lambda (expr rename compare)
+     (let ((target (cadr expr)))
+       (if (pair? target)
+           `(,(rename '%define) ,(car target)
+             (,(rename 'name-procedure)
+              (,(rename 'sendable-lambda) ,(cdr target) ,@(cddr expr))
+              ',(car target)))
+           `(,(rename '%define) ,@(cdr expr)))))))
+
+(define (name-procedure proc name)
+  (procedure-name-set! proc name)
+  proc)
+
+(define (closure-info proc)
+  (let ((vars (procedure-vars proc)))
+    (let loop ((i 0))
+      (cond ((= i (vector-length vars)) #f)
+            ((sendable-info? (vector-ref vars i)) (vector-ref vars i))
+            (else (loop (+ i 1)))))))
+
+;;> True when \var{proc} carries its source.
+(define (sendable-procedure? proc)
+  (and (procedure? proc) (not (opcode? proc)) (closure-info proc) #t))
+
+;;; Proxies
+
+;; A proxy is a closure of this one lambda over a proxy-ref: encoding
+;; recognises it by its code, so no table of proxies is needed.
+(define (make-proxy-procedure ref call)
+  (lambda args (call ref args)))
+
+(define proxy-code
+  (procedure-code (make-proxy-procedure #f #f)))
+
+(define (proxy-procedure-ref proc)
+  (and (procedure? proc)
+       (not (opcode? proc))
+       (eq? (procedure-code proc) proxy-code)
+       (vector-ref (procedure-vars proc) 0)))
+
+;;; Encoding
+
+(define (global-name proc env)
+  (let ((name (if (opcode? proc)
+                  (string->symbol (opcode-name proc))
+                  (procedure-name proc))))
+    (and (symbol? name)
+         (let ((cell (env-cell env name)))
+           (and cell (eq? (cdr cell) proc)))
+         name)))
+
+(define (tag? x)
+  (and (vector? x) (> (vector-length x) 0)
+       (memq (vector-ref x 0) '(murdoch:global murdoch:closure murdoch:proxy
+                               murdoch:vector murdoch:void murdoch:eof))))
+
+(define void-value (if #f #f))
+
+(define (describe x)
+  (cond ((input-port? x) "an input port")
+        ((output-port? x) "an output port")
+        ((thread? x) "a thread")
+        ((mutex? x) "a mutex")
+        ((condition-variable? x) "a condition variable")
+        ((procedure? x) "a procedure made without Murdoch's lambda")
+        (else (string-append "a " (symbol->string (type-name (type-of x)))))))
+
+;;> The S-expression that stands for \var{x} on the wire.  \var{env} is the
+;;> environment whose procedures travel by name; \var{what} names \var{x}
+;;> in an error message.
+(define (encode x env what)
+  (define (enc x what)
+    (cond
+     ((or (number? x) (string? x) (symbol? x) (char? x) (boolean? x)
+          (null? x) (bytevector? x))
+      x)
+     ((pair? x) (cons (enc (car x) what) (enc (cdr x) what)))
+     ((vector? x)
+      (list->vector
+       (cons 'murdoch:vector (map (lambda (e) (enc e what)) (vector->list x)))))
+     ((eof-object? x) (vector 'murdoch:eof))
+     ((eq? x void-value) (vector 'murdoch:void))
+     ((procedure? x) (enc-procedure x what))
+     (else (send-fail "cannot send " what ": it is " (describe x)))))
+  (define (enc-procedure p what)
+    (cond
+     ((proxy-procedure-ref p)
+      => (lambda (ref) (vector 'murdoch:proxy (proxy-ref-uid ref)
+                               (proxy-ref-id ref))))
+     ((global-name p env) => (lambda (name) (vector 'murdoch:global name)))
+     ((and (not (opcode? p)) (closure-info p)) => enc-closure)
+     (else (send-fail "cannot send " what ": it is " (describe p)))))
+  (define (enc-closure info)
+    (let* ((source+names (sendable-info-source+names info))
+           (source (car source+names)))
+      (vector 'murdoch:closure source
+              (map (lambda (name value)
+                     (cons name
+                           (enc value (string-append
+                                       "variable " (symbol->string name)
+                                       " of " (short-source source)))))
+                   (cdr source+names)
+                   ((sendable-info-values info))))))
+  (enc x what))
+
+(define (short-source source)
+  (let ((s (let ((out (open-output-string)))
+             (write source out)
+             (get-output-string out))))
+    (if (> (string-length s) 60) (string-append (substring s 0 57) "...") s)))
+
+;;; Decoding
+
+;; Compiling a closure's source is the dear part of decoding, and the same
+;; closure is sent again and again, so makers are kept by source.
+(define (make-closure-compiler env)
+  (let ((makers (make-hash-table equal?)))
+    (lambda (source names)
+      (let ((key (cons source names)))
+        (or (hash-table-ref/default makers key #f)
+            (let ((maker (eval `(lambda ,names ,source) env)))
+              (hash-table-set! makers key maker)
+              maker))))))
+
+;;> Returns a procedure that rebuilds values encoded by \scheme{encode}:
+;;> globals and closure sources are resolved in \var{env}, and proxies
+;;> are made by \var{proxy}, a procedure of a uid and an id.
+(define (make-decoder env proxy)
+  (let ((compile (make-closure-compiler env)))
+    (define (dec x)
+      (cond
+       ((pair? x) (cons (dec (car x)) (dec (cdr x))))
+       ((not (vector? x)) x)
+       (else (dec-tagged x))))
+    (define (dec-tagged v)
+      (case (vector-ref v 0)
+        ((murdoch:vector)
+         (list->vector (map dec (cdr (vector->list v)))))
+        ((murdoch:global) (global-ref (vector-ref v 1)))
+        ((murdoch:closure)
+         (let ((bindings (vector-ref v 2)))
+           (apply (compile (vector-ref v 1) (map car bindings))
+                  (map (lambda (b) (dec (cdr b))) bindings))))
+        ((murdoch:proxy) (proxy (vector-ref v 1) (vector-ref v 2)))
+        ((murdoch:void) void-value)
+        ((murdoch:eof) (eof-object))
+        (else (error "unknown tag in a received value" v))))
+    (define (global-ref name)
+      (let ((cell (env-cell env name)))
+        (if (and cell (procedure? (cdr cell)))
+            (cdr cell)
+            (error "no procedure of this name here" name))))
+    dec))
