@@ -81,7 +81,7 @@
     (make-syntactic-closure
      mac-env '()
      `(let ((info (make-sendable-info
-                   ',(cons (strip-syntactic-closures expr)
+                   ',(cons `(lambda ,@(strip-syntactic-closures (cdr expr)))
                            (map strip-syntactic-closures locals))
                    (%lambda () (list ,@(map close locals))))))
         (%lambda ,formals
@@ -112,12 +112,14 @@
   (procedure-name-set! proc name)
   proc)
 
-(define (closure-info proc)
+(define (closure-var proc pred)
   (let ((vars (procedure-vars proc)))
     (let loop ((i 0))
       (cond ((= i (vector-length vars)) #f)
-            ((sendable-info? (vector-ref vars i)) (vector-ref vars i))
+            ((pred (vector-ref vars i)) (vector-ref vars i))
             (else (loop (+ i 1)))))))
+
+(define (closure-info proc) (closure-var proc sendable-info?))
 
 ;;> True when \var{proc} carries its source.
 (define (sendable-procedure? proc)
@@ -137,7 +139,7 @@
   (and (procedure? proc)
        (not (opcode? proc))
        (eq? (procedure-code proc) proxy-code)
-       (vector-ref (procedure-vars proc) 0)))
+       (closure-var proc proxy-ref?)))
 
 ;;; Encoding
 

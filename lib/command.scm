@@ -1,0 +1,33 @@
+;;;; bin/murdoch: start address spaces, join a lab at a REPL.
+
+;;> Makes this process address space \var{uid} of the lab at
+;;> \var{lab-file} and starts serving; answers the lab environment.
+(define (join-lab lab-file uid . port)
+  (let* ((lab (read-lab lab-file))
+         (env (make-lab-environment lab)))
+    (apply start-aspace! lab uid env port)
+    env))
+
+;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
+(define (run-aspace lab-file uid)
+  (join-lab lab-file uid)
+  (log-info "murdoch: " uid " listening on " (aspace-host (local-aspace)) ":"
+            (aspace-port (local-aspace)))
+  (let wait () (thread-sleep! 3600) (wait)))
+
+;;> `murdoch repl LAB [NAME]`: join the lab and read-eval-print.
+(define (run-repl lab-file uid)
+  (let* ((lab (read-lab lab-file))
+         (guest? (not uid))
+         (uid (or uid (string->symbol
+                       (string-append "guest-" (number->string
+                                                (current-process-id))))))
+         (lab-env (make-lab-environment lab)))
+    (if guest?
+        (start-aspace! lab uid lab-env (lab-guest-port lab))
+        (start-aspace! lab uid lab-env))
+    (repl 'environment: (make-repl-environment lab lab-env)
+          'raw?: (not (is-a-tty? (current-input-port)))
+          'make-prompt: (lambda (module)
+                          (string-append (symbol->string uid) "> ")))
+    (exit 0)))

@@ -1,0 +1,11 @@
+(define-library (murdoch command)
+  (export join-lab run-aspace run-repl make-lab-environment
+          make-repl-environment)
+  (import (scheme base) (scheme read) (scheme eval) (scheme file)
+          (scheme process-context)
+          (srfi 1) (srfi 18)
+          (only (chibi process) current-process-id)
+          (only (chibi filesystem) is-a-tty?)
+          (chibi log) (chibi repl)
+          (murdoch lab) (murdoch remote))
+  (include "../environment.scm" "../command.scm"))

@@ -1,0 +1,18 @@
+(define-library (murdoch remote)
+  (export aspace? aspace-uid aspace-host aspace-port make-aspace
+          local-aspace local-aspace-uid uid->aspace known-uids
+          learn-aspace! forget-aspace! current-lab lab-environment
+          remote-run! remote-apply remote-timeout set-remote-timeout!
+          remote-error? remote-error-uid remote-error-message
+          encap release-proxy! start-aspace!
+          var-ref var-set! display-remote)
+  (import (scheme base) (scheme write) (scheme read) (scheme char)
+          (srfi 1) (srfi 18) (srfi 69)
+          (only (chibi) call-with-output-string make-exception exception?
+                exception-kind exception-irritants
+                strip-syntactic-closures)
+          (only (chibi filesystem) open-input-file-descriptor
+                open-output-file-descriptor close-file-descriptor)
+          (chibi net) (chibi log)
+          (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
+  (include "../remote.scm"))

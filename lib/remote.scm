@@ -1,0 +1,607 @@
+;;;; Address spaces, remote-run! and remote-apply (thesis §3.3.2).
+;;
+;; An address space is one Chibi process with a uid; the lab file says
+;; where each listens.  remote-run! and remote-apply carry a procedure and
+;; its arguments to another address space, where the procedure is applied;
+;; procedures travel as S-expressions (sendable.scm).
+;;
+;; The wire protocol.  Each connection is opened by the address space that
+;; calls; the callee only answers on it.  Every frame is a netstring whose
+;; payload is 64 hex digits of HMAC-SHA256 followed by an S-expression:
+;;
+;;   MAC = HMAC(key, NONCE ":" COUNT ":" S-EXPRESSION)
+;;
+;; where NONCE is the one the receiving side chose for this connection and
+;; COUNT numbers the frames sent in this direction from 1.  A recorded frame
+;; is thus worthless on another connection or at another place in this one.
+;;
+;;  1. Caller -> callee: (hello UID HOST PORT NONCE), MAC'd with nonce
+;;     "hello" and count 0.  HOST and PORT say where the caller listens.
+;;  2. Callee -> caller: (welcome UID NONCE), MAC'd with the caller's nonce
+;;     and count 0.  From here on each side uses the other's nonce.
+;;  3. Caller -> callee, any number, pipelined:
+;;       (run ID PROC ARGS)    apply in a new thread, answer at once
+;;       (apply ID PROC ARGS)  apply in a new thread, answer with the value
+;;     PROC and ARGS are encoded values (sendable.scm); ID is the caller's.
+;;  4. Callee -> caller, in any order:
+;;       (ack ID)  (value ID VALUE)  (error ID MESSAGE)
+;;
+;; A frame that is not a netstring, fails its MAC, or is not one of these
+;; closes its connection after one log line; the address space and its
+;; other connections carry on.  Nothing is evaluated before its MAC checks.
+
+;;; Address spaces
+
+(define-record-type aspace
+  (make-aspace uid host port)
+  aspace?
+  (uid aspace-uid)
+  (host aspace-host)
+  (port aspace-port))
+
+(define *local* #f)                     ; the local aspace, once started
+(define *lab* #f)
+(define *peers* (make-hash-table eq?))  ; uid -> aspace, from lab and hellos
+(define *peers-lock* (make-mutex 'peers))
+
+;;> The local address space.
+(define (local-aspace)
+  (or *local* (error "this process has not joined a lab")))
+
+;;> The uid of the local address space.
+(define (local-aspace-uid) (aspace-uid (local-aspace)))
+
+;;> The address space named \var{uid}.
+(define (uid->aspace uid)
+  (or (with-lock *peers-lock* (lambda () (hash-table-ref/default *peers* uid #f)))
+      (error "no address space of this uid is known" uid)))
+
+;;> The uids of every address space known here (the thesis's *uids*).
+(define (known-uids)
+  (with-lock *peers-lock* (lambda () (hash-table-keys *peers*))))
+
+(define (learn-aspace! a)
+  (with-lock *peers-lock*
+    (lambda () (hash-table-set! *peers* (aspace-uid a) a))))
+
+;;> Forgets the address space \var{uid} (used by live membership).
+(define (forget-aspace! uid)
+  (with-lock *peers-lock* (lambda () (hash-table-delete! *peers* uid))))
+
+(define (with-lock m thunk)
+  (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
+
+;;; Settings
+
+(define *default-timeout* 5)
+
+;;> Seconds remote-apply waits for an answer: the global default.
+(define (set-remote-timeout! seconds) (set! *default-timeout* seconds))
+
+;;> A per-call override: (parameterize ((remote-timeout 1)) ...).
+(define remote-timeout (make-parameter #f))
+
+(define (current-timeout) (or (remote-timeout) *default-timeout*))
+
+;;; Errors
+
+;;> Raised by remote-apply for an error in the target, a lost connection
+;;> or a timeout.  Its irritants are the target's uid, the procedure and
+;;> the original message.
+(define (remote-error uid what message)
+  (raise (make-exception 'remote-error
+                         (string-append "remote-apply on "
+                                        (symbol->string uid) " failed")
+                         (list uid what message) #f #f)))
+
+(define (remote-error? e)
+  (and (exception? e) (eq? (exception-kind e) 'remote-error)))
+
+(define (remote-error-uid e) (car (exception-irritants e)))
+(define (remote-error-message e) (car (cddr (exception-irritants e))))
+
+(define (error-message e)
+  (cond
+   ((send-error? e) (send-error-message e))
+   ((error-object? e)
+    (call-with-output-string
+      (lambda (out)
+        (write-string (error-object-message e) out)
+        (for-each (lambda (x)
+                    (write-char #\space out)
+                    (write (strip-syntactic-closures x) out))
+                  (error-object-irritants e)))))
+   (else (call-with-output-string
+           (lambda (out) (write-string "raised " out) (write e out))))))
+
+(define (describe-procedure proc)
+  (let ((encoded (guard (e (#t #f)) (encode proc *environment* "procedure"))))
+    (cond ((and (vector? encoded) (eq? (vector-ref encoded 0) 'murdoch:global))
+           (vector-ref encoded 1))
+          ((and (vector? encoded) (eq? (vector-ref encoded 0) 'murdoch:closure))
+           (vector-ref encoded 1))
+          (else proc))))
+
+;;; The environment received code runs in
+
+(define *environment* #f)
+(define *decode* #f)
+
+;;> The environment received code runs in: R7RS base, Murdoch's API and the
+;;> lab's code files; no file, process, load or eval primitives.
+(define (lab-environment) *environment*)
+
+;;; Frames
+
+(define *mac* #f)                       ; HMAC under the lab's key
+(define *max-frame* 1048576)
+
+(define (frame-mac nonce count text)
+  (*mac* (string->utf8
+          (string-append nonce ":" (number->string count) ":" text))))
+
+(define (write-frame! out nonce count message)
+  (let* ((text (call-with-output-string (lambda (o) (write message o))))
+         (payload (string-append (frame-mac nonce count text) text)))
+    (write-netstring (string->utf8 payload) out)
+    (flush-output-port out)))
+
+;;> Raised for a frame that breaks the protocol; the connection closes.
+(define-record-type frame-error
+  (make-frame-error message)
+  frame-error?
+  (message frame-error-message))
+
+(define (frame-fail . parts)
+  (raise (make-frame-error (apply string-append parts))))
+
+;; The next frame's message, or an eof object when the peer closed.
+(define (read-frame in nonce count)
+  (let ((payload (guard (e ((netstring-error? e)
+                            (frame-fail (netstring-error-message e))))
+                   (read-netstring in *max-frame*))))
+    (if (eof-object? payload)
+        payload
+        (let ((text (guard (e (#t (frame-fail "payload is not UTF-8")))
+                      (utf8->string payload))))
+          (if (or (< (string-length text) 64)
+                  (not (string=? (substring text 0 64)
+                                 (frame-mac nonce count
+                                            (substring text 64
+                                                       (string-length text))))))
+              (frame-fail "bad MAC"))
+          (parse-message (substring text 64 (string-length text)))))))
+
+(define (parse-message text)
+  (guard (e (#t (frame-fail "unreadable message")))
+    (let* ((in (open-input-string text))
+           (message (read in)))
+      (if (not (eof-object? (read in))) (frame-fail "trailing data"))
+      message)))
+
+;;; Waiting with a deadline
+
+;; A one-shot mailbox: the reader thread puts an answer, the caller takes
+;; it or gives up at its deadline.
+(define-record-type mailbox
+  (%make-mailbox mutex condvar value full?)
+  mailbox?
+  (mutex mailbox-mutex)
+  (condvar mailbox-condvar)
+  (value mailbox-value mailbox-value-set!)
+  (full? mailbox-full? mailbox-full?-set!))
+
+(define (make-mailbox)
+  (%make-mailbox (make-mutex) (make-condition-variable) #f #f))
+
+(define (mailbox-put! mb value)
+  (mutex-lock! (mailbox-mutex mb))
+  (mailbox-value-set! mb value)
+  (mailbox-full?-set! mb #t)
+  (condition-variable-broadcast! (mailbox-condvar mb))
+  (mutex-unlock! (mailbox-mutex mb)))
+
+(define (mailbox-take mb seconds timed-out)
+  (let ((deadline (seconds->time (+ (time->seconds (current-time)) seconds))))
+    (let loop ()
+      (mutex-lock! (mailbox-mutex mb))
+      (cond
+       ((mailbox-full? mb)
+        (mutex-unlock! (mailbox-mutex mb))
+        (mailbox-value mb))
+       ((mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) deadline)
+        (loop))
+       (else (timed-out))))))
+
+;;; Connections to other address spaces
+
+(define-record-type connection
+  (make-connection uid socket in out write-lock pending)
+  connection?
+  (uid connection-uid)
+  (socket connection-socket)
+  (in connection-in)
+  (out connection-out)
+  (write-lock connection-write-lock)
+  (pending connection-pending)                 ; id -> mailbox
+  (nonce connection-nonce connection-nonce-set!) ; the callee's
+  (sent connection-sent connection-sent-set!)
+  (next-id connection-next-id connection-next-id-set!)
+  (open? connection-open? connection-open?-set!))
+
+(define *connections* (make-hash-table eq?))  ; uid -> connection
+(define *connections-lock* (make-mutex 'connections))
+
+(define (open-socket host port)
+  (let ((io (guard (e (#t #f)) (open-net-io host port))))
+    (if (not (pair? io))
+        #f
+        io)))
+
+;; The open connection to uid, made (and greeted) if there is none.
+(define (connection-to a seconds)
+  (let ((uid (aspace-uid a)))
+    (with-lock *connections-lock*
+      (lambda ()
+        (let ((c (hash-table-ref/default *connections* uid #f)))
+          (if (and c (connection-open? c))
+              c
+              (let ((c (connect! a seconds)))
+                (hash-table-set! *connections* uid c)
+                c)))))))
+
+(define (connect! a seconds)
+  (let ((io (open-socket (aspace-host a) (aspace-port a))))
+    (if (not io)
+        (remote-error (aspace-uid a) 'connect
+                      (string-append "cannot connect to " (aspace-host a) ":"
+                                     (number->string (aspace-port a)))))
+    (let ((c (make-connection (aspace-uid a) (car io) (cadr io) (car (cddr io))
+                              (make-mutex) (make-hash-table eqv?)))
+          (nonce (random-hex 16))
+          (welcome (make-mailbox)))
+      (connection-sent-set! c 0)
+      (connection-next-id-set! c 0)
+      (connection-open?-set! c #t)
+      (write-frame! (connection-out c) "hello" 0
+                    `(hello ,(aspace-uid *local*) ,(aspace-host *local*)
+                            ,(aspace-port *local*) ,nonce))
+      (thread-start! (make-thread (lambda () (read-answers c nonce welcome))
+                                  'answers))
+      (mailbox-take welcome seconds
+                    (lambda ()
+                      (close-connection! c)
+                      (remote-error (aspace-uid a) 'connect "no welcome")))
+      (if (not (connection-nonce c))
+          (remote-error (aspace-uid a) 'connect "refused the greeting"))
+      c)))
+
+;; The reader of one outgoing connection: the welcome, then answers, each
+;; handed to the mailbox of the call that waits for it.
+(define (read-answers c nonce welcome)
+  (guard (e (#t (log-fault (connection-uid c) e)))
+    (let ((w (read-frame (connection-in c) nonce 0)))
+      (if (not (and (pair? w) (eq? (car w) 'welcome) (= (length w) 3)
+                    (string? (car (cddr w)))))
+          (frame-fail "expected a welcome"))
+      (connection-nonce-set! c (car (cddr w)))
+      (mailbox-put! welcome #t)
+      (let loop ((count 1))
+        (let ((answer (read-frame (connection-in c) nonce count)))
+          (if (not (eof-object? answer))
+              (begin (deliver-answer! c answer) (loop (+ count 1))))))))
+  (mailbox-put! welcome #f)
+  (close-connection! c))
+
+(define (deliver-answer! c answer)
+  (if (not (and (pair? answer) (memq (car answer) '(ack value error))
+                (pair? (cdr answer)) (integer? (cadr answer))))
+      (frame-fail "not an answer"))
+  (let ((mb (with-lock (connection-write-lock c)
+              (lambda ()
+                (let ((mb (hash-table-ref/default (connection-pending c)
+                                                  (cadr answer) #f)))
+                  (hash-table-delete! (connection-pending c) (cadr answer))
+                  mb)))))
+    (if mb (mailbox-put! mb answer))))   ; else the caller gave up
+
+;; Close once; every call still waiting hears that the connection is lost.
+(define (close-connection! c)
+  (let ((waiting
+         (with-lock (connection-write-lock c)
+           (lambda ()
+             (and (connection-open? c)
+                  (begin
+                    (connection-open?-set! c #f)
+                    (let ((mbs (hash-table-values (connection-pending c))))
+                      (for-each (lambda (id)
+                                  (hash-table-delete! (connection-pending c) id))
+                                (hash-table-keys (connection-pending c)))
+                      mbs)))))))
+    (when waiting
+      (guard (e (#t #f)) (close-input-port (connection-in c)))
+      (guard (e (#t #f)) (close-output-port (connection-out c)))
+      (close-file-descriptor (connection-socket c))
+      (for-each (lambda (mb) (mailbox-put! mb '(lost))) waiting))))
+
+;; Send one call; answers a mailbox that will hold its answer.
+(define (send-call! c kind proc-code args-code)
+  (with-lock (connection-write-lock c)
+    (lambda ()
+      (if (not (connection-open? c))
+          (remote-error (connection-uid c) 'send "connection lost"))
+      (let ((id (+ 1 (connection-next-id c)))
+            (count (+ 1 (connection-sent c)))
+            (mb (make-mailbox)))
+        (connection-next-id-set! c id)
+        (connection-sent-set! c count)
+        (hash-table-set! (connection-pending c) id mb)
+        (guard (e (#t (connection-open?-set! c #f) (raise e)))
+          (write-frame! (connection-out c) (connection-nonce c) count
+                        (list kind id proc-code args-code)))
+        (cons id mb)))))
+
+(define (forget-call! c id)
+  (with-lock (connection-write-lock c)
+    (lambda () (hash-table-delete! (connection-pending c) id))))
+
+;;; remote-run! and remote-apply
+
+(define (call a kind proc args)
+  (let* ((uid (aspace-uid a))
+         (seconds (current-timeout))
+         (proc-code (encode proc *environment* "the procedure"))
+         (args-code (encode-arguments args))
+         (c (connection-to a seconds))
+         (sent (send-call! c kind proc-code args-code))
+         (answer (mailbox-take (cdr sent) seconds
+                               (lambda ()
+                                 (forget-call! c (car sent))
+                                 (remote-error uid (describe-procedure proc)
+                                               (string-append
+                                                "no answer within "
+                                                (number->string seconds)
+                                                " s"))))))
+    (case (car answer)
+      ((ack) #t)
+      ((value) (*decode* (car (cddr answer))))
+      ((error) (remote-error uid (describe-procedure proc) (car (cddr answer))))
+      (else (remote-error uid (describe-procedure proc) "connection lost")))))
+
+(define (encode-arguments args)
+  (let loop ((args args) (i 1) (acc '()))
+    (if (null? args)
+        (reverse acc)
+        (loop (cdr args) (+ i 1)
+              (cons (encode (car args) *environment*
+                            (string-append "argument " (number->string i)))
+                    acc)))))
+
+(define (local? a) (eq? (aspace-uid a) (aspace-uid (local-aspace))))
+
+(define (apply-here uid proc args)
+  (guard (e ((remote-error? e) (raise e))
+            (#t (remote-error uid (describe-procedure proc) (error-message e))))
+    (apply proc args)))
+
+;;> Applies \var{proc} to \var{args} in a new thread of address space
+;;> \var{a}; returns #t once \var{a} has acknowledged.  The result is
+;;> discarded.
+(define (remote-run! a proc . args)
+  (if (local? a)
+      (begin (spawn (lambda () (apply proc args)) 'remote-run) #t)
+      (call a 'run proc args)))
+
+;;> Applies \var{proc} to \var{args} in address space \var{a} and returns
+;;> the result.  Raises a remote-error naming \var{a}, the procedure and
+;;> the message when the application raised, the connection broke, or no
+;;> answer came within (remote-timeout) seconds.
+(define (remote-apply a proc . args)
+  (if (local? a)
+      (apply-here (aspace-uid a) proc args)
+      (call a 'apply proc args)))
+
+(define (spawn thunk name)
+  (thread-start!
+   (make-thread (lambda ()
+                  (guard (e (#t (log-warn "murdoch: " name ": "
+                                          (error-message e))))
+                    (thunk)))
+                name)))
+
+;;; Serving calls
+
+(define (serve-connection fd peer)
+  (let ((in (open-input-file-descriptor fd #t))
+        (out (open-output-file-descriptor fd #t))
+        (write-lock (make-mutex)))
+    (guard (e (#t (log-fault peer e)))
+      (let* ((hello (read-frame in "hello" 0))
+             (nonce (random-hex 16))
+             (caller-nonce (greet! hello)))
+        (write-frame! out caller-nonce 0
+                      `(welcome ,(aspace-uid *local*) ,nonce))
+        (let ((sent 0))
+          (define (answer! message)
+            (with-lock write-lock
+              (lambda ()
+                (set! sent (+ sent 1))
+                (guard (e (#t #f))     ; the caller left; nothing to tell
+                  (write-frame! out caller-nonce sent message)))))
+          (let loop ((count 1))
+            (let ((message (read-frame in nonce count)))
+              (if (not (eof-object? message))
+                  (begin (serve-call message answer!)
+                         (loop (+ count 1)))))))))
+    (guard (e (#t #f)) (close-input-port in))
+    (guard (e (#t #f)) (close-output-port out))))
+
+;; Check a hello and learn where its sender listens; answers its nonce.
+(define (greet! hello)
+  (if (eof-object? hello) (frame-fail "closed before hello"))
+  (if (not (and (list? hello) (= (length hello) 5) (eq? (car hello) 'hello)
+                (symbol? (list-ref hello 1)) (string? (list-ref hello 2))
+                (exact-integer? (list-ref hello 3))
+                (string? (list-ref hello 4))))
+      (frame-fail "expected a hello"))
+  (learn-aspace! (make-aspace (list-ref hello 1) (list-ref hello 2)
+                              (list-ref hello 3)))
+  (list-ref hello 4))
+
+(define (serve-call message answer!)
+  (if (not (and (list? message) (= (length message) 4)
+                (memq (car message) '(run apply))
+                (exact-integer? (cadr message))
+                (list? (list-ref message 3))))
+      (frame-fail "expected a call"))
+  (let ((kind (car message))
+        (id (cadr message)))
+    (guard (e (#t (answer! `(error ,id ,(error-message e)))))
+      (let ((proc (*decode* (list-ref message 2)))
+            (args (*decode* (list-ref message 3))))
+        (if (not (procedure? proc))
+            (error "not a procedure" proc))
+        (if (eq? kind 'run)
+            (begin (answer! `(ack ,id))
+                   (spawn (lambda () (apply proc args)) 'remote-run))
+            (spawn (lambda () (answer! (apply-and-encode id proc args)))
+                   'remote-apply))))))
+
+(define (apply-and-encode id proc args)
+  (guard (e (#t `(error ,id ,(error-message e))))
+    `(value ,id ,(encode (apply proc args) *environment* "the result"))))
+
+(define (peer-name sockaddr)
+  (string-append (sockaddr-name sockaddr) ":"
+                 (number->string (sockaddr-port sockaddr))))
+
+(define (log-fault peer e)
+  (log-warn "murdoch: connection with " peer " closed: "
+            (cond ((frame-error? e) (frame-error-message e))
+                  (else (error-message e)))))
+
+(define (accept-loop listener)
+  (let ((addr (get-address-info (aspace-host *local*) (aspace-port *local*))))
+  (let loop ()
+    (let ((fd (accept listener (address-info-address addr)
+                      (address-info-address-length addr))))
+      (if fd
+          (let ((peer (peer-name (address-info-address addr))))
+            (spawn (lambda () (serve-connection fd peer)) 'connection)))
+      (loop)))))
+
+;;; Proxies
+
+(define *proxies* (make-hash-table eqv?))        ; id -> procedure
+(define *proxy-stubs* (make-hash-table equal?))  ; (uid . id) -> proxy
+(define *proxies-lock* (make-mutex 'proxies))
+(define *next-proxy-id* 0)
+
+;;> Returns a proxy for \var{proc}: a procedure that, applied in any address
+;;> space, applies \var{proc} in this one and returns its result.
+(define (encap proc)
+  (with-lock *proxies-lock*
+    (lambda ()
+      (set! *next-proxy-id* (+ *next-proxy-id* 1))
+      (hash-table-set! *proxies* *next-proxy-id* proc)
+      (proxy-stub (local-aspace-uid) *next-proxy-id*))))
+
+;;> Forgets the procedure behind \var{proxy}, which must have been made
+;;> here; applying the proxy afterwards raises an error.
+(define (release-proxy! proxy)
+  (let ((ref (proxy-procedure-ref proxy)))
+    (with-lock *proxies-lock*
+      (lambda ()
+        (hash-table-delete! *proxies* (proxy-ref-id ref))
+        (hash-table-delete! *proxy-stubs*
+                            (cons (proxy-ref-uid ref) (proxy-ref-id ref)))))))
+
+;; The one proxy procedure this address space has for (uid . id), so that
+;; a proxy sent back and forth stays the same proxy.  Caller holds the lock.
+(define (proxy-stub uid id)
+  (let ((key (cons uid id)))
+    (or (hash-table-ref/default *proxy-stubs* key #f)
+        (let ((stub (make-proxy-procedure (make-proxy-ref uid id) apply-proxy)))
+          (hash-table-set! *proxy-stubs* key stub)
+          stub))))
+
+(define (decode-proxy uid id)
+  (with-lock *proxies-lock* (lambda () (proxy-stub uid id))))
+
+(define (apply-proxy ref args)
+  (let ((uid (proxy-ref-uid ref)))
+    (if (eq? uid (local-aspace-uid))
+        (let ((proc (with-lock *proxies-lock*
+                      (lambda ()
+                        (hash-table-ref/default *proxies* (proxy-ref-id ref)
+                                                #f)))))
+          (if (not proc)
+              (error "this proxy no longer exists" uid (proxy-ref-id ref)))
+          (apply proc args))
+        (apply remote-apply (uid->aspace uid)
+               (decode-proxy uid (proxy-ref-id ref)) args))))
+
+;;; Starting an address space
+
+(define *listener* #f)
+
+;;> Makes this process the address space \var{uid} of \var{lab} (a lab
+;;> record, see read-lab), with \var{environment} as the environment that
+;;> received code runs in, and starts answering calls.  \var{port} may
+;;> override the lab's port for uid.
+(define (start-aspace! lab uid environment . port)
+  (let ((entry (lab-aspace-by-uid lab uid)))
+    (set! *lab* lab)
+    (set! *local* (make-aspace uid
+                               (if entry (lab-aspace-host entry)
+                                   (lab-setting lab 'interface "127.0.0.1"))
+                               (cond ((pair? port) (car port))
+                                     (entry (lab-aspace-port entry))
+                                     (else (error "not in the lab" uid)))))
+    (set! *environment* environment)
+    (set! *decode* (make-decoder environment decode-proxy))
+    (set! *mac* (make-hmac-sha256 (lab-key lab)))
+    (set! *max-frame* (lab-setting lab 'max-frame 1048576))
+    (set! *default-timeout* (lab-setting lab 'timeout 5))
+    (for-each (lambda (a)
+                (learn-aspace! (make-aspace (lab-aspace-uid a)
+                                            (lab-aspace-host a)
+                                            (lab-aspace-port a))))
+              (lab-aspaces lab))
+    (learn-aspace! *local*)
+    (set! *listener* (listen-on (aspace-host *local*) (aspace-port *local*)))
+    (spawn (lambda () (accept-loop *listener*)) 'accept)
+    *local*))
+
+(define (listen-on host port)
+  (let ((addr (get-address-info host port)))
+    (if (not addr) (error "cannot resolve the interface" host))
+    (guard (e (#t (error (string-append "cannot listen on " host ":"
+                                        (number->string port)
+                                        " (is another process there?)"))))
+      (make-listener-socket addr))))
+
+;;> The lab this address space belongs to.
+(define (current-lab) (or *lab* (error "this process has not joined a lab")))
+
+;;; From aux.scm
+
+;;> Evaluates \var{var} in the address space \var{uid}.
+(define-syntax var-ref
+  (syntax-rules ()
+    ((var-ref uid var)
+     (remote-apply (uid->aspace uid) (sendable-lambda () var)))))
+
+;;> Assigns \var{value} (evaluated here) to \var{var} in address space
+;;> \var{uid}.
+(define-syntax var-set!
+  (syntax-rules ()
+    ((var-set! uid var value)
+     (let ((v value))
+       (remote-apply (uid->aspace uid) (sendable-lambda () (set! var v)))))))
+
+;;> Displays \var{string} on the standard output of address space \var{uid}.
+(define (display-remote uid string)
+  (remote-run! (uid->aspace uid)
+               (sendable-lambda ()
+                 (display string) (newline) (flush-output-port))))

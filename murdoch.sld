@@ -1,0 +1,13 @@
+;;> The library that user code imports: Murdoch's whole user interface, as
+;;> the thesis names it.  It is also what received code can reach, so it
+;;> exports nothing that touches files or processes.  Its lambda and define
+;;> make closures that can travel; import it after (scheme base), or import
+;;> (scheme base) without lambda and define.
+
+(define-library (murdoch)
+  (export (rename sendable-lambda lambda) (rename sendable-define define)
+          aspace? aspace-uid local-aspace local-aspace-uid uid->aspace
+          known-uids remote-run! remote-apply remote-timeout
+          remote-error? remote-error-uid remote-error-message
+          encap var-ref var-set! display-remote)
+  (import (murdoch sendable) (murdoch remote)))
