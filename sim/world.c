@@ -1,0 +1,440 @@
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "trace.h"
+#include "world.h"
+
+static const double RAD = M_PI / 180;
+
+double wrap180(double a)
+{
+    a = fmod(a, 360);
+    if (a > 180)
+        a -= 360;
+    if (a <= -180)
+        a += 360;
+    return a;
+}
+
+static double clip(double v, double limit)
+{
+    return v > limit ? limit : v < -limit ? -limit : v;
+}
+
+/* splitmix64: one stream per robot, so readings do not depend on which
+ * thread took them or in which order robots fired */
+static uint64_t next_random(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static double gaussian(uint64_t *s)
+{
+    double u = ((next_random(s) >> 11) + 0.5) / 9007199254740992.0;
+    double v = (next_random(s) >> 11) / 9007199254740992.0;
+    return sqrt(-2 * log(u)) * cos(2 * M_PI * v);
+}
+
+/* The grid covers every wall, box and robot with a margin. */
+static sense *make_sense(const lab *l)
+{
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY, m = 1000;
+    int i;
+#define COVER(x, y) (x0 = fmin(x0, x), y0 = fmin(y0, y), x1 = fmax(x1, x), y1 = fmax(y1, y))
+    for (i = 0; i < l->nwalls; i++) {
+        COVER(l->walls[i].x1, l->walls[i].y1);
+        COVER(l->walls[i].x2, l->walls[i].y2);
+    }
+    for (i = 0; i < l->nboxes; i++)
+        COVER(l->boxes[i].x, l->boxes[i].y);
+    for (i = 0; i < l->nrobots; i++)
+        COVER(l->robots[i].x, l->robots[i].y);
+#undef COVER
+    if (x0 > x1) {
+        x0 = y0 = -5000;
+        x1 = y1 = 5000;
+    }
+    return sense_new(x0 - m, y0 - m, x1 + m, y1 + m, 1000);
+}
+
+world *world_new(lab *l)
+{
+    world *w = calloc(1, sizeof *w);
+    int i;
+    w->lab = l;
+    w->dt = 1.0 / l->step_hz;
+    w->threads = 2;
+    w->phys = physics_new();
+    w->sense = make_sense(l);
+    for (i = 0; i < l->nwalls; i++) {
+        const lab_wall *a = &l->walls[i];
+        physics_add_wall(w->phys, a->x1, a->y1, a->x2, a->y2, a->thick);
+        sense_add_wall(w->sense, a->x1, a->y1, a->x2, a->y2, a->thick);
+    }
+    for (i = 0; i < l->nboxes; i++) {
+        const lab_box *b = &l->boxes[i];
+        pose at = { b->x, b->y, b->heading };
+        physics_add_box(w->phys, at, b->w, b->d, b->mass, l->friction);
+        sense_place_box(w->sense, sense_add_box(w->sense, b->w, b->d), at);
+    }
+    w->robots = calloc(l->nrobots ? l->nrobots : 1, sizeof *w->robots);
+    w->nrobots = l->nrobots;
+    for (i = 0; i < l->nrobots; i++) {
+        const lab_robot *c = &l->robots[i];
+        robot *r = &w->robots[i];
+        strcpy(r->name, c->name);
+        r->at = r->before = (pose){ c->x, c->y, c->heading };
+        r->body = physics_add_robot(w->phys, r->at, l->b14.radius, l->b14.mass);
+        r->circle = sense_add_circle(w->sense, l->b14.radius);
+        sense_place_circle(w->sense, r->circle, c->x, c->y);
+        r->battery = c->battery;
+        r->tethered = c->tethered;
+        r->rng = l->seed * 1000003ULL + i;
+        r->sonar_step = -1;
+    }
+    sense_refile(w->sense, 0);
+    return w;
+}
+
+void world_free(world *w)
+{
+    physics_free(w->phys);
+    sense_free(w->sense);
+    free(w->robots);
+    free(w);
+}
+
+double world_time(const world *w)
+{
+    return w->step * w->dt;
+}
+
+/* ---- motion ---------------------------------------------------------- */
+
+static void start(robot *r, enum motion_kind kind)
+{
+    memset(&r->m, 0, sizeof r->m);
+    r->m.kind = kind;
+}
+
+void robot_velocity(world *w, int i, double tv, double rv)
+{
+    robot *r = &w->robots[i];
+    start(r, VELOCITY);
+    r->m.tv = clip(tv, w->lab->b14.max_speed);
+    r->m.rv = clip(rv, w->lab->b14.max_turn);
+}
+
+void robot_translate(world *w, int i, double d)
+{
+    start(&w->robots[i], TRANSLATE);
+    w->robots[i].m.left = d;
+}
+
+void robot_rotate(world *w, int i, double a)
+{
+    start(&w->robots[i], ROTATE);
+    w->robots[i].m.left = a;
+}
+
+void robot_goto(world *w, int i, double x, double y)
+{
+    robot *r = &w->robots[i];
+    double c = cos(-r->odth * RAD), s = sin(-r->odth * RAD);
+    double ux = x - r->odx, uy = y - r->ody;
+    start(r, GOTO);
+    r->m.gx = ux * c - uy * s;
+    r->m.gy = ux * s + uy * c;
+    r->m.turning = 1;
+}
+
+void robot_stop(world *w, int i)
+{
+    start(&w->robots[i], IDLE);
+}
+
+pose robot_reckon(const world *w, int i)
+{
+    const robot *r = &w->robots[i];
+    double c = cos(r->odth * RAD), s = sin(r->odth * RAD);
+    return (pose){ r->at.x * c - r->at.y * s + r->odx, r->at.x * s + r->at.y * c + r->ody,
+                   wrap180(r->at.heading + r->odth) };
+}
+
+void robot_set_position(world *w, int i, double x, double y)
+{
+    robot *r = &w->robots[i];
+    pose now = robot_reckon(w, i);
+    r->odx += x - now.x;
+    r->ody += y - now.y;
+}
+
+void robot_set_heading(world *w, int i, double h)
+{
+    robot *r = &w->robots[i];
+    pose now = robot_reckon(w, i);
+    r->odth = h - r->at.heading;
+    robot_set_position(w, i, now.x, now.y);
+}
+
+/* Proportional approach with a floor, so a motion ends rather than creeps. */
+static double approach(double left, double gain, double floor, double limit)
+{
+    double v = fmax(fabs(left) * gain, floor);
+    return copysign(fmin(v, limit), left);
+}
+
+/* What the wheels do this step, from the motion under way. */
+static void control(const b14_params *p, robot *r)
+{
+    motion *m = &r->m;
+    double dist, bearing;
+    r->v = r->w = 0;
+    switch (m->kind) {
+    case IDLE:
+        return;
+    case VELOCITY:
+        r->v = m->tv;
+        r->w = m->rv;
+        return;
+    case TRANSLATE:
+        if (fabs(m->left) < 0.5)
+            break;
+        r->v = approach(m->left, 3, 5, p->speed);
+        return;
+    case ROTATE:
+        if (fabs(m->left) < 0.05)
+            break;
+        r->w = approach(m->left, 3, 1, p->turn);
+        return;
+    case GOTO:
+        dist = hypot(m->gx - r->at.x, m->gy - r->at.y);
+        bearing = wrap180(atan2(m->gy - r->at.y, m->gx - r->at.x) / RAD - r->at.heading);
+        if (m->turning && dist > 30 && fabs(bearing) > 0.2) {
+            r->w = approach(bearing, 3, 1, p->turn);
+            return;
+        }
+        m->turning = 0;
+        /* close in along the heading; steering so near the goal would only
+         * chase the bearing round, and the lateral error is already tiny */
+        dist *= cos(bearing * RAD);
+        if (fabs(dist) < 0.5)
+            break;
+        r->v = approach(dist, 3, 5, p->speed);
+        if (hypot(m->gx - r->at.x, m->gy - r->at.y) > 60)
+            r->w = clip(3 * bearing, p->turn);
+        return;
+    }
+    start(r, IDLE);
+}
+
+/* Progress of the motion under way, from where the body actually went. */
+static void account(world *w, robot *r)
+{
+    double dx = r->at.x - r->before.x, dy = r->at.y - r->before.y;
+    double along = dx * cos(r->before.heading * RAD) + dy * sin(r->before.heading * RAD);
+    double turned = wrap180(r->at.heading - r->before.heading);
+    motion *m = &r->m;
+    if (m->kind == TRANSLATE)
+        m->left -= along;
+    else if (m->kind == ROTATE)
+        m->left -= turned;
+    if (fabs(r->v) > 1 && fabs(along) < 0.2 * fabs(r->v) * w->dt)
+        m->stuck += w->dt;
+    else
+        m->stuck = 0;
+    if (m->stuck > 2) {
+        if (m->kind == VELOCITY) {
+            m->stalled = 1;
+        } else {
+            start(r, IDLE);
+            r->m.stalled = 1;
+        }
+    }
+}
+
+static void battery(const b14_params *p, robot *r, double dt)
+{
+    int moving = fabs(r->v) > 0 || fabs(r->w) > 0;
+    r->battery -= (moving ? p->drain : p->idle) * dt;
+    if (r->tethered)
+        r->battery += p->charge * dt;
+    r->battery = fmin(fmax(r->battery, p->v_low), p->v_high);
+}
+
+/* ---- sensing --------------------------------------------------------- */
+
+/* Cast the rays of every sonar cone; ranges from the skin, noiseless. */
+static void sonar_geometry(const world *w, robot *r)
+{
+    const b14_params *p = &w->lab->b14;
+    int i, j, n = p->sonar_rays;
+    double reach = 0;
+    for (i = 0; i < SONARS; i++) {
+        double best = p->sonar_max;
+        for (j = 0; j < n; j++) {
+            double off = n == 1 ? 0 : p->sonar_cone * ((double)j / (n - 1) - 0.5);
+            double dir = r->at.heading + 22.5 * i + off;
+            double sx = r->at.x + p->radius * cos(dir * RAD), sy = r->at.y + p->radius * sin(dir * RAD);
+            best = fmin(best, sense_ray(w->sense, r->circle, sx, sy, dir, best));
+        }
+        r->sonar_geo[i] = best;
+        reach = fmax(reach, best);
+    }
+    r->sonar_reach = reach + p->radius;
+}
+
+static int reusable(const world *w, const robot *r)
+{
+    return r->sonar_step >= 0 && r->sonar_at.x == r->at.x && r->sonar_at.y == r->at.y
+        && r->sonar_at.heading == r->at.heading
+        && sense_still(w->sense, r->at.x, r->at.y, r->sonar_reach, r->sonar_step + 1);
+}
+
+/* One reading: geometry (fresh or reused) plus this reading's noise. */
+static int scan(const world *w, robot *r)
+{
+    const b14_params *p = &w->lab->b14;
+    int i, reuse = reusable(w, r);
+    if (!reuse)
+        sonar_geometry(w, r);
+    r->sonar_at = r->at;
+    r->sonar_step = w->step;
+    for (i = 0; i < SONARS; i++) {
+        double g = r->sonar_geo[i];
+        if (g < p->sonar_max)
+            g += p->sonar_noise * gaussian(&r->rng);
+        r->sonar[i] = fmin(fmax(g, p->sonar_min), p->sonar_max);
+    }
+    r->sonar_seq++;
+    return reuse;
+}
+
+void robot_sonar_fire(world *w, int i)
+{
+    robot *r = &w->robots[i];
+    w->reused += scan(w, r);
+    w->scans++;
+    r->sonar_fired = 1;
+    if (w->trace)
+        trace_sonar(w->trace, w, i);
+}
+
+void robot_ir(const world *w, int i, double out[IRS])
+{
+    const robot *r = &w->robots[i];
+    const b14_params *p = &w->lab->b14;
+    int k;
+    for (k = 0; k < IRS; k++) {
+        double dir = r->at.heading + 22.5 * k;
+        out[k] = sense_ray(w->sense, r->circle, r->at.x + p->radius * cos(dir * RAD),
+                           r->at.y + p->radius * sin(dir * RAD), dir, p->ir_range);
+    }
+}
+
+void robot_contacts(const world *w, int i, int bumpers[BUMPERS], int skirt[SKIRTS])
+{
+    const robot *r = &w->robots[i];
+    double dirs[16];
+    int n = physics_robot_touches(w->phys, r->body, dirs, 16), k;
+    memset(bumpers, 0, BUMPERS * sizeof(int));
+    memset(skirt, 0, SKIRTS * sizeof(int));
+    for (k = 0; k < n; k++) {
+        double rel = wrap180(dirs[k] - r->at.heading);
+        int s = (int)floor(wrap180(rel + 30) / 60 + 6) % 6;
+        skirt[s] = 1;
+        if (fabs(rel) < 90)
+            bumpers[(int)fmin(floor((rel + 90) / 15), BUMPERS - 1)] = 1;
+    }
+}
+
+void robot_say(world *w, int i, const char *text, size_t n)
+{
+    char clean[512];
+    size_t k;
+    for (k = 0; k < n && k < sizeof clean - 1; k++)
+        clean[k] = text[k] >= 0x20 && text[k] < 0x7f ? text[k] : '?';
+    clean[k] = 0;
+    fprintf(stderr, "b14: %.3f %s says: %s\n", world_time(w), w->robots[i].name, clean);
+    if (w->trace)
+        trace_say(w->trace, w, i, clean);
+}
+
+/* ---- the step -------------------------------------------------------- */
+
+typedef struct {
+    world *w;
+    int *due, n, reused;
+} scan_job;
+
+static void *scan_some(void *arg)
+{
+    scan_job *j = arg;
+    int k;
+    for (k = 0; k < j->n; k++)
+        j->reused += scan(j->w, &j->w->robots[j->due[k]]);
+    return NULL;
+}
+
+/* Started sonars fire every step_hz / sonar_hz steps, staggered by robot so
+ * that each step carries a like share of the work. */
+static void fire_due_sonars(world *w)
+{
+    int period = (int)fmax(1, round(w->lab->step_hz / w->lab->b14.sonar_hz));
+    int *due = malloc((w->nrobots + 1) * sizeof(int)), n = 0, i;
+    scan_job jobs[2];
+    pthread_t worker;
+    for (i = 0; i < w->nrobots; i++)
+        if (w->robots[i].sonar_on && (w->step + i) % period == 0)
+            due[n++] = i;
+    jobs[0] = (scan_job){ w, due, n / 2, 0 };
+    jobs[1] = (scan_job){ w, due + n / 2, n - n / 2, 0 };
+    if (w->threads > 1 && n >= 32 && pthread_create(&worker, NULL, scan_some, &jobs[1]) == 0) {
+        scan_some(&jobs[0]);
+        pthread_join(worker, NULL);
+    } else {
+        jobs[0].n = n;
+        scan_some(&jobs[0]);
+        jobs[1].reused = 0;
+    }
+    w->scans += n;
+    w->reused += jobs[0].reused + jobs[1].reused;
+    for (i = 0; i < n; i++) {
+        w->robots[due[i]].sonar_fired = 1;
+        if (w->trace)
+            trace_sonar(w->trace, w, due[i]);
+    }
+    free(due);
+}
+
+void world_step(world *w)
+{
+    const b14_params *p = &w->lab->b14;
+    int i;
+    for (i = 0; i < w->nrobots; i++) {
+        robot *r = &w->robots[i];
+        control(p, r);
+        physics_drive(w->phys, r->body, r->v, r->w);
+    }
+    physics_step(w->phys, w->dt);
+    w->step++;
+    for (i = 0; i < w->nrobots; i++) {
+        robot *r = &w->robots[i];
+        r->before = r->at;
+        r->at = physics_robot_pose(w->phys, r->body);
+        sense_place_circle(w->sense, r->circle, r->at.x, r->at.y);
+        account(w, r);
+        battery(p, r, w->dt);
+    }
+    for (i = 0; i < w->lab->nboxes; i++)
+        sense_place_box(w->sense, i, physics_box_pose(w->phys, i));
+    sense_refile(w->sense, w->step);
+    fire_due_sonars(w);
+    if (w->trace)
+        trace_step(w->trace, w);
+}
