@@ -1,0 +1,19 @@
+;;> Takes the 10 ms nap out of Chibi's green-thread scheduler.
+;;>
+;;> Importing this library is enough: from then on, whenever every
+;;> thread of the process is blocked, the process sleeps in
+;;> \scheme{ppoll} on the descriptors the threads wait on, until the
+;;> nearest thread's deadline, instead of napping 10 ms at a time.
+;;> Threads, mutexes and condition variables of (srfi 18) behave as
+;;> before.  The library's body is lib/scheduler.c, built into
+;;> lib/murdoch/scheduler.so by \scheme{make native}.
+;;>
+;;> \procedure{(poll-scheduler-installed?)}
+;;> Returns \scheme{#t} once the wrapper is in place, which importing
+;;> the library does.
+
+(define-library (murdoch scheduler)
+  (export poll-scheduler-installed?)
+  ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
+  (import (scheme base) (srfi 18))
+  (include-shared "scheduler"))

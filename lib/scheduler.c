@@ -1,0 +1,262 @@
+/*  scheduler.c -- wait on descriptors instead of napping when all threads block
+ *
+ *  Chibi's SRFI 18 scheduler, when no thread can run, naps 10 ms and looks
+ *  again: a thread blocked on a socket sees its data up to 10 ms late, so a
+ *  request/reply between two Chibi processes costs about 11 ms.  This module
+ *  puts a wrapper in front of that scheduler.  When the wrapper sees that no
+ *  thread can run, it waits in ppoll() on the descriptors the blocked threads
+ *  wait on, until the nearest thread's deadline, and only then hands over to
+ *  Chibi's scheduler, which finds something ready and so never naps.
+ *
+ *  The wrapper changes none of Chibi's queues but one: a current thread whose
+ *  own timed wait has run out is woken here (see end_own_wait_if_expired).
+ *  Everything it reads -- the paused list, the run queue, each thread's wait
+ *  flag, deadline and event -- is public in sexp.h.
+ */
+
+#include <chibi/eval.h>
+#include <errno.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/time.h>
+#include <time.h>
+
+#if ! SEXP_USE_GREEN_THREADS
+#error "(murdoch scheduler) needs a Chibi-Scheme built with green threads"
+#endif
+
+/* What one look at the blocked threads decided. */
+enum wait_result {
+  WAIT_AGAIN,      /* a deadline came or a signal broke in: look again */
+  WAIT_DONE        /* something is ready, or there is nothing to wait on */
+};
+
+/* One array reused for every wait; the process has one OS thread. */
+static struct pollfd *pollfds;
+static size_t pollfds_size;
+
+/* Chibi leaves the deadline at zero for a wait without timeout. */
+static int has_deadline (sexp thread) {
+  return sexp_context_timeval(thread).tv_sec != 0
+    || sexp_context_timeval(thread).tv_usec != 0;
+}
+
+static int before (const struct timeval *a, const struct timeval *b) {
+  return a->tv_sec < b->tv_sec
+    || (a->tv_sec == b->tv_sec && a->tv_usec < b->tv_usec);
+}
+
+/* Chibi calls a deadline past only once it is strictly before now. */
+static int deadline_passed (sexp thread, const struct timeval *now) {
+  return has_deadline(thread) && before(&sexp_context_timeval(thread), now);
+}
+
+/* The descriptor a thread is blocked on, as Chibi's blocker registered it:
+ * ports and plain integers only, output ports for writing.  Returns -1 when
+ * the thread waits on something else.  A closed port's stream is freed, so
+ * it must not be asked for its descriptor. */
+static int blocked_fd (sexp thread, short *events) {
+  sexp event = sexp_context_event(thread);
+  if (sexp_fixnump(event)) {
+    *events = POLLIN;
+    return sexp_unbox_fixnum(event);
+  }
+  if (sexp_portp(event) && sexp_port_openp(event)) {
+    *events = sexp_oportp(event) ? POLLOUT : POLLIN;
+    return sexp_port_fileno(event);
+  }
+  return -1;
+}
+
+/* Chibi's test for "blocked on I/O", whether or not the descriptor is good. */
+static int blocked_on_io (sexp thread) {
+  sexp event = sexp_context_event(thread);
+  return sexp_fixnump(event) || sexp_portp(event);
+}
+
+static int ensure_pollfds (size_t n) {
+  struct pollfd *grown;
+  size_t size = pollfds_size ? pollfds_size : 16;
+  if (n <= pollfds_size) return 1;
+  while (size < n) size *= 2;
+  grown = realloc(pollfds, size * sizeof(*grown));
+  if (!grown) return 0;
+  pollfds = grown;
+  pollfds_size = size;
+  return 1;
+}
+
+/* Remove a thread from the paused list, if it is there. */
+static void unpause (sexp ctx, sexp thread) {
+  sexp prev = SEXP_FALSE, ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED);
+  for ( ; sexp_pairp(ls); prev = ls, ls = sexp_cdr(ls)) {
+    if (sexp_car(ls) != thread) continue;
+    if (sexp_pairp(prev))
+      sexp_cdr(prev) = sexp_cdr(ls);
+    else
+      sexp_global(ctx, SEXP_G_THREADS_PAUSED) = sexp_cdr(ls);
+    return;
+  }
+}
+
+/* Chibi's timeout sweep moves every expired paused thread to the run queue,
+ * the current one included, which then also keeps running: it sits in the
+ * queue twice, and later, blocked again, is picked from the queue while
+ * still waiting, which costs a 10 ms nap.  Without the wrapper this is rare
+ * (a current thread rarely outlives its own deadline); with it, it would
+ * follow every thread-sleep! of a lone thread.  So end the current thread's
+ * expired wait here, with the flags the sweep would set. */
+static void end_own_wait_if_expired (sexp ctx) {
+  struct timeval now;
+  if (sexp_context_refuel(ctx) <= 0 || !sexp_context_waitp(ctx)
+      || !has_deadline(ctx) || gettimeofday(&now, NULL) != 0
+      || !deadline_passed(ctx, &now))
+    return;
+  unpause(ctx, ctx);
+  sexp_context_waitp(ctx) = 0;
+  sexp_context_timeoutp(ctx) = 1;
+}
+
+static int waits_on (sexp thread, sexp target) {
+  return sexp_context_event(thread) == target;
+}
+
+/* Whether Chibi's scheduler, called now, would nap: nothing in the run
+ * queue, no signal to deliver, and the thread it would pick is waiting.
+ * Errs towards "no": a wrong "yes" could block the process. */
+static int nothing_runnable (sexp ctx) {
+  sexp ls, paused = sexp_global(ctx, SEXP_G_THREADS_PAUSED);
+  if (sexp_global(ctx, SEXP_G_THREADS_SIGNALS) != SEXP_ZERO
+      || sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_FRONT)))
+    return 0;
+  if (sexp_context_refuel(ctx) > 0)
+    return sexp_context_waitp(ctx);
+  /* The current thread has ended: Chibi wakes the threads joining it, else
+   * picks the first thread blocked on a descriptor, else the ended one. */
+  for (ls = paused; sexp_pairp(ls); ls = sexp_cdr(ls))
+    if (waits_on(sexp_car(ls), ctx))
+      return 0;
+  for (ls = paused; sexp_pairp(ls); ls = sexp_cdr(ls))
+    if (blocked_on_io(sexp_car(ls)))
+      return sexp_context_waitp(sexp_car(ls));
+  return sexp_context_waitp(ctx);
+}
+
+/* Add a blocked thread's descriptor and deadline to the wait; 0 when the
+ * array cannot grow. */
+static int note_waiter (sexp thread, nfds_t *n, struct timeval **deadline) {
+  short events;
+  int fd = blocked_fd(thread, &events);
+  if (fd >= 0) {
+    if (!ensure_pollfds(*n + 1)) return 0;
+    pollfds[*n].fd = fd;
+    pollfds[*n].events = events;
+    pollfds[*n].revents = 0;
+    ++*n;
+  }
+  if (has_deadline(thread)
+      && (!*deadline || before(&sexp_context_timeval(thread), *deadline)))
+    *deadline = &sexp_context_timeval(thread);
+  return 1;
+}
+
+/* The time from now until just past the deadline; 0 when it has passed. */
+static int time_until (const struct timeval *deadline, struct timespec *ts) {
+  struct timeval now;
+  long long usecs;
+  if (gettimeofday(&now, NULL) != 0 || before(deadline, &now))
+    return 0;
+  usecs = (long long)(deadline->tv_sec - now.tv_sec) * 1000000
+    + (deadline->tv_usec - now.tv_usec) + 1;
+  ts->tv_sec = usecs / 1000000;
+  ts->tv_nsec = (usecs % 1000000) * 1000;
+  return 1;
+}
+
+/* Sleep until a blocked thread's descriptor is ready, the nearest deadline
+ * passes or a signal arrives.  Signals are blocked by the caller and let in
+ * only inside ppoll(), so one arriving after the caller's check cannot be
+ * slept through.  With nothing to wait on, leave it to Chibi, which naps. */
+static enum wait_result wait_once (sexp ctx, const sigset_t *mask) {
+  sexp ls;
+  nfds_t n = 0;
+  struct timeval *deadline = NULL;
+  struct timespec timeout;
+  for (ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED); sexp_pairp(ls);
+       ls = sexp_cdr(ls))
+    if (!note_waiter(sexp_car(ls), &n, &deadline))
+      return WAIT_DONE;
+  /* Chibi's nap takes the current thread off the paused list. */
+  if (sexp_context_waitp(ctx) && !note_waiter(ctx, &n, &deadline))
+    return WAIT_DONE;
+  if (n == 0 && !deadline)
+    return WAIT_DONE;
+  if (deadline && !time_until(deadline, &timeout))
+    return WAIT_DONE;
+  switch (ppoll(pollfds, n, deadline ? &timeout : NULL, mask)) {
+  case 0:
+    return WAIT_AGAIN;
+  case -1:
+    return errno == EINTR ? WAIT_AGAIN : WAIT_DONE;
+  default:
+    return WAIT_DONE;
+  }
+}
+
+static void wait_for_wakeup (sexp ctx) {
+  sigset_t all, old;
+  sigfillset(&all);
+  if (sigprocmask(SIG_BLOCK, &all, &old) != 0)
+    return;
+  while (nothing_runnable(ctx) && wait_once(ctx, &old) == WAIT_AGAIN)
+    end_own_wait_if_expired(ctx);
+  sigprocmask(SIG_SETMASK, &old, NULL);
+}
+
+/* The scheduler the VM calls at the end of every time slice.  The common
+ * case, a runnable thread, costs two loads and a call. */
+static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
+  sexp chibi = sexp_opcode_data(self);
+  end_own_wait_if_expired(ctx);
+  if (nothing_runnable(ctx))
+    wait_for_wakeup(ctx);
+  return ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+}
+
+static int installed (sexp ctx) {
+  sexp s = sexp_global(ctx, SEXP_G_THREADS_SCHEDULER);
+  return sexp_opcodep(s) && sexp_opcode_func(s) == (sexp_proc1)poll_scheduler;
+}
+
+static sexp poll_scheduler_installedp (sexp ctx, sexp self, sexp_sint_t n) {
+  return sexp_make_boolean(installed(ctx));
+}
+
+/* Chibi's own scheduler is kept as the wrapper's data, which also keeps the
+ * collector from freeing it. */
+static sexp install (sexp ctx) {
+  sexp chibi = sexp_global(ctx, SEXP_G_THREADS_SCHEDULER), wrapper;
+  if (installed(ctx))
+    return SEXP_VOID;
+  if (!(sexp_opcodep(chibi) && sexp_opcode_func(chibi)))
+    return sexp_user_exception(ctx, SEXP_FALSE,
+                               "(murdoch scheduler): load (srfi 18) first",
+                               chibi);
+  wrapper = sexp_make_foreign(ctx, "poll-scheduler", 1, 0, "poll_scheduler",
+                              (sexp_proc1)poll_scheduler, chibi);
+  if (sexp_exceptionp(wrapper))
+    return wrapper;
+  sexp_global(ctx, SEXP_G_THREADS_SCHEDULER) = wrapper;
+  return SEXP_VOID;
+}
+
+sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
+                        const char *version, const sexp_abi_identifier_t abi) {
+  if (!(sexp_version_compatible(ctx, version, sexp_version)
+        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
+    return SEXP_ABI_ERROR;
+  sexp_define_foreign(ctx, env, "poll-scheduler-installed?", 0,
+                      poll_scheduler_installedp);
+  return install(ctx);
+}
