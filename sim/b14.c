@@ -33,8 +33,7 @@ enum {
     MAX_CLIENTS = 256,
     READ_SLICE = 16384,         /* per client per turn: nobody starves */
     MAX_BACKLOG = 65536,        /* unread replies before a client is dropped */
-    MAX_FRAME_ERRORS = 16,
-    STALL_SECONDS = 10
+    MAX_FRAME_ERRORS = 16
 };
 
 typedef struct {
@@ -189,7 +188,7 @@ static void after_step(server *sv)
             drop(sv, k);
             continue;
         }
-        if (c->pending_since && now - c->pending_since > STALL_SECONDS) {
+        if (c->pending_since && now - c->pending_since > sv->lab.stall_timeout) {
             send_payload(c, "0 err stalled incomplete frame for too long", 43);
             flush_out(c);
             drop(sv, k);

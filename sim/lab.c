@@ -22,6 +22,7 @@ void lab_defaults(lab *l)
     l->seed = 1;
     l->speed = 1;
     l->friction = 0.4;
+    l->stall_timeout = 10;
     l->b14 = b14;
 }
 
@@ -144,7 +145,7 @@ static int read_world(lab *l, const sx *world, char *err, int errlen)
 static int read_simulator(lab *l, const sx *sim, char *err, int errlen)
 {
     const sx *c;
-    double v;
+    double v = 0;
     for (c = sim->head->next; c; c = c->next) {
         int n = numbers(c, &v, 1);
         if (sx_is(c->head, "step-hz") && n == 1 && v >= 1)
@@ -153,6 +154,8 @@ static int read_simulator(lab *l, const sx *sim, char *err, int errlen)
             l->seed = (unsigned long)v;
         else if (sx_is(c->head, "speed") && n == 1 && v > 0)
             l->speed = v;
+        else if (sx_is(c->head, "stall-timeout") && n == 1 && v > 0)
+            l->stall_timeout = v;
         else if (sx_is(c->head, "speed") && sx_is(sx_nth(c, 1), "fast"))
             l->speed = 0;
         else
@@ -202,7 +205,7 @@ static int read_lab(lab *l, const sx *top, char *err, int errlen)
 {
     const sx *c;
     int aspace = 0;
-    double v;
+    double v = 0;
     if (top->kind != SX_LIST || !sx_is(top->head, "lab"))
         return bad(err, errlen, "top-level (lab NAME ...)", NULL);
     for (c = sx_nth(top, 2); c; c = c->next) {

@@ -31,6 +31,7 @@ typedef struct {
     unsigned long seed;
     double speed;               /* simulated s per wall s; 0: as fast as possible */
     double friction;
+    double stall_timeout;       /* wall seconds a client may sit on half a frame */
     b14_params b14;
     lab_robot *robots;
     int nrobots;

@@ -1,0 +1,358 @@
+/* trip over TCP against a real sim/b14 process: each error path of
+ * docs/trip-protocol.md, device exclusion between two clients, and a client
+ * killed while it holds a device.
+ *
+ *   test_trip B14 PORT-BASE TMPDIR
+ *
+ * Nothing here depends on timing except bounded waits for the server. */
+#include <errno.h>
+#include <netinet/in.h>
+#include <arpa/inet.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "check.h"
+#include "../../sim/frame.h"
+
+static int port_base;
+static pid_t server;
+
+typedef struct {
+    int fd;
+    frame_parser p;
+    unsigned char buf[4096];
+} conn;
+
+static int dial(conn *c, int robot)
+{
+    struct sockaddr_in sa = { .sin_family = AF_INET, .sin_port = htons(port_base + 100 + robot) };
+    inet_pton(AF_INET, "127.0.0.1", &sa.sin_addr);
+    c->fd = socket(AF_INET, SOCK_STREAM, 0);
+    frame_init(&c->p, c->buf, sizeof c->buf - 1);
+    return connect(c->fd, (struct sockaddr *)&sa, sizeof sa);
+}
+
+static void send_raw(conn *c, const void *data, size_t n)
+{
+    if (write(c->fd, data, n) != (ssize_t)n)
+        perror("test_trip: write");
+}
+
+static void send_frame(conn *c, const char *payload, size_t n)
+{
+    unsigned char out[8192];
+    send_raw(c, out, frame_encode((const unsigned char *)payload, n, out));
+}
+
+/* The next frame's payload as a string; "" on a closed connection or after
+ * 10 s of silence. */
+static const char *next_reply(conn *c)
+{
+    for (;;) {
+        unsigned char b;
+        enum frame_event ev;
+        struct pollfd pfd = { c->fd, POLLIN, 0 };
+        if (poll(&pfd, 1, 10000) <= 0 || read(c->fd, &b, 1) != 1)
+            return "";
+        frame_feed(&c->p, &b, 1, &ev);
+        if (ev == FRAME_OK) {
+            c->buf[c->p.len] = 0;
+            return (const char *)c->buf;
+        }
+    }
+}
+
+static const char *ask(conn *c, const char *payload)
+{
+    send_frame(c, payload, strlen(payload));
+    return next_reply(c);
+}
+
+static int starts(const char *s, const char *prefix)
+{
+    return strncmp(s, prefix, strlen(prefix)) == 0;
+}
+
+static int closed(conn *c)
+{
+    char b;
+    struct pollfd pfd = { c->fd, POLLIN, 0 };
+    while (poll(&pfd, 1, 10000) > 0) {
+        ssize_t n = read(c->fd, &b, 1);
+        if (n <= 0)
+            return 1;
+    }
+    return 0;
+}
+
+static void test_basics(void)
+{
+    conn c;
+    CHECK("connect", dial(&c, 0) == 0);
+    CHECK("ping", strcmp(ask(&c, "1 ping"), "1 ok pong") == 0);
+    CHECK("who names the robot", strcmp(ask(&c, "2 who"), "2 ok moseley b14-sim") == 0);
+    CHECK("open base", strcmp(ask(&c, "3 open base"), "3 ok") == 0);
+    CHECK("reckon", strcmp(ask(&c, "4 base reckon"), "4 ok 0.0 0.0 0.00") == 0);
+    CHECK("open sonar", strcmp(ask(&c, "5 open sonar"), "5 ok") == 0);
+    {
+        const char *r = ask(&c, "6 sonar read");
+        int spaces = 0;
+        for (; *r; r++)
+            spaces += *r == ' ';
+        CHECK("sonar read gives 16 ranges", starts((char *)c.buf, "6 ok ") && spaces == 17);
+    }
+    CHECK("open speech", strcmp(ask(&c, "7 open speech"), "7 ok") == 0);
+    {
+        const char say[] = "8 speech say stx\002 etx\003 dle\020 end";
+        send_frame(&c, say, sizeof say - 1);
+        CHECK("every special byte survives stuffing in a request", strcmp(next_reply(&c), "8 ok") == 0);
+    }
+    CHECK("buttons press needs no open", strcmp(ask(&c, "9 buttons press 2"), "9 ok") == 0);
+    ask(&c, "10 open buttons");
+    CHECK("buttons read shows the press", strcmp(ask(&c, "11 buttons read"), "11 ok 0 0 1 0") == 0);
+    CHECK("and clears it", strcmp(ask(&c, "12 buttons read"), "12 ok 0 0 0 0") == 0);
+    ask(&c, "13 open lights");
+    CHECK("lights set", strcmp(ask(&c, "14 lights set 1 0 1 1"), "14 ok") == 0);
+    CHECK("lights read", strcmp(ask(&c, "15 lights read"), "15 ok 1 0 1 1") == 0);
+    ask(&c, "16 open battery");
+    CHECK("battery read", starts(ask(&c, "17 battery read"), "17 ok 13."));
+    close(c.fd);
+}
+
+static void test_errors(void)
+{
+    conn c;
+    char big[3000];
+    dial(&c, 0);
+    CHECK("unknown command", strcmp(ask(&c, "1 dance"), "1 err unknown no command or device dance") == 0);
+    CHECK("unknown command of a device", strcmp(ask(&c, "2 base fly"), "2 err unknown base has no command fly") == 0);
+    ask(&c, "3 open base");
+    CHECK("unknown base command", starts(ask(&c, "4 base fly"), "4 err unknown base has no command fly"));
+    CHECK("too few arguments", starts(ask(&c, "5 base goto 1"), "5 err args"));
+    CHECK("too many arguments", starts(ask(&c, "6 base stop now"), "6 err args"));
+    CHECK("not a number", starts(ask(&c, "7 base rotate left"), "7 err args left is not a number"));
+    CHECK("not finite", starts(ask(&c, "8 base rotate inf"), "8 err args"));
+    CHECK("device not open", starts(ask(&c, "9 ir read"), "9 err not-open open ir first"));
+    CHECK("open of no device", starts(ask(&c, "10 open wings"), "10 err unknown"));
+    CHECK("no tag", starts(ask(&c, "ping"), "0 err syntax"));
+    CHECK("tag 0 is the server's", starts(ask(&c, "0 ping"), "0 err syntax"));
+    CHECK("empty frame", starts(ask(&c, ""), "0 err syntax"));
+    CHECK("bad button", starts(ask(&c, "11 buttons press 7"), "11 err args"));
+    send_raw(&c, "garbage", 7);
+    CHECK("bytes outside a frame", starts(ask(&c, "12 ping"), "0 err framing byte outside"));
+    CHECK("and the next frame is fine", strcmp(next_reply(&c), "12 ok pong") == 0);
+    send_raw(&c, "\0021 pi\0022 ping\003", 13);
+    CHECK("STX inside a frame", starts(next_reply(&c), "0 err framing frame interrupted"));
+    CHECK("the frame after it is answered", strcmp(next_reply(&c), "2 ok pong") == 0);
+    send_raw(&c, "\0023 \020Zping\003", 10);
+    CHECK("bad escape", starts(next_reply(&c), "0 err framing bad escape"));
+    memset(big, 'x', sizeof big);
+    memcpy(big, "13 speech say ", 14);
+    send_frame(&c, big, sizeof big);
+    CHECK("oversize frame", starts(next_reply(&c), "0 err too-long"));
+    CHECK("connection still serves", strcmp(ask(&c, "14 ping"), "14 ok pong") == 0);
+    {
+        const char two[] = "\00215 ping\003\00216 who\003";
+        size_t i;
+        for (i = 0; i < sizeof two - 1; i++)
+            send_raw(&c, &two[i], 1);
+        CHECK("frames sent a byte at a time", strcmp(next_reply(&c), "15 ok pong") == 0
+              && strcmp(next_reply(&c), "16 ok moseley b14-sim") == 0);
+    }
+    close(c.fd);
+}
+
+static void test_too_many_errors(void)
+{
+    conn c;
+    int i;
+    dial(&c, 0);
+    for (i = 0; i < 20; i++)
+        send_raw(&c, "\002\020Z\003", 4);
+    CHECK("a client that keeps breaking framing is closed", closed(&c));
+    close(c.fd);
+}
+
+static void test_flood(void)
+{
+    conn c, d;
+    static char burst[1 << 16];
+    int i, n = 0;
+    dial(&c, 0);
+    for (i = 0; n + 10 < (int)sizeof burst; i++)
+        n += frame_encode((const unsigned char *)"1 ping", 6, (unsigned char *)burst + n);
+    /* never read: replies pile up until the server gives up on us */
+    for (i = 0; i < 4096; i++) {
+        struct pollfd pfd = { c.fd, POLLOUT, 0 };
+        if (poll(&pfd, 1, 2000) <= 0 || send(c.fd, burst, n, MSG_NOSIGNAL) < 0)
+            break;
+    }
+    dial(&d, 1);
+    CHECK("others are served during a flood", strcmp(ask(&d, "1 ping"), "1 ok pong") == 0);
+    CHECK("a flooding client that never reads is dropped", i < 4096);
+    close(c.fd);
+    close(d.fd);
+}
+
+static void test_stall(void)
+{
+    conn c, d;
+    dial(&c, 0);
+    send_raw(&c, "\0021 pi", 5);
+    dial(&d, 0);
+    CHECK("others are served while one stalls", strcmp(ask(&d, "1 ping"), "1 ok pong") == 0);
+    CHECK("a stalled frame gets its error", starts(next_reply(&c), "0 err stalled"));
+    CHECK("and the connection is closed", closed(&c));
+    close(c.fd);
+    close(d.fd);
+}
+
+static void test_exclusion(void)
+{
+    conn a, b;
+    dial(&a, 0);
+    dial(&b, 0);
+    CHECK("first client opens base", strcmp(ask(&a, "1 open base"), "1 ok") == 0);
+    CHECK("second is refused, naming the device",
+          strcmp(ask(&b, "1 open base"), "1 err held base is held by another client") == 0);
+    CHECK("second may open another device", strcmp(ask(&b, "2 open sonar"), "2 ok") == 0);
+    CHECK("first may not have sonar now", starts(ask(&a, "2 open sonar"), "2 err held sonar"));
+    CHECK("close releases", strcmp(ask(&a, "3 close base"), "3 ok") == 0);
+    CHECK("then the second gets it", strcmp(ask(&b, "3 open base"), "3 ok") == 0);
+    close(a.fd);
+    close(b.fd);
+    {
+        conn e;
+        int k, ok = 0;
+        dial(&e, 1);
+        CHECK("ernst's base is a different lock", strcmp(ask(&e, "1 open base"), "1 ok") == 0);
+        close(e.fd);
+        /* b's locks go when its connection does */
+        dial(&e, 0);
+        for (k = 0; k < 100 && !ok; k++) {
+            ok = strcmp(ask(&e, "2 open base"), "2 ok") == 0;
+            if (!ok)
+                usleep(50000);
+        }
+        CHECK("a closed connection loses its locks", ok);
+        close(e.fd);
+    }
+}
+
+static void test_killed_client(void)
+{
+    int ready[2], k, held = 0, ok = 0;
+    char x;
+    pid_t child;
+    conn c;
+    if (pipe(ready) < 0)
+        return;
+    child = fork();
+    if (child == 0) {
+        conn h;
+        dial(&h, 1);
+        if (strcmp(ask(&h, "1 open base"), "1 ok") == 0 && write(ready[1], "y", 1) == 1)
+            pause();
+        _exit(1);
+    }
+    CHECK("holder got the base", read(ready[0], &x, 1) == 1);
+    dial(&c, 1);
+    held = starts(ask(&c, "1 open base"), "1 err held base");
+    CHECK("held while the holder lives", held);
+    kill(child, SIGKILL);
+    waitpid(child, NULL, 0);
+    for (k = 0; k < 100 && !ok; k++) {
+        ok = strcmp(ask(&c, "2 open base"), "2 ok") == 0;
+        if (!ok)
+            usleep(50000);
+    }
+    CHECK("a killed client's device is free", ok);
+    close(c.fd);
+    close(ready[0]);
+    close(ready[1]);
+}
+
+static void test_motion(void)
+{
+    conn c;
+    int k, moving = 1;
+    double x = 0, y = 0, h = 0;
+    dial(&c, 0);
+    ask(&c, "1 open base");
+    CHECK("goto accepted", strcmp(ask(&c, "2 base goto 500 -300"), "2 ok") == 0);
+    for (k = 0; k < 600 && moving; k++) {
+        int tv, st;
+        double rv;
+        usleep(20000);
+        sscanf(ask(&c, "3 base status"), "3 ok %lf %lf %lf %d %lf %d %d", &x, &y, &h, &tv, &rv, &moving, &st);
+    }
+    CHECK("goto over trip arrives within 2 cm", (x - 500) * (x - 500) + (y + 300) * (y + 300) < 400);
+    close(c.fd);
+}
+
+int main(int argc, char **argv)
+{
+    int ready[2], status;
+    char line[256];
+    FILE *out;
+    if (argc != 4) {
+        fprintf(stderr, "usage: test_trip B14 PORT-BASE TMPDIR\n");
+        return 2;
+    }
+    port_base = atoi(argv[2]);
+    signal(SIGPIPE, SIG_IGN);
+    {
+        char lab[512], trace[512], locks[512];
+        snprintf(lab, sizeof lab, "%s/lab.scm", argv[3]);
+        snprintf(trace, sizeof trace, "%s/run.svg", argv[3]);
+        snprintf(locks, sizeof locks, "%s/locks", argv[3]);
+        out = fopen(lab, "w");
+        fputs("(lab t (aspace moseley (robot (pose 0 0 0)))\n"
+              "       (aspace ernst (robot (pose -1000 1000 90) (tethered #t)))\n"
+              "       (world (wall -3000 -3000 3000 -3000) (wall 3000 -3000 3000 3000)\n"
+              "              (wall 3000 3000 -3000 3000) (wall -3000 3000 -3000 -3000)\n"
+              "              (box 1500 0 600 600 0))\n"
+              "       (simulator (speed 4) (stall-timeout 1)))\n", out);
+        fclose(out);
+        if (pipe(ready) < 0)
+            return 2;
+        server = fork();
+        if (server == 0) {
+            char pb[16];
+            snprintf(pb, sizeof pb, "%d", port_base);
+            dup2(ready[1], 1);
+            prctl(PR_SET_PDEATHSIG, SIGTERM);   /* no stray server if we crash */
+            execl(argv[1], argv[1], lab, "--port-base", pb, "--trace", trace, "--lock-dir", locks, (char *)NULL);
+            _exit(127);
+        }
+        close(ready[1]);
+        out = fdopen(ready[0], "r");
+        while (fgets(line, sizeof line, out) && strcmp(line, "b14: ready\n") != 0)
+            ;
+        test_basics();
+        test_errors();
+        test_too_many_errors();
+        test_flood();
+        test_stall();
+        test_exclusion();
+        test_killed_client();
+        test_motion();
+        kill(server, SIGTERM);
+        waitpid(server, &status, 0);
+        CHECK("SIGTERM ends the server with status 0", WIFEXITED(status) && WEXITSTATUS(status) == 0);
+        {
+            struct stat st;
+            char tmp[520];
+            snprintf(tmp, sizeof tmp, "%s.tmp", trace);
+            CHECK("the trace is written whole", stat(trace, &st) == 0 && st.st_size > 1000 && stat(tmp, &st) < 0);
+        }
+        fclose(out);
+    }
+    return check_summary();
+}
