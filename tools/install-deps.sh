@@ -26,7 +26,7 @@ need_root() {
 
 install_debian_packages() {
     missing=""
-    for p in build-essential g++ libbox2d-dev netcat-openbsd; do
+    for p in build-essential g++ libbox2d-dev netcat-openbsd clang; do
         dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
     done
     [ -z "$missing" ] && return 0
