@@ -1,0 +1,378 @@
+;;;; trip-client.scm -- the MOVER robot primitives, spoken over trip.
+;;;
+;;; The protocol is docs/trip-protocol.md; in short:
+;;;
+;;;   frame    STX payload ETX, with STX, ETX and DLE sent as DLE, byte^#x40
+;;;   request  "TAG WORD ARG ..."    TAG a number 1..999999999 we choose
+;;;   reply    "TAG ok VALUE ..."  or  "TAG err CODE TEXT"
+;;;   tag 0    the server's own messages (framing errors, streamed readings)
+;;;
+;;; One connection per robot.  A reader thread takes every frame off the
+;;; socket and hands the reply to the request waiting for it; requests on a
+;;; connection are serialized by its mutex, so green threads may call the
+;;; primitives at once.  Nothing waits forever: a reply not back within
+;;; (trip-timeout) seconds, and a motion not over within
+;;; (trip-motion-timeout), raise a trip error naming robot and command.
+;;;
+;;; The primitives act on (current-robot), the connection of the address
+;;; space's own robot (#f on a workstation).  Devices are opened on first
+;;; use; (im) opens them all at once, as MOVER's did.
+
+;;> Seconds to wait for any reply.
+(define trip-timeout (make-parameter 5))
+
+;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is
+;;> stopped and an error raised.
+(define trip-motion-timeout (make-parameter 120))
+
+;;> The connection the primitives use: #f on a workstation.  Set it for
+;;> the whole address space with \scheme{set-current-robot!} (threads do
+;;> not inherit \scheme{parameterize}).
+(define current-robot (make-parameter #f))
+
+(define (set-current-robot! c) (current-robot c))
+
+;;; Errors
+
+(define (trip-error robot command code text)
+  (raise (make-exception 'trip-error
+                         (string-append "trip: " robot ": " command ": " text)
+                         (list robot command code text) #f #f)))
+
+;;> True for the errors this library raises.
+(define (trip-error? e)
+  (and (exception? e) (eq? (exception-kind e) 'trip-error)))
+
+(define (trip-error-robot e) (car (exception-irritants e)))
+;;> The protocol's error code as a symbol: held, not-open, args, unknown,
+;;> timeout, closed, stalled ...
+(define (trip-error-code e) (string->symbol (list-ref (exception-irritants e) 2)))
+(define (trip-error-text e) (list-ref (exception-irritants e) 3))
+
+;;; Framing
+
+(define stx 2)
+(define etx 3)
+(define dle 16)
+(define max-reply 65536)
+
+(define (special? b) (or (= b stx) (= b etx) (= b dle)))
+
+(define (write-frame! payload out)
+  (let ((bytes (string->utf8 payload)))
+    (write-u8 stx out)
+    (do ((i 0 (+ i 1))) ((= i (bytevector-length bytes)))
+      (let ((b (bytevector-u8-ref bytes i)))
+        (if (special? b)
+            (begin (write-u8 dle out) (write-u8 (bitwise-xor b #x40) out))
+            (write-u8 b out))))
+    (write-u8 etx out)
+    (flush-output-port out)))
+
+;; The next whole frame's payload as a string, or an eof object.  Bytes
+;; between frames and broken frames are skipped: the server never sends
+;; them, and a reader that gives up would strand every waiting request.
+(define (read-frame in)
+  (let outside ()
+    (let ((b (read-u8 in)))
+      (cond
+       ((eof-object? b) b)
+       ((not (= b stx)) (outside))
+       (else
+        (let inside ((acc (open-output-bytevector)) (n 0))
+          (let ((b (read-u8 in)))
+            (cond
+             ((eof-object? b) b)
+             ((= b etx) (utf8->string (get-output-bytevector acc)))
+             ((or (= b stx) (> n max-reply)) (outside))
+             ((= b dle)
+              (let ((c (read-u8 in)))
+                (cond
+                 ((eof-object? c) c)
+                 ((special? (bitwise-xor c #x40))
+                  (write-u8 (bitwise-xor c #x40) acc)
+                  (inside acc (+ n 1)))
+                 (else (outside)))))
+             (else (write-u8 b acc) (inside acc (+ n 1)))))))))))
+
+;;; Connections
+
+(define-record-type trip-connection
+  (make-trip-connection host port socket in out lock replied opened)
+  trip-connection?
+  (host trip-connection-host)
+  (port trip-connection-port)
+  (socket trip-connection-socket)
+  (in trip-connection-in)
+  (out trip-connection-out)
+  (lock trip-connection-lock)              ; held from request to reply
+  (replied trip-connection-replied)        ; signalled when a reply is in
+  (opened trip-connection-opened trip-connection-opened-set!)
+  (name trip-connection-name trip-connection-name-set!)
+  (tag trip-connection-tag trip-connection-tag-set!)       ; awaited
+  (reply trip-connection-reply trip-connection-reply-set!) ; #f until in
+  (open? trip-connection-open? trip-connection-open?-set!))
+
+(define (robot-name c)
+  (or (trip-connection-name c)
+      (string-append (trip-connection-host c) ":"
+                     (number->string (trip-connection-port c)))))
+
+;;> Connects to the trip server of one robot and returns the connection;
+;;> its name is the robot's, as the server says.
+(define (trip-connect host port)
+  (let ((io (guard (e (#t #f)) (open-net-io host port))))
+    (if (not (pair? io))
+        (trip-error (string-append host ":" (number->string port)) "connect"
+                    "closed" "cannot connect"))
+    (let ((c (make-trip-connection host port (car io) (cadr io) (car (cddr io))
+                                   (make-mutex 'trip) (make-condition-variable)
+                                   '())))
+      (trip-connection-name-set! c #f)
+      (trip-connection-tag-set! c 0)
+      (trip-connection-reply-set! c #f)
+      (trip-connection-open?-set! c #t)
+      (thread-start! (make-thread (lambda () (read-replies c)) 'trip-reader))
+      (guard (e (#t (trip-close c) (raise e)))
+        (trip-connection-name-set! c (car (request c "who"))))
+      c)))
+
+;;> Closes the connection; the server frees every device it held.
+(define (trip-close c)
+  (when (trip-connection-open? c)
+    (trip-connection-open?-set! c #f)
+    (close-input-port (trip-connection-in c))
+    (close-output-port (trip-connection-out c))
+    (close-file-descriptor (trip-connection-socket c))))
+
+;; The reader thread: each reply goes to the request waiting for its tag;
+;; anything else (tag 0, a reply that came too late) is dropped.
+(define (read-replies c)
+  (let loop ()
+    (let ((frame (guard (e (#t (eof-object))) (read-frame (trip-connection-in c)))))
+      (mutex-lock! (trip-connection-lock c) #f #f)
+      (cond
+       ((eof-object? frame)
+        (trip-connection-open?-set! c #f)
+        (trip-connection-reply-set! c frame)
+        (condition-variable-broadcast! (trip-connection-replied c))
+        (mutex-unlock! (trip-connection-lock c)))
+       (else
+        (let ((words (split-words frame)))
+          (if (and (pair? words)
+                   (equal? (string->number (car words)) (trip-connection-tag c)))
+              (begin (trip-connection-reply-set! c (cdr words))
+                     (condition-variable-broadcast! (trip-connection-replied c)))))
+        (mutex-unlock! (trip-connection-lock c))
+        (loop))))))
+
+(define (split-words s)
+  (let loop ((i 0) (start 0) (acc '()))
+    (define (word) (if (= start i) acc (cons (substring s start i) acc)))
+    (cond
+     ((= i (string-length s)) (reverse (word)))
+     ((char=? (string-ref s i) #\space) (loop (+ i 1) (+ i 1) (word)))
+     (else (loop (+ i 1) start acc)))))
+
+(define (join words)
+  (if (null? words)
+      ""
+      (fold-left (lambda (acc w) (string-append acc " " w)) (car words) (cdr words))))
+
+(define (fold-left f acc ls)
+  (if (null? ls) acc (fold-left f (f acc (car ls)) (cdr ls))))
+
+(define (->word x)
+  (cond ((string? x) x)
+        ((symbol? x) (symbol->string x))
+        ((and (number? x) (exact? x)) (number->string x))
+        ((number? x) (number->string (/ (round (* x 1000)) 1000.)))
+        ((boolean? x) (if x "1" "0"))
+        (else (error "not a trip argument" x))))
+
+(define (reply-value w) (or (string->number w) w))
+
+;; Send one request and return the values of its ok reply; raise a trip
+;; error for an err reply, a lost connection or no reply in time.
+(define (request c . words)
+  (let ((command (join (map ->word words)))
+        (lock (trip-connection-lock c))
+        (deadline (seconds->time (+ (time->seconds (current-time)) (trip-timeout)))))
+    (define (fail code text)
+      (trip-connection-tag-set! c 0)
+      (mutex-unlock! lock)
+      (trip-error (robot-name c) command code text))
+    (mutex-lock! lock)
+    (if (not (trip-connection-open? c))
+        (fail "closed" "connection closed"))
+    (let ((tag (+ 1 (modulo (trip-connection-tag c) 999999998))))
+      (trip-connection-tag-set! c tag)
+      (trip-connection-reply-set! c #f)
+      (guard (e (#t (fail "closed" "cannot send")))
+        (write-frame! (string-append (number->string tag) " " command)
+                      (trip-connection-out c)))
+      (let wait ()
+        (let ((reply (trip-connection-reply c)))
+          (cond
+           ((eof-object? reply) (fail "closed" "connection lost"))
+           ((not reply)
+            (if (mutex-unlock! lock (trip-connection-replied c) deadline)
+                (begin (mutex-lock! lock) (wait))
+                (begin (mutex-lock! lock)
+                       (fail "timeout" (string-append
+                                        "no reply within "
+                                        (number->string (trip-timeout)) " s")))))
+           ((and (pair? reply) (equal? (car reply) "ok"))
+            (mutex-unlock! lock)
+            (map reply-value (cdr reply)))
+           (else
+            (fail (if (pair? (cdr reply)) (cadr reply) "protocol")
+                  (if (pair? (cdr reply)) (join (cddr reply)) (join reply))))))))))
+
+;;> One raw request on connection \var{c}: words are joined with spaces
+;;> (numbers, symbols and strings); returns the values of the reply.  For
+;;> tools and tests, e.g. \scheme{(trip-request c 'buttons 'press 2)}.
+(define (trip-request c . words) (apply request c words))
+
+;;; Devices
+
+(define devices '(base sonar ir bumpers skirt buttons lights speech battery))
+
+(define (robot)
+  (or (current-robot)
+      (error "no robot: this address space has no trip connection")))
+
+(define (open-device! c device)
+  (if (not (memq device (trip-connection-opened c)))
+      (begin (request c "open" device)
+             (trip-connection-opened-set! c (cons device (trip-connection-opened c))))))
+
+;; A device command to the current robot, opening the device first.
+(define (device device . words)
+  (let ((c (robot)))
+    (open-device! c device)
+    (apply request c device words)))
+
+;;> MOVER's initialisation: opens every device of the current robot, so
+;;> that a device held elsewhere shows up now rather than mid-task.
+(define (im)
+  (for-each (lambda (d) (open-device! (robot) d)) devices)
+  #t)
+
+;;; Motion
+
+(define (sleep-a-little) (thread-sleep! 0.05))
+
+;; Wait until the base's motion is over; the final odometry pose.
+(define (await-motion what)
+  (let ((deadline (+ (time->seconds (current-time)) (trip-motion-timeout))))
+    (let loop ()
+      (let ((status (device 'base "status")))
+        (cond
+         ((zero? (list-ref status 5))
+          (if (= 1 (list-ref status 6))
+              (trip-error (robot-name (robot)) what "stalled" "the base is blocked"))
+          (list (car status) (cadr status) (car (cddr status)) 0))
+         ((> (time->seconds (current-time)) deadline)
+          (device 'base "stop")
+          (trip-error (robot-name (robot)) what "timeout" "motion took too long"))
+         (else (sleep-a-little) (loop)))))))
+
+;;> Drives to \var{xy}, a list (x y) in millimetres of the odometry frame:
+;;> turns to face it, then goes.  Returns the pose reached, as reckon.
+(define (goto-xy xy)
+  (device 'base "goto" (car xy) (cadr xy))
+  (await-motion "goto-xy"))
+
+;;> \scheme{(rotate 'by degrees)} turns in place by an angle (counter-
+;;> clockwise positive); \scheme{(rotate 'to heading)} turns to a heading.
+;;> Returns the pose reached.
+(define (rotate how degrees)
+  (let ((by (case how
+              ((by) degrees)
+              ((to) (angle-to-heading degrees))
+              (else (error "rotate takes 'by or 'to" how)))))
+    (device 'base "rotate" by)
+    (await-motion "rotate")))
+
+;;> Moves \var{mm} millimetres along the heading (backwards when negative).
+(define (translate mm)
+  (device 'base "translate" mm)
+  (await-motion "translate"))
+
+;;> The turn, in (-180, 180], that brings the robot to \var{heading}.
+(define (angle-to-heading heading)
+  (let ((a (- heading (car (cddr (reckon))))))
+    (let ((w (- a (* 360 (round (/ a 360))))))
+      (if (<= w -180) (+ w 360) w))))
+
+;;> Translation (mm/s) and rotation (deg/s) velocities, until changed.
+(define (set-velocity tv rv) (device 'base "vel" tv rv) #t)
+(define (stop-base) (device 'base "stop") #t)
+
+;;> The odometry pose: (x y theta 0), millimetres and degrees.
+(define (reckon)
+  (append (device 'base "reckon") '(0)))
+
+(define (set-reckon-position! x y) (device 'base "set-position" x y) #t)
+(define (set-reckon-heading! theta) (device 'base "set-heading" theta) #t)
+
+;;; Sensors and the rest
+
+(define (sonar-start) (device 'sonar "start") #t)
+(define (sonar-stop) (device 'sonar "stop") #t)
+;;> The 16 sonar ranges in mm, sonar 0 facing ahead, counter-clockwise;
+;;> the latest reading, which stays after \scheme{sonar-stop}.
+(define (sonar-read) (device 'sonar "read"))
+(define (ir-read) (device 'ir "read"))
+(define (bumpers-read) (device 'bumpers "read"))
+(define (skirt-read) (device 'skirt "read"))
+;;> The buttons pressed since the last call, as four 0/1.
+(define (buttons-read) (device 'buttons "read"))
+
+;;> Sets the four LEDs from a list or four arguments of 0/1 or #f/#t;
+;;> with none, answers them.
+(define (lights . which)
+  (let ((ls (if (and (pair? which) (list? (car which))) (car which) which)))
+    (if (null? ls)
+        (device 'lights "read")
+        (begin (apply device 'lights "set" (map (lambda (x) (if (memv x '(#f 0)) 0 1)) ls))
+               #t))))
+
+;;> Says the things given, displayed and joined.
+(define (say . things)
+  (device 'speech "say"
+          (join (map (lambda (x)
+                       (if (string? x)
+                           x
+                           (call-with-output-string (lambda (out) (write x out)))))
+                     things)))
+  #t)
+
+;;> The battery in tenths of a volt, an integer (136 for 13.6 V): the unit
+;;> of the thesis's thresholds (130 charging, 100 low, 140 a workstation).
+(define (battery-voltage)
+  (exact (round (* 10 (car (device 'battery "read"))))))
+
+(define (tethered?) (= 1 (cadr (device 'battery "read"))))
+(define (set-tether! on?) (device 'battery "tether" on?) #t)
+
+;;; safe.scm: answers any address space can give
+
+;;> \scheme{im} on a robot, #t elsewhere.
+(define (safe-im)
+  (if (current-robot) (im) #t))
+
+;;> The battery on a robot; on a workstation 140, high enough to count as
+;;> charging.
+(define (safe-battery-voltage)
+  (if (current-robot) (battery-voltage) 140))
+
+;;> \scheme{reckon} on a robot; on a workstation its fixed \var{position},
+;;> (x y heading) from the lab file, as (x y heading 0); #f when it has
+;;> none.
+(define (safe-reckon . position)
+  (cond ((current-robot) (reckon))
+        ((and (pair? position) (car position))
+         (let ((p (car position))) (list (car p) (cadr p) (car (cddr p)) 0)))
+        (else #f)))
