@@ -8,10 +8,11 @@
  *  wait on, until the nearest thread's deadline, and only then hands over to
  *  Chibi's scheduler, which finds something ready and so never naps.
  *
- *  The wrapper changes none of Chibi's queues but one: a current thread whose
- *  own timed wait has run out is woken here (see end_own_wait_if_expired).
- *  Everything it reads -- the paused list, the run queue, each thread's wait
- *  flag, deadline and event -- is public in sexp.h.
+ *  The wrapper touches Chibi's queues in one way only: after Chibi's
+ *  scheduler has picked the next thread, it takes out of the run queue any
+ *  second copy of a thread (see unqueue_twins).  Everything it reads -- the
+ *  paused list, the run queue, each thread's wait flag, deadline and event
+ *  -- is public in sexp.h.
  */
 
 #include <chibi/eval.h>
@@ -47,11 +48,6 @@ static int before (const struct timeval *a, const struct timeval *b) {
     || (a->tv_sec == b->tv_sec && a->tv_usec < b->tv_usec);
 }
 
-/* Chibi calls a deadline past only once it is strictly before now. */
-static int deadline_passed (sexp thread, const struct timeval *now) {
-  return has_deadline(thread) && before(&sexp_context_timeval(thread), now);
-}
-
 /* The descriptor a thread is blocked on, as Chibi's blocker registered it:
  * ports and plain integers only, output ports for writing.  Returns -1 when
  * the thread waits on something else.  A closed port's stream is freed, so
@@ -85,37 +81,6 @@ static int ensure_pollfds (size_t n) {
   pollfds = grown;
   pollfds_size = size;
   return 1;
-}
-
-/* Remove a thread from the paused list, if it is there. */
-static void unpause (sexp ctx, sexp thread) {
-  sexp prev = SEXP_FALSE, ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED);
-  for ( ; sexp_pairp(ls); prev = ls, ls = sexp_cdr(ls)) {
-    if (sexp_car(ls) != thread) continue;
-    if (sexp_pairp(prev))
-      sexp_cdr(prev) = sexp_cdr(ls);
-    else
-      sexp_global(ctx, SEXP_G_THREADS_PAUSED) = sexp_cdr(ls);
-    return;
-  }
-}
-
-/* Chibi's timeout sweep moves every expired paused thread to the run queue,
- * the current one included, which then also keeps running: it sits in the
- * queue twice, and later, blocked again, is picked from the queue while
- * still waiting, which costs a 10 ms nap.  Without the wrapper this is rare
- * (a current thread rarely outlives its own deadline); with it, it would
- * follow every thread-sleep! of a lone thread.  So end the current thread's
- * expired wait here, with the flags the sweep would set. */
-static void end_own_wait_if_expired (sexp ctx) {
-  struct timeval now;
-  if (sexp_context_refuel(ctx) <= 0 || !sexp_context_waitp(ctx)
-      || !has_deadline(ctx) || gettimeofday(&now, NULL) != 0
-      || !deadline_passed(ctx, &now))
-    return;
-  unpause(ctx, ctx);
-  sexp_context_waitp(ctx) = 0;
-  sexp_context_timeoutp(ctx) = 1;
 }
 
 static int waits_on (sexp thread, sexp target) {
@@ -205,23 +170,49 @@ static enum wait_result wait_once (sexp ctx, const sigset_t *mask) {
 }
 
 static void wait_for_wakeup (sexp ctx) {
+  enum wait_result result = WAIT_AGAIN;
   sigset_t all, old;
   sigfillset(&all);
   if (sigprocmask(SIG_BLOCK, &all, &old) != 0)
     return;
-  while (nothing_runnable(ctx) && wait_once(ctx, &old) == WAIT_AGAIN)
-    end_own_wait_if_expired(ctx);
+  while (result == WAIT_AGAIN && nothing_runnable(ctx))
+    result = wait_once(ctx, &old);
   sigprocmask(SIG_SETMASK, &old, NULL);
 }
 
-/* The scheduler the VM calls at the end of every time slice.  The common
- * case, a runnable thread, costs two loads and a call. */
+/* Chibi's timeout sweep queues every paused thread whose deadline has
+ * passed, the current one too, although the current one then goes on
+ * running, or is put in the queue a second time: it would be resumed twice,
+ * the second time perhaps after it has ended, which crashes the VM.
+ * Chibi's own naps make this rare, since a thread seldom outlives its own
+ * deadline; with the wrapper it would follow most thread-sleep! calls.  So
+ * keep the thread that runs next out of the queue, and the one that ran
+ * before in it at most once. */
+static void unqueue_twins (sexp ctx, sexp previous, sexp next) {
+  sexp prev = SEXP_NULL, ls = sexp_global(ctx, SEXP_G_THREADS_FRONT);
+  int seen = 0;
+  for ( ; sexp_pairp(ls); ls = sexp_cdr(ls)) {
+    if (sexp_car(ls) == next || (sexp_car(ls) == previous && seen++)) {
+      if (sexp_pairp(prev))
+        sexp_cdr(prev) = sexp_cdr(ls);
+      else
+        sexp_global(ctx, SEXP_G_THREADS_FRONT) = sexp_cdr(ls);
+    } else {
+      prev = ls;
+    }
+  }
+  sexp_global(ctx, SEXP_G_THREADS_BACK) = prev;
+}
+
+/* The scheduler the VM calls at the end of every time slice. */
 static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
-  sexp chibi = sexp_opcode_data(self);
-  end_own_wait_if_expired(ctx);
+  sexp chibi = sexp_opcode_data(self), next;
   if (nothing_runnable(ctx))
     wait_for_wakeup(ctx);
-  return ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+  next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+  if (sexp_contextp(next))
+    unqueue_twins(ctx, ctx, next);
+  return next;
 }
 
 static int installed (sexp ctx) {

@@ -1,0 +1,257 @@
+;;; (murdoch scheduler): with the wrapper installed, threads blocked on
+;;; descriptors wake when data comes, sleepers and timeouts wake in order,
+;;; and runnable threads run.  Values and order only: durations are not
+;;; asserted, a loaded machine stretches them.
+;;;
+;;; The data comes from a forked peer process that writes when told, so that
+;;; it arrives while every thread of this process is blocked: that is the
+;;; case where the wrapper, not Chibi's own scheduler, does the waiting.
+(import (scheme base) (srfi 18) (srfi 151)
+        (chibi test) (chibi net) (chibi filesystem) (chibi process)
+        (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
+        (murdoch scheduler))
+
+;; A scheduler that never wakes fails the run instead of stalling it.
+(alarm 120)
+
+(define (nonblocking! fd)
+  (set-file-descriptor-status!
+   fd (bitwise-ior (get-file-descriptor-status fd) open/non-block))
+  fd)
+
+;; Both ends of a Unix socket pair, non-blocking as Chibi's threads want.
+(define (channel)
+  (map nonblocking! (open-socket-pair address-family/unix socket-type/stream 0)))
+
+(define (listen-somewhere)
+  (let try ((port (+ 20000 (modulo (* 7919 (current-process-id)) 40000)))
+            (tries 0))
+    (let ((sock (guard (e ((< tries 100) #f))
+                  (make-listener-socket (get-address-info "127.0.0.1" port)))))
+      (if sock
+          (cons sock port)
+          (try (+ 20000 (modulo (+ port 1 -20000) 40000)) (+ tries 1))))))
+
+;; ctl carries orders to the peer; d1 and d2 carry its data back; nothing is
+;; ever written to quiet, so a thread reading it stays blocked on it.
+(define ctl (channel))
+(define d1 (channel))
+(define d2 (channel))
+(define quiet (channel))
+(define listener (listen-somewhere))
+
+;;; The peer
+
+;; A forked child must not leave through exit: Chibi's exit and
+;; emergency-exit both call libc's exit, which moves the file offset the
+;; child shares with the parent's reader of this file.
+(define (vanish)
+  (kill (current-process-id) signal/kill))
+
+(define (send! out text)
+  (write-bytevector (string->utf8 text) out)
+  (flush-output-port out))
+
+(define (connect-and-send! text)
+  (let ((io (open-net-io "127.0.0.1" (cdr listener))))
+    (send! (car (cddr io)) text)))
+
+(define (obey order d1-out d2-out)
+  (case order
+    ((#\a) (send! d1-out "hello"))
+    ((#\b) (send! d2-out "world"))
+    ((#\p) (send! d1-out "hel"))
+    ((#\q) (send! d1-out "lo"))
+    ((#\c) (connect-and-send! "hi"))
+    ((#\s) (kill (parent-process-id) signal/user1))))
+
+;; Ends at end of file on ctl, which comes when the parent exits or dies,
+;; because the peer closes its own copy of the parent's end first.
+(define (run-peer)
+  (close-file-descriptor (car ctl))
+  (let ((in (open-input-file-descriptor (cadr ctl)))
+        (d1-out (open-output-file-descriptor (cadr d1)))
+        (d2-out (open-output-file-descriptor (cadr d2))))
+    (let loop ()
+      (let ((order (read-u8 in)))
+        (unless (eof-object? order)
+          (obey (integer->char order) d1-out d2-out)
+          (loop))))))
+
+;; Forked before any thread is made, so the peer has none to run.
+(define peer
+  (let ((pid (fork)))
+    (when (zero? pid)
+      (guard (e (#t (vanish))) (run-peer))
+      (vanish))
+    pid))
+
+;;; The test's side
+
+(define ctl-out (open-output-file-descriptor (car ctl)))
+(define d1-in (open-input-file-descriptor (car d1)))
+(define d2-in (open-input-file-descriptor (car d2)))
+(define quiet-in (open-input-file-descriptor (car quiet)))
+
+(define (tell-peer order)
+  (write-u8 (char->integer order) ctl-out)
+  (flush-output-port ctl-out))
+
+(define (start thunk)
+  (thread-start! (make-thread thunk)))
+
+(define (read-text n in)
+  (utf8->string (read-bytevector n in)))
+
+(define (block-forever)
+  (read-u8 quiet-in))
+
+(define (now)
+  (let ((tv (car (get-time-of-day))))
+    (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.))))
+
+;; Each sleeper sleeps until base + its delay, base being shared, so the
+;; order of wake-up does not depend on when each thread got to run.
+(define (wake-order delays-ms)
+  (let* ((woken '())
+         (base (+ (now) 0.3))
+         (sleeper
+          (lambda (ms)
+            (start (lambda ()
+                     (thread-sleep! (max 0 (- (+ base (/ ms 1000.)) (now))))
+                     (set! woken (cons ms woken)))))))
+    (for-each thread-join! (map sleeper delays-ms))
+    (reverse woken)))
+
+;; Lets the thread run until it owns the mutex and blocks.
+(define (wait-until-owned mutex thread)
+  (unless (eq? (mutex-state mutex) thread)
+    (thread-yield!)
+    (wait-until-owned mutex thread)))
+
+(test-begin "scheduler")
+
+(test "importing the library installs the wrapper" #t
+  (poll-scheduler-installed?))
+
+(test "a thread blocked reading a socket wakes when the peer writes" "hello"
+  (let ((reader (start (lambda () (read-text 5 d1-in)))))
+    (thread-yield!)
+    (tell-peer #\a)
+    (thread-join! reader)))
+
+(test "two threads blocked on two sockets both get their data"
+    '("hello" "world")
+  (let ((r1 (start (lambda () (read-text 5 d1-in))))
+        (r2 (start (lambda () (read-text 5 d2-in)))))
+    (thread-yield!)
+    (tell-peer #\b)
+    (tell-peer #\a)
+    (list (thread-join! r1) (thread-join! r2))))
+
+(test "a reader that gets part of a write, then the rest" "hello"
+  (let ((reader (start (lambda () (read-text 5 d1-in)))))
+    (tell-peer #\p)
+    (thread-sleep! 0.05)
+    (tell-peer #\q)
+    (thread-join! reader)))
+
+(test "accept wakes when a client connects" "hi"
+  (let* ((addr (get-address-info "127.0.0.1" (cdr listener)))
+         (server
+          (start (lambda ()
+                   (let ((sock (accept (car listener)
+                                       (address-info-address addr)
+                                       (address-info-address-length addr))))
+                     (read-text 2 (open-input-file-descriptor sock)))))))
+    (thread-yield!)
+    (tell-peer #\c)
+    (thread-join! server)))
+
+(test "a sleep ends while another thread waits on a socket" '(slept "hello")
+  (let* ((events '())
+         (reader (start (lambda ()
+                          (let ((text (read-text 5 d1-in)))
+                            (set! events (cons text events))))))
+         (sleeper (start (lambda ()
+                           (thread-sleep! 0.05)
+                           (set! events (cons 'slept events))
+                           (tell-peer #\a)))))
+    (thread-join! sleeper)
+    (thread-join! reader)
+    (reverse events)))
+
+(test "sleepers started shortest last wake in deadline order"
+    '(0 20 40 60 80 100 120 140)
+  (wake-order '(140 120 100 80 60 40 20 0)))
+
+(test "sleepers started in shuffled order wake in deadline order"
+    '(0 20 40 60 80 100 120 140 160 180)
+  (wake-order '(100 20 180 60 0 140 40 160 120 80)))
+
+(test "mutex-lock! with a timeout gives up on a held mutex" '(#f #t)
+  (let* ((m (make-mutex))
+         (holder (start (lambda () (mutex-lock! m) (block-forever)))))
+    (wait-until-owned m holder)
+    (let ((locked (mutex-lock! m 0.05)))
+      (list locked (eq? (mutex-state m) holder)))))
+
+(test "mutex-lock! with a timeout gets a mutex released in time" #t
+  (let* ((m (make-mutex))
+         (holder (start (lambda ()
+                          (mutex-lock! m)
+                          (thread-sleep! 0.05)
+                          (mutex-unlock! m)))))
+    (wait-until-owned m holder)
+    (mutex-lock! m 60)))
+
+(test "thread-join! with a timeout returns the timeout value" 'timed-out
+  (thread-join! (start block-forever) 0.05 'timed-out))
+
+(test "thread-join! with a timeout gets a result that comes in time" 'done
+  (thread-join! (start (lambda () (thread-sleep! 0.05) 'done)) 60 'timed-out))
+
+(test "a condition variable signalled from another thread" '(signalled #t)
+  (let ((m (make-mutex))
+        (cv (make-condition-variable))
+        (state 'waiting))
+    (mutex-lock! m)
+    (start (lambda ()
+             (thread-sleep! 0.05)
+             (mutex-lock! m)
+             (set! state 'signalled)
+             (condition-variable-signal! cv)
+             (mutex-unlock! m)))
+    (let ((woken (mutex-unlock! m cv)))
+      (list state woken))))
+
+(test "waiting on a condition variable nobody signals times out" #f
+  (let ((m (make-mutex)))
+    (mutex-lock! m)
+    (mutex-unlock! m (make-condition-variable) 0.05)))
+
+(test "a runnable thread runs while others wait on sockets" '(200000 "hello")
+  (let* ((reader (start (lambda () (read-text 5 d1-in))))
+         (busy (start (lambda ()
+                        (let count ((i 0))
+                          (if (< i 200000) (count (+ i 1)) i))))))
+    (let ((n (thread-join! busy)))
+      (tell-peer #\a)
+      (list n (thread-join! reader)))))
+
+(test "a signal is handled while every thread waits" signal/user1
+  (let ((gate (make-mutex))
+        (caught #f))
+    (set-signal-action! signal/user1
+                        (lambda (n) (set! caught n) (mutex-unlock! gate)))
+    (start block-forever)
+    (mutex-lock! gate)
+    (tell-peer #\s)
+    (mutex-lock! gate)
+    caught))
+
+(test-end)
+
+(kill peer signal/kill)
+(waitpid peer 0)
+(test-exit)
