@@ -1,0 +1,26 @@
+# Murdoch's C outside the simulator, for the top Makefile to include; paths
+# are from the top of the repository.
+#   make native         builds lib/murdoch/scheduler.so, the body of
+#                       (murdoch scheduler), and bench/c-pingpong
+#   make native-clean   removes them
+
+# tools/chibi-cflags names the directory of Chibi's headers, which in the
+# private install also holds a newer libc's headers; searched after the
+# system's directories, it gives chibi/*.h without mixing the two libcs.
+NATIVE_CHIBI_INCLUDE := $(patsubst -I%,%,$(filter -I%,$(shell tools/chibi-cflags)))
+NATIVE_CHIBI_CFLAGS := $(addprefix -idirafter ,$(NATIVE_CHIBI_INCLUDE))
+NATIVE_CHIBI_HEADERS := $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)))
+NATIVE_CFLAGS ?= -O2 -g -Wall
+
+native: lib/murdoch/scheduler.so bench/c-pingpong
+
+lib/murdoch/scheduler.so: lib/scheduler.c $(NATIVE_CHIBI_HEADERS)
+	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ lib/scheduler.c
+
+bench/c-pingpong: bench/c-pingpong.c
+	$(CC) $(NATIVE_CFLAGS) -o $@ bench/c-pingpong.c
+
+native-clean:
+	rm -f lib/murdoch/scheduler.so bench/c-pingpong
+
+.PHONY: native native-clean
