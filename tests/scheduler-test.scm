@@ -6,7 +6,7 @@
 ;;; The data comes from a forked peer process that writes when told, so that
 ;;; it arrives while every thread of this process is blocked: that is the
 ;;; case where the wrapper, not Chibi's own scheduler, does the waiting.
-(import (scheme base) (srfi 18) (srfi 151)
+(import (scheme base) (srfi 18) (srfi 132) (srfi 151)
         (chibi test) (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
         (murdoch scheduler))
@@ -59,6 +59,7 @@
 (define (obey order d1-out d2-out)
   (case order
     ((#\a) (send! d1-out "hello"))
+    ((#\t) (send! d1-out "abc"))
     ((#\b) (send! d2-out "world"))
     ((#\p) (send! d1-out "hel"))
     ((#\q) (send! d1-out "lo"))
@@ -109,6 +110,30 @@
 (define (now)
   (let ((tv (car (get-time-of-day))))
     (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.))))
+
+;; Writes size bytes of 7, in chunks, as fast as the socket takes them.
+(define (write-sevens fd size)
+  (let ((out (open-output-file-descriptor fd))
+        (chunk (make-bytevector 4096 7)))
+    (do ((sent 0 (+ sent 4096)))
+        ((>= sent size))
+      (write-bytevector chunk out)
+      (flush-output-port out))))
+
+;; Reads size bytes; their count and their sum.
+(define (sum-bytes fd size)
+  (let ((in (open-input-file-descriptor fd)))
+    (let loop ((got 0) (sum 0))
+      (if (= got size)
+          (list got sum)
+          (let ((bv (read-bytevector (min 8192 (- size got)) in)))
+            (loop (+ got (bytevector-length bv))
+                  (+ sum (bytevector-sum bv))))))))
+
+(define (bytevector-sum bv)
+  (do ((i 0 (+ i 1))
+       (sum 0 (+ sum (bytevector-u8-ref bv i))))
+      ((= i (bytevector-length bv)) sum)))
 
 ;; Each sleeper sleeps until base + its delay, base being shared, so the
 ;; order of wake-up does not depend on when each thread got to run.
@@ -180,6 +205,43 @@
     (thread-join! sleeper)
     (thread-join! reader)
     (reverse events)))
+
+(test "three threads blocked on one socket get a byte each" '(97 98 99)
+  (let ((readers (map (lambda (i) (start (lambda () (read-u8 d1-in))))
+                      '(1 2 3))))
+    (thread-yield!)
+    (tell-peer #\t)
+    (list-sort < (map thread-join! readers))))
+
+(test "a thread ends while another waits on a socket" '(ended "hello")
+  (let* ((events '())
+         (ender (start (lambda ()
+                         (thread-sleep! 0.05)
+                         (tell-peer #\a)
+                         (set! events (cons 'ended events))))))
+    (let ((text (read-text 5 d1-in)))
+      (thread-join! ender)
+      (reverse (cons text events)))))
+
+(test-assert "a thread blocked on a socket can be terminated and joined"
+  (let ((reader (start block-forever)))
+    (thread-yield!)
+    (thread-terminate! reader)
+    (guard (e (#t #t))
+      (thread-join! reader)
+      #t)))
+
+(test "a megabyte crosses a socket pair between two threads"
+    (list (* 1024 1024) (* 7 1024 1024))
+  (let* ((ends (channel))
+         (size (* 1024 1024))
+         (writer (start (lambda () (write-sevens (car ends) size))))
+         (total (sum-bytes (cadr ends) size)))
+    (thread-join! writer)
+    total))
+
+(test "a receive with a timeout on a silent socket gives up" #f
+  (receive/non-blocking (car quiet) 16 0.05))
 
 (test "sleepers started shortest last wake in deadline order"
     '(0 20 40 60 80 100 120 140)
