@@ -43,9 +43,14 @@ static int has_deadline (sexp thread) {
     || sexp_context_timeval(thread).tv_usec != 0;
 }
 
+/* Chibi leaves the microseconds of a deadline in the past negative, so
+ * deadlines are compared as counts of microseconds, not field by field. */
+static long long microseconds (const struct timeval *t) {
+  return (long long)t->tv_sec * 1000000 + t->tv_usec;
+}
+
 static int before (const struct timeval *a, const struct timeval *b) {
-  return a->tv_sec < b->tv_sec
-    || (a->tv_sec == b->tv_sec && a->tv_usec < b->tv_usec);
+  return microseconds(a) < microseconds(b);
 }
 
 /* The descriptor a thread is blocked on, as Chibi's blocker registered it:
@@ -130,10 +135,11 @@ static int note_waiter (sexp thread, nfds_t *n, struct timeval **deadline) {
 static int time_until (const struct timeval *deadline, struct timespec *ts) {
   struct timeval now;
   long long usecs;
-  if (gettimeofday(&now, NULL) != 0 || before(deadline, &now))
+  if (gettimeofday(&now, NULL) != 0)
     return 0;
-  usecs = (long long)(deadline->tv_sec - now.tv_sec) * 1000000
-    + (deadline->tv_usec - now.tv_usec) + 1;
+  usecs = microseconds(deadline) - microseconds(&now) + 1;
+  if (usecs <= 0)
+    return 0;
   ts->tv_sec = usecs / 1000000;
   ts->tv_nsec = (usecs % 1000000) * 1000;
   return 1;
