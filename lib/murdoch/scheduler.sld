@@ -15,5 +15,5 @@
 (define-library (murdoch scheduler)
   (export poll-scheduler-installed?)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
-  (import (scheme base) (srfi 18))
+  (import (srfi 18))
   (include-shared "scheduler"))
