@@ -210,13 +210,16 @@ static void unqueue_twins (sexp ctx, sexp previous, sexp next) {
   sexp_global(ctx, SEXP_G_THREADS_BACK) = prev;
 }
 
-/* The scheduler the VM calls at the end of every time slice. */
+/* The scheduler the VM calls at the end of every time slice.  Only a
+ * current thread in a timed wait can be swept into the queue, so the queue
+ * is walked only then, and a runnable thread costs a few loads. */
 static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   sexp chibi = sexp_opcode_data(self), next;
+  int may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
   if (nothing_runnable(ctx))
     wait_for_wakeup(ctx);
   next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
-  if (sexp_contextp(next))
+  if (may_twin && sexp_contextp(next))
     unqueue_twins(ctx, ctx, next);
   return next;
 }
