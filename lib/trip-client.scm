@@ -7,12 +7,15 @@
 ;;;   reply    "TAG ok VALUE ..."  or  "TAG err CODE TEXT"
 ;;;   tag 0    the server's own messages (framing errors, streamed readings)
 ;;;
-;;; One connection per robot.  A reader thread takes every frame off the
-;;; socket and hands the reply to the request waiting for it; requests on a
-;;; connection are serialized by its mutex, so green threads may call the
-;;; primitives at once.  Nothing waits forever: a reply not back within
-;;; (trip-timeout) seconds, and a motion not over within
-;;; (trip-motion-timeout), raise a trip error naming robot and command.
+;;; One connection per robot.  Requests on a connection are serialized by
+;;; its mutex, so green threads may call the primitives at once; the thread
+;;; that sent a request reads frames until its reply comes, skipping any
+;;; other (tag 0, or a reply that came too late).  It reads only bytes that
+;;; are already there and naps between looks, so nothing ever blocks in a
+;;; read: a reply not back within (trip-timeout) seconds, and a motion not
+;;; over within (trip-motion-timeout), raise a trip error naming robot and
+;;; command.  (No reader thread and no timed condition wait: Chibi 0.12's
+;;; scheduler was seen to lose threads once such a wait had timed out.)
 ;;;
 ;;; The primitives act on (current-robot), the connection of the address
 ;;; space's own robot (#f on a workstation).  Devices are opened on first
@@ -69,26 +72,34 @@
     (write-u8 etx out)
     (flush-output-port out)))
 
-;; The next whole frame's payload as a string, or an eof object.  Bytes
-;; between frames and broken frames are skipped: the server never sends
-;; them, and a reader that gives up would strand every waiting request.
-(define (read-frame in)
+;; The next byte, an eof object, or #f once the deadline has passed;
+;; waits only by napping, never in a read.
+(define (next-byte in deadline)
+  (let loop ()
+    (cond ((u8-ready? in) (read-u8 in))
+          ((> (time->seconds (current-time)) deadline) #f)
+          (else (thread-sleep! 0.001) (loop)))))
+
+;; The next whole frame's payload as a string, an eof object, or #f at the
+;; deadline.  Bytes between frames and broken frames are skipped: the server
+;; never sends them.
+(define (read-frame in deadline)
   (let outside ()
-    (let ((b (read-u8 in)))
+    (let ((b (next-byte in deadline)))
       (cond
-       ((eof-object? b) b)
+       ((or (not b) (eof-object? b)) b)
        ((not (= b stx)) (outside))
        (else
         (let inside ((acc (open-output-bytevector)) (n 0))
-          (let ((b (read-u8 in)))
+          (let ((b (next-byte in deadline)))
             (cond
-             ((eof-object? b) b)
+             ((or (not b) (eof-object? b)) b)
              ((= b etx) (utf8->string (get-output-bytevector acc)))
              ((or (= b stx) (> n max-reply)) (outside))
              ((= b dle)
-              (let ((c (read-u8 in)))
+              (let ((c (next-byte in deadline)))
                 (cond
-                 ((eof-object? c) c)
+                 ((or (not c) (eof-object? c)) c)
                  ((special? (bitwise-xor c #x40))
                   (write-u8 (bitwise-xor c #x40) acc)
                   (inside acc (+ n 1)))
@@ -98,7 +109,7 @@
 ;;; Connections
 
 (define-record-type trip-connection
-  (make-trip-connection host port socket in out lock replied opened)
+  (make-trip-connection host port socket in out lock opened)
   trip-connection?
   (host trip-connection-host)
   (port trip-connection-port)
@@ -106,11 +117,9 @@
   (in trip-connection-in)
   (out trip-connection-out)
   (lock trip-connection-lock)              ; held from request to reply
-  (replied trip-connection-replied)        ; signalled when a reply is in
   (opened trip-connection-opened trip-connection-opened-set!)
   (name trip-connection-name trip-connection-name-set!)
-  (tag trip-connection-tag trip-connection-tag-set!)       ; awaited
-  (reply trip-connection-reply trip-connection-reply-set!) ; #f until in
+  (tag trip-connection-tag trip-connection-tag-set!)       ; the last sent
   (open? trip-connection-open? trip-connection-open?-set!))
 
 (define (robot-name c)
@@ -126,45 +135,26 @@
         (trip-error (string-append host ":" (number->string port)) "connect"
                     "closed" "cannot connect"))
     (let ((c (make-trip-connection host port (car io) (cadr io) (car (cddr io))
-                                   (make-mutex 'trip) (make-condition-variable)
-                                   '())))
+                                   (make-mutex 'trip) '())))
       (trip-connection-name-set! c #f)
       (trip-connection-tag-set! c 0)
-      (trip-connection-reply-set! c #f)
       (trip-connection-open?-set! c #t)
-      (thread-start! (make-thread (lambda () (read-replies c)) 'trip-reader))
       (guard (e (#t (trip-close c) (raise e)))
         (trip-connection-name-set! c (car (request c "who"))))
       c)))
 
 ;;> Closes the connection; the server frees every device it held.
 (define (trip-close c)
-  (when (trip-connection-open? c)
-    (trip-connection-open?-set! c #f)
-    (close-input-port (trip-connection-in c))
-    (close-output-port (trip-connection-out c))
-    (close-file-descriptor (trip-connection-socket c))))
+  (mutex-lock! (trip-connection-lock c))
+  (if (trip-connection-open? c) (shut! c))
+  (mutex-unlock! (trip-connection-lock c)))
 
-;; The reader thread: each reply goes to the request waiting for its tag;
-;; anything else (tag 0, a reply that came too late) is dropped.
-(define (read-replies c)
-  (let loop ()
-    (let ((frame (guard (e (#t (eof-object))) (read-frame (trip-connection-in c)))))
-      (mutex-lock! (trip-connection-lock c) #f #f)
-      (cond
-       ((eof-object? frame)
-        (trip-connection-open?-set! c #f)
-        (trip-connection-reply-set! c frame)
-        (condition-variable-broadcast! (trip-connection-replied c))
-        (mutex-unlock! (trip-connection-lock c)))
-       (else
-        (let ((words (split-words frame)))
-          (if (and (pair? words)
-                   (equal? (string->number (car words)) (trip-connection-tag c)))
-              (begin (trip-connection-reply-set! c (cdr words))
-                     (condition-variable-broadcast! (trip-connection-replied c)))))
-        (mutex-unlock! (trip-connection-lock c))
-        (loop))))))
+;; Close the socket; the caller holds the lock.
+(define (shut! c)
+  (trip-connection-open?-set! c #f)
+  (guard (e (#t #f)) (close-input-port (trip-connection-in c)))
+  (guard (e (#t #f)) (close-output-port (trip-connection-out c)))
+  (close-file-descriptor (trip-connection-socket c)))
 
 (define (split-words s)
   (let loop ((i 0) (start 0) (acc '()))
@@ -197,9 +187,8 @@
 (define (request c . words)
   (let ((command (join (map ->word words)))
         (lock (trip-connection-lock c))
-        (deadline (seconds->time (+ (time->seconds (current-time)) (trip-timeout)))))
+        (deadline (+ (time->seconds (current-time)) (trip-timeout))))
     (define (fail code text)
-      (trip-connection-tag-set! c 0)
       (mutex-unlock! lock)
       (trip-error (robot-name c) command code text))
     (mutex-lock! lock)
@@ -207,27 +196,28 @@
         (fail "closed" "connection closed"))
     (let ((tag (+ 1 (modulo (trip-connection-tag c) 999999998))))
       (trip-connection-tag-set! c tag)
-      (trip-connection-reply-set! c #f)
-      (guard (e (#t (fail "closed" "cannot send")))
+      (guard (e (#t (shut! c) (fail "closed" "cannot send")))
         (write-frame! (string-append (number->string tag) " " command)
                       (trip-connection-out c)))
       (let wait ()
-        (let ((reply (trip-connection-reply c)))
+        (let ((frame (guard (e (#t (eof-object)))
+                       (read-frame (trip-connection-in c) deadline))))
           (cond
-           ((eof-object? reply) (fail "closed" "connection lost"))
-           ((not reply)
-            (if (mutex-unlock! lock (trip-connection-replied c) deadline)
-                (begin (mutex-lock! lock) (wait))
-                (begin (mutex-lock! lock)
-                       (fail "timeout" (string-append
-                                        "no reply within "
-                                        (number->string (trip-timeout)) " s")))))
-           ((and (pair? reply) (equal? (car reply) "ok"))
-            (mutex-unlock! lock)
-            (map reply-value (cdr reply)))
+           ((eof-object? frame) (shut! c) (fail "closed" "connection lost"))
+           ((not frame)
+            (fail "timeout" (string-append "no reply within "
+                                           (number->string (trip-timeout)) " s")))
            (else
-            (fail (if (pair? (cdr reply)) (cadr reply) "protocol")
-                  (if (pair? (cdr reply)) (join (cddr reply)) (join reply))))))))))
+            (let ((reply (split-words frame)))
+              (cond
+               ((not (and (pair? reply) (equal? (string->number (car reply)) tag)))
+                (wait))
+               ((and (pair? (cdr reply)) (equal? (cadr reply) "ok"))
+                (mutex-unlock! lock)
+                (map reply-value (cddr reply)))
+               (else
+                (fail (if (pair? (cddr reply)) (car (cddr reply)) "protocol")
+                      (join (if (pair? (cddr reply)) (cdr (cddr reply)) reply)))))))))))))
 
 ;;> One raw request on connection \var{c}: words are joined with spaces
 ;;> (numbers, symbols and strings); returns the values of the reply.  For

@@ -145,12 +145,12 @@ struct nearest : b2RayCastCallback {
 };
 }
 
-double physics_ray(const physics *p, int robot, double x, double y, double heading, double range)
+double physics_ray(const physics *p, int robot, double x, double y, double dx, double dy, double range)
 {
     nearest cb;
     cb.self = p->robots[robot];
     b2Vec2 from(x * MM, y * MM);
-    b2Vec2 to((x + range * cos(heading * DEG)) * MM, (y + range * sin(heading * DEG)) * MM);
+    b2Vec2 to((x + range * dx) * MM, (y + range * dy) * MM);
     p->world.RayCast(&cb, from, to);
     return cb.fraction * range;
 }

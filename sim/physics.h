@@ -27,9 +27,9 @@ pose physics_box_pose(const physics *p, int box);
  * touches something; returns how many, at most max. */
 int physics_robot_touches(const physics *p, int robot, double *dirs, int max);
 /* The plain loop the bench compares against: Box2D's own ray cast, nearest
- * hit from (x, y) along heading within range, mm; range when nothing.
- * Ignores the robot's own body. */
-double physics_ray(const physics *p, int robot, double x, double y, double heading, double range);
+ * hit from (x, y) along the unit vector (dx, dy) within range, mm; range
+ * when nothing.  Ignores the robot's own body. */
+double physics_ray(const physics *p, int robot, double x, double y, double dx, double dy, double range);
 
 #ifdef __cplusplus
 }

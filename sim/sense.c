@@ -25,7 +25,7 @@ struct sense {
     int ncircles;
     box *boxes;
     int nboxes;
-    filing walls, moving;
+    filing cells;               /* everything, refiled each step */
     int *changed;               /* per cell: last step something moved there */
     int *count;                 /* scratch for filing */
 };
@@ -50,8 +50,7 @@ sense *sense_new(double x0, double y0, double x1, double y1, double cell)
     s->nx = (int)ceil((x1 - x0) / cell) + 1;
     s->ny = (int)ceil((y1 - y0) / cell) + 1;
     cells = s->nx * s->ny;
-    s->walls.start = calloc(cells + 1, sizeof(int));
-    s->moving.start = calloc(cells + 1, sizeof(int));
+    s->cells.start = calloc(cells + 1, sizeof(int));
     s->changed = calloc(cells, sizeof(int));
     s->count = calloc(cells + 1, sizeof(int));
     memset(s->changed, 0xff, cells * sizeof(int));   /* -1: never */
@@ -63,10 +62,8 @@ void sense_free(sense *s)
     free(s->segs);
     free(s->circles);
     free(s->boxes);
-    free(s->walls.start);
-    free(s->walls.ids);
-    free(s->moving.start);
-    free(s->moving.ids);
+    free(s->cells.start);
+    free(s->cells.ids);
     free(s->changed);
     free(s->count);
     free(s);
@@ -93,8 +90,8 @@ static void cells_of(const sense *s, int id, int *cx0, int *cy0, int *cx1, int *
     double ax, ay, bx, by;
     if (id >= 0) {
         const segment *g = &s->segs[id];
-        ax = fmin(g->x1, g->x2); bx = fmax(g->x1, g->x2);
-        ay = fmin(g->y1, g->y2); by = fmax(g->y1, g->y2);
+        ax = lesser(g->x1, g->x2); bx = greater(g->x1, g->x2);
+        ay = lesser(g->y1, g->y2); by = greater(g->y1, g->y2);
     } else {
         const circle *c = &s->circles[~id];
         ax = c->x - c->r; bx = c->x + c->r;
@@ -158,19 +155,14 @@ static void rectangle(segment *segs, pose at, double w, double d)
 
 void sense_add_wall(sense *s, double x1, double y1, double x2, double y2, double thick)
 {
-    /* walls come before any box, so the wall filing is rebuilt only here */
+    /* walls come before any box: segs[0..nwall_segs) */
     double dx = x2 - x1, dy = y2 - y1;
     pose at = { (x1 + x2) / 2, (y1 + y2) / 2, atan2(dy, dx) * 180 / M_PI };
-    int i, first = s->nsegs, *ids;
+    int i, first = s->nsegs;
     for (i = 0; i < 4; i++)
         add_segment(s, 0, 0, 0, 0);
     rectangle(&s->segs[first], at, hypot(dx, dy) + thick, thick);
     s->nwall_segs = s->nsegs;
-    ids = xrealloc(NULL, s->nwall_segs * sizeof(int));
-    for (i = 0; i < s->nwall_segs; i++)
-        ids[i] = i;
-    file(s, &s->walls, ids, s->nwall_segs);
-    free(ids);
 }
 
 int sense_add_box(sense *s, double w, double d)
@@ -223,10 +215,14 @@ static void stamp(sense *s, int id, int step)
             s->changed[y * s->nx + x] = step;
 }
 
+/* One filing for walls and moving shapes alike, so that a cast looks up
+ * each cell once; walls are few enough to refile with the rest. */
 void sense_refile(sense *s, int step)
 {
-    int n = s->ncircles + 4 * s->nboxes, k = 0, i, j;
+    int n = s->nsegs + s->ncircles, k = 0, i, j;
     int *ids = xrealloc(NULL, n * sizeof(int));
+    for (i = 0; i < s->nwall_segs; i++)
+        ids[k++] = i;
     for (i = 0; i < s->nboxes; i++) {
         int first = s->nwall_segs + 4 * i;
         if (s->boxes[i].moved) {
@@ -254,78 +250,182 @@ void sense_refile(sense *s, int step)
             c->r = r;
             c->moved = 0;
         }
-    file(s, &s->moving, ids, k);
+    file(s, &s->cells, ids, k);
     free(ids);
 }
 
-/* Ray (ox, oy) + t (dx, dy), |d| = 1: the t of the first hit, or `best`. */
-static double hit_segment(const segment *g, double ox, double oy, double dx, double dy, double best)
+void sense_scratch_free(sense_scratch *sc)
 {
-    double ex = g->x2 - g->x1, ey = g->y2 - g->y1;
-    double den = dx * ey - dy * ex, t, u;
-    if (fabs(den) < 1e-12)
-        return best;
-    t = ((g->x1 - ox) * ey - (g->y1 - oy) * ex) / den;
-    u = ((g->x1 - ox) * dy - (g->y1 - oy) * dx) / den;
-    return t >= 0 && t < best && u >= 0 && u <= 1 ? t : best;
+    free(sc->met);
+    memset(sc, 0, sizeof *sc);
 }
 
-static double hit_circle(const circle *c, double ox, double oy, double dx, double dy, double best)
+/* True the first time this cast meets shape id. */
+static int first_meeting(const sense *s, sense_scratch *sc, int id)
 {
-    double fx = ox - c->x, fy = oy - c->y;
-    double b = fx * dx + fy * dy, q = fx * fx + fy * fy - c->r * c->r, disc, t;
-    if (q <= 0)
-        return 0;               /* starts inside: touching */
-    disc = b * b - q;
-    if (b > 0 || disc < 0)
-        return best;
-    t = -b - sqrt(disc);
-    return t < best ? t : best;
+    int k = id >= 0 ? id : s->nsegs + ~id;
+    if (sc->met[k] == sc->cast)
+        return 0;
+    sc->met[k] = sc->cast;
+    return 1;
 }
 
-static double hit_cell(const sense *s, const filing *f, int cell, int self,
-                       double ox, double oy, double dx, double dy, double best)
+static void start_cast(const sense *s, sense_scratch *sc)
 {
+    int shapes = s->nsegs + s->ncircles;
+    if (shapes > sc->cap || ++sc->cast == 0) {
+        sc->cap = shapes > sc->cap ? shapes : sc->cap;
+        free(sc->met);
+        sc->met = calloc(sc->cap, sizeof *sc->met);
+        sc->cast = 1;
+    }
+}
+
+/* A stand-in for atan2 that grows with the angle over [0, 4) and costs no
+ * trigonometry: rays and shapes are only compared by it. */
+static double pseudo_angle(double x, double y)
+{
+    if (y >= 0)
+        return x >= 0 ? (x + y > 0 ? y / (x + y) : 0) : 1 - x / (y - x);
+    return x < 0 ? 2 - y / (-x - y) : 3 + x / (x - y);
+}
+
+/* Sort the rays by pseudo-angle: they go round counter-clockwise, so this
+ * is a rotation of their order.  The list is kept twice over, so that an
+ * arc across angle 0 is one run. */
+static void order_rays(sense_scratch *sc, const double *dx, const double *dy, int n)
+{
+    int k, first = 0;
+    double a[SENSE_MAX_RAYS];
+    for (k = 0; k < n; k++) {
+        a[k] = pseudo_angle(dx[k], dy[k]);
+        if (a[k] < a[first])
+            first = k;
+    }
+    for (k = 0; k < 2 * n; k++) {
+        int r = (first + k) % n;
+        sc->ray[k] = r;
+        sc->angle[k] = a[r] + (k >= n ? 4 : 0);
+    }
+    sc->n = n;
+}
+
+/* The rays within the arc from pseudo-angle lo counter-clockwise to hi:
+ * indices [*from, *to) of sc->ray. */
+static void arc(const sense_scratch *sc, double lo, double hi, int *from, int *to)
+{
+    int a = 0, b = sc->n;
+    if (hi < lo)
+        hi += 4;
+    while (a < b) {             /* first angle >= lo */
+        int m = (a + b) / 2;
+        if (sc->angle[m] < lo)
+            a = m + 1;
+        else
+            b = m;
+    }
+    *from = a;
+    for (b = a; b < a + sc->n && sc->angle[b] <= hi; b++)
+        ;
+    *to = b;
+}
+
+/* The rays that meet a segment: solve origin + t d = p1 + u (p2 - p1). */
+static void fan_segment(const segment *g, const sense_scratch *sc, double x, double y,
+                        const double *dx, const double *dy, double *out)
+{
+    double ax = g->x1 - x, ay = g->y1 - y, bx = g->x2 - x, by = g->y2 - y;
+    double ex = bx - ax, ey = by - ay, tn = ax * ey - ay * ex, cross = ax * by - ay * bx;
+    int i, from, to;
+    if (cross == 0)
+        return;                 /* seen edge on */
+    if (cross > 0)
+        arc(sc, pseudo_angle(ax, ay), pseudo_angle(bx, by), &from, &to);
+    else
+        arc(sc, pseudo_angle(bx, by), pseudo_angle(ax, ay), &from, &to);
+    for (i = from; i < to; i++) {
+        int k = sc->ray[i];
+        double den = dx[k] * ey - dy[k] * ex, t = tn / den;
+        if (den != 0 && t >= 0 && t < out[k])
+            out[k] = t;
+    }
+}
+
+/* The rays that meet a circle, between its two tangents; none when the
+ * origin is inside it. */
+static void fan_circle(const circle *c, const sense_scratch *sc, double x, double y,
+                       const double *dx, const double *dy, double *out)
+{
+    double vx = c->x - x, vy = c->y - y, d2 = vx * vx + vy * vy, r2 = c->r * c->r, h;
+    int i, from, to;
+    if (d2 <= r2)
+        return;
+    h = sqrt(d2 - r2);          /* tangents: v turned by +-asin(r/d), scaled by d */
+    arc(sc, pseudo_angle(vx * h + vy * c->r, vy * h - vx * c->r),
+        pseudo_angle(vx * h - vy * c->r, vy * h + vx * c->r), &from, &to);
+    for (i = from; i < to; i++) {
+        int k = sc->ray[i];
+        double b = vx * dx[k] + vy * dy[k], disc = b * b - d2 + r2;
+        if (disc >= 0 && b - sqrt(disc) < out[k])
+            out[k] = b - sqrt(disc);
+    }
+}
+
+static void fan_cell(const sense *s, sense_scratch *sc, int cell, int self,
+                     double x, double y, const double *dx, const double *dy, double *out)
+{
+    const filing *f = &s->cells;
     int k;
     for (k = f->start[cell]; k < f->start[cell + 1]; k++) {
         int id = f->ids[k];
+        if (id == ~self || !first_meeting(s, sc, id))
+            continue;
         if (id >= 0)
-            best = hit_segment(&s->segs[id], ox, oy, dx, dy, best);
-        else if (~id != self)
-            best = hit_circle(&s->circles[~id], ox, oy, dx, dy, best);
+            fan_segment(&s->segs[id], sc, x, y, dx, dy, out);
+        else
+            fan_circle(&s->circles[~id], sc, x, y, dx, dy, out);
     }
-    return best;
 }
 
-double sense_ray(const sense *s, int self, double x, double y, double dir_deg, double range)
+static double longest(const double *out, int n)
 {
-    double h = dir_deg * M_PI / 180, dx = cos(h), dy = sin(h);
-    int cx = cell_x(s, x), cy = cell_y(s, y);
-    int stepx = dx > 0 ? 1 : -1, stepy = dy > 0 ? 1 : -1;
-    /* t at which the ray crosses the next vertical / horizontal cell line */
-    double nextx = s->x0 + (cx + (dx > 0)) * s->cell, nexty = s->y0 + (cy + (dy > 0)) * s->cell;
-    double tx = fabs(dx) < 1e-12 ? INFINITY : (nextx - x) / dx;
-    double ty = fabs(dy) < 1e-12 ? INFINITY : (nexty - y) / dy;
-    double ddx = fabs(dx) < 1e-12 ? INFINITY : s->cell / fabs(dx);
-    double ddy = fabs(dy) < 1e-12 ? INFINITY : s->cell / fabs(dy);
-    double best = range;
-    for (;;) {
-        int cell = cy * s->nx + cx;
-        double exit = fmin(tx, ty);
-        best = hit_cell(s, &s->walls, cell, self, x, y, dx, dy, best);
-        best = hit_cell(s, &s->moving, cell, self, x, y, dx, dy, best);
-        if (best <= exit || exit >= range)
-            return best;
-        if (tx < ty) {
-            cx += stepx;
-            tx += ddx;
-            if (cx < 0 || cx >= s->nx)
-                return best;
-        } else {
-            cy += stepy;
-            ty += ddy;
-            if (cy < 0 || cy >= s->ny)
-                return best;
+    double m = 0;
+    int k;
+    for (k = 0; k < n; k++)
+        m = out[k] > m ? out[k] : m;
+    return m;
+}
+
+/* The square of how far (x, y) is from cell (i, j): 0 inside it. */
+static double cell_distance2(const sense *s, int i, int j, double x, double y)
+{
+    double ex = fabs(x - (s->x0 + (i + 0.5) * s->cell)) - s->cell / 2;
+    double ey = fabs(y - (s->y0 + (j + 0.5) * s->cell)) - s->cell / 2;
+    ex = ex > 0 ? ex : 0;
+    ey = ey > 0 ? ey : 0;
+    return ex * ex + ey * ey;
+}
+
+void sense_fan(const sense *s, sense_scratch *sc, int self, double x, double y,
+               const double *dx, const double *dy, int n, double range, double *out)
+{
+    int cx = cell_x(s, x), cy = cell_y(s, y), ring, k;
+    double reach = range;
+    start_cast(s, sc);
+    order_rays(sc, dx, dy, n);
+    for (k = 0; k < n; k++)
+        out[k] = range;
+    /* every cell of ring r+1 is at least r cells away from (x, y); within a
+     * ring, cells beyond the longest ray still unanswered are skipped */
+    for (ring = 0; ring == 0 || (ring - 1) * s->cell < (reach = longest(out, n)); ring++) {
+        int x0 = cx - ring, x1 = cx + ring, y0 = cy - ring, y1 = cy + ring, i, j;
+        if (x0 < 0 && y0 < 0 && x1 >= s->nx && y1 >= s->ny)
+            break;
+        for (j = y0 > 0 ? y0 : 0; j <= y1 && j < s->ny; j++) {
+            int step = (j == y0 || j == y1) ? 1 : x1 - x0;   /* only the ring's edge */
+            for (i = x0; i <= x1; i += step > 0 ? step : 1)
+                if (i >= 0 && i < s->nx && (ring < 2 || cell_distance2(s, i, j, x, y) < reach * reach))
+                    fan_cell(s, sc, j * s->nx + i, self, x, y, dx, dy, out);
         }
     }
 }

@@ -1,6 +1,10 @@
 /* Range sensing without the physics engine: the room as segments (walls and
- * box edges) and circles (robots) in a uniform grid, so that a ray visits only
- * the few cells it crosses and the few shapes in them.  Walls are filed once;
+ * box edges) and circles (robots) in a uniform grid.  A robot's rays all
+ * start at its centre, so they are cast together: the cells around it are
+ * visited ring by ring, nearest first; each shape found is met once, and only
+ * the rays within the angle it subtends are intersected with it; the search
+ * stops as soon as every ray has hit something nearer than the next ring.
+ * Walls are filed once;
  * moving shapes are refiled every step, and each cell remembers the last step
  * something moved in it, so a robot whose surroundings stood still can reuse
  * its last geometry (see world.c). */
@@ -9,6 +13,10 @@
 #include "physics.h"
 
 typedef struct sense sense;
+
+/* fmin and fmax are calls, for their NaN rules; these are an instruction. */
+static inline double lesser(double a, double b) { return a < b ? a : b; }
+static inline double greater(double a, double b) { return a > b ? a : b; }
 
 /* The grid covers [x0, x1] x [y0, y1] in cells of `cell` mm; shapes outside
  * it are filed in the border cells. */
@@ -21,9 +29,23 @@ void sense_place_box(sense *s, int box, pose at);
 void sense_place_circle(sense *s, int circle, double x, double y);
 /* Refile what moved; `step` stamps the cells it left and entered. */
 void sense_refile(sense *s, int step);
-/* Distance along the ray from (x, y) to the nearest shape, not counting
- * circle `self`; range when nothing is nearer. */
-double sense_ray(const sense *s, int self, double x, double y, double dir_deg, double range);
+/* Per-thread working memory of sense_fan: which shapes this cast has met. */
+typedef struct {
+    unsigned *met;
+    int cap;
+    unsigned cast;
+    double angle[2 * 256];      /* the rays' pseudo-angles, ascending, twice */
+    int ray[2 * 256];           /* which ray each is */
+    int n;
+} sense_scratch;
+
+void sense_scratch_free(sense_scratch *sc);
+/* For each of the n rays from (x, y) along unit vectors (dx[k], dy[k]), the
+ * distance to the nearest shape other than circle `self`, or range.  The
+ * rays must go round counter-clockwise (from any start); n <= SENSE_MAX_RAYS. */
+enum { SENSE_MAX_RAYS = 256 };
+void sense_fan(const sense *s, sense_scratch *sc, int self, double x, double y,
+               const double *dx, const double *dy, int n, double range, double *out);
 /* True when nothing moved within `reach` of (x, y) after step `since`. */
 int sense_still(const sense *s, double x, double y, double reach, int since);
 #endif

@@ -33,11 +33,14 @@ static uint64_t next_random(uint64_t *s)
     return z ^ (z >> 31);
 }
 
-static double gaussian(uint64_t *s)
+/* Two independent standard normal numbers (Box-Muller). */
+static void gaussians(uint64_t *s, double *a, double *b)
 {
     double u = ((next_random(s) >> 11) + 0.5) / 9007199254740992.0;
     double v = (next_random(s) >> 11) / 9007199254740992.0;
-    return sqrt(-2 * log(u)) * cos(2 * M_PI * v);
+    double m = sqrt(-2 * log(u));
+    *a = m * cos(2 * M_PI * v);
+    *b = m * sin(2 * M_PI * v);
 }
 
 /* The grid covers every wall, box and robot with a margin. */
@@ -59,7 +62,42 @@ static sense *make_sense(const lab *l)
         x0 = y0 = -5000;
         x1 = y1 = 5000;
     }
-    return sense_new(x0 - m, y0 - m, x1 + m, y1 + m, 1000);
+    return sense_new(x0 - m, y0 - m, x1 + m, y1 + m, 1500);
+}
+
+enum { MAX_RAYS = SENSE_MAX_RAYS };
+
+typedef struct { double angle; int sonar; } ray;
+
+static int by_angle(const void *a, const void *b)
+{
+    double x = ((const ray *)a)->angle, y = ((const ray *)b)->angle;
+    return (x > y) - (x < y);
+}
+
+/* The rays' offsets from the heading, counter-clockwise as sense_fan wants
+ * them: the sonar cones' rays (and which sonar each belongs to), then the
+ * ir ring. */
+static void make_fan(world *w)
+{
+    const b14_params *p = &w->lab->b14;
+    int n = p->sonar_rays, i, j, k = 0, rays = SONARS * n;
+    ray r[MAX_RAYS];
+    w->fan = malloc(2 * (rays + IRS) * sizeof *w->fan);
+    w->fan_sonar = malloc(rays * sizeof *w->fan_sonar);
+    for (i = 0; i < SONARS; i++)
+        for (j = 0; j < n; j++, k++) {
+            double off = 22.5 * i + (n == 1 ? 0 : p->sonar_cone * ((double)j / (n - 1) - 0.5));
+            r[k] = (ray){ fmod(off + 360, 360), i };
+        }
+    qsort(r, rays, sizeof r[0], by_angle);
+    for (k = 0; k < rays + IRS; k++) {
+        double off = (k < rays ? r[k].angle : 22.5 * (k - rays)) * RAD;
+        w->fan[2 * k] = cos(off);
+        w->fan[2 * k + 1] = sin(off);
+        if (k < rays)
+            w->fan_sonar[k] = r[k].sonar;
+    }
 }
 
 world *world_new(lab *l)
@@ -71,6 +109,7 @@ world *world_new(lab *l)
     w->threads = 2;
     w->phys = physics_new();
     w->sense = make_sense(l);
+    make_fan(w);
     for (i = 0; i < l->nwalls; i++) {
         const lab_wall *a = &l->walls[i];
         physics_add_wall(w->phys, a->x1, a->y1, a->x2, a->y2, a->thick);
@@ -105,6 +144,10 @@ void world_free(world *w)
 {
     physics_free(w->phys);
     sense_free(w->sense);
+    sense_scratch_free(&w->scratch[0]);
+    sense_scratch_free(&w->scratch[1]);
+    free(w->fan);
+    free(w->fan_sonar);
     free(w->robots);
     free(w);
 }
@@ -269,23 +312,45 @@ static void battery(const b14_params *p, robot *r, double dt)
 
 /* ---- sensing --------------------------------------------------------- */
 
-/* Cast the rays of every sonar cone; ranges from the skin, noiseless. */
-static void sonar_geometry(const world *w, robot *r)
+/* Distances from the skin along n rays of the fan, starting at ray first. */
+static void cast(world *w, const robot *r, sense_scratch *sc, int first, int n, double range, double *t)
+{
+    double c = cos(r->at.heading * RAD), s = sin(r->at.heading * RAD);
+    double dx[MAX_RAYS] = { 0 }, dy[MAX_RAYS] = { 0 };
+    double radius = w->lab->b14.radius;
+    const double *fan = w->fan + 2 * first;
+    int k;
+    for (k = 0; k < n; k++) {
+        dx[k] = c * fan[2 * k] - s * fan[2 * k + 1];
+        dy[k] = s * fan[2 * k] + c * fan[2 * k + 1];
+    }
+    if (w->plain) {
+        for (k = 0; k < n; k++)
+            t[k] = physics_ray(w->phys, r->body, r->at.x + radius * dx[k], r->at.y + radius * dy[k],
+                               dx[k], dy[k], range);
+        return;
+    }
+    /* rays from the centre are the same lines as rays from the skin */
+    sense_fan(w->sense, sc, r->circle, r->at.x, r->at.y, dx, dy, n, range + radius, t);
+    for (k = 0; k < n; k++)
+        t[k] = greater(t[k] - radius, 0);
+}
+
+/* Every sonar cone, noiseless: the nearest of its rays. */
+static void sonar_geometry(world *w, robot *r, sense_scratch *sc)
 {
     const b14_params *p = &w->lab->b14;
-    int i, j, n = p->sonar_rays;
-    double reach = 0;
-    for (i = 0; i < SONARS; i++) {
-        double best = p->sonar_max;
-        for (j = 0; j < n; j++) {
-            double off = n == 1 ? 0 : p->sonar_cone * ((double)j / (n - 1) - 0.5);
-            double dir = r->at.heading + 22.5 * i + off;
-            double sx = r->at.x + p->radius * cos(dir * RAD), sy = r->at.y + p->radius * sin(dir * RAD);
-            best = fmin(best, sense_ray(w->sense, r->circle, sx, sy, dir, best));
-        }
-        r->sonar_geo[i] = best;
-        reach = fmax(reach, best);
+    int rays = SONARS * p->sonar_rays, i, k;
+    double t[MAX_RAYS], reach = 0;
+    cast(w, r, sc, 0, rays, p->sonar_max, t);
+    for (i = 0; i < SONARS; i++)
+        r->sonar_geo[i] = p->sonar_max;
+    for (k = 0; k < rays; k++) {
+        i = w->fan_sonar[k];
+        r->sonar_geo[i] = lesser(r->sonar_geo[i], t[k]);
     }
+    for (i = 0; i < SONARS; i++)
+        reach = greater(reach, r->sonar_geo[i]);
     r->sonar_reach = reach + p->radius;
 }
 
@@ -297,19 +362,22 @@ static int reusable(const world *w, const robot *r)
 }
 
 /* One reading: geometry (fresh or reused) plus this reading's noise. */
-static int scan(const world *w, robot *r)
+static int scan(world *w, robot *r, sense_scratch *sc)
 {
     const b14_params *p = &w->lab->b14;
-    int i, reuse = reusable(w, r);
+    int i, reuse = !w->plain && reusable(w, r);
+    double noise[SONARS];
     if (!reuse)
-        sonar_geometry(w, r);
+        sonar_geometry(w, r, sc);
     r->sonar_at = r->at;
     r->sonar_step = w->step;
+    for (i = 0; i < SONARS; i += 2)
+        gaussians(&r->rng, &noise[i], &noise[i + 1]);
     for (i = 0; i < SONARS; i++) {
         double g = r->sonar_geo[i];
         if (g < p->sonar_max)
-            g += p->sonar_noise * gaussian(&r->rng);
-        r->sonar[i] = fmin(fmax(g, p->sonar_min), p->sonar_max);
+            g += p->sonar_noise * noise[i];
+        r->sonar[i] = lesser(greater(g, p->sonar_min), p->sonar_max);
     }
     r->sonar_seq++;
     return reuse;
@@ -318,23 +386,17 @@ static int scan(const world *w, robot *r)
 void robot_sonar_fire(world *w, int i)
 {
     robot *r = &w->robots[i];
-    w->reused += scan(w, r);
+    w->reused += scan(w, r, &w->scratch[0]);
     w->scans++;
     r->sonar_fired = 1;
     if (w->trace)
         trace_sonar(w->trace, w, i);
 }
 
-void robot_ir(const world *w, int i, double out[IRS])
+void robot_ir(world *w, int i, double out[IRS])
 {
-    const robot *r = &w->robots[i];
-    const b14_params *p = &w->lab->b14;
-    int k;
-    for (k = 0; k < IRS; k++) {
-        double dir = r->at.heading + 22.5 * k;
-        out[k] = sense_ray(w->sense, r->circle, r->at.x + p->radius * cos(dir * RAD),
-                           r->at.y + p->radius * sin(dir * RAD), dir, p->ir_range);
-    }
+    cast(w, &w->robots[i], &w->scratch[0], SONARS * w->lab->b14.sonar_rays, IRS,
+         w->lab->b14.ir_range, out);
 }
 
 void robot_contacts(const world *w, int i, int bumpers[BUMPERS], int skirt[SKIRTS])
@@ -370,6 +432,7 @@ void robot_say(world *w, int i, const char *text, size_t n)
 typedef struct {
     world *w;
     int *due, n, reused;
+    sense_scratch *scratch;
 } scan_job;
 
 static void *scan_some(void *arg)
@@ -377,12 +440,13 @@ static void *scan_some(void *arg)
     scan_job *j = arg;
     int k;
     for (k = 0; k < j->n; k++)
-        j->reused += scan(j->w, &j->w->robots[j->due[k]]);
+        j->reused += scan(j->w, &j->w->robots[j->due[k]], j->scratch);
     return NULL;
 }
 
-/* Started sonars fire every step_hz / sonar_hz steps, staggered by robot so
- * that each step carries a like share of the work. */
+/* Started sonars fire together every step_hz / sonar_hz steps, so that a
+ * round of readings is one job split between two threads, for the price of
+ * one hand-off. */
 static void fire_due_sonars(world *w)
 {
     int period = (int)fmax(1, round(w->lab->step_hz / w->lab->b14.sonar_hz));
@@ -390,11 +454,11 @@ static void fire_due_sonars(world *w)
     scan_job jobs[2];
     pthread_t worker;
     for (i = 0; i < w->nrobots; i++)
-        if (w->robots[i].sonar_on && (w->step + i) % period == 0)
+        if (w->robots[i].sonar_on && w->step % period == 0)
             due[n++] = i;
-    jobs[0] = (scan_job){ w, due, n / 2, 0 };
-    jobs[1] = (scan_job){ w, due + n / 2, n - n / 2, 0 };
-    if (w->threads > 1 && n >= 32 && pthread_create(&worker, NULL, scan_some, &jobs[1]) == 0) {
+    jobs[0] = (scan_job){ w, due, n / 2, 0, &w->scratch[0] };
+    jobs[1] = (scan_job){ w, due + n / 2, n - n / 2, 0, &w->scratch[1] };
+    if (w->threads > 1 && !w->plain && n >= 32 && pthread_create(&worker, NULL, scan_some, &jobs[1]) == 0) {
         scan_some(&jobs[0]);
         pthread_join(worker, NULL);
     } else {

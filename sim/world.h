@@ -56,7 +56,13 @@ typedef struct world {
     int step;
     double dt;
     int threads;                /* sonar workers, counting the caller */
+    int plain;                  /* sense through Box2D's ray cast, one thread,
+                                   no reuse: the bench's reference */
     struct trace *trace;        /* NULL: no trace */
+    double *fan;                /* sonar rays then ir rays: cos, sin of the
+                                   offset from the heading, in pairs */
+    int *fan_sonar;             /* the sonar each sonar ray belongs to */
+    sense_scratch scratch[2];   /* one per sonar worker */
     long scans, reused;         /* sonar statistics */
 } world;
 
@@ -77,7 +83,7 @@ void robot_set_heading(world *w, int r, double h);
 
 /* Sensors */
 void robot_sonar_fire(world *w, int r);
-void robot_ir(const world *w, int r, double out[IRS]);
+void robot_ir(world *w, int r, double out[IRS]);
 void robot_contacts(const world *w, int r, int bumpers[BUMPERS], int skirt[SKIRTS]);
 void robot_say(world *w, int r, const char *text, size_t n);
 
