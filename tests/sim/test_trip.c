@@ -278,6 +278,24 @@ static void test_killed_client(void)
     close(ready[1]);
 }
 
+static void test_stream(void)
+{
+    conn c;
+    int k, events = 0;
+    dial(&c, 1);
+    ask(&c, "1 open sonar");
+    ask(&c, "2 sonar start");
+    CHECK("sonar stream on", strcmp(ask(&c, "3 sonar stream on"), "3 ok") == 0);
+    for (k = 0; k < 3; k++)
+        events += starts(next_reply(&c), "0 sonar ");
+    CHECK("started sonars stream their readings with tag 0", events == 3);
+    send_frame(&c, "4 sonar stream off", 18);
+    for (k = 0; k < 20 && !starts(next_reply(&c), "4 ok"); k++)
+        ;
+    CHECK("and stop when told", k < 20);
+    close(c.fd);
+}
+
 static void test_motion(void)
 {
     conn c;
@@ -342,6 +360,7 @@ int main(int argc, char **argv)
         test_stall();
         test_exclusion();
         test_killed_client();
+        test_stream();
         test_motion();
         kill(server, SIGTERM);
         waitpid(server, &status, 0);
