@@ -70,12 +70,6 @@ static int blocked_fd (sexp thread, short *events) {
   return -1;
 }
 
-/* Chibi's test for "blocked on I/O", whether or not the descriptor is good. */
-static int blocked_on_io (sexp thread) {
-  sexp event = sexp_context_event(thread);
-  return sexp_fixnump(event) || sexp_portp(event);
-}
-
 static int ensure_pollfds (size_t n) {
   struct pollfd *grown;
   size_t size = pollfds_size ? pollfds_size : 16;
@@ -92,9 +86,10 @@ static int waits_on (sexp thread, sexp target) {
   return sexp_context_event(thread) == target;
 }
 
-/* Whether Chibi's scheduler, called now, would nap: nothing in the run
- * queue, no signal to deliver, and the thread it would pick is waiting.
- * Errs towards "no": a wrong "yes" could block the process. */
+/* Whether Chibi's scheduler, called now, would find nothing to run:
+ * nothing in the run queue, no signal to deliver, and the thread it would
+ * pick is waiting.  Errs towards "no": a wrong "yes" could block the
+ * process. */
 static int nothing_runnable (sexp ctx) {
   sexp ls, paused = sexp_global(ctx, SEXP_G_THREADS_PAUSED);
   if (sexp_global(ctx, SEXP_G_THREADS_SIGNALS) != SEXP_ZERO
@@ -102,15 +97,14 @@ static int nothing_runnable (sexp ctx) {
     return 0;
   if (sexp_context_refuel(ctx) > 0)
     return sexp_context_waitp(ctx);
-  /* The current thread has ended: Chibi wakes the threads joining it, else
-   * picks the first thread blocked on a descriptor, else the ended one. */
+  /* The current thread has ended.  Chibi wakes the threads joining it;
+   * failing those it hands back a blocked thread after a nap, or the ended
+   * thread itself, and then the VM calls it again at once: a spin at full
+   * CPU until some deadline, which waiting here replaces. */
   for (ls = paused; sexp_pairp(ls); ls = sexp_cdr(ls))
     if (waits_on(sexp_car(ls), ctx))
       return 0;
-  for (ls = paused; sexp_pairp(ls); ls = sexp_cdr(ls))
-    if (blocked_on_io(sexp_car(ls)))
-      return sexp_context_waitp(sexp_car(ls));
-  return sexp_context_waitp(ctx);
+  return 1;
 }
 
 /* Add a blocked thread's descriptor and deadline to the wait; 0 when the

@@ -223,6 +223,16 @@
       (thread-join! ender)
       (reverse (cons text events)))))
 
+(test "a thread ends while another sleeps" '(ended woke)
+  (let* ((events '())
+         (ender (start (lambda ()
+                         (thread-sleep! 0.02)
+                         (set! events (cons 'ended events))))))
+    (thread-sleep! 0.1)
+    (set! events (cons 'woke events))
+    (thread-join! ender)
+    (reverse events)))
+
 (test-assert "a thread blocked on a socket can be terminated and joined"
   (let ((reader (start block-forever)))
     (thread-yield!)
