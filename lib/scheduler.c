@@ -188,20 +188,20 @@ static void wait_for_wakeup (sexp ctx) {
  * deadline; with the wrapper it would follow most thread-sleep! calls.  So
  * keep the thread that runs next out of the queue, and the one that ran
  * before in it at most once. */
-static void unqueue_twins (sexp ctx, sexp previous, sexp next) {
-  sexp prev = SEXP_NULL, ls = sexp_global(ctx, SEXP_G_THREADS_FRONT);
+static void unqueue_twins (sexp previous, sexp next) {
+  sexp prev = SEXP_NULL, ls = sexp_global(previous, SEXP_G_THREADS_FRONT);
   int seen = 0;
   for ( ; sexp_pairp(ls); ls = sexp_cdr(ls)) {
     if (sexp_car(ls) == next || (sexp_car(ls) == previous && seen++)) {
       if (sexp_pairp(prev))
         sexp_cdr(prev) = sexp_cdr(ls);
       else
-        sexp_global(ctx, SEXP_G_THREADS_FRONT) = sexp_cdr(ls);
+        sexp_global(previous, SEXP_G_THREADS_FRONT) = sexp_cdr(ls);
     } else {
       prev = ls;
     }
   }
-  sexp_global(ctx, SEXP_G_THREADS_BACK) = prev;
+  sexp_global(previous, SEXP_G_THREADS_BACK) = prev;
 }
 
 /* The scheduler the VM calls at the end of every time slice.  Only a
@@ -214,7 +214,7 @@ static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
     wait_for_wakeup(ctx);
   next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
   if (may_twin && sexp_contextp(next))
-    unqueue_twins(ctx, ctx, next);
+    unqueue_twins(ctx, next);
   return next;
 }
 
