@@ -7,9 +7,10 @@
 # tools/chibi-cflags names the directory of Chibi's headers, which in the
 # private install also holds a newer libc's headers; searched after the
 # system's directories, it gives chibi/*.h without mixing the two libcs.
-NATIVE_CHIBI_INCLUDE := $(patsubst -I%,%,$(filter -I%,$(shell tools/chibi-cflags)))
-NATIVE_CHIBI_CFLAGS := $(addprefix -idirafter ,$(NATIVE_CHIBI_INCLUDE))
-NATIVE_CHIBI_HEADERS := $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)))
+# Expanded late, so that "make deps native" sees the install deps made.
+NATIVE_CHIBI_INCLUDE = $(patsubst -I%,%,$(filter -I%,$(shell tools/chibi-cflags)))
+NATIVE_CHIBI_CFLAGS = $(addprefix -idirafter ,$(NATIVE_CHIBI_INCLUDE))
+NATIVE_CHIBI_HEADERS = $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)))
 NATIVE_CFLAGS ?= -O2 -g -Wall
 
 native: lib/murdoch/scheduler.so bench/c-pingpong
