@@ -11,7 +11,7 @@
 ;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
 (define (run-aspace lab-file uid)
   (join-lab lab-file uid)
-  (log-info "murdoch: " uid " listening on " (aspace-host (local-aspace)) ":"
+  (log-note "listening on " (aspace-host (local-aspace)) ":"
             (aspace-port (local-aspace)))
   (let wait () (thread-sleep! 3600) (wait)))
 
@@ -26,7 +26,10 @@
     (if guest?
         (start-aspace! lab uid lab-env (lab-guest-port lab))
         (start-aspace! lab uid lab-env))
-    (repl 'environment: (make-repl-environment lab lab-env)
+    ;; (chibi repl) is loaded here, not imported: it costs seconds, and
+    ;; only a person at a REPL needs it.
+    ((eval 'repl (environment '(chibi repl)))
+          'environment: (make-repl-environment lab lab-env)
           'raw?: (not (is-a-tty? (current-input-port)))
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))

@@ -16,7 +16,7 @@
 ;;> loaded.  Each file is read here and evaluated in the environment, so
 ;;> the files themselves can use no more than received code can.
 (define (make-lab-environment lab)
-  (let ((env (apply environment sandbox-libraries)))
+  (let ((env (apply mutable-environment sandbox-libraries)))
     (for-each (lambda (file) (load-into (lab-path lab file) env))
               (lab-code-files lab))
     env))
@@ -28,7 +28,7 @@
 ;;> and the very procedures the lab's code defined in \var{lab-env}, so
 ;;> that they travel by name.
 (define (make-repl-environment lab lab-env)
-  (let ((env (environment '(except (scheme base) lambda define)
+  (let ((env (mutable-environment '(except (scheme base) lambda define)
                           '(scheme char) '(scheme cxr) '(scheme inexact)
                           '(scheme complex) '(scheme lazy) '(scheme time)
                           '(scheme case-lambda) '(scheme write) '(scheme read)

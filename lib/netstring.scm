@@ -3,8 +3,8 @@
 ;; A netstring is "LENGTH:PAYLOAD," with LENGTH in decimal (D. J. Bernstein).
 ;; The reader is strict, because a frame comes from the network: digits
 ;; only, no leading zero but for the empty payload, at most MAX bytes of
-;; payload, and the comma.  It reads the payload with one read-bytevector,
-;; not byte by byte, so a large frame costs one copy.
+;; payload, and the comma.  It reads the payload into one bytevector, not
+;; byte by byte.
 
 ;;> Raised when a peer sends something that is not a netstring; the
 ;;> message says what was wrong, for the log.
@@ -38,6 +38,18 @@
           (netstring-fail "length over " (number->string max) " bytes"))
          (else (loop (+ (* n 10) (- b 48)) (+ digits 1))))))))
 
+;; A socket hands over what has arrived, so a large payload may take
+;; several reads; the end of the port before the last byte is a fault.
+(define (read-payload in n)
+  (let ((payload (make-bytevector n)))
+    (let loop ((have 0))
+      (if (= have n)
+          payload
+          (let ((got (read-bytevector! payload in have n)))
+            (if (eof-object? got)
+                (netstring-fail "truncated payload")
+                (loop (+ have got))))))))
+
 ;;> Reads one netstring from the binary port \var{in} and returns its
 ;;> payload as a bytevector, or an eof object when the port ends cleanly
 ;;> between frames.  Raises a \scheme{netstring-error} on anything else.
@@ -49,9 +61,7 @@
       (netstring-fail "length " (number->string n) " over "
                       (number->string max) " bytes"))
      (else
-      (let ((payload (if (zero? n) (bytevector) (read-bytevector n in))))
-        (if (or (eof-object? payload) (< (bytevector-length payload) n))
-            (netstring-fail "truncated payload"))
+      (let ((payload (read-payload in n)))
         (let ((comma (read-u8 in)))
           (if (not (eqv? comma 44))
               (netstring-fail "missing comma after payload")))

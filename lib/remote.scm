@@ -102,7 +102,6 @@
 
 (define (error-message e)
   (cond
-   ((send-error? e) (send-error-message e))
    ((error-object? e)
     (call-with-output-string
       (lambda (out)
@@ -201,17 +200,23 @@
   (condition-variable-broadcast! (mailbox-condvar mb))
   (mutex-unlock! (mailbox-mutex mb)))
 
+;; Chibi's SRFI-18 time objects count whole seconds, so the deadline is
+;; kept with current-second and each wait is given as seconds left.
 (define (mailbox-take mb seconds timed-out)
-  (let ((deadline (seconds->time (+ (time->seconds (current-time)) seconds))))
+  (let ((deadline (+ (current-second) seconds)))
     (let loop ()
       (mutex-lock! (mailbox-mutex mb))
       (cond
        ((mailbox-full? mb)
         (mutex-unlock! (mailbox-mutex mb))
         (mailbox-value mb))
-       ((mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) deadline)
+       ((and (> deadline (current-second))
+             (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb)
+                            (inexact (- deadline (current-second)))))
         (loop))
-       (else (timed-out))))))
+       (else
+        (mutex-unlock! (mailbox-mutex mb))
+        (timed-out))))))
 
 ;;; Connections to other address spaces
 
@@ -404,41 +409,95 @@
 (define (spawn thunk name)
   (thread-start!
    (make-thread (lambda ()
-                  (guard (e (#t (log-warn "murdoch: " name ": "
+                  (guard (e (#t (log-warn name ": "
                                           (error-message e))))
                     (thunk)))
                 name)))
 
 ;;; Serving calls
 
+;; A connection being served.  Its deadline is set while a frame is half
+;; read: a peer that stalls mid-frame would otherwise hold a thread and a
+;; socket for ever, so the janitor ends it when the deadline passes.
+(define-record-type serving
+  (make-serving peer thread in out)
+  serving?
+  (peer serving-peer)
+  (thread serving-thread)
+  (in serving-in)
+  (out serving-out)
+  (deadline serving-deadline serving-deadline-set!))
+
+(define *serving* '())
+(define *serving-lock* (make-mutex 'serving))
+(define *frame-timeout* 5)
+
 (define (serve-connection fd peer)
-  (let ((in (open-input-file-descriptor fd #t))
-        (out (open-output-file-descriptor fd #t))
-        (write-lock (make-mutex)))
+  (let ((s (make-serving peer (current-thread)
+                         (open-input-file-descriptor fd #t)
+                         (open-output-file-descriptor fd #t))))
+    (serving-deadline-set! s #f)
+    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
     (guard (e (#t (log-fault peer e)))
-      (let* ((hello (read-frame in "hello" 0))
-             (nonce (random-hex 16))
-             (caller-nonce (greet! hello)))
-        (write-frame! out caller-nonce 0
-                      `(welcome ,(aspace-uid *local*) ,nonce))
-        (let ((sent 0))
-          (define (answer! message)
-            (with-lock write-lock
+      (let ((hello (read-served-frame s "hello" 0)))
+        ;; A peer that connects and leaves at once is probing the port.
+        (if (not (eof-object? hello))
+            (serve-calls s hello))))
+    (end-serving! s)))
+
+(define (end-serving! s)
+  (with-lock *serving-lock*
+    (lambda () (set! *serving* (remove (lambda (x) (eq? x s)) *serving*))))
+  (guard (e (#t #f)) (close-input-port (serving-in s)))
+  (guard (e (#t #f)) (close-output-port (serving-out s))))
+
+;; Waits as long as need be for a frame to begin, then gives it
+;; *frame-timeout* seconds to arrive whole.
+(define (read-served-frame s nonce count)
+  (if (eof-object? (peek-u8 (serving-in s)))
+      (eof-object)
+      (begin
+        (serving-deadline-set! s (+ (current-second) *frame-timeout*))
+        (let ((message (read-frame (serving-in s) nonce count)))
+          (serving-deadline-set! s #f)
+          message))))
+
+(define (janitor)
+  (thread-sleep! 0.5)
+  (for-each (lambda (s)
+              (log-warn "connection with " (serving-peer s)
+                        " closed: stalled in the middle of a frame")
+              (thread-terminate! (serving-thread s))
+              (end-serving! s))
+            (with-lock *serving-lock*
               (lambda ()
-                (set! sent (+ sent 1))
-                (guard (e (#t #f))     ; the caller left; nothing to tell
-                  (write-frame! out caller-nonce sent message)))))
-          (let loop ((count 1))
-            (let ((message (read-frame in nonce count)))
-              (if (not (eof-object? message))
-                  (begin (serve-call message answer!)
-                         (loop (+ count 1)))))))))
-    (guard (e (#t #f)) (close-input-port in))
-    (guard (e (#t #f)) (close-output-port out))))
+                (filter (lambda (s)
+                          (let ((d (serving-deadline s)))
+                            (and d (< d (current-second)))))
+                        *serving*))))
+  (janitor))
+
+(define (serve-calls s hello)
+  (let* ((caller-nonce (greet! hello))
+         (nonce (random-hex 16))
+         (write-lock (make-mutex))
+         (sent 0))
+    (define (answer! message)
+      (with-lock write-lock
+        (lambda ()
+          (set! sent (+ sent 1))
+          (guard (e (#t #f))           ; the caller left; nothing to tell
+            (write-frame! (serving-out s) caller-nonce sent message)))))
+    (write-frame! (serving-out s) caller-nonce 0
+                  `(welcome ,(aspace-uid *local*) ,nonce))
+    (let loop ((count 1))
+      (let ((message (read-served-frame s nonce count)))
+        (if (not (eof-object? message))
+            (begin (serve-call message answer!)
+                   (loop (+ count 1))))))))
 
 ;; Check a hello and learn where its sender listens; answers its nonce.
 (define (greet! hello)
-  (if (eof-object? hello) (frame-fail "closed before hello"))
   (if (not (and (list? hello) (= (length hello) 5) (eq? (car hello) 'hello)
                 (symbol? (list-ref hello 1)) (string? (list-ref hello 2))
                 (exact-integer? (list-ref hello 3))
@@ -476,7 +535,7 @@
                  (number->string (sockaddr-port sockaddr))))
 
 (define (log-fault peer e)
-  (log-warn "murdoch: connection with " peer " closed: "
+  (log-warn "connection with " peer " closed: "
             (cond ((frame-error? e) (frame-error-message e))
                   (else (error-message e)))))
 
@@ -558,11 +617,13 @@
                                (cond ((pair? port) (car port))
                                      (entry (lab-aspace-port entry))
                                      (else (error "not in the lab" uid)))))
+    (set-log-name! (string-append "murdoch " (symbol->string uid)))
     (set! *environment* environment)
     (set! *decode* (make-decoder environment decode-proxy))
     (set! *mac* (make-hmac-sha256 (lab-key lab)))
     (set! *max-frame* (lab-setting lab 'max-frame 1048576))
     (set! *default-timeout* (lab-setting lab 'timeout 5))
+    (set! *frame-timeout* (lab-setting lab 'frame-timeout 5))
     (for-each (lambda (a)
                 (learn-aspace! (make-aspace (lab-aspace-uid a)
                                             (lab-aspace-host a)
@@ -571,6 +632,7 @@
     (learn-aspace! *local*)
     (set! *listener* (listen-on (aspace-host *local*) (aspace-port *local*)))
     (spawn (lambda () (accept-loop *listener*)) 'accept)
+    (spawn janitor 'janitor)
     *local*))
 
 (define (listen-on host port)

@@ -34,14 +34,13 @@
   (uid proxy-ref-uid)
   (id proxy-ref-id))
 
-;;> Raised when a value cannot travel; the message names what held it.
-(define-record-type send-error
-  (make-send-error message)
-  send-error?
-  (message send-error-message))
-
+;;> Raised when a value cannot travel: an error object whose message
+;;> names what held it.
 (define (send-fail . parts)
-  (raise (make-send-error (apply string-append parts))))
+  (raise (make-exception 'send-error (apply string-append parts) '() #f #f)))
+
+(define (send-error? e)
+  (and (exception? e) (eq? (exception-kind e) 'send-error)))
 
 ;;; The lambda that keeps its source
 

@@ -6,6 +6,7 @@
           (srfi 1) (srfi 18)
           (only (chibi process) current-process-id)
           (only (chibi filesystem) is-a-tty?)
-          (chibi log) (chibi repl)
+          (murdoch log)
+          (only (meta) mutable-environment)
           (murdoch lab) (murdoch remote))
   (include "../environment.scm" "../command.scm"))

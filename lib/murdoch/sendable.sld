@@ -1,13 +1,14 @@
 (define-library (murdoch sendable)
   (export sendable-lambda sendable-define sendable-procedure?
-          encode make-decoder send-error? send-error-message
+          encode make-decoder send-error?
           make-proxy-ref proxy-ref? proxy-ref-uid proxy-ref-id
           make-proxy-procedure proxy-procedure-ref)
   (import (scheme base) (scheme eval) (scheme write)
           (rename (only (scheme base) lambda define)
                   (lambda %lambda) (define %define))
           (only (chibi) er-macro-transformer make-syntactic-closure
-                strip-syntactic-closures)
+                strip-syntactic-closures
+                make-exception exception? exception-kind)
           (chibi ast)
           (srfi 1) (srfi 18) (srfi 69))
   (include "../sendable.scm"))

@@ -1,0 +1,30 @@
+# Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
+# machine (see README.md).
+
+.PHONY: all deps native sim test bench bench-sim demo clean
+
+all: deps
+	$(MAKE) native
+	$(MAKE) -C sim all
+
+# Installs what is missing: Debian packages, and Chibi-Scheme when there is
+# none >= 0.10 on PATH.  Cheap when everything is there.
+deps:
+	tools/install-deps.sh
+
+include lib/native.mk
+
+test: all
+	tests/run
+
+bench: all
+	bench/run
+
+bench-sim: all
+	$(MAKE) -C sim bench
+
+demo: all
+	bin/murdoch demo examples/tulane-lab.scm
+
+clean: native-clean
+	$(MAKE) -C sim clean

@@ -1,0 +1,110 @@
+;;;; What the multi-process tests share: labs in temporary folders on free
+;;;; ports, and child processes that are always stopped.
+
+(define top
+  (let* ((here (or (get-environment-variable "MURDOCH_TOP") ".")))
+    here))
+
+;;> The path of a file of the repository.
+(define (tool-path rel) (string-append top "/" rel))
+
+(define-record-type test-lab
+  (%make-test-lab file directory port-base)
+  test-lab?
+  (file test-lab-file)
+  (directory test-lab-directory)
+  (port-base test-lab-port-base))
+
+(define (command-output cmd)
+  (call-with-process-io cmd
+    (lambda (pid in out err)
+      (close-output-port in)
+      (let ((line (read-line out)))
+        (waitpid pid 0)
+        line))))
+
+(define (temporary-directory)
+  (let* ((base (or (get-environment-variable "TMPDIR") "/tmp"))
+         (dir (command-output
+               (list "mktemp" "-d" (string-append base "/murdoch-test.XXXXXX")))))
+    dir))
+
+;;> Writes a lab file with \var{clauses} into a fresh temporary folder, on
+;;> a port base no other lab on this machine is using.  \var{files} is a
+;;> list of (name . text) written beside it (code files).
+(define (make-test-lab clauses . files)
+  (let* ((dir (temporary-directory))
+         (base (string->number (command-output
+                                (list (tool-path "tools/free-port-base")))))
+         (file (string-append dir "/lab.scm")))
+    (call-with-output-file file
+      (lambda (out)
+        (write `(lab test (port-base ,base) ,@clauses) out)
+        (newline out)))
+    (for-each (lambda (f)
+                (call-with-output-file (string-append dir "/" (car f))
+                  (lambda (out) (write-string (cdr f) out))))
+              (if (pair? files) (car files) '()))
+    (%make-test-lab file dir base)))
+
+(define (remove-test-lab! lab)
+  (delete-file-hierarchy (test-lab-directory lab)))
+
+(define *children* '())
+
+;;> Starts \var{args} (a command and its arguments) with its output going
+;;> to \var{log-file}; answers the pid.  The environment variable
+;;> MURDOCH_PORT_BASE is cleared for it, so the lab file rules.
+(define (start-process! args log-file)
+  (let ((pid (fork)))
+    (cond
+     ((zero? pid)
+      (execute "/bin/sh"
+               (append (list "/bin/sh" "-c"
+                             "unset MURDOCH_PORT_BASE; exec \"$@\" >>\"$0\" 2>&1"
+                             log-file)
+                       args))
+      (exit 127))
+     (else
+      (set! *children* (cons pid *children*))
+      pid))))
+
+(define (reap! pid)
+  (waitpid pid 0)
+  (set! *children* (remove-pid pid *children*)))
+
+(define (remove-pid pid ls)
+  (cond ((null? ls) '()) ((= pid (car ls)) (cdr ls))
+        (else (cons (car ls) (remove-pid pid (cdr ls))))))
+
+;;> Asks \var{pid} to stop (SIGTERM) and waits for it.
+(define (stop-process! pid)
+  (kill pid signal/term)
+  (reap! pid))
+
+;;> Kills \var{pid} at once (SIGKILL), as a crash would, and waits for it.
+(define (kill-process! pid)
+  (kill pid signal/kill)
+  (reap! pid))
+
+(define (stop-all-processes!)
+  (for-each stop-process! *children*))
+
+;;> Waits until \var{thunk} answers true, checking every 50 ms, for at most
+;;> \var{seconds}; answers its last value.
+(define (wait-until seconds thunk)
+  (let loop ((left (* seconds 20)))
+    (or (thunk)
+        (and (> left 0)
+             (begin (thread-sleep! 0.05) (loop (- left 1)))))))
+
+;;> Waits until something accepts connections on \var{port}.
+(define (wait-for-port port seconds)
+  (wait-until seconds
+    (lambda ()
+      (let ((io (guard (e (#t #f)) (open-net-io "127.0.0.1" port))))
+        (and (pair? io)
+             (begin (close-input-port (cadr io))
+                    (close-output-port (car (cddr io)))
+                    (close-file-descriptor (car io))
+                    #t))))))

@@ -1,0 +1,10 @@
+(define-library (murdoch testing)
+  (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
+          start-process! stop-process! kill-process! stop-all-processes!
+          wait-for-port wait-until remove-test-lab! tool-path)
+  (import (scheme base) (scheme write) (scheme file) (scheme process-context)
+          (srfi 18)
+          (chibi net) (chibi process) (chibi io)
+          (only (chibi filesystem) create-directory delete-file-hierarchy
+                close-file-descriptor))
+  (include "testing.scm"))

@@ -1,0 +1,244 @@
+;;; The remote layer between real address spaces on loopback.
+(import (except (scheme base) lambda define) (scheme write) (scheme file)
+        (scheme eval) (scheme read)
+        (srfi 18) (chibi test) (chibi net)
+        (only (chibi filesystem) close-file-descriptor)
+        (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
+        (murdoch netstring) (murdoch hmac) (murdoch testing))
+
+(define shared-code "
+(define *counter* 0)
+(define (bump!) (set! *counter* (+ *counter* 1)) *counter*)
+(define (slow seconds) (thread-sleep! seconds) 'done)
+")
+
+(define lab
+  (make-test-lab '((code "shared.scm") (frame-timeout 1)
+                   (aspace tester) (aspace troy)
+                   (aspace praline))
+                 `(("shared.scm" . ,shared-code))))
+
+(define (port-of uid)
+  (+ (test-lab-port-base lab)
+     (cadr (assq uid '((tester 0) (troy 1) (praline 2))))))
+
+(define (start! uid)
+  (let ((pid (start-process!
+              (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
+                    (symbol->string uid))
+              (string-append (test-lab-directory lab) "/"
+                             (symbol->string uid) ".log"))))
+    (wait-for-port (port-of uid) 20)
+    pid))
+
+;; The lab's code, as this address space loaded it.
+(define (lab-procedure name) (eval name (lab-environment)))
+(define bump! #f)
+(define slow #f)
+
+(define troy-pid (start! 'troy))
+(define praline-pid (start! 'praline))
+(join-lab (test-lab-file lab) 'tester)
+(set! bump! (lab-procedure 'bump!))
+(set! slow (lab-procedure 'slow))
+
+(define (troy) (uid->aspace 'troy))
+(define (error-text thunk)
+  (guard (e ((remote-error? e) (remote-error-message e))
+            ((error-object? e) (error-object-message e)))
+    (thunk)
+    'no-error))
+
+(test-begin "remote")
+
+(test-group "remote-apply"
+  (test 3 (remote-apply (troy) (lambda () (+ 1 2))))
+  (test "arguments travel" '(2 4 6)
+    (remote-apply (troy) (lambda (xs k) (map (lambda (x) (* x k)) xs))
+                  '(1 2 3) 2))
+  (test "data of every kind comes back"
+      '(1 2.5 1/3 "é" #\x sym #u8(1 2) #(1 #(2)) () #t #f)
+    (remote-apply (troy) (lambda ()
+                           (list 1 2.5 1/3 "é" #\x 'sym (bytevector 1 2)
+                                 (vector 1 (vector 2)) '() #t #f))))
+  (test "a closure over data, as the thesis sends them" '(300 200 0)
+    (let ((coords '(300 200 0)))
+      (remote-apply (troy) (lambda () coords))))
+  (test "a closure made there comes back and runs here" 42
+    ((remote-apply (troy) (lambda () (let ((n 41)) (lambda () (+ n 1)))))))
+  (test "runs in the target, not here" 'troy
+    (remote-apply (troy) (lambda () (local-aspace-uid))))
+  (test "a local target runs in-process" 'tester
+    (remote-apply (local-aspace) (lambda () (local-aspace-uid)))))
+
+(test-group "errors"
+  (test "an error there names the target, procedure and message"
+      '(troy (lambda () (car '())) "car: not a pair ()")
+    (guard (e ((remote-error? e) (error-object-irritants e)))
+      (remote-apply (troy) (lambda () (car '())))))
+  (test "an unsendable value is refused here, naming the variable"
+      "cannot send variable port of (lambda () port): it is an output port"
+    (let ((port (current-output-port)))
+      (error-text (lambda () (remote-apply (troy) (lambda () port))))))
+  (test "a timeout, set per call"
+      "no answer within 1/2 s"
+    (parameterize ((remote-timeout 1/2))
+      (error-text (lambda () (remote-apply (troy) slow 3)))))
+  (test "the connection still works after a timeout" 3
+    (remote-apply (troy) (lambda () 3))))
+
+(test-group "remote-run!"
+  (test "acknowledged" #t (remote-run! (troy) bump!))
+  (test "applied there in a thread of its own" 1
+    (wait-until 5 (lambda () (let ((n (var-ref 'troy *counter*)))
+                               (and (= n 1) n)))))
+  (test "var-set!" 10 (begin (var-set! 'troy *counter* 10)
+                             (var-ref 'troy *counter*))))
+
+(test-group "encap"
+  (let ((p (remote-apply (troy)
+                         (lambda ()
+                           (let ((n 0))
+                             (encap (lambda () (set! n (+ n 1))
+                                            (list (local-aspace-uid) n))))))))
+    (test "a proxy runs where it was made" '(troy 1) (p))
+    (test "and keeps its state there" '(troy 2) (p))
+    (test "sent back and forth, it stays the same proxy" #t
+      (eq? p (remote-apply (troy) (lambda (q) q) p)))
+    (test "applied from a third address space, it still runs there"
+        '(troy 3)
+      (remote-apply (uid->aspace 'praline) (lambda (q) (q)) p))))
+
+(test-group "dead and returning peers"
+  (kill-process! praline-pid)
+  (test "a dead target raises instead of hanging" #t
+    (remote-error? (guard (e (#t e))
+                     (remote-apply (uid->aspace 'praline) (lambda () 1)))))
+  (set! praline-pid (start! 'praline))
+  (test "a restarted target is reached again" 7
+    (remote-apply (uid->aspace 'praline) (lambda () 7))))
+
+(test-group "the sandbox"
+  (let ((victim (string-append (test-lab-directory lab) "/victim")))
+    (call-with-output-file victim (lambda (out) (write-string "keep" out)))
+    (test "no delete-file there" "undefined variable delete-file"
+      (error-text (lambda ()
+                    (remote-apply (troy) (lambda () (delete-file victim))))))
+    (test "the file is still there" #t (file-exists? victim))
+    (test "no open-output-file there" "undefined variable open-output-file"
+      (error-text (lambda ()
+                    (remote-apply (troy)
+                                  (lambda () (open-output-file
+                                              (string-append victim "2")))))))
+    (test "no file was made" #f (file-exists? (string-append victim "2")))
+    (test "no exit there" "undefined variable exit"
+      (error-text (lambda () (remote-apply (troy) (lambda () (exit 1))))))
+    (test "no eval of another environment" "undefined variable eval"
+      (error-text (lambda ()
+                    (remote-apply (troy) (lambda () (eval '(exit 1) #f))))))))
+
+;;; Raw connections, for what a well-behaved peer never sends
+
+(define (raw-connect)
+  (let ((io (open-net-io "127.0.0.1" (port-of 'troy))))
+    (cons (cadr io) (car (cddr io)))))
+
+(define (raw-send! conn bytes)
+  (write-bytevector bytes (cdr conn))
+  (flush-output-port (cdr conn)))
+
+;; True when the server closes the connection (reads end of file).
+(define (closed? conn)
+  (eof-object? (guard (e (#t (eof-object))) (read-u8 (car conn)))))
+
+(define (framed mac text)
+  (let ((out (open-output-bytevector)))
+    (write-netstring (string->utf8 (string-append mac text)) out)
+    (get-output-bytevector out)))
+
+(define (hello-text nonce)
+  (let ((out (open-output-string)))
+    (write `(hello intruder "127.0.0.1" 1 ,nonce) out)
+    (get-output-string out)))
+
+(define key (lab-key (read-lab (test-lab-file lab))))
+(define (mac nonce count text)
+  (hmac-sha256 key (string->utf8 (string-append nonce ":"
+                                               (number->string count) ":"
+                                               text))))
+
+(test-group "bad frames close only their own connection"
+  (let ((bystander (raw-connect)))
+    (raw-send! bystander (framed (mac "hello" 0 (hello-text "n1"))
+                                 (hello-text "n1")))
+    (for-each
+     (lambda (name bytes)
+       (let ((conn (raw-connect)))
+         (raw-send! conn bytes)
+         (test name #t (closed? conn))))
+     '("garbage" "over-long length" "a frame that stalls half-way"
+       "no comma" "no key: a wrong MAC")
+     (list (string->utf8 "GET / HTTP/1.0\r\n\r\n")
+           (string->utf8 "99999999999:")
+           (string->utf8 "100:abc")
+           (string->utf8 "3:abc;")
+           (framed (make-string 64 #\0) (hello-text "n2"))))
+    (let ((conn (raw-connect)))
+      (raw-send! conn (string->utf8 "100:abc"))
+      (close-output-port (cdr conn))  ; the peer goes away mid-frame
+      (test "a frame cut short" #t (closed? conn)))
+    (test "the bystander connection is still open, and answers" #t
+      (let ((w (read-netstring (car bystander) 100000)))
+        (bytevector? w)))
+    (test "the address space still answers calls" 5
+      (remote-apply (troy) (lambda () 5)))))
+
+(test-group "nothing is evaluated without the key"
+  (let ((before (var-ref 'troy *counter*))
+        (conn (raw-connect))
+        (call-text (let ((out (open-output-string)))
+                     (write '(run 1 #(murdoch:global bump!) ()) out)
+                     (get-output-string out))))
+    (raw-send! conn (framed (mac "hello" 0 (hello-text "n3")) (hello-text "n3")))
+    (let ((welcome (utf8->string (read-netstring (car conn) 100000))))
+      ;; A call MAC'd with a made-up key is refused and closes the connection.
+      (raw-send! conn (framed (hmac-sha256 (string->utf8 "not the key")
+                                           (string->utf8 call-text))
+                              call-text))
+      (test "the connection is closed" #t (closed? conn))
+      (test "and bump! never ran" before (var-ref 'troy *counter*)))))
+
+(test-group "a recorded frame cannot be replayed"
+  (let ((before (var-ref 'troy *counter*))
+        (call-text (let ((out (open-output-string)))
+                     (write '(run 1 #(murdoch:global bump!) ()) out)
+                     (get-output-string out))))
+    ;; First a genuine exchange, recorded.
+    (let* ((conn (raw-connect))
+           (_ (raw-send! conn (framed (mac "hello" 0 (hello-text "n4"))
+                                      (hello-text "n4"))))
+           (welcome (read (open-input-string
+                           (let ((t (utf8->string (read-netstring (car conn) 100000))))
+                             (substring t 64 (string-length t))))))
+           (nonce (list-ref welcome 2))
+           (call (framed (mac nonce 1 call-text) call-text)))
+      (raw-send! conn call)
+      (test "the genuine call runs" (+ before 1)
+        (wait-until 5 (lambda () (let ((n (var-ref 'troy *counter*)))
+                                   (and (= n (+ before 1)) n)))))
+      (test "replayed on the same connection, it is refused" #t
+        (begin (read-netstring (car conn) 100000)   ; the ack
+               (raw-send! conn call)
+               (closed? conn)))
+      (let ((again (raw-connect)))
+        (raw-send! again (framed (mac "hello" 0 (hello-text "n4"))
+                                 (hello-text "n4")))
+        (read-netstring (car again) 100000)
+        (raw-send! again call)
+        (test "replayed on a new connection, it is refused" #t (closed? again)))
+      (test "bump! ran once only" (+ before 1) (var-ref 'troy *counter*)))))
+
+(test-end)
+(stop-all-processes!)
+(remove-test-lab! lab)
+(test-exit)
