@@ -3,14 +3,33 @@
  * the request handler of a one-robot world.  Checks that parsing never
  * overruns, that every payload re-encodes to a frame that parses back to
  * itself, and that every reply fits and carries a tag. */
+#include <dirent.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "../../sim/frame.h"
 #include "../../sim/trip.h"
 
 static world *w;
 static lab l;
 static char lockdir[] = "/tmp/b14-fuzz-XXXXXX";
+
+/* The lock files the fuzzed opens made, and their folder, go at exit. */
+static void remove_lockdir(void)
+{
+    DIR *d = opendir(lockdir);
+    struct dirent *e;
+    char path[sizeof lockdir + 300];
+    while (d && (e = readdir(d)))
+        if (e->d_name[0] != '.') {
+            snprintf(path, sizeof path, "%s/%s", lockdir, e->d_name);
+            unlink(path);
+        }
+    if (d)
+        closedir(d);
+    rmdir(lockdir);
+}
 
 static void setup(void)
 {
@@ -25,6 +44,7 @@ static void setup(void)
     w = world_new(&l);
     if (!mkdtemp(lockdir))
         abort();
+    atexit(remove_lockdir);
 }
 
 static void round_trip(const unsigned char *p, size_t n)
