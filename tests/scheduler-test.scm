@@ -23,6 +23,8 @@
 (define (channel)
   (map nonblocking! (open-socket-pair address-family/unix socket-type/stream 0)))
 
+;; A loopback listener on no fixed port: start from one derived from the
+;; process id, so that runs at once start apart, and step on while taken.
 (define (listen-somewhere)
   (let try ((port (+ 20000 (modulo (* 7919 (current-process-id)) 40000)))
             (tries 0))
