@@ -1,5 +1,6 @@
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -429,45 +430,67 @@ void robot_say(world *w, int i, const char *text, size_t n)
 
 /* ---- the step -------------------------------------------------------- */
 
+/* A round of readings, taken by whichever thread claims the next few robots
+ * first: on a machine whose other core is busy elsewhere, the caller simply
+ * does more of the round instead of waiting for a slow helper. */
 typedef struct {
     world *w;
-    int *due, n, reused;
-    sense_scratch *scratch;
-} scan_job;
+    const int *due;
+    int n;
+    atomic_int next;
+    atomic_long reused;
+} round_job;
 
-static void *scan_some(void *arg)
+typedef struct {
+    round_job *round;
+    sense_scratch *scratch;
+} scanner;
+
+enum { CLAIM = 8 };
+
+static void *scan_claimed(void *arg)
 {
-    scan_job *j = arg;
-    int k;
-    for (k = 0; k < j->n; k++)
-        j->reused += scan(j->w, &j->w->robots[j->due[k]], j->scratch);
+    scanner *me = arg;
+    round_job *j = me->round;
+    long reused = 0;
+    int first, k;
+    while ((first = atomic_fetch_add(&j->next, CLAIM)) < j->n)
+        for (k = first; k < first + CLAIM && k < j->n; k++)
+            reused += scan(j->w, &j->w->robots[j->due[k]], me->scratch);
+    atomic_fetch_add(&j->reused, reused);
     return NULL;
 }
 
 /* Started sonars fire together every step_hz / sonar_hz steps, so that a
- * round of readings is one job split between two threads, for the price of
- * one hand-off. */
+ * round of readings is one job shared by two threads, for the price of one
+ * hand-off. */
 static void fire_due_sonars(world *w)
 {
     int period = (int)fmax(1, round(w->lab->step_hz / w->lab->b14.sonar_hz));
-    int *due = malloc((w->nrobots + 1) * sizeof(int)), n = 0, i;
-    scan_job jobs[2];
+    int *due, n = 0, i;
+    round_job job;
+    scanner mine = { &job, &w->scratch[0] }, helper = { &job, &w->scratch[1] };
     pthread_t worker;
+    if (w->step % period != 0)
+        return;
+    due = malloc((w->nrobots + 1) * sizeof(int));
     for (i = 0; i < w->nrobots; i++)
-        if (w->robots[i].sonar_on && w->step % period == 0)
+        if (w->robots[i].sonar_on)
             due[n++] = i;
-    jobs[0] = (scan_job){ w, due, n / 2, 0, &w->scratch[0] };
-    jobs[1] = (scan_job){ w, due + n / 2, n - n / 2, 0, &w->scratch[1] };
-    if (w->threads > 1 && !w->plain && n >= 32 && pthread_create(&worker, NULL, scan_some, &jobs[1]) == 0) {
-        scan_some(&jobs[0]);
+    job.w = w;
+    job.due = due;
+    job.n = n;
+    atomic_init(&job.next, 0);
+    atomic_init(&job.reused, 0);
+    if (w->threads > 1 && !w->plain && n >= 4 * CLAIM
+        && pthread_create(&worker, NULL, scan_claimed, &helper) == 0) {
+        scan_claimed(&mine);
         pthread_join(worker, NULL);
     } else {
-        jobs[0].n = n;
-        scan_some(&jobs[0]);
-        jobs[1].reused = 0;
+        scan_claimed(&mine);
     }
     w->scans += n;
-    w->reused += jobs[0].reused + jobs[1].reused;
+    w->reused += atomic_load(&job.reused);
     for (i = 0; i < n; i++) {
         w->robots[due[i]].sonar_fired = 1;
         if (w->trace)
