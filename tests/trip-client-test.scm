@@ -32,7 +32,7 @@
 LAB
             \"$b14\" lab.scm --port-base $base --lock-dir locks >out 2>err &
             pid=$!
-            ( while kill -0 \"$2\" && kill -0 $pid; do sleep 1; done
+            ( while kill -0 \"$2\" && kill -0 $pid; do sleep 0.2; done
               kill $pid; rm -rf \"$dir\" ) >/dev/null 2>&1 &
             i=0
             until grep -q '^b14: ready' out 2>/dev/null; do
