@@ -358,11 +358,16 @@
 (define (safe-battery-voltage)
   (if (current-robot) (battery-voltage) 140))
 
+;;> Where a workstation says it is, (x y heading) from its lab clause
+;;> \scheme{(position X Y HEADING)}; #f when it has none.  Set it once, as
+;;> \scheme{(workstation-position '(-1524 -2743.2 90))}.
+(define workstation-position (make-parameter #f))
+
 ;;> \scheme{reckon} on a robot; on a workstation its fixed \var{position},
-;;> (x y heading) from the lab file, as (x y heading 0); #f when it has
-;;> none.
+;;> by default \scheme{(workstation-position)}, as (x y heading 0); #f when
+;;> it has none.
 (define (safe-reckon . position)
-  (cond ((current-robot) (reckon))
-        ((and (pair? position) (car position))
-         (let ((p (car position))) (list (car p) (cadr p) (car (cddr p)) 0)))
-        (else #f)))
+  (let ((p (if (pair? position) (car position) (workstation-position))))
+    (cond ((current-robot) (reckon))
+          (p (list (car p) (cadr p) (car (cddr p)) 0))
+          (else #f))))

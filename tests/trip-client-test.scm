@@ -167,6 +167,9 @@ LAB
     (test "safe-reckon on a workstation: its position" '(-1524 -2743.2 90 0)
           (safe-reckon '(-1524 -2743.2 90)))
     (test "safe-reckon without a position" #f (safe-reckon))
+    (workstation-position '(-1524 -2743.2 90))
+    (test "safe-reckon from workstation-position" '(-1524 -2743.2 90 0) (safe-reckon))
+    (workstation-position #f)
     (test-assert "safe-im on a workstation" (safe-im))
     (test-error "a primitive without a robot" (reckon))))
 
