@@ -92,15 +92,20 @@ static void xml_text(FILE *f, const char *s)
         }
 }
 
-/* translate and rotate animations of column k of the samples */
+/* Column k of the samples as a moving group: placed where it starts (for
+ * viewers that do not animate), then translated and, in an inner group,
+ * rotated through every sample.  The caller closes both groups. */
 static void animate(FILE *f, const struct trace *t, int k, double dur)
 {
+    const pose *first = &t->samples[k];
     int s;
-    fprintf(f, "<animateTransform attributeName=\"transform\" type=\"translate\" dur=\"%.2fs\" fill=\"freeze\" values=\"", dur);
+    fprintf(f, "<g transform=\"translate(%.0f,%.0f)\"><animateTransform attributeName=\"transform\" type=\"translate\" dur=\"%.2fs\" fill=\"freeze\" values=\"",
+            first->x, first->y, dur);
     for (s = 0; s < t->nsamples; s++)
         fprintf(f, "%s%.0f,%.0f", s ? ";" : "", t->samples[(size_t)s * t->width + k].x,
                 t->samples[(size_t)s * t->width + k].y);
-    fprintf(f, "\"/><g><animateTransform attributeName=\"transform\" type=\"rotate\" dur=\"%.2fs\" fill=\"freeze\" values=\"", dur);
+    fprintf(f, "\"/><g transform=\"rotate(%.1f)\"><animateTransform attributeName=\"transform\" type=\"rotate\" dur=\"%.2fs\" fill=\"freeze\" values=\"",
+            first->heading, dur);
     for (s = 0; s < t->nsamples; s++)
         fprintf(f, "%s%.1f", s ? ";" : "", t->samples[(size_t)s * t->width + k].heading);
     fputs("\"/>", f);
@@ -118,7 +123,7 @@ static void write_paths(FILE *f, const struct trace *t, const world *w)
 {
     int i, s;
     for (i = 0; i < w->nrobots; i++) {
-        fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-opacity=\"0.4\" stroke-width=\"20\" points=\"", colour(i));
+        fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-opacity=\"0.5\" stroke-width=\"40\" points=\"", colour(i));
         for (s = 0; s < t->nsamples; s++)
             fprintf(f, "%.0f,%.0f ", t->samples[(size_t)s * t->width + i].x, t->samples[(size_t)s * t->width + i].y);
         fputs("\"/>\n", f);
@@ -130,14 +135,12 @@ static void write_bodies(FILE *f, const struct trace *t, const world *w, double 
     int i;
     for (i = 0; i < w->lab->nboxes; i++) {
         const lab_box *b = &w->lab->boxes[i];
-        fputs("<g>", f);
         animate(f, t, w->nrobots + i, dur);
         fprintf(f, "<rect x=\"%g\" y=\"%g\" width=\"%g\" height=\"%g\" fill=\"#c8a165\" stroke=\"#7a5c2e\" stroke-width=\"15\"/></g></g>\n",
                 -b->w / 2, -b->d / 2, b->w, b->d);
     }
     for (i = 0; i < w->nrobots; i++) {
         double r = w->lab->b14.radius;
-        fputs("<g>", f);
         animate(f, t, i, dur);
         fprintf(f, "<circle r=\"%g\" fill=\"%s\" fill-opacity=\"0.8\"/><line x1=\"0\" y1=\"0\" x2=\"%g\" y2=\"0\" stroke=\"white\" stroke-width=\"30\"/></g></g>\n",
                 r, colour(i), r);
