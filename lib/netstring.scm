@@ -67,10 +67,18 @@
               (netstring-fail "missing comma after payload")))
         payload)))))
 
-;;> Writes \var{payload}, a bytevector, to \var{out} as one netstring.
-;;> Does not flush: the caller knows when a batch of frames is complete.
+;;> Writes \var{payload}, a bytevector or a string (its UTF-8 bytes), to
+;;> \var{out} as one netstring.  A string goes out with one write-string,
+;;> which Chibi does in C; write-bytevector is a loop in Scheme.  Does not
+;;> flush: the caller knows when a batch of frames is complete.
 (define (write-netstring payload out)
-  (write-string (number->string (bytevector-length payload)) out)
-  (write-u8 58 out)
-  (write-bytevector payload out)
-  (write-u8 44 out))
+  (if (string? payload)
+      (write-string (string-append
+                     (number->string (bytevector-length (string->utf8 payload)))
+                     ":" payload ",")
+                    out)
+      (begin
+        (write-string (number->string (bytevector-length payload)) out)
+        (write-u8 58 out)
+        (write-bytevector payload out)
+        (write-u8 44 out))))

@@ -136,13 +136,12 @@
 (define *max-frame* 1048576)
 
 (define (frame-mac nonce count text)
-  (*mac* (string->utf8
-          (string-append nonce ":" (number->string count) ":" text))))
+  (*mac* (string-append nonce ":" (number->string count) ":" text)))
 
 (define (write-frame! out nonce count message)
-  (let* ((text (call-with-output-string (lambda (o) (write message o))))
+  (let* ((text (call-with-output-string (lambda (o) (write-simple message o))))
          (payload (string-append (frame-mac nonce count text) text)))
-    (write-netstring (string->utf8 payload) out)
+    (write-netstring payload out)
     (flush-output-port out)))
 
 ;;> Raised for a frame that breaks the protocol; the connection closes.
@@ -171,11 +170,15 @@
               (frame-fail "bad MAC"))
           (parse-message (substring text 64 (string-length text)))))))
 
+;; Chibi's own reader, in C: (scheme read) is SRFI 38's, with datum
+;; labels, written in Scheme and a hundred times slower.  Messages have no
+;; labels: encode sends no cycles.
 (define (parse-message text)
-  (guard (e (#t (frame-fail "unreadable message")))
-    (let* ((in (open-input-string text))
-           (message (read in)))
-      (if (not (eof-object? (read in))) (frame-fail "trailing data"))
+  (let ((in (open-input-string text)))
+    (let ((message (guard (e (#t (frame-fail "unreadable message")))
+                     (read-datum in))))
+      (if (not (eof-object? (guard (e (#t #f)) (read-datum in))))
+          (frame-fail "trailing data"))
       message)))
 
 ;;; Waiting with a deadline
@@ -324,9 +327,10 @@
                                 (hash-table-keys (connection-pending c)))
                       mbs)))))))
     (when waiting
+      ;; Closing both ports closes the socket; closing it again could close
+      ;; another connection's socket that has taken its number.
       (guard (e (#t #f)) (close-input-port (connection-in c)))
       (guard (e (#t #f)) (close-output-port (connection-out c)))
-      (close-file-descriptor (connection-socket c))
       (for-each (lambda (mb) (mailbox-put! mb '(lost))) waiting))))
 
 ;; Send one call; answers a mailbox that will hold its answer.
@@ -407,12 +411,52 @@
       (call a 'apply proc args)))
 
 (define (spawn thunk name)
-  (thread-start!
-   (make-thread (lambda ()
-                  (guard (e (#t (log-warn name ": "
-                                          (error-message e))))
-                    (thunk)))
-                name)))
+  (thread-start! (make-thread (lambda () (run-logged thunk name)) name)))
+
+(define (run-logged thunk name)
+  (guard (e (#t (log-warn name ": " (error-message e))))
+    (thunk)))
+
+;;; Workers
+
+;; Received procedures run in threads of their own, so that a long task
+;; does not hold up the calls behind it.  Making a thread costs Chibi more
+;; than the rest of a call, so a thread that is done waits a while for the
+;; next procedure to run instead of ending.
+(define *idle-workers* '())             ; mailboxes of waiting workers
+(define *workers-lock* (make-mutex 'workers))
+(define worker-idle-seconds 10)
+
+(define (run-in-worker thunk)
+  (let ((idle (with-lock *workers-lock*
+                (lambda ()
+                  (and (pair? *idle-workers*)
+                       (let ((mb (car *idle-workers*)))
+                         (set! *idle-workers* (cdr *idle-workers*))
+                         mb))))))
+    (if idle
+        (mailbox-put! idle thunk)
+        (spawn (lambda () (work thunk)) 'worker))))
+
+(define (work thunk)
+  (run-logged thunk 'worker)
+  (let ((mb (make-mailbox)))
+    (with-lock *workers-lock*
+      (lambda () (set! *idle-workers* (cons mb *idle-workers*))))
+    (let ((next (mailbox-take mb worker-idle-seconds (lambda () #f))))
+      (cond
+       (next (work next))
+       ;; Timed out; but a caller may have taken this worker meanwhile, in
+       ;; which case its procedure is on the way.
+       ((with-lock *workers-lock*
+          (lambda ()
+            (and (memq mb *idle-workers*)
+                 (begin (set! *idle-workers* (delete mb *idle-workers* eq?))
+                        #t))))
+        #f)
+       (else (work (mailbox-take mb 3600 (lambda () void))))))))
+
+(define (void) #f)
 
 ;;; Serving calls
 
@@ -522,9 +566,9 @@
             (error "not a procedure" proc))
         (if (eq? kind 'run)
             (begin (answer! `(ack ,id))
-                   (spawn (lambda () (apply proc args)) 'remote-run))
-            (spawn (lambda () (answer! (apply-and-encode id proc args)))
-                   'remote-apply))))))
+                   (run-in-worker (lambda () (apply proc args))))
+            (run-in-worker
+             (lambda () (answer! (apply-and-encode id proc args)))))))))
 
 (define (apply-and-encode id proc args)
   (guard (e (#t `(error ,id ,(error-message e))))

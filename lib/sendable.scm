@@ -167,9 +167,13 @@
         ((procedure? x) "a procedure made without Murdoch's lambda")
         (else (string-append "a " (symbol->string (type-name (type-of x)))))))
 
+;; What held a value, for an error message; made only when needed, since
+;; writing a closure's source costs more than sending it.
+(define (what-string what) (if (procedure? what) (what) what))
+
 ;;> The S-expression that stands for \var{x} on the wire.  \var{env} is the
 ;;> environment whose procedures travel by name; \var{what} names \var{x}
-;;> in an error message.
+;;> in an error message (a string, or a thunk that makes one).
 (define (encode x env what)
   (define (enc x what)
     (cond
@@ -183,7 +187,8 @@
      ((eof-object? x) (vector 'murdoch:eof))
      ((eq? x void-value) (vector 'murdoch:void))
      ((procedure? x) (enc-procedure x what))
-     (else (send-fail "cannot send " what ": it is " (describe x)))))
+     (else (send-fail "cannot send " (what-string what) ": it is "
+                      (describe x)))))
   (define (enc-procedure p what)
     (cond
      ((proxy-procedure-ref p)
@@ -191,16 +196,18 @@
                                (proxy-ref-id ref))))
      ((global-name p env) => (lambda (name) (vector 'murdoch:global name)))
      ((and (not (opcode? p)) (closure-info p)) => enc-closure)
-     (else (send-fail "cannot send " what ": it is " (describe p)))))
+     (else (send-fail "cannot send " (what-string what) ": it is "
+                      (describe p)))))
   (define (enc-closure info)
     (let* ((source+names (sendable-info-source+names info))
            (source (car source+names)))
       (vector 'murdoch:closure source
               (map (lambda (name value)
                      (cons name
-                           (enc value (string-append
-                                       "variable " (symbol->string name)
-                                       " of " (short-source source)))))
+                           (enc value (lambda ()
+                                        (string-append
+                                         "variable " (symbol->string name)
+                                         " of " (short-source source))))))
                    (cdr source+names)
                    ((sendable-info-values info))))))
   (enc x what))

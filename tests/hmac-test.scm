@@ -29,5 +29,11 @@
     "9b09ffa71b942fcb27635fbcd5b0e944bfdc63644f0713938a7f51535c3a35e2"
   (hmac-sha256 (repeat #xaa 131)
                (text "This is a test using a larger than block-size key and a larger than block-size data. The key needs to be hashed before being used by the HMAC algorithm.")))
+(test "an ASCII key and a string message take the string path, same value"
+    "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843"
+  (hmac-sha256 (text "Jefe") "what do ya want for nothing?"))
+(test "a non-ASCII message as a string hashes its UTF-8 bytes"
+  (hmac-sha256 (text "Jefe") (text "caf\xe9;"))
+  (hmac-sha256 (text "Jefe") "caf\xe9;"))
 (test-end)
 (test-exit)

@@ -22,6 +22,10 @@
 (test "empty input is no frame" '() (read-all "" 100))
 (test "exactly the maximum" '("abcd") (read-all "4:abcd," 4))
 (test "writer" "3:abc," (framed "abc"))
+(test "a string is framed by its UTF-8 bytes" "5:caf\xe9;,"
+  (let ((out (open-output-bytevector)))
+    (write-netstring "caf\xe9;" out)
+    (utf8->string (get-output-bytevector out))))
 (test "round trip of every byte value" 256
   (let* ((bv (let ((b (make-bytevector 256)))
                (do ((i 0 (+ i 1))) ((= i 256) b) (bytevector-u8-set! b i i))))

@@ -6,14 +6,15 @@
           remote-error? remote-error-uid remote-error-message
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote)
-  (import (scheme base) (scheme write) (scheme read) (scheme char)
+  (import (scheme base) (scheme write) (scheme char)
           (scheme time)
           (srfi 1) (srfi 18) (srfi 69)
+          (rename (only (chibi) read) (read read-datum))
           (only (chibi) call-with-output-string make-exception exception?
                 exception-kind exception-irritants
                 strip-syntactic-closures)
           (only (chibi filesystem) open-input-file-descriptor
-                open-output-file-descriptor close-file-descriptor)
+                open-output-file-descriptor)
           (chibi net)
           (murdoch scheduler) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
   (include "../remote.scm"))

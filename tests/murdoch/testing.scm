@@ -106,5 +106,4 @@
         (and (pair? io)
              (begin (close-input-port (cadr io))
                     (close-output-port (car (cddr io)))
-                    (close-file-descriptor (car io))
                     #t))))))

@@ -5,6 +5,5 @@
   (import (scheme base) (scheme write) (scheme file) (scheme process-context)
           (srfi 18)
           (chibi net) (chibi process) (chibi io)
-          (only (chibi filesystem) create-directory delete-file-hierarchy
-                close-file-descriptor))
+          (only (chibi filesystem) delete-file-hierarchy))
   (include "testing.scm"))

@@ -1,0 +1,58 @@
+;;;; The remote layer's figures: remote-apply round trips and remote-run!
+;;;; throughput between two address spaces on this machine.
+;;
+;; Prints, one line each, medians over many calls after a warm-up:
+;;   bench: remote-apply-rtt VALUE us       a trivial closure
+;;   bench: remote-apply-rtt-1k VALUE us    a closure capturing 1 KB
+;;   bench: remote-run-throughput VALUE per-s
+;; The C floor (bench/c-pingpong) and the ratio are printed by bench/run.
+
+(import (except (scheme base) lambda define) (scheme write) (scheme time)
+        (srfi 132)
+        (murdoch) (murdoch command) (murdoch testing))
+
+(define lab (make-test-lab '((aspace bencher) (aspace troy))))
+
+(define troy-pid
+  (start-process! (list (tool-path "bin/murdoch") "aspace"
+                        (test-lab-file lab) "troy")
+                  (string-append (test-lab-directory lab) "/troy.log")))
+(wait-for-port (+ 1 (test-lab-port-base lab)) 20)
+(join-lab (test-lab-file lab) 'bencher)
+
+(define (now-us) (* 1000000 (current-second)))
+
+(define (median-us calls thunk)
+  (let loop ((i 0) (times '()))
+    (if (= i calls)
+        (list-ref (list-sort < times) (quotient calls 2))
+        (let ((t0 (now-us)))
+          (thunk)
+          (loop (+ i 1) (cons (- (now-us) t0) times))))))
+
+(define (report name value unit)
+  (display "bench: ") (display name) (display " ")
+  (display (/ (round (* 10 value)) 10.)) (display " ") (display unit)
+  (newline))
+
+(define troy (uid->aspace 'troy))
+
+
+(median-us 200 (lambda () (remote-apply troy (lambda () 1))))   ; warm-up
+(report "remote-apply-rtt"
+        (median-us 3000 (lambda () (remote-apply troy (lambda () 1))))
+        "us")
+(let ((kilobyte (make-string 1024 #\m)))
+  (report "remote-apply-rtt-1k"
+          (median-us 3000 (lambda ()
+                            (remote-apply troy
+                                          (lambda () (string-length kilobyte)))))
+          "us"))
+(let* ((n 5000)
+       (t0 (current-second)))
+  (do ((i 0 (+ i 1))) ((= i n))
+    (remote-run! troy (lambda () #t)))
+  (report "remote-run-throughput" (/ n (- (current-second) t0)) "per-s"))
+
+(stop-all-processes!)
+(remove-test-lab! lab)
