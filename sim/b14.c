@@ -53,6 +53,8 @@ typedef struct {
     const char *lockdir;
     int *listeners;
     client *clients[MAX_CLIENTS];
+    struct pollfd *fds;         /* poll's arrays: listeners, then clients */
+    int *who;                   /* -1 - robot for a listener, else client */
 } server;
 
 static volatile sig_atomic_t stopping;
@@ -203,9 +205,9 @@ static void after_step(server *sv)
 
 static void poll_once(server *sv, int timeout_ms)
 {
-    struct pollfd fds[MAX_CLIENTS + 1024];
-    int who[MAX_CLIENTS + 1024], n = 0, k, r = sv->w->nrobots;
-    for (k = 0; k < r && n < 1024; k++) {
+    struct pollfd *fds = sv->fds;
+    int *who = sv->who, n = 0, k, r = sv->w->nrobots;
+    for (k = 0; k < r; k++) {
         fds[n] = (struct pollfd){ sv->listeners[k], POLLIN, 0 };
         who[n++] = -1 - k;
     }
@@ -372,6 +374,8 @@ int main(int argc, char **argv)
     if (o.trace)
         sv.w->trace = trace_open(o.trace);
     sv.listeners = malloc((sv.lab.nrobots + 1) * sizeof(int));
+    sv.fds = malloc((sv.lab.nrobots + MAX_CLIENTS) * sizeof *sv.fds);
+    sv.who = malloc((sv.lab.nrobots + MAX_CLIENTS) * sizeof *sv.who);
     for (i = 0; i < sv.lab.nrobots; i++) {
         int port = lab_trip_port(&sv.lab, &sv.lab.robots[i]);
         sv.listeners[i] = listen_on(sv.lab.interface, port);
