@@ -64,9 +64,41 @@
   (with-lock *peers-lock*
     (lambda () (hash-table-set! *peers* (aspace-uid a) a))))
 
-;;> Forgets the address space \var{uid} (used by live membership).
-(define (forget-aspace! uid)
-  (with-lock *peers-lock* (lambda () (hash-table-delete! *peers* uid))))
+;;; Live membership
+;;
+;; Address spaces come and go.  One that fails to connect, loses its
+;; connection or does not answer in time is taken out of the live set, so
+;; that publish and request stop waiting on it; a prober tries it again
+;; every second and puts it back when it answers.  A newcomer is learned
+;; from its hello, so it joins by calling anyone.
+
+(define *unreachable* (make-hash-table eq?))   ; uid -> #t
+
+(define (note-unreachable! uid)
+  (if (not (eq? uid (aspace-uid *local*)))
+      (with-lock *peers-lock*
+        (lambda () (hash-table-set! *unreachable* uid #t)))))
+
+;;> The uids of the address spaces that answer: the broadcast set.
+(define (live-uids)
+  (with-lock *peers-lock*
+    (lambda ()
+      (remove (lambda (uid) (hash-table-ref/default *unreachable* uid #f))
+              (hash-table-keys *peers*)))))
+
+(define probe-seconds 1)
+
+(define (prober)
+  (thread-sleep! probe-seconds)
+  (for-each (lambda (uid)
+              (guard (e (#t #f))       ; still away
+                (parameterize ((remote-timeout probe-seconds))
+                  (call (uid->aspace uid) 'apply local-aspace-uid '()))
+                (with-lock *peers-lock*
+                  (lambda () (hash-table-delete! *unreachable* uid)))))
+            (with-lock *peers-lock*
+              (lambda () (hash-table-keys *unreachable*))))
+  (prober))
 
 (define (with-lock m thunk)
   (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
@@ -357,25 +389,92 @@
 ;;; remote-run! and remote-apply
 
 (define (call a kind proc args)
-  (let* ((uid (aspace-uid a))
-         (seconds (current-timeout))
-         (proc-code (encode proc *environment* "the procedure"))
-         (args-code (encode-arguments args))
-         (c (connection-to a seconds))
-         (sent (send-call! c kind proc-code args-code))
-         (answer (mailbox-take (cdr sent) seconds
-                               (lambda ()
-                                 (forget-call! c (car sent))
-                                 (remote-error uid (describe-procedure proc)
-                                               (string-append
-                                                "no answer within "
-                                                (number->string seconds)
-                                                " s"))))))
+  (let ((seconds (current-timeout)))
+    (finish-call
+     (start-call a kind (encode proc *environment* "the procedure")
+                 (encode-arguments args) seconds)
+     (+ (current-second) seconds) seconds proc)))
+
+;; A call on its way: where it went, and the mailbox its answer will reach.
+(define-record-type pending-call
+  (make-pending-call uid connection id mailbox)
+  pending-call?
+  (uid pending-call-uid)
+  (connection pending-call-connection)
+  (id pending-call-id)
+  (mailbox pending-call-mailbox))
+
+(define (start-call a kind proc-code args-code seconds)
+  (guard (e ((remote-error? e) (note-unreachable! (aspace-uid a)) (raise e)))
+    (let* ((c (connection-to a seconds))
+           (sent (send-call! c kind proc-code args-code)))
+      (make-pending-call (aspace-uid a) c (car sent) (cdr sent)))))
+
+;; The answer to a pending call, by the deadline (in current-second's
+;; terms), which is \var{seconds} after the call began: the value, or a
+;; remote-error.
+(define (finish-call p deadline seconds proc)
+  (let* ((uid (pending-call-uid p))
+         (answer (mailbox-take
+                  (pending-call-mailbox p) (max 0 (- deadline (current-second)))
+                  (lambda ()
+                    (forget-call! (pending-call-connection p) (pending-call-id p))
+                    (note-unreachable! uid)
+                    (remote-error uid (describe-procedure proc)
+                                  (string-append "no answer within "
+                                                 (number->string seconds)
+                                                 " s"))))))
     (case (car answer)
       ((ack) #t)
       ((value) (*decode* (car (cddr answer))))
       ((error) (remote-error uid (describe-procedure proc) (car (cddr answer))))
-      (else (remote-error uid (describe-procedure proc) "connection lost")))))
+      (else (note-unreachable! uid)
+            (remote-error uid (describe-procedure proc) "connection lost")))))
+
+;;> Applies \var{proc} to \var{args} in each address space of
+;;> \var{aspaces} at once, and answers, in their order, (uid #t value) for
+;;> each that answered and (uid #f message) for each that failed or did not
+;;> answer within (remote-timeout) seconds.  The procedure is encoded once,
+;;> and every call is sent before the first answer is awaited, so the time
+;;> taken is about that of the slowest answer, not their sum.
+(define (remote-apply-all aspaces proc . args)
+  (call-all aspaces 'apply proc args))
+
+;;> As remote-apply-all, with remote-run!: the values are #t.
+(define (remote-run-all! aspaces proc . args)
+  (call-all aspaces 'run proc args))
+
+(define (call-all aspaces kind proc args)
+  (let* ((seconds (current-timeout))
+         (deadline (+ (current-second) seconds))
+         (proc-code (encode proc *environment* "the procedure"))
+         (args-code (encode-arguments args))
+         (started
+          (map (lambda (a)
+                 (capture (aspace-uid a)
+                          (lambda ()
+                            (if (local? a)
+                                (local-call kind proc args)
+                                (start-call a kind proc-code args-code
+                                            seconds)))))
+               aspaces)))
+    (map (lambda (s)
+           (if (and (cadr s) (pending-call? (car (cddr s))))
+               (capture (car s)
+                        (lambda ()
+                          (finish-call (car (cddr s)) deadline seconds proc)))
+               s))
+         started)))
+
+(define (local-call kind proc args)
+  (if (eq? kind 'run)
+      (begin (run-in-worker (lambda () (apply proc args))) #t)
+      (apply-here (local-aspace-uid) proc args)))
+
+(define (capture uid thunk)
+  (guard (e ((remote-error? e) (list uid #f (remote-error-message e)))
+            (#t (list uid #f (error-message e))))
+    (list uid #t (thunk))))
 
 (define (encode-arguments args)
   (let loop ((args args) (i 1) (acc '()))
@@ -398,7 +497,7 @@
 ;;> discarded.
 (define (remote-run! a proc . args)
   (if (local? a)
-      (begin (spawn (lambda () (apply proc args)) 'remote-run) #t)
+      (local-call 'run proc args)
       (call a 'run proc args)))
 
 ;;> Applies \var{proc} to \var{args} in address space \var{a} and returns
@@ -407,7 +506,7 @@
 ;;> answer came within (remote-timeout) seconds.
 (define (remote-apply a proc . args)
   (if (local? a)
-      (apply-here (aspace-uid a) proc args)
+      (local-call 'apply proc args)
       (call a 'apply proc args)))
 
 (define (spawn thunk name)
@@ -677,6 +776,7 @@
     (set! *listener* (listen-on (aspace-host *local*) (aspace-port *local*)))
     (spawn (lambda () (accept-loop *listener*)) 'accept)
     (spawn janitor 'janitor)
+    (spawn prober 'prober)
     *local*))
 
 (define (listen-on host port)

@@ -1,8 +1,9 @@
 (define-library (murdoch remote)
   (export aspace? aspace-uid aspace-host aspace-port make-aspace
           local-aspace local-aspace-uid uid->aspace known-uids
-          learn-aspace! forget-aspace! current-lab lab-environment
+          learn-aspace! live-uids current-lab lab-environment
           remote-run! remote-apply remote-timeout set-remote-timeout!
+          remote-apply-all remote-run-all!
           remote-error? remote-error-uid remote-error-message
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote)
