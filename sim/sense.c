@@ -69,6 +69,30 @@ void sense_free(sense *s)
     free(s);
 }
 
+static void *copy(void *to, const void *from, size_t n)
+{
+    return memcpy(xrealloc(to, n), from, n);
+}
+
+sense *sense_snapshot(sense *into, const sense *from)
+{
+    sense kept;
+    int cells = from->nx * from->ny;
+    if (!into)
+        into = calloc(1, sizeof *into);
+    kept = *into;
+    *into = *from;
+    into->segs = copy(kept.segs, from->segs, from->nsegs * sizeof *from->segs);
+    into->circles = copy(kept.circles, from->circles, from->ncircles * sizeof *from->circles);
+    into->boxes = copy(kept.boxes, from->boxes, from->nboxes * sizeof *from->boxes);
+    into->cells.start = copy(kept.cells.start, from->cells.start, (cells + 1) * sizeof(int));
+    into->cells.ids = copy(kept.cells.ids, from->cells.ids, from->cells.nids * sizeof(int));
+    into->cells.capids = from->cells.nids;
+    into->changed = copy(kept.changed, from->changed, cells * sizeof(int));
+    into->count = copy(kept.count, from->count, (cells + 1) * sizeof(int));
+    return into;
+}
+
 static int clampi(int v, int lo, int hi)
 {
     return v < lo ? lo : v > hi ? hi : v;

@@ -27,6 +27,9 @@ int sense_add_box(sense *s, double w, double d);
 int sense_add_circle(sense *s, double radius);
 void sense_place_box(sense *s, int box, pose at);
 void sense_place_circle(sense *s, int circle, double x, double y);
+/* Copy the grid and every shape into `into` (made when NULL), for a
+ * thread that casts while the original moves on; returns the copy. */
+sense *sense_snapshot(sense *into, const sense *from);
 /* Refile what moved; `step` stamps the cells it left and entered. */
 void sense_refile(sense *s, int step);
 /* Per-thread working memory of sense_fan: which shapes this cast has met. */

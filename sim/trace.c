@@ -50,7 +50,7 @@ void trace_step(struct trace *t, const world *w)
 
 void trace_sonar(struct trace *t, const world *w, int r)
 {
-    double now = world_time(w);
+    double now = w->robots[r].ss.step * w->dt;   /* when it fired */
     sonar_event *e;
     if (!t->last_sonar) {
         int i;
@@ -63,7 +63,7 @@ void trace_sonar(struct trace *t, const world *w, int r)
     t->last_sonar[r] = now;
     e = &t->sonars[t->nsonars++];
     e->t = now;
-    e->at = w->robots[r].at;
+    e->at = w->robots[r].ss.at;
     e->robot = r;
     memcpy(e->ranges, w->robots[r].sonar, sizeof e->ranges);
 }

@@ -44,6 +44,33 @@ static void gaussians(uint64_t *s, double *a, double *b)
     *b = m * sin(2 * M_PI * v);
 }
 
+/* One robot's reading in the making: its pose when the sonars fired, and
+ * the state its last reading left, which this one replaces. */
+typedef struct {
+    int robot;
+    pose at;
+    sonar_state ss;
+    double reading[SONARS];
+} shot;
+
+typedef struct {
+    struct world *w;
+    sense_scratch *scratch;
+} taker;
+
+/* The round of readings under way (see fire_due_sonars). */
+struct round {
+    shot *shots;
+    int n, step;
+    const sense *grid;          /* the world's grid, or snapshot when helped */
+    sense *snapshot;
+    atomic_int next;
+    atomic_long reused;
+    pthread_t helper;
+    int helped;                 /* a helper thread is at work on it */
+    taker helping;              /* what the helper was given */
+};
+
 /* The grid covers every wall, box and robot with a margin. */
 static sense *make_sense(const lab *l)
 {
@@ -134,15 +161,22 @@ world *world_new(lab *l)
         sense_place_circle(w->sense, r->circle, c->x, c->y);
         r->battery = c->battery;
         r->tethered = c->tethered;
-        r->rng = l->seed * 1000003ULL + i;
-        r->sonar_step = -1;
+        r->ss.rng = l->seed * 1000003ULL + i;
+        r->ss.step = -1;
     }
     sense_refile(w->sense, 0);
+    w->round = calloc(1, sizeof *w->round);
+    w->round->shots = malloc((w->nrobots + 1) * sizeof *w->round->shots);
     return w;
 }
 
 void world_free(world *w)
 {
+    world_sync(w);
+    if (w->round->snapshot)
+        sense_free(w->round->snapshot);
+    free(w->round->shots);
+    free(w->round);
     physics_free(w->phys);
     sense_free(w->sense);
     sense_scratch_free(&w->scratch[0]);
@@ -313,11 +347,13 @@ static void battery(const b14_params *p, robot *r, double dt)
 
 /* ---- sensing --------------------------------------------------------- */
 
-/* Distances from the skin along n rays of the fan, starting at ray first. */
-static void cast(world *w, const robot *r, sense_scratch *sc, int first, int n, double range, double *t)
+/* Distances from the skin along n rays of the fan, starting at ray first,
+ * cast in `grid` from a robot at `at`. */
+static void cast(const world *w, const sense *grid, const robot *r, pose at, sense_scratch *sc,
+                 int first, int n, double range, double *t)
 {
-    double c = cos(r->at.heading * RAD), s = sin(r->at.heading * RAD);
-    double dx[MAX_RAYS] = { 0 }, dy[MAX_RAYS] = { 0 };
+    double c = cos(at.heading * RAD), s = sin(at.heading * RAD);
+    double dx[MAX_RAYS] = { 0 }, dy[MAX_RAYS] = { 0 };  /* all set below; gcc cannot tell */
     double radius = w->lab->b14.radius;
     const double *fan = w->fan + 2 * first;
     int k;
@@ -327,76 +363,100 @@ static void cast(world *w, const robot *r, sense_scratch *sc, int first, int n, 
     }
     if (w->plain) {
         for (k = 0; k < n; k++)
-            t[k] = physics_ray(w->phys, r->body, r->at.x + radius * dx[k], r->at.y + radius * dy[k],
+            t[k] = physics_ray(w->phys, r->body, at.x + radius * dx[k], at.y + radius * dy[k],
                                dx[k], dy[k], range);
         return;
     }
     /* rays from the centre are the same lines as rays from the skin */
-    sense_fan(w->sense, sc, r->circle, r->at.x, r->at.y, dx, dy, n, range + radius, t);
+    sense_fan(grid, sc, r->circle, at.x, at.y, dx, dy, n, range + radius, t);
     for (k = 0; k < n; k++)
         t[k] = greater(t[k] - radius, 0);
 }
 
 /* Every sonar cone, noiseless: the nearest of its rays. */
-static void sonar_geometry(world *w, robot *r, sense_scratch *sc)
+static void sonar_geometry(const world *w, const sense *grid, shot *h, sense_scratch *sc)
 {
     const b14_params *p = &w->lab->b14;
     int rays = SONARS * p->sonar_rays, i, k;
     double t[MAX_RAYS], reach = 0;
-    cast(w, r, sc, 0, rays, p->sonar_max, t);
+    cast(w, grid, &w->robots[h->robot], h->at, sc, 0, rays, p->sonar_max, t);
     for (i = 0; i < SONARS; i++)
-        r->sonar_geo[i] = p->sonar_max;
+        h->ss.geo[i] = p->sonar_max;
     for (k = 0; k < rays; k++) {
         i = w->fan_sonar[k];
-        r->sonar_geo[i] = lesser(r->sonar_geo[i], t[k]);
+        h->ss.geo[i] = lesser(h->ss.geo[i], t[k]);
     }
     for (i = 0; i < SONARS; i++)
-        reach = greater(reach, r->sonar_geo[i]);
-    r->sonar_reach = reach + p->radius;
+        reach = greater(reach, h->ss.geo[i]);
+    h->ss.reach = reach + p->radius;
 }
 
-static int reusable(const world *w, const robot *r)
+/* The last geometry still holds if the robot has not moved and nothing
+ * has moved within its reach since. */
+static int reusable(const world *w, const sense *grid, const shot *h)
 {
-    return r->sonar_step >= 0 && r->sonar_at.x == r->at.x && r->sonar_at.y == r->at.y
-        && r->sonar_at.heading == r->at.heading
-        && sense_still(w->sense, r->at.x, r->at.y, r->sonar_reach, r->sonar_step + 1);
+    return !w->plain && h->ss.step >= 0 && h->ss.at.x == h->at.x && h->ss.at.y == h->at.y
+        && h->ss.at.heading == h->at.heading
+        && sense_still(grid, h->at.x, h->at.y, h->ss.reach, h->ss.step + 1);
 }
 
-/* One reading: geometry (fresh or reused) plus this reading's noise. */
-static int scan(world *w, robot *r, sense_scratch *sc)
+/* One reading at `step`: geometry (fresh or reused) plus this reading's
+ * noise.  Touches nothing but the shot, so helpers may take shots at once. */
+static int take(const world *w, const sense *grid, int step, shot *h, sense_scratch *sc)
 {
     const b14_params *p = &w->lab->b14;
-    int i, reuse = !w->plain && reusable(w, r);
+    int i, reuse = reusable(w, grid, h);
     double noise[SONARS];
     if (!reuse)
-        sonar_geometry(w, r, sc);
-    r->sonar_at = r->at;
-    r->sonar_step = w->step;
+        sonar_geometry(w, grid, h, sc);
+    h->ss.at = h->at;
+    h->ss.step = step;
     for (i = 0; i < SONARS; i += 2)
-        gaussians(&r->rng, &noise[i], &noise[i + 1]);
+        gaussians(&h->ss.rng, &noise[i], &noise[i + 1]);
     for (i = 0; i < SONARS; i++) {
-        double g = r->sonar_geo[i];
+        double g = h->ss.geo[i];
         if (g < p->sonar_max)
             g += p->sonar_noise * noise[i];
-        r->sonar[i] = lesser(greater(g, p->sonar_min), p->sonar_max);
+        h->reading[i] = lesser(greater(g, p->sonar_min), p->sonar_max);
     }
-    r->sonar_seq++;
     return reuse;
+}
+
+static shot aim(const world *w, int i)
+{
+    shot h;
+    h.robot = i;
+    h.at = w->robots[i].at;
+    h.ss = w->robots[i].ss;
+    return h;
+}
+
+/* The reading becomes the robot's. */
+static void publish(world *w, const shot *h)
+{
+    robot *r = &w->robots[h->robot];
+    r->ss = h->ss;
+    memcpy(r->sonar, h->reading, sizeof r->sonar);
+    r->sonar_seq++;
+    r->sonar_fired = 1;
+    if (w->trace)
+        trace_sonar(w->trace, w, h->robot);
 }
 
 void robot_sonar_fire(world *w, int i)
 {
-    robot *r = &w->robots[i];
-    w->reused += scan(w, r, &w->scratch[0]);
+    shot h;
+    world_sync(w);
+    h = aim(w, i);
+    w->reused += take(w, w->sense, w->step, &h, &w->scratch[0]);
     w->scans++;
-    r->sonar_fired = 1;
-    if (w->trace)
-        trace_sonar(w->trace, w, i);
+    publish(w, &h);
 }
 
 void robot_ir(world *w, int i, double out[IRS])
 {
-    cast(w, &w->robots[i], &w->scratch[0], SONARS * w->lab->b14.sonar_rays, IRS,
+    const robot *r = &w->robots[i];
+    cast(w, w->sense, r, r->at, &w->scratch[0], SONARS * w->lab->b14.sonar_rays, IRS,
          w->lab->b14.ir_range, out);
 }
 
@@ -433,70 +493,73 @@ void robot_say(world *w, int i, const char *text, size_t n)
 /* A round of readings, taken by whichever thread claims the next few robots
  * first: on a machine whose other core is busy elsewhere, the caller simply
  * does more of the round instead of waiting for a slow helper. */
-typedef struct {
-    world *w;
-    const int *due;
-    int n;
-    atomic_int next;
-    atomic_long reused;
-} round_job;
-
-typedef struct {
-    round_job *round;
-    sense_scratch *scratch;
-} scanner;
 
 enum { CLAIM = 8 };
 
-static void *scan_claimed(void *arg)
+static void *take_claimed(void *arg)
 {
-    scanner *me = arg;
-    round_job *j = me->round;
+    taker *me = arg;
+    struct round *o = me->w->round;
     long reused = 0;
     int first, k;
-    while ((first = atomic_fetch_add(&j->next, CLAIM)) < j->n)
-        for (k = first; k < first + CLAIM && k < j->n; k++)
-            reused += scan(j->w, &j->w->robots[j->due[k]], me->scratch);
-    atomic_fetch_add(&j->reused, reused);
+    while ((first = atomic_fetch_add(&o->next, CLAIM)) < o->n)
+        for (k = first; k < first + CLAIM && k < o->n; k++)
+            reused += take(me->w, o->grid, o->step, &o->shots[k], me->scratch);
+    atomic_fetch_add(&o->reused, reused);
     return NULL;
 }
 
-/* Started sonars fire together every step_hz / sonar_hz steps, so that a
- * round of readings is one job shared by two threads, for the price of one
- * hand-off. */
+static void finish_round(world *w)
+{
+    struct round *o = w->round;
+    int k;
+    for (k = 0; k < o->n; k++)
+        publish(w, &o->shots[k]);
+    w->scans += o->n;
+    w->reused += atomic_load(&o->reused);
+    o->n = 0;
+}
+
+void world_sync(world *w)
+{
+    struct round *o = w->round;
+    taker mine = { w, &w->scratch[0] };
+    if (!o->helped)
+        return;
+    take_claimed(&mine);
+    pthread_join(o->helper, NULL);
+    o->helped = 0;
+    finish_round(w);
+}
+
+/* Started sonars fire together every step_hz / sonar_hz steps.  A round big
+ * enough to share goes to a helper thread with a snapshot of the grid, so
+ * that the steps until the next round overlap it. */
 static void fire_due_sonars(world *w)
 {
-    int period = (int)fmax(1, round(w->lab->step_hz / w->lab->b14.sonar_hz));
-    int *due, n = 0, i;
-    round_job job;
-    scanner mine = { &job, &w->scratch[0] }, helper = { &job, &w->scratch[1] };
-    pthread_t worker;
+    int period = (int)fmax(1, round(w->lab->step_hz / w->lab->b14.sonar_hz)), i;
+    struct round *o = w->round;
+    taker mine = { w, &w->scratch[0] };
     if (w->step % period != 0)
         return;
-    due = malloc((w->nrobots + 1) * sizeof(int));
+    world_sync(w);
     for (i = 0; i < w->nrobots; i++)
         if (w->robots[i].sonar_on)
-            due[n++] = i;
-    job.w = w;
-    job.due = due;
-    job.n = n;
-    atomic_init(&job.next, 0);
-    atomic_init(&job.reused, 0);
-    if (w->threads > 1 && !w->plain && n >= 4 * CLAIM
-        && pthread_create(&worker, NULL, scan_claimed, &helper) == 0) {
-        scan_claimed(&mine);
-        pthread_join(worker, NULL);
-    } else {
-        scan_claimed(&mine);
+            o->shots[o->n++] = aim(w, i);
+    o->step = w->step;
+    atomic_init(&o->next, 0);
+    atomic_init(&o->reused, 0);
+    if (w->threads > 1 && !w->plain && o->n >= 4 * CLAIM) {
+        o->snapshot = sense_snapshot(o->snapshot, w->sense);
+        o->grid = o->snapshot;
+        o->helping = (taker){ w, &w->scratch[1] };
+        o->helped = pthread_create(&o->helper, NULL, take_claimed, &o->helping) == 0;
+        if (o->helped)
+            return;
     }
-    w->scans += n;
-    w->reused += atomic_load(&job.reused);
-    for (i = 0; i < n; i++) {
-        w->robots[due[i]].sonar_fired = 1;
-        if (w->trace)
-            trace_sonar(w->trace, w, due[i]);
-    }
-    free(due);
+    o->grid = w->sense;
+    take_claimed(&mine);
+    finish_round(w);
 }
 
 void world_step(world *w)

@@ -1,9 +1,13 @@
 /* The simulated lab: B14s, boxes and walls, stepped at a fixed rate.  One
  * step is a pipeline: controllers set wheel velocities, Box2D moves the
  * bodies, the sensing grid is refiled from the new poses, batteries and
- * stalls are updated, and the sonars that are due fire (in parallel when
- * there are many).  Everything a robot reports is computed here; trip.c only
- * turns requests into calls of these procedures. */
+ * stalls are updated, and the sonars that are due fire.  A round of many
+ * readings is taken by a helper thread from a snapshot of the grid while
+ * the following steps go on, and published at the next round (the caller
+ * lends a hand then if the helper is behind): readings in a crowd arrive
+ * one round late, as a real ring's do.  A few readings are taken at once.
+ * Everything a robot reports is computed here; trip.c only turns requests
+ * into calls of these procedures. */
 #ifndef WORLD_H
 #define WORLD_H
 #include <stdint.h>
@@ -25,6 +29,15 @@ typedef struct {
     int stalled;
 } motion;
 
+/* What a reading leaves behind for the next one of the same robot. */
+typedef struct {
+    pose at;                    /* where the robot was */
+    int step;                   /* when; -1: never */
+    double geo[SONARS];         /* noiseless ranges, reused if nothing moved */
+    double reach;               /* how far that geometry looked */
+    uint64_t rng;               /* the robot's noise stream */
+} sonar_state;
+
 typedef struct {
     char name[64];
     int body, circle;
@@ -36,16 +49,13 @@ typedef struct {
     int tethered;
     int sonar_on, sonar_fired;
     double sonar[SONARS];       /* last reading, with noise */
-    double sonar_geo[SONARS];   /* its noiseless geometry, for reuse */
-    pose sonar_at;
-    int sonar_step;
-    double sonar_reach;
     int sonar_seq;              /* readings so far */
+    sonar_state ss;
     int buttons[BUTTONS], lights[LIGHTS];
-    uint64_t rng;
 } robot;
 
 struct trace;
+struct round;
 
 typedef struct world {
     lab *lab;
@@ -62,7 +72,8 @@ typedef struct world {
     double *fan;                /* sonar rays then ir rays: cos, sin of the
                                    offset from the heading, in pairs */
     int *fan_sonar;             /* the sonar each sonar ray belongs to */
-    sense_scratch scratch[2];   /* one per sonar worker */
+    sense_scratch scratch[2];   /* [0] the caller's, [1] the helper's */
+    struct round *round;        /* the round of readings under way */
     long scans, reused;         /* sonar statistics */
 } world;
 
@@ -83,6 +94,8 @@ void robot_set_heading(world *w, int r, double h);
 
 /* Sensors */
 void robot_sonar_fire(world *w, int r);
+/* Finish and publish the round of readings under way, if any. */
+void world_sync(world *w);
 void robot_ir(world *w, int r, double out[IRS]);
 void robot_contacts(const world *w, int r, int bumpers[BUMPERS], int skirt[SKIRTS]);
 void robot_say(world *w, int r, const char *text, size_t n);
