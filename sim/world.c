@@ -490,12 +490,12 @@ void robot_say(world *w, int i, const char *text, size_t n)
 
 /* ---- the step -------------------------------------------------------- */
 
-/* A round of readings, taken by whichever thread claims the next few robots
- * first: on a machine whose other core is busy elsewhere, the caller simply
- * does more of the round instead of waiting for a slow helper. */
-
 enum { CLAIM = 8 };
 
+/* Take the readings of a round, a few robots at a time, as long as any are
+ * left unclaimed: on a machine whose other core is busy elsewhere, the
+ * caller simply does more of the round instead of waiting for a slow
+ * helper. */
 static void *take_claimed(void *arg)
 {
     taker *me = arg;
