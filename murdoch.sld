@@ -9,5 +9,15 @@
           aspace? aspace-uid local-aspace local-aspace-uid uid->aspace
           known-uids remote-run! remote-apply remote-timeout
           remote-error? remote-error-uid remote-error-message
-          encap var-ref var-set! display-remote)
-  (import (murdoch sendable) (murdoch remote)))
+          remote-apply-all remote-run-all! live-uids
+          encap var-ref var-set! display-remote
+          ;; publish/subscribe (lib/pubsub.scm)
+          subscribe unsubscribe subscriptions topic-status set-topic-status!
+          subscribe-remote unsubscribe-remote
+          publish request request-exclusive request-non-exclusive
+          request-status subscription-statuses
+          receive-publication receive-request receive-request-exclusive
+          receive-request-non-exclusive
+          get-system-load load-monitor battery-monitor
+          *battery-charging* *battery-low* *load-threshold*)
+  (import (murdoch sendable) (murdoch remote) (murdoch pubsub)))

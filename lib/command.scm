@@ -1,11 +1,16 @@
 ;;;; bin/murdoch: start address spaces, join a lab at a REPL.
 
 ;;> Makes this process address space \var{uid} of the lab at
-;;> \var{lab-file} and starts serving; answers the lab environment.
+;;> \var{lab-file}, or of \var{lab} when it is already read, and starts
+;;> serving with its subscriptions and monitors; answers the environment
+;;> received code runs in.
 (define (join-lab lab-file uid . port)
-  (let* ((lab (read-lab lab-file))
-         (env (make-lab-environment lab)))
+  (join-read-lab (read-lab lab-file) uid port))
+
+(define (join-read-lab lab uid port)
+  (let ((env (make-lab-environment lab)))
     (apply start-aspace! lab uid env port)
+    (initialize-subscriptions! lab (lab-aspace-by-uid lab uid))
     env))
 
 ;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
@@ -22,10 +27,8 @@
          (uid (or uid (string->symbol
                        (string-append "guest-" (number->string
                                                 (current-process-id))))))
-         (lab-env (make-lab-environment lab)))
-    (if guest?
-        (start-aspace! lab uid lab-env (lab-guest-port lab))
-        (start-aspace! lab uid lab-env))
+         (lab-env (join-read-lab lab uid
+                                 (if guest? (list (lab-guest-port lab)) '()))))
     ;; (chibi repl) is loaded here, not imported: it costs seconds, and
     ;; only a person at a REPL needs it.
     ((eval 'repl (environment '(chibi repl)))

@@ -8,5 +8,5 @@
           (only (chibi filesystem) is-a-tty?)
           (murdoch log)
           (only (meta) mutable-environment)
-          (murdoch lab) (murdoch remote))
+          (murdoch lab) (murdoch remote) (murdoch pubsub))
   (include "../environment.scm" "../command.scm"))

@@ -1,0 +1,14 @@
+(define-library (murdoch pubsub)
+  (export subscribe unsubscribe subscriptions topic-status set-topic-status!
+          subscribe-remote unsubscribe-remote subject-matches?
+          publish request request-exclusive request-non-exclusive
+          request-status subscription-statuses
+          receive-publication receive-request receive-request-exclusive
+          receive-request-non-exclusive set-lease!
+          get-system-load load-monitor battery-monitor
+          *battery-charging* *battery-low* *load-threshold*
+          initialize-subscriptions!)
+  (import (scheme base) (scheme read) (scheme file) (scheme time)
+          (srfi 1) (srfi 18)
+          (murdoch log) (murdoch lab) (murdoch remote) (murdoch trip-client))
+  (include "../pubsub.scm"))

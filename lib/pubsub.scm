@@ -1,0 +1,454 @@
+;;;; Publish/subscribe messaging (thesis §4.1, appendix A.8 publish.scm,
+;;;; A.2 initial.scm, A.6 monitor.scm).
+;;
+;; Each address space keeps its own subscription list: the subjects it
+;; answers to, each free or reserved.  A message is addressed to a subject
+;; or a list of them and carries a procedure; it is sent to every live
+;; address space (the thesis's simulated broadcast), and an address space
+;; evaluates it only when every subject of the address is one of its
+;; subscriptions.
+;;
+;; Subjects are symbols; a dot makes levels (mobile.in_use).  In an
+;; address, * stands for one level and > for all the levels that follow,
+;; so mobile.* reaches mobile.in_use.  An exclusively reserved subject S is
+;; joined by S.in_use while it is held, so that a sender can see why S is
+;; not available, and request-status says who holds what.
+
+;;; The subscription list
+
+(define-record-type subscription
+  (make-subscription topic status holds)
+  subscription?
+  (topic subscription-topic)
+  (status subscription-status subscription-status-set!) ; (), task, shared
+  (holds subscription-holds subscription-holds-set!))   ; live reservations
+
+;; Guarded by *subscriptions-lock*, as in the thesis: monitor threads
+;; change the list while messages read it.
+(define *subscriptions* '())
+(define *subscriptions-lock* (make-mutex 'subscriptions))
+
+(define (with-subscriptions thunk)
+  (dynamic-wind (lambda () (mutex-lock! *subscriptions-lock*))
+                thunk
+                (lambda () (mutex-unlock! *subscriptions-lock*))))
+
+(define (find-subscription topic)
+  (find (lambda (s) (eq? (subscription-topic s) topic)) *subscriptions*))
+
+(define (add-subscription! topic)
+  (if (not (find-subscription topic))
+      (set! *subscriptions*
+            (cons (make-subscription topic '() 0) *subscriptions*))))
+
+(define (remove-subscription! topic)
+  (set! *subscriptions*
+        (remove (lambda (s) (eq? (subscription-topic s) topic))
+                *subscriptions*)))
+
+;;> Starts listening to \var{topic}; does nothing if already listening.
+(define (subscribe topic)
+  (with-subscriptions (lambda () (add-subscription! topic)))
+  #t)
+
+;;> Stops listening to \var{topic}; does nothing if not listening.
+(define (unsubscribe topic)
+  (with-subscriptions (lambda () (remove-subscription! topic)))
+  #t)
+
+;;> The subjects this address space listens to.
+(define (subscriptions)
+  (with-subscriptions (lambda () (map subscription-topic *subscriptions*))))
+
+;;> The status of \var{topic}: () when free, the task-name that holds it
+;;> exclusively, \scheme{shared} while non-exclusive readers hold it, or
+;;> #f when not subscribed.
+(define (topic-status topic)
+  (with-subscriptions
+    (lambda ()
+      (let ((s (find-subscription topic)))
+        (and s (subscription-status s))))))
+
+;;> Sets the status of \var{topic}, when subscribed.
+(define (set-topic-status! topic status)
+  (with-subscriptions
+    (lambda ()
+      (let ((s (find-subscription topic)))
+        (if s (subscription-status-set! s status))))))
+
+;;> Subscribes address space \var{uid} to \var{topic}, a subject or a list.
+(define (subscribe-remote uid topic)
+  (remote-apply (uid->aspace uid) for-each subscribe (subject-list topic)))
+
+;;> Unsubscribes address space \var{uid} from \var{topic}.
+(define (unsubscribe-remote uid topic)
+  (remote-apply (uid->aspace uid) for-each unsubscribe (subject-list topic)))
+
+;;; Addresses
+
+(define (subject-list topic) (if (list? topic) topic (list topic)))
+
+(define (subject-levels subject)
+  (let ((s (symbol->string subject)))
+    (let loop ((start 0) (i 0) (acc '()))
+      (cond ((= i (string-length s))
+             (reverse (cons (substring s start i) acc)))
+            ((char=? (string-ref s i) #\.)
+             (loop (+ i 1) (+ i 1) (cons (substring s start i) acc)))
+            (else (loop start (+ i 1) acc))))))
+
+(define (wildcard? subject)
+  (let ((levels (subject-levels subject)))
+    (or (member "*" levels) (member ">" levels))))
+
+;;> True when the address subject \var{pattern} reaches \var{topic}.
+(define (subject-matches? pattern topic)
+  (or (eq? pattern topic)
+      (and (wildcard? pattern)
+           (let loop ((p (subject-levels pattern)) (t (subject-levels topic)))
+             (cond ((null? p) (null? t))
+                   ((equal? (car p) ">") (pair? t))
+                   ((null? t) #f)
+                   ((or (equal? (car p) "*") (equal? (car p) (car t)))
+                    (loop (cdr p) (cdr t)))
+                   (else #f))))))
+
+;; True when every subject of the address is among the subscriptions
+;; (the thesis says "proper subset"; it means subset).  Caller holds the lock.
+(define (addressed-here? topic)
+  (every (lambda (pattern)
+           (any (lambda (s) (subject-matches? pattern (subscription-topic s)))
+                *subscriptions*))
+         (subject-list topic)))
+
+;;; Sending
+
+(define (live-aspaces) (map uid->aspace (live-uids)))
+
+;;> Publishes a message (asynchronous, Figure 4.1): each live address
+;;> space subscribed to every subject of \var{topic} applies \var{proc} to
+;;> \var{args}.  Answers the uids of the address spaces that acknowledged,
+;;> which says nothing of who evaluated it.
+(define (publish topic proc . args)
+  (filter-map (lambda (r) (and (cadr r) (car r)))
+              (remote-run-all! (live-aspaces) receive-publication topic
+                               (local-aspace-uid) proc args)))
+
+;;> Publishes and waits for the results (synchronous, Figure 4.2): answers
+;;> ((uid result) ...) for the address spaces that evaluated the message,
+;;> possibly none.  One that dies or stalls is left out after
+;;> (remote-timeout) seconds.
+(define (request topic proc . args)
+  (answers (remote-apply-all (live-aspaces) receive-request topic
+                             (local-aspace-uid) proc args)))
+
+;; The evaluators' (uid value) from the receivers' (#t uid value) and
+;; (#f uid) answers.
+(define (answers results)
+  (filter-map (lambda (r)
+                (and (cadr r) (car (car (cddr r)))
+                     (cdr (car (cddr r)))))
+              results))
+
+;; A capability list in the ((exclusive ...) (non-exclusive ...)) layout,
+;; from any of the appendix's forms: a bare subject or a flat list of
+;; subjects, needed non-exclusively, or the two lists.
+(define (capability-layout topic)
+  (cond ((not (list? topic)) (list '() (list topic)))
+        ((null? topic) (list '() '()))
+        ((not (list? (car topic))) (list '() topic))
+        (else (list (car topic) (if (pair? (cdr topic)) (cadr topic) '())))))
+
+;;> Reserves, then promises (Figure 4.3): each live address space that has
+;;> every subject of \var{topic}, with the exclusive ones free (or held for
+;;> \var{task-name}), reserves the exclusive ones for \var{task-name} and
+;;> answers a promise.  Answers ((uid promise) ...).  A promise applied to
+;;> #t applies \var{proc} to \var{args} there, frees the subjects and
+;;> returns the result; applied to #f it only frees them.  A promise never
+;;> applied is freed after the lab's lease.
+(define (request-exclusive topic task-name proc . args)
+  (answers (remote-apply-all (live-aspaces) receive-request-exclusive
+                             (capability-layout topic) task-name
+                             (local-aspace-uid) proc args)))
+
+;;> As request-exclusive, but the subjects of \var{topic} are reserved for
+;;> sharing: other non-exclusive requests still get them, exclusive ones
+;;> are refused until every promise is applied (the thesis's chapter 6).
+(define (request-non-exclusive topic task-name proc . args)
+  (answers (remote-apply-all (live-aspaces) receive-request-non-exclusive
+                             (subject-list topic) task-name
+                             (local-aspace-uid) proc args)))
+
+;;> Who holds what: for each address space with a subscription matching
+;;> \var{topic}, (uid ((subject status) ...)).
+(define (request-status topic)
+  (filter (lambda (r) (pair? (cadr r)))
+          (map (lambda (r) (list (car r) (cadr r)))
+               (request 'all subscription-statuses topic))))
+
+;;> The (subject status) of the subscriptions here that match \var{topic}.
+(define (subscription-statuses topic)
+  (with-subscriptions
+    (lambda ()
+      (filter-map (lambda (s)
+                    (and (subject-matches? topic (subscription-topic s))
+                         (list (subscription-topic s) (subscription-status s))))
+                  *subscriptions*))))
+
+;;; Receiving: what the senders above run in each address space
+
+;;> Evaluates a publication if it is addressed here.
+(define (receive-publication topic uid proc args)
+  (if (with-subscriptions (lambda () (addressed-here? topic)))
+      (apply proc args))
+  #t)
+
+;;> Evaluates a request if it is addressed here: (#t uid result) or
+;;> (#f uid).
+(define (receive-request topic uid proc args)
+  (if (with-subscriptions (lambda () (addressed-here? topic)))
+      (list #t (local-aspace-uid) (apply proc args))
+      (list #f (local-aspace-uid))))
+
+;;> Reserves and promises, if addressed here and free: (#t uid promise)
+;;> or (#f uid).
+(define (receive-request-exclusive topiclist task-name uid proc args)
+  (promise-for (reserve! (car topiclist) (cadr topiclist) task-name)
+               proc args))
+
+;;> The shared counterpart of receive-request-exclusive.
+(define (receive-request-non-exclusive topics task-name uid proc args)
+  (promise-for (reserve-shared! topics task-name) proc args))
+
+;;; Reservations
+
+(define-record-type reservation
+  (make-reservation task exclusive shared deadline state)
+  reservation?
+  (task reservation-task)
+  (exclusive reservation-exclusive)     ; subjects held exclusively
+  (shared reservation-shared)           ; subjects held for sharing
+  (deadline reservation-deadline)
+  (state reservation-state reservation-state-set!)) ; reserved running done
+
+(define *reservations* '())             ; those not yet promised away
+(define *lease* 30)
+
+;;> Seconds an unapplied promise holds its subjects.
+(define (set-lease! seconds) (set! *lease* seconds))
+
+;; A subject is free for task when it is free or already held by task: two
+;; components of one task may both get a promise from one robot, and
+;; conflict resolution gives that robot at most one of them.
+(define (free-for? s task)
+  (let ((status (subscription-status s)))
+    (or (null? status) (eq? status task))))
+
+(define (not-held-by-another? s task)
+  (let ((status (subscription-status s)))
+    (or (null? status) (eq? status task) (eq? status 'shared))))
+
+(define (hold! s status)
+  (subscription-status-set! s status)
+  (subscription-holds-set! s (+ 1 (subscription-holds s))))
+
+;; Caller holds the lock.  Answers the subscriptions, or #f if one is
+;; missing or not acceptable.
+(define (subscriptions-if topics ok?)
+  (let ((subs (map find-subscription topics)))
+    (and (every (lambda (s) (and s (ok? s))) subs) subs)))
+
+(define (reserve! exclusive non-exclusive task)
+  (with-subscriptions
+    (lambda ()
+      (let ((ex (subscriptions-if exclusive (lambda (s) (free-for? s task))))
+            (non (subscriptions-if non-exclusive
+                                   (lambda (s) (not-held-by-another? s task)))))
+        (and ex non
+             (begin
+               (for-each (lambda (s)
+                           (hold! s task)
+                           (add-subscription!
+                            (in-use-subject (subscription-topic s))))
+                         ex)
+               (new-reservation! task exclusive '())))))))
+
+(define (reserve-shared! topics task)
+  (with-subscriptions
+    (lambda ()
+      (let ((subs (subscriptions-if
+                   topics
+                   (lambda (s) (memq (subscription-status s) '(() shared))))))
+        (and subs
+             (begin (for-each (lambda (s) (hold! s 'shared)) subs)
+                    (new-reservation! task '() topics)))))))
+
+(define (new-reservation! task exclusive shared)
+  (let ((r (make-reservation task exclusive shared
+                             (+ (current-second) *lease*) 'reserved)))
+    (set! *reservations* (cons r *reservations*))
+    r))
+
+(define (in-use-subject topic)
+  (string->symbol (string-append (symbol->string topic) ".in_use")))
+
+;; Frees a reservation's subjects, once.  A subject is free again when no
+;; reservation holds it any more.
+(define (release! r)
+  (with-subscriptions
+    (lambda ()
+      (if (not (eq? (reservation-state r) 'done))
+          (begin
+            (reservation-state-set! r 'done)
+            (set! *reservations* (remove (lambda (x) (eq? x r)) *reservations*))
+            (for-each (lambda (topic) (let-go! topic #t))
+                      (reservation-exclusive r))
+            (for-each (lambda (topic) (let-go! topic #f))
+                      (reservation-shared r)))))))
+
+(define (let-go! topic exclusive?)
+  (let ((s (find-subscription topic)))
+    (when s
+      (subscription-holds-set! s (max 0 (- (subscription-holds s) 1)))
+      (when (zero? (subscription-holds s))
+        (subscription-status-set! s '())
+        (if exclusive? (remove-subscription! (in-use-subject topic)))))))
+
+;; Marks r as being promised away; #f if its lease already ran out.
+(define (claim! r)
+  (with-subscriptions
+    (lambda ()
+      (and (eq? (reservation-state r) 'reserved)
+           (begin (reservation-state-set! r 'running)
+                  (set! *reservations*
+                        (remove (lambda (x) (eq? x r)) *reservations*))
+                  #t)))))
+
+(define (promise-for r proc args)
+  (if (not r)
+      (list #f (local-aspace-uid))
+      (list #t (local-aspace-uid)
+            (letrec ((promise
+                      (encap
+                       (lambda (commit?)
+                         (if (not (claim! r))
+                             (error "this promise's reservation has ended"
+                                    (reservation-task r)))
+                         (release-proxy! promise)
+                         (dynamic-wind
+                          (lambda () #f)
+                          (lambda () (and commit? (apply proc args)))
+                          (lambda () (release! r)))))))
+              promise))))
+
+;; Frees the reservations whose promise was never applied: the sender
+;; died, or the network broke.  No subject is held for ever.
+(define (lease-keeper)
+  (thread-sleep! (min 1 (/ *lease* 4)))
+  (for-each (lambda (r)
+              (log-warn "lease ran out: freeing " (reservation-exclusive r)
+                        (reservation-shared r) " held for "
+                        (reservation-task r))
+              (release! r))
+            (with-subscriptions
+              (lambda ()
+                (filter (lambda (r)
+                          (< (reservation-deadline r) (current-second)))
+                        *reservations*))))
+  (lease-keeper))
+
+;;; Monitors (A.6): capabilities that come and go with the machine's state
+
+(define *battery-charging* 130)         ; tenths of a volt
+(define *battery-low* 100)
+
+;; A string, as in the thesis, where it crossed differently byte-ordered
+;; machines.
+(define *load-threshold* ".75")
+
+(define *monitor-period* 60)
+(define *load-source* #f)               ; a thunk answering a number
+
+;;> This machine's load as a string, e.g. "0.42": from the lab's (load ...)
+;;> clause, else the one-minute average of /proc/loadavg.
+(define (get-system-load)
+  (number->string (*load-source*)))
+
+(define (start-thread! name thunk)
+  (thread-start! (make-thread thunk name)))
+
+(define *load-monitor-thread* #f)
+(define *battery-monitor-thread* #f)
+
+(define (restart-monitor! old name thunk)
+  (if (thread? old)
+      (begin (log-warn "terminating the running " name " thread")
+             (thread-terminate! old)))
+  (start-thread! name thunk))
+
+;;> Subscribes to idle while the load is under *load-threshold*.
+(define (load-monitor)
+  (set! *load-monitor-thread*
+        (restart-monitor! *load-monitor-thread* 'load-monitor
+                          load-monitor-procedure))
+  #t)
+
+(define (load-monitor-procedure)
+  (if (< (string->number (get-system-load)) (string->number *load-threshold*))
+      (subscribe 'idle)
+      (unsubscribe 'idle))
+  (thread-sleep! *monitor-period*)
+  (load-monitor-procedure))
+
+;;> Subscribes to untethered while the battery is under
+;;> *battery-charging*, as when its charging tether is off.
+(define (battery-monitor)
+  (set! *battery-monitor-thread*
+        (restart-monitor! *battery-monitor-thread* 'battery-monitor
+                          battery-monitor-procedure))
+  #t)
+
+(define (battery-monitor-procedure)
+  (if (< (safe-battery-voltage) *battery-charging*)
+      (subscribe 'untethered)
+      (unsubscribe 'untethered))
+  (thread-sleep! *monitor-period*)
+  (battery-monitor-procedure))
+
+;;; Initialization (A.2), from the lab file rather than host names
+
+;; The lab's (load L) or (load ((SECONDS L) ...)): a fixed load, or one
+;; that steps to each L at SECONDS after start; else /proc/loadavg.
+(define (load-source clause)
+  (let ((start (current-second)))
+    (cond
+     ((not clause) read-loadavg)
+     ((number? (cadr clause)) (lambda () (cadr clause)))
+     (else
+      (let ((steps (cadr clause)))
+        (lambda ()
+          (let ((now (- (current-second) start)))
+            (fold (lambda (step load) (if (>= now (car step)) (cadr step) load))
+                  (cadr (car steps))
+                  steps))))))))
+
+(define (read-loadavg)
+  (call-with-input-file "/proc/loadavg"
+    (lambda (in) (read in))))
+
+;;> Sets up this address space's subscriptions and monitors from its lab
+;;> clause (the thesis's make-subscription-initializer): all, its uid, its
+;;> capabilities; idle through load-monitor; untethered through
+;;> battery-monitor on robots.
+(define (initialize-subscriptions! lab entry)
+  (set! *monitor-period* (lab-setting lab 'monitor-period 60))
+  (set! *lease* (lab-setting lab 'lease 30))
+  (set! *load-source* (load-source (and entry (lab-aspace-clause entry 'load))))
+  (for-each subscribe (list 'all (local-aspace-uid)))
+  (for-each subscribe
+            (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
+                  (else '())))
+  (load-monitor)
+  (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))
+  (start-thread! 'lease-keeper lease-keeper)
+  #t)
