@@ -8,10 +8,34 @@
   (join-read-lab (read-lab lab-file) uid port))
 
 (define (join-read-lab lab uid port)
-  (let ((env (make-lab-environment lab)))
+  (let ((env (make-lab-environment lab))
+        (entry (lab-aspace-by-uid lab uid)))
+    (if entry (take-body! lab entry))
     (apply start-aspace! lab uid env port)
-    (initialize-subscriptions! lab (lab-aspace-by-uid lab uid))
+    (initialize-subscriptions! lab entry)
     env))
+
+;; A robot's address space drives its robot through trip, at the port the
+;; lab gives it; a workstation answers safe-reckon from its lab position.
+(define (take-body! lab entry)
+  (cond
+   ((lab-aspace-clause entry 'robot)
+    (let ((port (lab-trip-port lab entry)))
+      (set-current-robot!
+       (or (wait-for (lambda ()
+                       (guard (e (#t #f))
+                         (trip-connect (lab-aspace-host entry) port))))
+           (error "cannot reach the robot's trip server"
+                  (lab-aspace-uid entry) (lab-aspace-host entry) port)))
+      (im)))
+   ((lab-aspace-clause entry 'position)
+    => (lambda (clause) (workstation-position (cdr clause))))))
+
+;; The simulator may still be starting: try for ten seconds.
+(define (wait-for thunk)
+  (let loop ((tries 100))
+    (or (thunk)
+        (and (> tries 0) (begin (thread-sleep! 0.1) (loop (- tries 1)))))))
 
 ;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
 (define (run-aspace lab-file uid)

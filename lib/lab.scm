@@ -97,6 +97,15 @@
 (define (lab-aspace-by-uid lab uid)
   (find (lambda (a) (eq? (lab-aspace-uid a) uid)) (lab-aspaces lab)))
 
+;;> The port of the trip server of robot \var{a}: its (robot (trip-port N))
+;;> or port-base + 100 + its index.
+(define (lab-trip-port lab a)
+  (let ((robot (lab-aspace-clause a 'robot)))
+    (cond ((and robot (find (lambda (c) (and (pair? c) (eq? (car c) 'trip-port)))
+                            (cdr robot)))
+           => cadr)
+          (else (+ (lab-port-base (lab-settings lab)) 100 (lab-aspace-index a))))))
+
 ;;> The uids of the lab's robots, in file order.
 (define (lab-robots lab)
   (map lab-aspace-uid

@@ -8,5 +8,6 @@
           (only (chibi filesystem) is-a-tty?)
           (murdoch log)
           (only (meta) mutable-environment)
-          (murdoch lab) (murdoch remote) (murdoch pubsub))
+          (murdoch lab) (murdoch remote) (murdoch pubsub)
+          (murdoch trip-client))
   (include "../environment.scm" "../command.scm"))
