@@ -385,6 +385,7 @@ int main(int argc, char **argv)
     fflush(stdout);
 
     run(&sv, sv.lab.speed);
+    world_sync(sv.w);           /* the last round's readings, for the trace */
 
     for (i = 0; i < MAX_CLIENTS; i++)
         if (sv.clients[i])
