@@ -222,7 +222,7 @@
 ;;> One raw request on connection \var{c}: words are joined with spaces
 ;;> (numbers, symbols and strings); returns the values of the reply.  For
 ;;> tools and tests, e.g. \scheme{(trip-request c 'buttons 'press 2)}.
-(define (trip-request c . words) (apply request c words))
+(define trip-request request)
 
 ;;; Devices
 
