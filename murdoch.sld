@@ -19,5 +19,18 @@
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive
           get-system-load load-monitor battery-monitor
-          *battery-charging* *battery-low* *load-threshold*)
-  (import (murdoch sendable) (murdoch remote) (murdoch pubsub)))
+          *battery-charging* *battery-low* *load-threshold*
+          ;; pose-task and dynamic teams (lib/pose-task.scm)
+          pose-task negotiate pose-task-progress
+          location-metric-maker load-metric-maker load-metric reverse-metric
+          metric-by reckon-distance-between resolve-conflicts
+          with-team-proc-maker with-team on-list current-team t
+          sort-list make-maxrandom
+          ;; the robot (lib/trip-client.scm)
+          im goto-xy rotate translate angle-to-heading set-velocity stop-base
+          reckon set-reckon-position! set-reckon-heading!
+          sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
+          buttons-read lights say battery-voltage tethered? set-tether!
+          safe-im safe-battery-voltage safe-reckon)
+  (import (murdoch sendable) (murdoch remote) (murdoch pubsub)
+          (murdoch pose-task) (murdoch trip-client)))

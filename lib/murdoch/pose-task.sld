@@ -1,0 +1,12 @@
+(define-library (murdoch pose-task)
+  (export pose-task negotiate pose-task-progress
+          location-metric-maker load-metric-maker load-metric reverse-metric
+          metric-by reckon-distance-between sort-response resolve-conflicts
+          with-team-proc-maker with-team on-list current-team exec-on t
+          sort-list make-maxrandom)
+  (import (scheme base) (scheme write) (scheme inexact) (scheme cxr)
+          (srfi 1) (srfi 18) (srfi 27) (srfi 132)
+          (only (chibi ast) procedure-code procedure-vars opcode?)
+          (murdoch log) (murdoch sendable) (murdoch remote) (murdoch pubsub)
+          (murdoch trip-client))
+  (include "../pose-task.scm"))
