@@ -1,0 +1,133 @@
+;;; pose-task between real address spaces: choice by metric, conflicts,
+;;; failure that frees everything, a one-robot task, errors, and two tasks
+;;; posed at once.  Workstations stand in for robots here (their positions
+;;; come from the lab file); tests/transcripts drive the simulated robots.
+(import (except (scheme base) lambda define) (scheme write) (scheme eval)
+        (srfi 1) (srfi 18) (srfi 132) (chibi test)
+        (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
+
+(define lab-code "
+;; A component that says who ran it, holding its robot a moment.
+(define (who-am-i) (thread-sleep! 0.2) (local-aspace-uid))
+(define (fail) (error \"the component broke\"))
+(define (free-everywhere? subjects)
+  (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
+         (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects)))))
+(define (pose-one name)
+  (pose-task name 1 (list '((mobile) ())) (list #f) (list who-am-i)))
+")
+
+(define uids '(tester near far busy quiet))
+
+(define lab
+  (make-test-lab
+   '((code "code.scm") (lease 30)
+     (aspace tester)
+     (aspace near (position 100 100 0) (capabilities mobile sonar) (load 0.5))
+     (aspace far (position 3000 3000 0) (capabilities mobile sonar) (load 0.5))
+     (aspace busy (position 0 0 0) (load 0.6))
+     (aspace quiet (position 0 0 0) (load 0.1)))
+   `(("code.scm" . ,lab-code))))
+
+(define (start! uid)
+  (let ((pid (start-process!
+              (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
+                    (symbol->string uid))
+              (string-append (test-lab-directory lab) "/"
+                             (symbol->string uid) ".log"))))
+    (wait-for-port (+ (test-lab-port-base lab)
+                      (list-index (lambda (u) (eq? u uid)) uids))
+                   20)
+    pid))
+
+(for-each start! '(near far busy quiet))
+(join-lab (test-lab-file lab) 'tester)
+
+(define (lab-proc name) (eval name (lab-environment)))
+(define who-am-i #f)
+(define fail #f)
+(set! who-am-i (lab-proc 'who-am-i))
+(set! fail (lab-proc 'fail))
+(define (all-free?) ((lab-proc 'free-everywhere?) '(mobile sonar idle)))
+
+(test-begin "pose-task")
+
+(test "resolve-conflicts: the first list wins, later ones take the next"
+    '((a 1) (b 2) (c 3))
+  (resolve-conflicts '(((a 1) (b 1)) ((a 2) (b 2)) ((c 3) (a 3)))))
+(test "resolve-conflicts: #f when a list runs out" #f
+  (resolve-conflicts '(((a 1)) ((a 2)))))
+
+(test "the closest robot gets each target, the least loaded the sums"
+    '(near far quiet)
+  (pose-task 'two-targets 3
+             (list '((mobile) (sonar)) '((mobile) (sonar)) 'idle)
+             (list (location-metric-maker '(0 0 0 0))
+                   (location-metric-maker '(0 0 0 0))
+                   load-metric)
+             (list who-am-i who-am-i who-am-i)))
+(test "and afterwards every subject is free" #t (all-free?))
+
+(test "a metric that prefers the farther robot" '(far)
+  (pose-task 'far-away 1 (list '((mobile) ()))
+             (list (reverse-metric (location-metric-maker '(0 0 0 0))))
+             (list who-am-i)))
+
+(test "a one-robot task frees its robot" #t
+  (begin (pose-task 'one 1 (list '((mobile) ())) (list #f) (list who-am-i))
+         (all-free?)))
+
+(test "three mobile components, two mobile robots: not enough takers"
+    'not-enough-takers
+  (pose-task 'too-big 3 (list '((mobile) ()) '((mobile) ()) '((mobile) ()))
+             (list #f #f #f) (list who-am-i who-am-i who-am-i)))
+(test "and every reservation is freed" #t (all-free?))
+
+(test "a capability nobody has: not enough takers" 'not-enough-takers
+  (pose-task 'no-arm 2 (list '((mobile) ()) '((arm) ()))
+             (list #f #f) (list who-am-i who-am-i)))
+(test "and the robot promised for the first component is free" #t (all-free?))
+
+(test "an error in one component is reported, the others finish"
+    '(near (error far "the component broke"))
+  (pose-task 'half-broken 2 (list '((mobile) ()) '((mobile) ()))
+             (list (location-metric-maker '(0 0 0 0))
+                   (location-metric-maker '(0 0 0 0)))
+             (list who-am-i fail)))
+(test "and nothing stays reserved" #t (all-free?))
+
+(test "a wrong number of components is a clear error"
+    "pose-task: num-robots, capabilities, metrics and procedures do not agree"
+  (guard (e ((error-object? e) (error-object-message e)))
+    (pose-task 'wrong 2 (list 'idle) (list #f) (list who-am-i))))
+
+;; Two address spaces pose a one-robot task each, at once, ten times:
+;; they never get the same robot at once, and never deadlock.
+(let* ((here (make-thread
+              (lambda ()
+                (map (lambda (i) ((lab-proc 'pose-one) 'from-tester)) (iota 10)))))
+       (there (make-thread
+               (lambda ()
+                 (let ((pose-one (lab-proc 'pose-one)))
+                   (parameterize ((remote-timeout 120))
+                     (remote-apply (uid->aspace 'busy)
+                                   (lambda ()
+                                     (map (lambda (i) (pose-one 'from-busy))
+                                          (iota 10))))))))))
+  (thread-start! here) (thread-start! there)
+  (let ((mine (thread-join! here))
+        (theirs (thread-join! there)))
+    (test "two tasks posed at once: each pose ends, with a robot or not"
+        20
+      (length (filter (lambda (r) (or (eq? r 'not-enough-takers) (pair? r)))
+                      (append mine theirs))))
+    (test "the robots they got were mobile ones" #t
+      (every (lambda (r) (or (eq? r 'not-enough-takers)
+                             (and (memq (car r) '(near far)) #t)))
+             (append mine theirs)))
+    (test "and afterwards every subject is free" #t (all-free?))))
+
+(test-end)
+(stop-all-processes!)
+(remove-test-lab! lab)
+(test-exit)
