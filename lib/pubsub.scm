@@ -125,13 +125,22 @@
 
 (define (live-aspaces) (map uid->aspace (live-uids)))
 
+;; Where a message must go.  An address that is one address space's uid
+;; reaches that address space alone (each subscribes to its own uid and to
+;; no other's), so it is sent there only, not to the whole lab: metrics ask
+;; each candidate point to point, and would otherwise cost N messages each.
+(define (recipients topic)
+  (if (and (symbol? topic) (memq topic (live-uids)))
+      (list (uid->aspace topic))
+      (live-aspaces)))
+
 ;;> Publishes a message (asynchronous, Figure 4.1): each live address
 ;;> space subscribed to every subject of \var{topic} applies \var{proc} to
 ;;> \var{args}.  Answers the uids of the address spaces that acknowledged,
 ;;> which says nothing of who evaluated it.
 (define (publish topic proc . args)
   (filter-map (lambda (r) (and (cadr r) (car r)))
-              (remote-run-all! (live-aspaces) receive-publication topic
+              (remote-run-all! (recipients topic) receive-publication topic
                                (local-aspace-uid) proc args)))
 
 ;;> Publishes and waits for the results (synchronous, Figure 4.2): answers
@@ -139,7 +148,7 @@
 ;;> possibly none.  One that dies or stalls is left out after
 ;;> (remote-timeout) seconds.
 (define (request topic proc . args)
-  (answers (remote-apply-all (live-aspaces) receive-request topic
+  (answers (remote-apply-all (recipients topic) receive-request topic
                              (local-aspace-uid) proc args)))
 
 ;; The evaluators' (uid value) from the receivers' (#t uid value) and

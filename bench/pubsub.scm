@@ -1,0 +1,74 @@
+;;;; Publish/subscribe and negotiation figures for labs of N address spaces
+;;;; on this machine (simulated broadcast):
+;;;;   bench: request-latency-NN VALUE ms          a request to all, answered
+;;;;                                                by every address space
+;;;;   bench: pose-task-negotiation-NN VALUE ms    pose-task's negotiation of
+;;;;                                                the dual-sonar task
+;; Two address spaces stand in for the robots (workstations with mobile
+;; and sonar, at the thesis's robot positions), so that the figure is the
+;; negotiation's, not the simulator's; the rest are workstations.
+;; Medians over many runs.  Usage: tools/chibi bench/pubsub.scm N (one lab a
+;; process: an address space joins one lab); bench/run runs 4, 16 and 64.
+
+(import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
+        (scheme process-context) (srfi 1) (srfi 132)
+        (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
+
+(define (aspace-clause i)
+  (let ((name (string->symbol (string-append "w" (number->string i)))))
+    (case i
+      ((1) `(aspace ,name (position 1200 -400 180) (capabilities mobile sonar) (load 0.5)))
+      ((2) `(aspace ,name (position -1800 -600 90) (capabilities mobile sonar) (load 0.5)))
+      (else `(aspace ,name (position 0 0 0) (load ,(/ i 100.)))))))
+
+(define (start-lab n)
+  (let ((lab (make-test-lab
+              `((code ,(tool-path "examples/dual-sonar.scm")) (aspace bencher)
+                ,@(map aspace-clause (iota n 1))))))
+    (for-each (lambda (i)
+                (start-process!
+                 (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
+                       (string-append "w" (number->string i)))
+                 (string-append (test-lab-directory lab) "/w"
+                                (number->string i) ".log")))
+              (iota n 1))
+    (for-each (lambda (i) (wait-for-port (+ (test-lab-port-base lab) i) 120))
+              (iota n 1))
+    lab))
+
+(define (median-ms runs thunk)
+  (let loop ((i 0) (times '()))
+    (if (= i runs)
+        (list-ref (list-sort < times) (quotient runs 2))
+        (let ((t0 (current-second)))
+          (thunk)
+          (loop (+ i 1) (cons (* 1000 (- (current-second) t0)) times))))))
+
+(define (report name n value)
+  (display "bench: ") (display name) (display "-N") (display n) (display " ")
+  (display (/ (round (* 100 value)) 100.)) (display " ms") (newline))
+
+(define (negotiate-and-release task)
+  (let ((team (apply negotiate task)))
+    (if (symbol? team) (error "negotiation failed" team))
+    (for-each (lambda (winner type)
+                (if (eq? type 'exclusive) ((cadr winner) #f)))
+              (car team) (cadr team))))
+
+(define (bench-lab n)
+  (let ((lab (start-lab n)))
+    (join-lab (test-lab-file lab) 'bencher)
+    (let ((task (eval '(dual-sonar-task) (lab-environment))))
+      (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
+      (report "request-latency" n
+              (median-ms 50 (lambda ()
+                              (let ((answers (request 'all (lambda () #t))))
+                                (if (< (length answers) n)
+                                    (error "not every address space answered"
+                                           (length answers)))))))
+      (report "pose-task-negotiation" n
+              (median-ms 20 (lambda () (negotiate-and-release task)))))
+    (stop-all-processes!)
+    (remove-test-lab! lab)))
+
+(bench-lab (string->number (cadr (command-line))))
