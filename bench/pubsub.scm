@@ -32,7 +32,11 @@
                  (string-append (test-lab-directory lab) "/w"
                                 (number->string i) ".log")))
               (iota n 1))
-    (for-each (lambda (i) (wait-for-port (+ (test-lab-port-base lab) i) 120))
+    (for-each (lambda (i)
+                (if (not (wait-for-port (+ (test-lab-port-base lab) i) 60))
+                    (begin (stop-all-processes!)
+                           (error "an address space did not start; see its log"
+                                  (test-lab-directory lab) i))))
               (iota n 1))
     lab))
 

@@ -39,7 +39,7 @@
          (file (string-append dir "/lab.scm")))
     (call-with-output-file file
       (lambda (out)
-        (write `(lab test (port-base ,base) ,@clauses) out)
+        (write-simple `(lab test (port-base ,base) ,@clauses) out)
         (newline out)))
     (for-each (lambda (f)
                 (call-with-output-file (string-append dir "/" (car f))
