@@ -274,9 +274,7 @@
 
 (define (open-socket host port)
   (let ((io (guard (e (#t #f)) (open-net-io host port))))
-    (if (not (pair? io))
-        #f
-        io)))
+    (and (pair? io) io)))
 
 ;; The open connection to uid, made (and greeted) if there is none.
 (define (connection-to a seconds)
@@ -553,9 +551,8 @@
                  (begin (set! *idle-workers* (delete mb *idle-workers* eq?))
                         #t))))
         #f)
-       (else (work (mailbox-take mb 3600 (lambda () void))))))))
-
-(define (void) #f)
+       ;; The job is on its way; an hour is only a bound.
+       (else (work (mailbox-take mb 3600 (lambda () (lambda () #f)))))))))
 
 ;;; Serving calls
 
