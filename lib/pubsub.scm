@@ -389,11 +389,31 @@
 (define *load-monitor-thread* #f)
 (define *battery-monitor-thread* #f)
 
+;; A monitor keeps subject in the subscription list while present? holds,
+;; looking every *monitor-period* seconds.
+(define (watch subject present?)
+  (lambda ()
+    (let loop ()
+      (if (present?) (subscribe subject) (unsubscribe subject))
+      (thread-sleep! *monitor-period*)
+      (loop))))
+
+;; Starts a monitor thread, terminating the one it replaces, as A.6 does.
 (define (restart-monitor! old name thunk)
   (if (thread? old)
       (begin (log-warn "terminating the running " name " thread")
              (thread-terminate! old)))
   (start-thread! name thunk))
+
+(define load-monitor-procedure
+  (watch 'idle
+         (lambda ()
+           (< (string->number (get-system-load))
+              (string->number *load-threshold*)))))
+
+(define battery-monitor-procedure
+  (watch 'untethered
+         (lambda () (< (safe-battery-voltage) *battery-charging*))))
 
 ;;> Subscribes to idle while the load is under *load-threshold*.
 (define (load-monitor)
@@ -402,13 +422,6 @@
                           load-monitor-procedure))
   #t)
 
-(define (load-monitor-procedure)
-  (if (< (string->number (get-system-load)) (string->number *load-threshold*))
-      (subscribe 'idle)
-      (unsubscribe 'idle))
-  (thread-sleep! *monitor-period*)
-  (load-monitor-procedure))
-
 ;;> Subscribes to untethered while the battery is under
 ;;> *battery-charging*, as when its charging tether is off.
 (define (battery-monitor)
@@ -416,13 +429,6 @@
         (restart-monitor! *battery-monitor-thread* 'battery-monitor
                           battery-monitor-procedure))
   #t)
-
-(define (battery-monitor-procedure)
-  (if (< (safe-battery-voltage) *battery-charging*)
-      (subscribe 'untethered)
-      (unsubscribe 'untethered))
-  (thread-sleep! *monitor-period*)
-  (battery-monitor-procedure))
 
 ;;; Initialization (A.2), from the lab file rather than host names
 

@@ -17,8 +17,6 @@
   (pose-task name 1 (list '((mobile) ())) (list #f) (list who-am-i)))
 ")
 
-(define uids '(tester near far busy quiet))
-
 (define lab
   (make-test-lab
    '((code "code.scm") (lease 30)
@@ -29,18 +27,8 @@
      (aspace quiet (position 0 0 0) (load 0.1)))
    `(("code.scm" . ,lab-code))))
 
-(define (start! uid)
-  (let ((pid (start-process!
-              (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
-                    (symbol->string uid))
-              (string-append (test-lab-directory lab) "/"
-                             (symbol->string uid) ".log"))))
-    (wait-for-port (+ (test-lab-port-base lab)
-                      (list-index (lambda (u) (eq? u uid)) uids))
-                   20)
-    pid))
 
-(for-each start! '(near far busy quiet))
+(for-each (lambda (uid) (start-lab-aspace! lab uid)) '(near far busy quiet))
 (join-lab (test-lab-file lab) 'tester)
 
 (define (lab-proc name) (eval name (lab-environment)))

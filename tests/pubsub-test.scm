@@ -31,7 +31,6 @@
   (thread-sleep! 3600))
 ")
 
-(define uids '(tester a b c d))
 
 (define lab
   (make-test-lab
@@ -43,18 +42,8 @@
      (aspace d))
    `(("code.scm" . ,lab-code))))
 
-(define (port-of uid) (+ (test-lab-port-base lab) (list-index (lambda (u) (eq? u uid)) uids)))
 
-(define (start! uid)
-  (let ((pid (start-process!
-              (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
-                    (symbol->string uid))
-              (string-append (test-lab-directory lab) "/"
-                             (symbol->string uid) ".log"))))
-    (wait-for-port (port-of uid) 20)
-    pid))
-
-(define pids (map (lambda (uid) (cons uid (start! uid))) '(a b c d)))
+(define pids (map (lambda (uid) (cons uid (start-lab-aspace! lab uid))) '(a b c d)))
 (join-lab (test-lab-file lab) 'tester)
 
 (define (at uid proc . args) (apply remote-apply (uid->aspace uid) proc args))
@@ -194,7 +183,7 @@
   (test "a peer that is killed is not counted" '(b c tester)
     (begin (kill-process! (cdr (assq 'a pids)))
            (sorted-uids (publish 'all (lambda () #t)))))
-  (set-cdr! (assq 'a pids) (start! 'a))
+  (set-cdr! (assq 'a pids) (start-lab-aspace! lab 'a))
   (test "restarted, it is counted again within seconds" '(a b c tester)
     (wait-until 10 (lambda ()
                      (let ((acks (sorted-uids (publish 'all (lambda () #t)))))

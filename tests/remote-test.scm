@@ -18,26 +18,14 @@
                    (aspace praline))
                  `(("shared.scm" . ,shared-code))))
 
-(define (port-of uid)
-  (+ (test-lab-port-base lab)
-     (cadr (assq uid '((tester 0) (troy 1) (praline 2))))))
-
-(define (start! uid)
-  (let ((pid (start-process!
-              (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
-                    (symbol->string uid))
-              (string-append (test-lab-directory lab) "/"
-                             (symbol->string uid) ".log"))))
-    (wait-for-port (port-of uid) 20)
-    pid))
 
 ;; The lab's code, as this address space loaded it.
 (define (lab-procedure name) (eval name (lab-environment)))
 (define bump! #f)
 (define slow #f)
 
-(define troy-pid (start! 'troy))
-(define praline-pid (start! 'praline))
+(define troy-pid (start-lab-aspace! lab 'troy))
+(define praline-pid (start-lab-aspace! lab 'praline))
 (join-lab (test-lab-file lab) 'tester)
 (set! bump! (lab-procedure 'bump!))
 (set! slow (lab-procedure 'slow))
@@ -114,7 +102,7 @@
   (test "a dead target raises instead of hanging" #t
     (remote-error? (guard (e (#t e))
                      (remote-apply (uid->aspace 'praline) (lambda () 1)))))
-  (set! praline-pid (start! 'praline))
+  (set! praline-pid (start-lab-aspace! lab 'praline))
   (test "a restarted target is reached again" 7
     (remote-apply (uid->aspace 'praline) (lambda () 7))))
 
@@ -140,7 +128,7 @@
 ;;; Raw connections, for what a well-behaved peer never sends
 
 (define (raw-connect)
-  (let ((io (open-net-io "127.0.0.1" (port-of 'troy))))
+  (let ((io (open-net-io "127.0.0.1" (aspace-port (uid->aspace 'troy)))))
     (cons (cadr io) (car (cddr io)))))
 
 (define (raw-send! conn bytes)

@@ -5,6 +5,10 @@
   (let* ((here (or (get-environment-variable "MURDOCH_TOP") ".")))
     here))
 
+;; The lab file's port base rules in tests; an exported MURDOCH_PORT_BASE
+;; would move this process and not its children.
+(unsetenv "MURDOCH_PORT_BASE")
+
 ;;> The path of a file of the repository.
 (define (tool-path rel) (string-append top "/" rel))
 
@@ -97,6 +101,21 @@
     (or (thunk)
         (and (> left 0)
              (begin (thread-sleep! 0.05) (loop (- left 1)))))))
+
+;;> Starts address space \var{uid} of the test lab as a process of its own,
+;;> logging to UID.log in the lab's folder, and waits until it listens;
+;;> answers its pid.
+(define (start-lab-aspace! lab uid)
+  (let* ((entry (lab-aspace-by-uid (read-lab (test-lab-file lab)) uid))
+         (pid (start-process!
+               (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
+                     (symbol->string uid))
+               (string-append (test-lab-directory lab) "/"
+                              (symbol->string uid) ".log"))))
+    (if (not (wait-for-port (lab-aspace-port entry) 60))
+        (error "an address space did not start; see its log" uid
+               (test-lab-directory lab)))
+    pid))
 
 ;;> Waits until something accepts connections on \var{port}.
 (define (wait-for-port port seconds)

@@ -1,9 +1,12 @@
 (define-library (murdoch testing)
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
           start-process! stop-process! kill-process! stop-all-processes!
-          wait-for-port wait-until remove-test-lab! tool-path)
+          start-lab-aspace! wait-for-port wait-until remove-test-lab!
+          tool-path)
   (import (scheme base) (scheme write) (scheme file) (scheme process-context)
           (srfi 18)
           (chibi net) (chibi process) (chibi io)
+          (only (chibi ast) unsetenv)
+          (murdoch lab)
           (only (chibi filesystem) delete-file-hierarchy))
   (include "testing.scm"))
