@@ -1,0 +1,78 @@
+;;;; bin/murdoch lab, pose and demo.
+;;
+;; Supervising processes is left to sh scripts beside bin/murdoch
+;; (murdoch-lab, murdoch-demo): this side reads the lab file, which only
+;; Scheme can, and hands them what they need on their command line.
+
+;;> One line per address space of \var{lab}: name, where it listens, robot
+;;> or workstation, and the capabilities its lab clause gives it, as
+;;> \scheme{"moseley 127.0.0.1:7100 robot (trip 127.0.0.1:7200) sonar mobile"}.
+(define (lab-lines lab)
+  (map (lambda (a)
+         (string-join
+          (cons* (symbol->string (lab-aspace-uid a))
+                 (address (lab-aspace-host a) (lab-aspace-port a))
+                 (append (body-words lab a)
+                         (map symbol->string (capabilities a))))))
+       (lab-aspaces lab)))
+
+(define (body-words lab a)
+  (if (lab-aspace-clause a 'robot)
+      (list "robot" (string-append "(trip " (address (lab-aspace-host a)
+                                                     (lab-trip-port lab a))
+                                   ")"))
+      (list "workstation")))
+
+(define (capabilities a)
+  (cond ((lab-aspace-clause a 'capabilities) => cdr) (else '())))
+
+(define (address host port) (string-append host ":" (number->string port)))
+
+(define (string-join words)
+  (fold (lambda (w acc) (string-append acc " " w)) (car words) (cdr words)))
+
+;;> `murdoch lab LAB`: becomes bin/murdoch-lab, found in \var{bin}, for the
+;;> lab at \var{lab-file}.  \var{logs}, \var{trace} and \var{speed} are
+;;> strings or #f.
+(define (run-lab bin lab-file logs trace speed)
+  (execute "/bin/sh"
+           (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
+                  (or logs "") (or trace "") (or speed "")
+                  (lab-lines (read-lab lab-file)))))
+
+;;> `murdoch demo LAB`: becomes bin/murdoch-demo, found in \var{bin}.
+(define (run-demo bin lab-file)
+  (execute "/bin/sh" (list "/bin/sh" (string-append bin "/murdoch-demo")
+                           lab-file)))
+
+;;> `murdoch pose LAB FILE`: joins the lab as a guest, evaluates the forms
+;;> of \var{task-file} in a REPL's environment, poses the task its last
+;;> form names (see task-of), and writes the result.  pose-task's progress
+;;> lines go to the standard output as it works.
+(define (run-pose lab-file task-file)
+  (let* ((lab (read-lab lab-file))
+         (uid (string->symbol (string-append
+                               "pose-" (number->string (current-process-id)))))
+         (env (make-repl-environment lab (join-lab lab-file uid
+                                                   (lab-guest-port lab)))))
+    (eval `(pose-task-progress (current-output-port)) env)
+    (write (apply (eval 'pose-task env) (task-of task-file env)))
+    (newline)
+    (exit 0)))
+
+;;> The task \var{file} evaluates to in \var{env}: the value of its last
+;;> form, or, when that form defines a procedure of no arguments, what the
+;;> procedure answers, as the thesis's \scheme{(define (dual-sonar-task) ...)}.
+(define (task-of file env)
+  (let* ((forms (call-with-input-file file read-all))
+         (last-value (fold (lambda (form acc) (eval form env)) #f forms))
+         (last-form (and (pair? forms) (last forms))))
+    (if (and (pair? last-form) (eq? (car last-form) 'define)
+             (pair? (cadr last-form)) (null? (cdr (cadr last-form))))
+        (eval (cadr last-form) env)
+        last-value)))
+
+(define (read-all in)
+  (let loop ((acc '()))
+    (let ((form (read in)))
+      (if (eof-object? form) (reverse acc) (loop (cons form acc))))))

@@ -1,0 +1,11 @@
+;;> The commands that run a whole lab: \scheme{lab} starts it, \scheme{pose}
+;;> poses a task to it from a file, \scheme{demo} does both for the thesis's
+;;> dual-sonar task.
+(define-library (murdoch launch)
+  (export lab-lines run-lab run-pose run-demo)
+  (import (scheme base) (scheme read) (scheme write) (scheme eval)
+          (scheme file) (scheme process-context)
+          (srfi 1)
+          (only (chibi process) execute current-process-id)
+          (murdoch lab) (murdoch command))
+  (include "../launch.scm"))
