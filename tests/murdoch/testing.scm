@@ -1,9 +1,10 @@
 ;;;; What the multi-process tests share: labs in temporary folders on free
 ;;;; ports, and child processes that are always stopped.
 
+;; The repository: MURDOCH_TOP, as tests/run sets it, else the current
+;; folder, which is where tests/run and bench/run work.
 (define top
-  (let* ((here (or (get-environment-variable "MURDOCH_TOP") ".")))
-    here))
+  (or (get-environment-variable "MURDOCH_TOP") (current-directory)))
 
 ;; The lab file's port base rules in tests; an exported MURDOCH_PORT_BASE
 ;; would move this process and not its children.
@@ -27,19 +28,37 @@
         (waitpid pid 0)
         line))))
 
+;;> A fresh folder of its own under $TMPDIR, made with mktemp -d.
 (define (temporary-directory)
   (let* ((base (or (get-environment-variable "TMPDIR") "/tmp"))
          (dir (command-output
                (list "mktemp" "-d" (string-append base "/murdoch-test.XXXXXX")))))
     dir))
 
+;;> A port base B such that nothing listens on B to B + 199.
+(define (free-port-base)
+  (string->number (command-output (list (tool-path "tools/free-port-base")))))
+
+;;> The whole text of \var{file}, or "" when there is none yet.
+(define (file-text file)
+  (if (file-exists? file)
+      (call-with-input-file file
+        (lambda (in) (let ((s (read-string 10000000 in))) (if (eof-object? s) "" s))))
+      ""))
+
+;;> True when \var{word} occurs in \var{text}.
+(define (text-contains? text word)
+  (let ((n (string-length word)))
+    (let loop ((i 0))
+      (and (<= (+ i n) (string-length text))
+           (or (string=? word (substring text i (+ i n))) (loop (+ i 1)))))))
+
 ;;> Writes a lab file with \var{clauses} into a fresh temporary folder, on
 ;;> a port base no other lab on this machine is using.  \var{files} is a
 ;;> list of (name . text) written beside it (code files).
 (define (make-test-lab clauses . files)
   (let* ((dir (temporary-directory))
-         (base (string->number (command-output
-                                (list (tool-path "tools/free-port-base")))))
+         (base (free-port-base))
          (file (string-append dir "/lab.scm")))
     (call-with-output-file file
       (lambda (out)

@@ -2,11 +2,12 @@
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
           start-process! stop-process! kill-process! stop-all-processes!
           start-lab-aspace! wait-for-port wait-until remove-test-lab!
-          tool-path)
+          tool-path temporary-directory free-port-base file-text
+          text-contains?)
   (import (scheme base) (scheme write) (scheme file) (scheme process-context)
           (srfi 18)
           (chibi net) (chibi process) (chibi io)
           (only (chibi ast) unsetenv)
           (murdoch lab)
-          (only (chibi filesystem) delete-file-hierarchy))
+          (only (chibi filesystem) delete-file-hierarchy current-directory))
   (include "testing.scm"))

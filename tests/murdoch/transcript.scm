@@ -1,0 +1,133 @@
+;;;; Transcripts: what to type at a REPL, and what it should answer.
+
+(define-record-type transcript
+  (make-transcript lab as steps)
+  transcript?
+  (lab transcript-lab)          ; the lab file, relative to the repository
+  (as transcript-as)            ; the address space to join as, or #f
+  (steps transcript-steps))     ; ((input expected-line ...) ...)
+
+(define (prefixed? prefix line)
+  (and (>= (string-length line) (string-length prefix))
+       (string=? prefix (substring line 0 (string-length prefix)))))
+
+(define (after prefix line)
+  (string-trim (substring line (string-length prefix) (string-length line))))
+
+(define (string-trim s)
+  (let loop ((i 0) (j (string-length s)))
+    (cond ((and (< i j) (char-whitespace? (string-ref s i))) (loop (+ i 1) j))
+          ((and (< i j) (char-whitespace? (string-ref s (- j 1)))) (loop i (- j 1)))
+          (else (substring s i j)))))
+
+(define (read-lines file)
+  (call-with-input-file file
+    (lambda (in)
+      (let loop ((acc '()))
+        (let ((line (read-line in)))
+          (if (eof-object? line) (reverse acc) (loop (cons line acc))))))))
+
+;;> Reads the transcript \var{file}.  Comments (";;") and blank lines are
+;;> dropped; "lab:" and "as:" lines are the header; "> " lines are input,
+;;> and the lines after each are what it should print.
+(define (read-transcript file)
+  (let loop ((lines (read-lines file)) (lab #f) (as #f) (steps '()))
+    (cond
+     ((null? lines)
+      (if (not lab) (error "a transcript needs a lab: line" file))
+      (make-transcript lab as (reverse (map reverse steps))))
+     (else
+      (let ((line (car lines)) (rest (cdr lines)))
+        (cond
+         ((or (prefixed? ";;" line) (string=? "" (string-trim line)))
+          (loop rest lab as steps))
+         ((and (null? steps) (prefixed? "lab:" line))
+          (loop rest (after "lab:" line) as steps))
+         ((and (null? steps) (prefixed? "as:" line))
+          (loop rest lab (string->symbol (after "as:" line)) steps))
+         ((prefixed? "> " line)
+          (loop rest lab as (cons (list (after "> " line)) steps)))
+         ((null? steps) (error "output before any input" file line))
+         (else
+          (loop rest lab as (cons (cons line (car steps)) (cdr steps))))))))))
+
+;;> The text to pipe into the REPL: every input line.
+(define (transcript-input t)
+  (apply string-append
+         (map (lambda (step) (string-append (car step) "\n"))
+              (transcript-steps t))))
+
+;;> Compares the REPL's \var{output} with transcript \var{t}; the REPL's
+;;> prompt is \var{prompt}.  Answers a list of readable mismatches, empty
+;;> when everything matched.
+(define (transcript-mismatches t prompt output)
+  (let ((answers (split-at-prompts output prompt))
+        (steps (transcript-steps t)))
+    (if (not (= (length answers) (+ 1 (length steps))))
+        (list (list 'prompts-expected (+ 1 (length steps))
+                    'prompts-seen (length answers)))
+        (append-map step-mismatches steps (take answers (length steps))))))
+
+;; What the REPL printed after each prompt, as lists of lines; what came
+;; before the first prompt (the lab's start) is left out.
+(define (split-at-prompts output prompt)
+  (let loop ((start (string-search prompt output 0)) (acc '()))
+    (if (not start)
+        (reverse acc)
+        (let* ((from (+ start (string-length prompt)))
+               (next (string-search prompt output from)))
+          (loop next
+                (cons (text-lines (substring output from
+                                             (or next (string-length output))))
+                      acc))))))
+
+(define (text-lines text)
+  (let loop ((i 0) (start 0) (acc '()))
+    (cond ((= i (string-length text))
+           (reverse (if (= start i) acc (cons (substring text start i) acc))))
+          ((char=? #\newline (string-ref text i))
+           (loop (+ i 1) (+ i 1) (cons (substring text start i) acc)))
+          (else (loop (+ i 1) start acc)))))
+
+(define (string-search pattern text from)
+  (let ((n (string-length pattern)) (end (string-length text)))
+    (let loop ((i from))
+      (cond ((> (+ i n) end) #f)
+            ((string=? pattern (substring text i (+ i n))) i)
+            (else (loop (+ i 1)))))))
+
+(define (step-mismatches step actual)
+  (let ((expected (cdr step)))
+    (if (and (= (length expected) (length actual))
+             (every line-matches? expected actual))
+        '()
+        (list (list 'input (car step) 'expected expected 'actual actual)))))
+
+;;> True when \var{line} matches \var{pattern}: text matches itself,
+;;> \scheme{{number}} a number as Scheme writes it, \scheme{{any}} any text.
+(define (line-matches? pattern line)
+  (let match ((p 0) (l 0))
+    (cond
+     ((= p (string-length pattern)) (= l (string-length line)))
+     ((placeholder-at pattern p "{any}")
+      => (lambda (p*) (any (lambda (l*) (match p* l*))
+                           (iota (+ 1 (- (string-length line) l)) l))))
+     ((placeholder-at pattern p "{number}")
+      => (lambda (p*) (any (lambda (l*) (match p* l*))
+                           (number-ends line l))))
+     ((and (< l (string-length line))
+           (char=? (string-ref pattern p) (string-ref line l)))
+      (match (+ p 1) (+ l 1)))
+     (else #f))))
+
+(define (placeholder-at pattern p name)
+  (let ((end (+ p (string-length name))))
+    (and (<= end (string-length pattern))
+         (string=? name (substring pattern p end))
+         end)))
+
+;; Every end e such that line[l, e) reads as a number.
+(define (number-ends line l)
+  (filter (lambda (e)
+            (string->number (substring line l e)))
+          (iota (- (string-length line) l) (+ l 1))))

@@ -1,0 +1,7 @@
+;;> Scripted REPL sessions (docs/transcripts.md): reading a transcript,
+;;> and comparing what a REPL printed with what it expects.
+(define-library (murdoch transcript)
+  (export read-transcript transcript-lab transcript-as transcript-steps
+          transcript-input transcript-mismatches line-matches?)
+  (import (scheme base) (scheme char) (scheme file) (srfi 1))
+  (include "transcript.scm"))
