@@ -18,9 +18,13 @@
 
 (define (lab cfg spec lab-file)
   (let ((option (lambda (name) (conf-get cfg (list 'command 'lab name)))))
-    (run-lab bin lab-file (option 'logs) (option 'trace)
+    (run-lab bin lab-file (except (option 'except)) (option 'logs) (option 'trace)
              (let ((speed (option 'speed)))
                (and speed (number->string speed))))))
+
+;; (chibi app) reads "--except a" as a and "--except a,b" as (a b).
+(define (except names)
+  (cond ((not names) '()) ((list? names) names) (else (list names))))
 
 (define (pose cfg spec lab-file task-file)
   (run-pose lab-file task-file))
@@ -53,7 +57,8 @@
     (lab "start the simulator and every address space of the lab, until stopped"
          (@ (trace string "write the simulator's animated SVG trace here")
             (speed real "simulated seconds per wall second")
-            (logs string "the children's logs go here (default: a fresh folder)"))
+            (logs string "the children's logs go here (default: a fresh folder)")
+            (except (list symbol) "start all but these address spaces (a,b,...)"))
          (,lab lab))
     (pose "pose the task FILE evaluates to, as a guest of the running lab"
           (@) (,pose lab file))

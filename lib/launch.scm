@@ -4,17 +4,19 @@
 ;; (murdoch-lab, murdoch-demo): this side reads the lab file, which only
 ;; Scheme can, and hands them what they need on their command line.
 
-;;> One line per address space of \var{lab}: name, where it listens, robot
+;;> One line per address space of \var{lab} but those named in the list
+;;> \var{except}: name, where it listens, robot
 ;;> or workstation, and the capabilities its lab clause gives it, as
 ;;> \scheme{"moseley 127.0.0.1:7100 robot (trip 127.0.0.1:7200) sonar mobile"}.
-(define (lab-lines lab)
+(define (lab-lines lab except)
   (map (lambda (a)
          (string-join
           (cons* (symbol->string (lab-aspace-uid a))
                  (address (lab-aspace-host a) (lab-aspace-port a))
                  (append (body-words lab a)
                          (map symbol->string (capabilities a))))))
-       (lab-aspaces lab)))
+       (remove (lambda (a) (memq (lab-aspace-uid a) except))
+               (lab-aspaces lab))))
 
 (define (body-words lab a)
   (if (lab-aspace-clause a 'robot)
@@ -32,13 +34,16 @@
   (fold (lambda (w acc) (string-append acc " " w)) (car words) (cdr words)))
 
 ;;> `murdoch lab LAB`: becomes bin/murdoch-lab, found in \var{bin}, for the
-;;> lab at \var{lab-file}.  \var{logs}, \var{trace} and \var{speed} are
-;;> strings or #f.
-(define (run-lab bin lab-file logs trace speed)
-  (execute "/bin/sh"
-           (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
-                  (or logs "") (or trace "") (or speed "")
-                  (lab-lines (read-lab lab-file)))))
+;;> lab at \var{lab-file} but for the address spaces named in \var{except},
+;;> which someone will start by hand (a REPL that joins as one of them,
+;;> say).  \var{logs}, \var{trace} and \var{speed} are strings or #f.
+(define (run-lab bin lab-file except logs trace speed)
+  (let ((lab (read-lab lab-file)))
+    (execute "/bin/sh"
+             (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
+                    (or logs "") (or trace "") (or speed "")
+                    (if (pair? (lab-robots lab)) "sim" "")
+                    (lab-lines lab except)))))
 
 ;;> `murdoch demo LAB`: becomes bin/murdoch-demo, found in \var{bin}.
 (define (run-demo bin lab-file)

@@ -27,15 +27,19 @@
 (define (write-text file text)
   (call-with-output-file file (lambda (out) (write-string text out))))
 
-;; The lab of transcript t, started in dir on a free port base; answers
+;; The lab of transcript t, started in dir on a free port base without the
+;; address space the REPL will be, if it is one of the lab's; answers
 ;; (pid . port-base) once it is ready, or raises with its output.
 (define (start-lab! t dir)
   (let* ((base (number->string (free-port-base)))
          (out (string-append dir "/lab.out"))
          (pid (start-process!
-               (list "env" (string-append "MURDOCH_PORT_BASE=" base)
-                     (tool-path "bin/murdoch") "lab" (tool-path (transcript-lab t))
-                     "--logs" (string-append dir "/logs"))
+               (cons* "env" (string-append "MURDOCH_PORT_BASE=" base)
+                      (tool-path "bin/murdoch") "lab" (tool-path (transcript-lab t))
+                      "--logs" (string-append dir "/logs")
+                      (if (transcript-as t)
+                          (list "--except" (symbol->string (transcript-as t)))
+                          '()))
                out)))
     (wait-until 90 (lambda () (let ((text (file-text out)))
                                 (or (text-contains? text "lab: ready")
