@@ -64,29 +64,25 @@
   (let ((cell (env-cell env id)))
     (and cell (lambda? (cdr cell)))))
 
-(define (formals->list formals)
-  (cond ((pair? formals) (cons (car formals) (formals->list (cdr formals))))
-        ((null? formals) '())
-        (else (list formals))))
-
 (define (expand-sendable-lambda expr use-env mac-env)
   (let* ((formals (cadr expr))
          (body (cddr expr))
          (locals (filter (lambda (id) (local-variable? id use-env))
-                         (body-symbols body))))
-    (define (close x) (make-syntactic-closure use-env '() x))
-    (define (close-body x) (make-syntactic-closure use-env params x))
-    (define params (formals->list formals))
-    (make-syntactic-closure
-     mac-env '()
-     `(let ((info (make-sendable-info
-                   ',(cons `(lambda ,@(strip-syntactic-closures (cdr expr)))
-                           (map strip-syntactic-closures locals))
-                   (%lambda () (list ,@(map close locals))))))
-        (%lambda ,formals
-          ;; The test keeps `info` among the closure's variables, where
-          ;; closure-info finds it; Chibi drops a reference with no use.
-          (if info (let () ,@(map close-body body)) #f))))))
+                         (body-symbols body)))
+         (r (lambda (name) (make-syntactic-closure mac-env '() name)))
+         (info (r 'info)))
+    ;; What the macro brings is closed in its own environment; the user's
+    ;; formals and body are left as they came, so that they mean what they
+    ;; mean where the lambda is written, globals defined later included.
+    `(,(r 'let) ((,info (,(r 'make-sendable-info)
+                         (,(r 'quote)
+                          ,(cons `(lambda ,@(strip-syntactic-closures (cdr expr)))
+                                 (map strip-syntactic-closures locals)))
+                         (,(r '%lambda) () (,(r 'list) ,@locals)))))
+       (,(r '%lambda) ,formals
+        ;; The test keeps `info' among the closure's variables, where
+        ;; closure-info finds it; Chibi drops a reference with no use.
+        (,(r 'if) ,info (,(r 'let) () ,@body) #f)))))
 
 ;;> Murdoch's \scheme{lambda}: an ordinary lambda whose closures can be
 ;;> sent to another address space.

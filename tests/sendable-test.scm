@@ -1,0 +1,43 @@
+;;; Murdoch's lambda and the encoding of values, in one process.
+(import (except (scheme base) lambda define) (scheme eval) (scheme read)
+        (scheme write) (chibi test)
+        (rename (murdoch sendable) (sendable-lambda lambda)
+                (sendable-define define)))
+
+(define env (environment '(scheme base)))
+(define (round-trip x)
+  (let ((text (let ((out (open-output-string)))
+                (write (encode x env "the value") out)
+                (get-output-string out))))
+    ((make-decoder env (lambda (uid id) (list 'proxy uid id)))
+     (read (open-input-string text)))))
+
+(define (show n) (list later n))        ; later is defined below
+(define later 'defined-later)
+(define (maker coords) (lambda () coords))
+(define (shadow info) (lambda () info)) ; the macro's own variable is hidden
+
+(test-begin "sendable")
+(test "a global defined after the lambda that uses it" '(defined-later 1)
+  (show 1))
+(test "a closure carries its source and captured locals"
+    '#(murdoch:closure (lambda () coords) ((coords 1 2)))
+  (encode (maker '(1 2)) env "it"))
+(test "and runs where it lands" '(1 2) ((round-trip (maker '(1 2)))))
+(test "a user's variable named info is the user's" 'mine ((shadow 'mine)))
+(test "rest arguments" '(1 (2 3)) ((lambda (a . rest) (list a rest)) 1 2 3))
+(test "a procedure of the environment travels by name"
+    '#(murdoch:global car)
+  (encode car env "it"))
+(test "data of every kind" '(1 2.5 "s" #\c sym #u8(1) #(1 #(2)) ())
+  (round-trip '(1 2.5 "s" #\c sym #u8(1) #(1 #(2)) ())))
+(test "a user's vector that looks like a tag stays a vector"
+    '#(murdoch:global car)
+  (round-trip (vector 'murdoch:global 'car)))
+(test "a port is refused, naming the variable"
+    "cannot send variable port of (lambda () port): it is an output port"
+  (guard (e ((send-error? e) (error-object-message e)))
+    (let ((port (current-output-port)))
+      (encode (lambda () port) env "it"))))
+(test-end)
+(test-exit)
