@@ -7,8 +7,9 @@
 ;; Two address spaces stand in for the robots (workstations with mobile
 ;; and sonar, at the thesis's robot positions), so that the figure is the
 ;; negotiation's, not the simulator's; the rest are workstations.
-;; Medians over many runs.  Usage: tools/chibi bench/pubsub.scm N (one lab a
-;; process: an address space joins one lab); bench/run runs 4, 16 and 64.
+;; Medians over many runs.  Usage: tools/chibi bench/pubsub.scm N [multicast]
+;; (one lab a process: an address space joins one lab); bench/run runs 4, 16
+;; and 64, by simulated broadcast and by multicast (NAME-mcast-NN).
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
         (scheme process-context) (srfi 1) (srfi 132)
@@ -21,9 +22,10 @@
       ((2) `(aspace ,name (position -1800 -600 90) (capabilities mobile sonar) (load 0.5)))
       (else `(aspace ,name (position 0 0 0) (load ,(/ i 100.)))))))
 
-(define (start-lab n)
+(define (start-lab n delivery)
   (let ((lab (make-test-lab
-              `((code ,(tool-path "examples/dual-sonar.scm")) (aspace bencher)
+              `((code ,(tool-path "examples/dual-sonar.scm")) ,@delivery
+                (aspace bencher)
                 ,@(map aspace-clause (iota n 1))))))
     (for-each (lambda (i)
                 (start-process!
@@ -49,7 +51,7 @@
           (loop (+ i 1) (cons (* 1000 (- (current-second) t0)) times))))))
 
 (define (report name n value)
-  (display "bench: ") (display name) (display "-N") (display n) (display " ")
+  (display "bench: ") (display name) (display suffix) (display n) (display " ")
   (display (/ (round (* 100 value)) 100.)) (display " ms") (newline))
 
 (define (negotiate-and-release task)
@@ -59,8 +61,8 @@
                 (if (eq? type 'exclusive) ((cadr winner) #f)))
               (car team) (cadr team))))
 
-(define (bench-lab n)
-  (let ((lab (start-lab n)))
+(define (bench-lab n delivery)
+  (let ((lab (start-lab n delivery)))
     (join-lab (test-lab-file lab) 'bencher)
     (let ((task (eval '(dual-sonar-task) (lab-environment))))
       (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
@@ -75,4 +77,8 @@
     (stop-all-processes!)
     (remove-test-lab! lab)))
 
-(bench-lab (string->number (cadr (command-line))))
+(define multicast? (and (pair? (cddr (command-line)))
+                       (equal? (car (cddr (command-line))) "multicast")))
+(define suffix (if multicast? "-mcast-N" "-N"))
+(bench-lab (string->number (cadr (command-line)))
+           (if multicast? '((delivery multicast "239.255.77.7")) '()))

@@ -123,16 +123,16 @@
 
 ;;; Sending
 
-(define (live-aspaces) (map uid->aspace (live-uids)))
-
-;; Where a message must go.  An address that is one address space's uid
-;; reaches that address space alone (each subscribes to its own uid and to
-;; no other's), so it is sent there only, not to the whole lab: metrics ask
-;; each candidate point to point, and would otherwise cost N messages each.
-(define (recipients topic)
+;; Sends a message to the lab (remote-apply-all's answers).  An address
+;; that is one address space's uid reaches that address space alone (each
+;; subscribes to its own uid and to no other's), so it is sent there only:
+;; metrics ask each candidate point to point, and would otherwise cost N
+;; messages each.
+(define (deliver kind topic proc . args)
   (if (and (symbol? topic) (memq topic (live-uids)))
-      (list (uid->aspace topic))
-      (live-aspaces)))
+      (apply (if (eq? kind 'run) remote-run-all! remote-apply-all)
+             (list (uid->aspace topic)) proc args)
+      (apply (if (eq? kind 'run) broadcast-run! broadcast-apply) proc args)))
 
 ;;> Publishes a message (asynchronous, Figure 4.1): each live address
 ;;> space subscribed to every subject of \var{topic} applies \var{proc} to
@@ -140,16 +140,16 @@
 ;;> which says nothing of who evaluated it.
 (define (publish topic proc . args)
   (filter-map (lambda (r) (and (cadr r) (car r)))
-              (remote-run-all! (recipients topic) receive-publication topic
-                               (local-aspace-uid) proc args)))
+              (deliver 'run topic receive-publication topic
+                       (local-aspace-uid) proc args)))
 
 ;;> Publishes and waits for the results (synchronous, Figure 4.2): answers
 ;;> ((uid result) ...) for the address spaces that evaluated the message,
 ;;> possibly none.  One that dies or stalls is left out after
 ;;> (remote-timeout) seconds.
 (define (request topic proc . args)
-  (answers (remote-apply-all (recipients topic) receive-request topic
-                             (local-aspace-uid) proc args)))
+  (answers (deliver 'apply topic receive-request topic
+                    (local-aspace-uid) proc args)))
 
 ;; The evaluators' (uid value) from the receivers' (#t uid value) and
 ;; (#f uid) answers.
@@ -176,17 +176,17 @@
 ;;> returns the result; applied to #f it only frees them.  A promise never
 ;;> applied is freed after the lab's lease.
 (define (request-exclusive topic task-name proc . args)
-  (answers (remote-apply-all (live-aspaces) receive-request-exclusive
-                             (capability-layout topic) task-name
-                             (local-aspace-uid) proc args)))
+  (answers (broadcast-apply receive-request-exclusive
+                           (capability-layout topic) task-name
+                           (local-aspace-uid) proc args)))
 
 ;;> As request-exclusive, but the subjects of \var{topic} are reserved for
 ;;> sharing: other non-exclusive requests still get them, exclusive ones
 ;;> are refused until every promise is applied (the thesis's chapter 6).
 (define (request-non-exclusive topic task-name proc . args)
-  (answers (remote-apply-all (live-aspaces) receive-request-non-exclusive
-                             (subject-list topic) task-name
-                             (local-aspace-uid) proc args)))
+  (answers (broadcast-apply receive-request-non-exclusive
+                           (subject-list topic) task-name
+                           (local-aspace-uid) proc args)))
 
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).

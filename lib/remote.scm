@@ -442,11 +442,30 @@
 (define (remote-run-all! aspaces proc . args)
   (call-all aspaces 'run proc args))
 
+;;> remote-apply-all to every live address space (here too): by one
+;;> multicast datagram when the lab's delivery is multicast and the message
+;;> fits, else to each in turn.
+(define (broadcast-apply proc . args) (broadcast 'apply proc args))
+
+;;> remote-run-all! to every live address space, as broadcast-apply.
+(define (broadcast-run! proc . args) (broadcast 'run proc args))
+
+(define (broadcast kind proc args)
+  (let ((seconds (current-timeout))
+        (proc-code (encode proc *environment* "the procedure"))
+        (args-code (encode-arguments args)))
+    (or (multicast-call-all kind proc-code args-code proc args seconds)
+        (send-all (map uid->aspace (live-uids)) kind proc args
+                  proc-code args-code seconds))))
+
 (define (call-all aspaces kind proc args)
-  (let* ((seconds (current-timeout))
-         (deadline (+ (current-second) seconds))
-         (proc-code (encode proc *environment* "the procedure"))
-         (args-code (encode-arguments args))
+  (send-all aspaces kind proc args
+            (encode proc *environment* "the procedure")
+            (encode-arguments args)
+            (current-timeout)))
+
+(define (send-all aspaces kind proc args proc-code args-code seconds)
+  (let* ((deadline (+ (current-second) seconds))
          (started
           (map (lambda (a)
                  (capture (aspace-uid a)
@@ -774,6 +793,7 @@
     (spawn (lambda () (accept-loop *listener*)) 'accept)
     (spawn janitor 'janitor)
     (spawn prober 'prober)
+    (start-multicast! lab)
     *local*))
 
 (define (listen-on host port)

@@ -3,7 +3,8 @@
           local-aspace local-aspace-uid uid->aspace known-uids
           learn-aspace! live-uids current-lab lab-environment
           remote-run! remote-apply remote-timeout set-remote-timeout!
-          remote-apply-all remote-run-all!
+          remote-apply-all remote-run-all! broadcast-apply broadcast-run!
+          multicast-answer delivery-mode
           remote-error? remote-error-uid remote-error-message
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote)
@@ -17,5 +18,5 @@
           (only (chibi filesystem) open-input-file-descriptor
                 open-output-file-descriptor)
           (chibi net)
-          (murdoch scheduler) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
-  (include "../remote.scm"))
+          (murdoch scheduler) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
+  (include "../remote.scm" "../multicast.scm"))

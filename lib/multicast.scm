@@ -1,0 +1,188 @@
+;;;; Multicast delivery: one datagram reaches the whole lab.
+;;
+;; The thesis sent each message to every machine in turn, for want of
+;; broadcast in Kali (§4.1), and wished for IP multicast (§1.2).  With
+;; (delivery multicast GROUP [PORT]) in the lab file, publish and the query
+;; phase of request and request-exclusive go out as one datagram to the
+;; lab's group; each address space answers the sender point to point over
+;; its TCP connection, as remote-run! of multicast-answer, so the
+;; semantics are the broadcast's.  A message too large for a datagram goes
+;; the broadcast way.
+;;
+;; A datagram is 64 hex digits of HMAC-SHA256 under the lab's key over
+;; "mcast:" and the text, then the text: (SENDER SEQUENCE BODY).  SEQUENCE
+;; grows with every datagram of a sender (it starts from the clock, so a
+;; restarted sender does not go back), and a receiver drops a datagram
+;; whose sequence it has passed: a recorded datagram cannot be replayed.
+;; BODY is one of
+;;   (beacon UID HOST PORT)         every second: here I am
+;;   (call ID KIND PROC ARGS)       KIND run or apply, as on a connection
+;;
+;; Beacons are live membership without a registry: an address space not
+;; heard from for three seconds leaves the live set, and its next beacon
+;; brings it back.
+
+(define *multicast* #f)                 ; (socket . group address), or #f
+(define *sequence* 0)
+(define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
+(define *last-heard* (make-hash-table eq?))     ; uid -> current-second
+(define max-datagram 60000)
+(define beacon-seconds 1)
+(define silence-seconds 3)
+
+(define (start-multicast! lab)
+  (let ((clause (assq 'delivery (lab-settings lab))))
+    ;; (delivery multicast GROUP [PORT])
+    (when (and clause (pair? (cdr clause)) (eq? (cadr clause) 'multicast))
+      (let ((group (list-ref clause 2))
+            (port (if (> (length clause) 3)
+                      (list-ref clause 3)
+                      (+ (lab-port-base (lab-settings lab)) 149))))
+        (set! *multicast*
+              (cons (open-multicast-socket group port (aspace-host *local*))
+                    (get-address-info group port)))
+        (set! *sequence* (exact (round (* 1000000 (current-second)))))
+        (spawn receive-datagrams 'multicast)
+        (spawn send-beacons 'beacon)))))
+
+;;> How publish and request reach the lab: \scheme{multicast} or
+;;> \scheme{broadcast}.
+(define (delivery-mode) (if *multicast* 'multicast 'broadcast))
+
+;;; Sending
+
+(define (datagram-mac text) (*mac* (string-append "mcast:" text)))
+
+;; Sends body to the group; #f when it is too large for a datagram.
+(define (send-datagram! body)
+  (set! *sequence* (+ *sequence* 1))
+  (let* ((text (call-with-output-string
+                 (lambda (o) (write-simple (list (aspace-uid *local*) *sequence* body) o))))
+         (bytes (string->utf8 (string-append (datagram-mac text) text))))
+    (and (<= (bytevector-length bytes) max-datagram)
+         (begin (send (car *multicast*) bytes 0 (cdr *multicast*)) #t))))
+
+(define (send-beacons)
+  (send-datagram! `(beacon ,(aspace-uid *local*) ,(aspace-host *local*)
+                           ,(aspace-port *local*)))
+  (let ((now (current-second)))
+    (for-each (lambda (uid)
+                (if (< (hash-table-ref/default *last-heard* uid now)
+                       (- now silence-seconds))
+                    (note-unreachable! uid)))
+              (known-uids)))
+  (thread-sleep! beacon-seconds)
+  (send-beacons))
+
+;;; The calls of one datagram, awaiting their answers
+
+(define *multicast-calls* (make-hash-table eqv?)) ; id -> ((uid . mailbox) ...)
+(define *next-multicast-id* 0)
+
+;;> Delivers an answer to a multicast call: what each address space that
+;;> received the call runs, here, through remote-run!.
+(define (multicast-answer id uid kind value)
+  (let ((waiting (with-lock *peers-lock*
+                   (lambda () (hash-table-ref/default *multicast-calls* id '())))))
+    (cond ((assq uid waiting)
+           => (lambda (w) (mailbox-put! (cdr w) (list kind id value))))))
+  #t)
+
+;; call-all over multicast, when it is on and the message fits a
+;; datagram: answers call-all's list, or #f to send the broadcast way.
+(define (multicast-call-all kind proc-code args-code proc args seconds)
+  (and *multicast*
+       (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
+                              (live-uids)))
+              (waiting (map (lambda (uid) (cons uid (make-mailbox))) others))
+              (id (with-lock *peers-lock*
+                    (lambda ()
+                      (set! *next-multicast-id* (+ *next-multicast-id* 1))
+                      (hash-table-set! *multicast-calls* *next-multicast-id*
+                                       waiting)
+                      *next-multicast-id*))))
+         (define (forget!)
+           (with-lock *peers-lock*
+             (lambda () (hash-table-delete! *multicast-calls* id))))
+         (if (send-datagram! (list 'call id kind proc-code args-code))
+             (let* ((here (capture (local-aspace-uid)
+                                   (lambda () (local-call kind proc args))))
+                    (deadline (+ (current-second) seconds))
+                    (there (map (lambda (w) (await-answer w deadline seconds proc))
+                                waiting)))
+               (forget!)
+               (cons here there))
+             (begin (forget!) #f)))))
+
+(define (await-answer w deadline seconds proc)
+  (let ((uid (car w)))
+    (capture uid
+             (lambda ()
+               (let ((answer (mailbox-take
+                              (cdr w) (max 0 (- deadline (current-second)))
+                              (lambda ()
+                                (note-unreachable! uid)
+                                (remote-error uid (describe-procedure proc)
+                                              (string-append
+                                               "no answer within "
+                                               (number->string seconds) " s"))))))
+                 (if (eq? (car answer) 'error)
+                     (remote-error uid (describe-procedure proc) (car (cddr answer)))
+                     (car (cddr answer))))))))
+
+;;; Receiving
+
+(define (receive-datagrams)
+  (let ((bytes (receive (car *multicast*) 65536)))
+    (if bytes
+        (guard (e (#t (log-warn "datagram dropped: "
+                                (if (frame-error? e) (frame-error-message e)
+                                    (error-message e)))))
+          (serve-datagram (open-datagram bytes))))
+    (receive-datagrams)))
+
+;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram.
+(define (open-datagram bytes)
+  (let ((text (guard (e (#t (frame-fail "not UTF-8"))) (utf8->string bytes))))
+    (if (or (< (string-length text) 64)
+            (not (string=? (substring text 0 64)
+                           (datagram-mac (substring text 64 (string-length text))))))
+        (frame-fail "bad MAC"))
+    (let ((d (parse-message (substring text 64 (string-length text)))))
+      (if (not (and (list? d) (= (length d) 3) (symbol? (car d))
+                    (exact-integer? (cadr d))))
+          (frame-fail "not a datagram"))
+      (if (<= (cadr d) (hash-table-ref/default *last-sequence* (car d) 0))
+          (frame-fail "replayed or out of order"))
+      (hash-table-set! *last-sequence* (car d) (cadr d))
+      d)))
+
+(define (serve-datagram d)
+  (let ((sender (car d)) (body (car (cddr d))))
+    (with-lock *peers-lock*
+      (lambda () (hash-table-set! *last-heard* sender (current-second))))
+    (cond
+     ((eq? sender (aspace-uid *local*)) #f)   ; our own, looped back
+     ((and (pair? body) (eq? (car body) 'beacon) (= (length body) 4))
+      (learn-aspace! (make-aspace (list-ref body 1) (list-ref body 2)
+                                  (list-ref body 3)))
+      (with-lock *peers-lock*
+        (lambda () (hash-table-delete! *unreachable* sender))))
+     ((and (pair? body) (eq? (car body) 'call) (= (length body) 5))
+      (serve-multicast-call sender (cdr body)))
+     (else (frame-fail "not a beacon or a call")))))
+
+;; Runs a call that came by datagram, and answers its sender by remote-run!.
+(define (serve-multicast-call sender call)
+  (let ((id (car call)) (kind (cadr call)))
+    (define (answer! kind value)
+      (remote-run! (uid->aspace sender) multicast-answer id
+                   (local-aspace-uid) kind value))
+    (run-in-worker
+     (lambda ()
+       (guard (e (#t (answer! 'error (error-message e))))
+         (let ((proc (*decode* (car (cddr call))))
+               (args (*decode* (cadr (cddr call)))))
+           (if (eq? kind 'run)
+               (begin (answer! 'ack #t) (apply proc args))
+               (answer! 'value (apply proc args)))))))))
