@@ -92,15 +92,18 @@
       (set! *children* (cons pid *children*))
       pid))))
 
+;;> Waits for \var{pid} to end; answers its wait status, 0 for a clean exit.
 (define (reap! pid)
-  (waitpid pid 0)
-  (set! *children* (remove-pid pid *children*)))
+  (let ((status (cadr (waitpid pid 0))))
+    (set! *children* (remove-pid pid *children*))
+    status))
 
 (define (remove-pid pid ls)
   (cond ((null? ls) '()) ((= pid (car ls)) (cdr ls))
         (else (cons (car ls) (remove-pid pid (cdr ls))))))
 
-;;> Asks \var{pid} to stop (SIGTERM) and waits for it.
+;;> Asks \var{pid} to stop (SIGTERM) and waits for it; answers its wait
+;;> status.
 (define (stop-process! pid)
   (kill pid signal/term)
   (reap! pid))

@@ -1,6 +1,6 @@
 (define-library (murdoch testing)
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
-          start-process! stop-process! kill-process! stop-all-processes!
+          start-process! stop-process! kill-process! reap! stop-all-processes!
           start-lab-aspace! wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
           text-contains?)

@@ -1,0 +1,103 @@
+;;; bin/murdoch lab and pose, as real processes: a lab comes up and goes
+;;; down whole, a child that dies takes the lab down with it, and pose
+;;; poses the task a file names.
+(import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
+        (only (chibi process) system? kill signal/kill)
+        (chibi io)
+        (murdoch testing))
+
+;; Workstations only, so that no simulator is needed: the launcher starts
+;; one only for labs with robots.
+(define lab
+  (make-test-lab '((aspace troy (capabilities camera)) (aspace praline))))
+(define dir (test-lab-directory lab))
+(define base (test-lab-port-base lab))
+
+(define (in-dir name) (string-append dir "/" name))
+
+;; Starts bin/murdoch lab on lab file `file`, its output in `out`; answers
+;; its pid once it says it is ready or has given up.
+(define (start-lab! file out)
+  (let ((pid (start-process! (list (tool-path "bin/murdoch") "lab" file
+                                   "--logs" (in-dir "logs"))
+                             out)))
+    (wait-until 60 (lambda () (let ((text (file-text out)))
+                                (or (text-contains? text "lab: ready")
+                                    (text-contains? text "stopping the lab")))))
+    pid))
+
+(define (listening? port) (wait-for-port port 0))
+
+;; The children of process `pid`, as ps lists them.
+(define (children-of pid)
+  (let ((file (in-dir "children")))
+    (system? "sh" "-c" "ps -o pid= --ppid \"$1\" >\"$2\"" "ps"
+             (number->string pid) file)
+    (map string->number (read-lines file))))
+
+(define (read-lines file)
+  (call-with-input-file file
+    (lambda (in)
+      (let loop ((acc '()))
+        (let ((l (read-line in)))
+          (if (eof-object? l) (reverse acc) (loop (cons l acc))))))))
+
+;; The lines `bin/murdoch pose` prints for the task file `task`.
+(define (pose-output task)
+  (let ((out (in-dir "pose.out")))
+    (system? "sh" "-c" "timeout -s KILL 60 \"$1\" pose \"$2\" \"$3\" >\"$4\" 2>&1"
+             "pose" (tool-path "bin/murdoch") (test-lab-file lab) (in-dir task) out)
+    (read-lines out)))
+
+(define (address port)
+  (string-append "127.0.0.1:" (number->string port)))
+
+(test-begin "lab")
+
+(test-group "a lab starts whole and stops whole"
+  (let ((pid (start-lab! (test-lab-file lab) (in-dir "lab.out"))))
+    (test "one line per address space, then ready"
+        (list (string-append "lab: troy " (address base) " workstation camera")
+              (string-append "lab: praline " (address (+ base 1)) " workstation")
+              "lab: ready")
+      (cdr (read-lines (in-dir "lab.out"))))
+    (test "every address space listens" '(#t #t)
+      (map listening? (list base (+ base 1))))
+    (test-group "pose"
+      (call-with-output-file (in-dir "task.scm")
+        (lambda (out)
+          (write-string "(list 'where 1 (list (list '() (list 'camera)))
+                               (list load-metric)
+                               (list (lambda () (local-aspace-uid))))\n"
+                        out)))
+      (call-with-output-file (in-dir "thunk.scm")
+        (lambda (out)
+          (write-string "(define (where-task)
+                           (list 'where 1 (list (list '() (list 'camera)))
+                                 (list load-metric)
+                                 (list (lambda () 'called))))\n"
+                        out)))
+      (test "the task a file's last form evaluates to is posed; the result ends the output"
+          "(troy)" (last (pose-output "task.scm")))
+      (test "pose-task's progress comes first" #t
+        (text-contains? (car (pose-output "task.scm")) "pose-task: where"))
+      (test "a file that defines its task as a procedure: it is called"
+          "(called)" (last (pose-output "thunk.scm"))))
+    (let ((status (stop-process! pid)))
+      (if (not (zero? status)) (display (file-text (in-dir "lab.out"))))
+      (test "SIGTERM: the lab exits 0" 0 status))
+    (test "and nothing listens any more" '(#f #f)
+      (map listening? (list base (+ base 1))))))
+
+(test-group "a child that dies takes the lab down"
+  (let ((pid (start-lab! (test-lab-file lab) (in-dir "lab2.out"))))
+    (kill (car (children-of pid)) signal/kill)
+    (test "the lab exits non-zero" #t (not (zero? (reap! pid))))
+    (test "naming the one that died" #t
+      (text-contains? (file-text (in-dir "lab2.out")) "troy died"))
+    (test "and stops the others" #f (listening? (+ base 1)))))
+
+(test-end)
+(stop-all-processes!)
+(remove-test-lab! lab)
+(test-exit)
