@@ -1,5 +1,6 @@
 ;;; The murdoch command: see `bin/murdoch help`.
 (import (scheme base) (scheme process-context) (srfi 1) (chibi app) (chibi config)
+        (only (chibi pathname) path-directory)
         (murdoch command) (murdoch launch))
 
 (define (aspace cfg spec lab-file name)
@@ -9,12 +10,7 @@
   (run-repl lab-file (and (pair? name) (string->symbol (car name)))))
 
 ;; The sh scripts that supervise processes live beside this file.
-(define bin
-  (let ((me (car (command-line))))
-    (let loop ((i (- (string-length me) 1)))
-      (cond ((< i 0) ".")
-            ((char=? (string-ref me i) #\/) (substring me 0 i))
-            (else (loop (- i 1)))))))
+(define bin (path-directory (car (command-line))))
 
 (define (lab cfg spec lab-file)
   (let ((option (lambda (name) (conf-get cfg (list 'command 'lab name)))))
