@@ -15,16 +15,8 @@
 
 (define (in-dir name) (string-append dir "/" name))
 
-;; Starts bin/murdoch lab on lab file `file`, its output in `out`; answers
-;; its pid once it says it is ready or has given up.
-(define (start-lab! file out)
-  (let ((pid (start-process! (list (tool-path "bin/murdoch") "lab" file
-                                   "--logs" (in-dir "logs"))
-                             out)))
-    (wait-until 60 (lambda () (let ((text (file-text out)))
-                                (or (text-contains? text "lab: ready")
-                                    (text-contains? text "stopping the lab")))))
-    pid))
+(define (start-lab! out)
+  (start-murdoch-lab! (list (test-lab-file lab) "--logs" (in-dir "logs")) out))
 
 (define (listening? port) (wait-for-port port 0))
 
@@ -55,7 +47,7 @@
 (test-begin "lab")
 
 (test-group "a lab starts whole and stops whole"
-  (let ((pid (start-lab! (test-lab-file lab) (in-dir "lab.out"))))
+  (let ((pid (start-lab! (in-dir "lab.out"))))
     (test "one line per address space, then ready"
         (list (string-append "lab: troy " (address base) " workstation camera")
               (string-append "lab: praline " (address (+ base 1)) " workstation")
@@ -90,7 +82,7 @@
       (map listening? (list base (+ base 1))))))
 
 (test-group "a child that dies takes the lab down"
-  (let ((pid (start-lab! (test-lab-file lab) (in-dir "lab2.out"))))
+  (let ((pid (start-lab! (in-dir "lab2.out"))))
     (kill (car (children-of pid)) signal/kill)
     (test "the lab exits non-zero" #t (not (zero? (reap! pid))))
     (test "naming the one that died" #t

@@ -139,6 +139,30 @@
                (test-lab-directory lab)))
     pid))
 
+;;> Starts `bin/murdoch lab` with \var{args} (the lab file and options),
+;;> its output going to \var{out}, and answers its pid once it says it is
+;;> ready.  If it gives up instead, it is stopped and an error raised that
+;;> holds its output.  \var{port-base}, if given, is the MURDOCH_PORT_BASE
+;;> it runs with.
+(define (start-murdoch-lab! args out . port-base)
+  (let ((pid (start-process!
+              (append (if (pair? port-base)
+                          (list "env" (string-append "MURDOCH_PORT_BASE="
+                                                     (number->string (car port-base))))
+                          '())
+                      (list (tool-path "bin/murdoch") "lab")
+                      args)
+              out)))
+    (wait-until 90 (lambda ()
+                     (let ((text (file-text out)))
+                       (or (text-contains? text "lab: ready")
+                           (text-contains? text "stopping the lab")
+                           (text-contains? text "ERROR")))))
+    (if (not (text-contains? (file-text out) "lab: ready"))
+        (begin (stop-process! pid)
+               (error "the lab did not start" (file-text out))))
+    pid))
+
 ;;> Waits until something accepts connections on \var{port}.
 (define (wait-for-port port seconds)
   (wait-until seconds

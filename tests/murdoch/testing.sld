@@ -1,7 +1,7 @@
 (define-library (murdoch testing)
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
           start-process! stop-process! kill-process! reap! stop-all-processes!
-          start-lab-aspace! wait-for-port wait-until remove-test-lab!
+          start-lab-aspace! start-murdoch-lab! wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
           text-contains?)
   (import (scheme base) (scheme write) (scheme file) (scheme process-context)
