@@ -118,7 +118,11 @@
   (let ((team (negotiate task-name num-robots capability-list metrics procs)))
     (if (symbol? team)
         team
-        ((with-team-proc-maker (car team) (cadr team) procs)))))
+        (begin
+          (progress "  running the team")
+          (let ((results ((with-team-proc-maker (car team) (cadr team) procs))))
+            (progress "  done")
+            results)))))
 
 ;;> The negotiation of pose-task without the running: answers (winners
 ;;> type-list), where winners are the chosen (uid promise-or-#t) entries,
@@ -257,7 +261,7 @@
                     (if (and (number? s) (positive? s)) s *task-timeout*)))
          (on-error (option options 'on-error team-error))
          (collect (option options 'collect list))
-         (debug? (option options 'debug (and (pose-task-progress) #t)))
+         (debug? (option options 'debug #f))
          (port (pose-task-progress)))   ; threads do not inherit parameters
     (if (not (= (length uids) (length procs)))
         (error "on-list: the team and the procedures do not pair up"
