@@ -18,11 +18,22 @@
 (define (progress . parts)
   (let ((out (pose-task-progress)))
     (when out
-      (write-string "pose-task: " out)
-      (for-each (lambda (p) (if (string? p) (write-string p out) (write p out)))
-                parts)
-      (newline out)
+      ;; One write-string a line, so lines from threads do not interleave.
+      (write-string
+       (call-with-output-string
+         (lambda (line)
+           (write-string "pose-task: " line)
+           (for-each (lambda (p)
+                       (if (string? p) (write-string p line) (write p line)))
+                     parts)
+           (newline line)))
+       out)
       (flush-output-port out))))
+
+;; A value written short enough for one progress line.
+(define (abridged value)
+  (let ((s (call-with-output-string (lambda (out) (write value out)))))
+    (if (> (string-length s) 50) (string-append (substring s 0 47) "...") s)))
 
 ;;; Metrics
 
@@ -118,10 +129,14 @@
   (let ((team (negotiate task-name num-robots capability-list metrics procs)))
     (if (symbol? team)
         team
-        (begin
-          (progress "  running the team")
+        (let ((uids (map car (car team))))
+          (for-each (lambda (i uid) (progress "  component " i " starts on " uid))
+                    (iota (length uids) 1) uids)
           (let ((results ((with-team-proc-maker (car team) (cadr team) procs))))
-            (progress "  done")
+            (for-each (lambda (i uid result)
+                        (progress "  component " i " done on " uid ": "
+                                  (abridged result)))
+                      (iota (length uids) 1) uids results)
             results)))))
 
 ;;> The negotiation of pose-task without the running: answers (winners
