@@ -1,8 +1,8 @@
 # Murdoch's C outside the simulator, for the top Makefile to include; paths
 # are from the top of the repository.
-#   make native         builds lib/murdoch/scheduler.so and multicast.so,
-#                       the bodies of (murdoch scheduler) and (murdoch
-#                       multicast), and bench/c-pingpong
+#   make native         builds lib/murdoch/scheduler.so, multicast.so and
+#                       hmac.so, the C of (murdoch scheduler), (murdoch
+#                       multicast) and (murdoch hmac), and bench/c-pingpong
 #   make native-clean   removes them
 
 # tools/chibi-cflags names the directory of Chibi's headers, which in the
@@ -14,18 +14,18 @@ NATIVE_CHIBI_CFLAGS = $(addprefix -idirafter ,$(NATIVE_CHIBI_INCLUDE))
 NATIVE_CHIBI_HEADERS = $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)))
 NATIVE_CFLAGS ?= -O2 -g -Wall
 
-native: lib/murdoch/scheduler.so lib/murdoch/multicast.so bench/c-pingpong
+NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
+                  lib/murdoch/hmac.so
 
-lib/murdoch/scheduler.so: lib/scheduler.c $(NATIVE_CHIBI_HEADERS)
-	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ lib/scheduler.c
+native: $(NATIVE_MODULES) bench/c-pingpong
 
-lib/murdoch/multicast.so: lib/multicast.c $(NATIVE_CHIBI_HEADERS)
-	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ lib/multicast.c
+lib/murdoch/%.so: lib/%.c $(NATIVE_CHIBI_HEADERS)
+	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $<
 
 bench/c-pingpong: bench/c-pingpong.c
 	$(CC) $(NATIVE_CFLAGS) -o $@ bench/c-pingpong.c
 
 native-clean:
-	rm -f lib/murdoch/scheduler.so lib/murdoch/multicast.so bench/c-pingpong
+	rm -f $(NATIVE_MODULES) bench/c-pingpong
 
 .PHONY: native native-clean
