@@ -42,13 +42,7 @@
               (iota n 1))
     lab))
 
-(define (median-ms runs thunk)
-  (let loop ((i 0) (times '()))
-    (if (= i runs)
-        (list-ref (list-sort < times) (quotient runs 2))
-        (let ((t0 (current-second)))
-          (thunk)
-          (loop (+ i 1) (cons (* 1000 (- (current-second) t0)) times))))))
+(define (median-ms runs thunk) (* 1000 (median-seconds runs thunk)))
 
 (define (report name n value)
   (display "bench: ") (display name) (display suffix) (display n) (display " ")

@@ -20,15 +20,7 @@
 (wait-for-port (+ 1 (test-lab-port-base lab)) 20)
 (join-lab (test-lab-file lab) 'bencher)
 
-(define (now-us) (* 1000000 (current-second)))
-
-(define (median-us calls thunk)
-  (let loop ((i 0) (times '()))
-    (if (= i calls)
-        (list-ref (list-sort < times) (quotient calls 2))
-        (let ((t0 (now-us)))
-          (thunk)
-          (loop (+ i 1) (cons (- (now-us) t0) times))))))
+(define (median-us calls thunk) (* 1000000 (median-seconds calls thunk)))
 
 (define (report name value unit)
   (display "bench: ") (display name) (display " ")

@@ -163,6 +163,17 @@
                (error "the lab did not start" (file-text out))))
     pid))
 
+;;> The median time in seconds of \var{runs} calls of \var{thunk}: the
+;;> benches' measure, so that a few calls delayed by the machine's other
+;;> work do not move it.
+(define (median-seconds runs thunk)
+  (let loop ((i 0) (times '()))
+    (if (= i runs)
+        (list-ref (list-sort < times) (quotient runs 2))
+        (let ((t0 (current-second)))
+          (thunk)
+          (loop (+ i 1) (cons (- (current-second) t0) times))))))
+
 ;;> Waits until something accepts connections on \var{port}.
 (define (wait-for-port port seconds)
   (wait-until seconds

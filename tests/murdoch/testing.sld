@@ -1,11 +1,13 @@
 (define-library (murdoch testing)
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
           start-process! stop-process! kill-process! reap! stop-all-processes!
-          start-lab-aspace! start-murdoch-lab! wait-for-port wait-until remove-test-lab!
+          start-lab-aspace! start-murdoch-lab! median-seconds
+          wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
           text-contains?)
-  (import (scheme base) (scheme write) (scheme file) (scheme process-context)
-          (srfi 18)
+  (import (scheme base) (scheme time) (scheme write) (scheme file)
+          (scheme process-context)
+          (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
           (only (chibi ast) unsetenv)
           (murdoch lab)
