@@ -133,6 +133,10 @@
           (for-each (lambda (i uid) (progress "  component " i " starts on " uid))
                     (iota (length uids) 1) uids)
           (let ((results ((with-team-proc-maker (car team) (cadr team) procs))))
+            ;; Applied promises are of no more use here.
+            (for-each (lambda (winner type)
+                        (if (eq? type 'exclusive) (release-proxy! (cadr winner))))
+                      (car team) (cadr team))
             (for-each (lambda (i uid result)
                         (progress "  component " i " done on " uid ": "
                                   (abridged result)))
@@ -196,7 +200,8 @@
                               (if (not (memq entry winners))
                                   (guard (e (#t (log-warn "releasing " (car entry)
                                                           ": " (error-object-message e))))
-                                    ((cadr entry) #f))))
+                                    ((cadr entry) #f)
+                                    (release-proxy! (cadr entry)))))
                             response)))
             responses type-list))
 

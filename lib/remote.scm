@@ -724,13 +724,15 @@
       (hash-table-set! *proxies* *next-proxy-id* proc)
       (proxy-stub (local-aspace-uid) *next-proxy-id*))))
 
-;;> Forgets the procedure behind \var{proxy}, which must have been made
-;;> here; applying the proxy afterwards raises an error.
+;;> Forgets \var{proxy} here: where it was made, the procedure behind it,
+;;> so that applying it afterwards raises an error; elsewhere, only this
+;;> address space's copy of it, which a later message may bring back.
 (define (release-proxy! proxy)
   (let ((ref (proxy-procedure-ref proxy)))
     (with-lock *proxies-lock*
       (lambda ()
-        (hash-table-delete! *proxies* (proxy-ref-id ref))
+        (if (eq? (proxy-ref-uid ref) (local-aspace-uid))
+            (hash-table-delete! *proxies* (proxy-ref-id ref)))
         (hash-table-delete! *proxy-stubs*
                             (cons (proxy-ref-uid ref) (proxy-ref-id ref)))))))
 
