@@ -292,17 +292,23 @@
             (let ((fault (get-socket-option sock level/socket socket-opt/error)))
               (cond
                ((and (integer? fault) (positive? fault))
-                (close-file-descriptor sock)
+                (close-socket sock)
                 (integer->error-string fault))
                ((get-peer-name sock (address-info-address addr))
                 (list sock (open-input-file-descriptor sock #t)
                       (open-output-file-descriptor sock #t)))
                ((> (current-second) deadline)
-                (close-file-descriptor sock)
+                (close-socket sock)
                 "no connection in time")
                (else (thread-sleep! 0.001) (wait)))))))))
 
 (define socket-opt/error 4)             ; SO_ERROR, which (chibi net) lacks
+
+;; Closed through a port: close-file-descriptor would leave the fileno
+;; marked open, and the collector would close its number again later,
+;; whatever socket had taken the number by then.
+(define (close-socket sock)
+  (close-port (open-input-file-descriptor sock)))
 
 ;; The open connection to uid, made (and greeted) if there is none.
 (define (connection-to a seconds)

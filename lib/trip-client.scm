@@ -149,12 +149,12 @@
   (if (trip-connection-open? c) (shut! c))
   (mutex-unlock! (trip-connection-lock c)))
 
-;; Close the socket; the caller holds the lock.
+;; Close the socket; the caller holds the lock.  Closing both ports closes
+;; it; closing its number again could close a socket that has taken it.
 (define (shut! c)
   (trip-connection-open?-set! c #f)
   (guard (e (#t #f)) (close-input-port (trip-connection-in c)))
-  (guard (e (#t #f)) (close-output-port (trip-connection-out c)))
-  (close-file-descriptor (trip-connection-socket c)))
+  (guard (e (#t #f)) (close-output-port (trip-connection-out c))))
 
 (define (split-words s)
   (let loop ((i 0) (start 0) (acc '()))

@@ -16,7 +16,7 @@
                 exception-kind exception-irritants
                 strip-syntactic-closures)
           (only (chibi filesystem) open-input-file-descriptor
-                open-output-file-descriptor close-file-descriptor
+                open-output-file-descriptor
                 get-file-descriptor-status set-file-descriptor-status!
                 open/non-block)
           (only (chibi ast) integer->error-string)

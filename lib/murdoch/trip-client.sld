@@ -13,6 +13,5 @@
   (import (scheme base) (scheme write) (srfi 18) (srfi 151)
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
-          (only (chibi filesystem) close-file-descriptor)
           (chibi net))
   (include "../trip-client.scm"))
