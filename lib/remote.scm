@@ -272,43 +272,9 @@
 (define *connections* (make-hash-table eq?))  ; uid -> connection
 (define *connections-lock* (make-mutex 'connections))
 
-;; (socket in out), connected within seconds, or a string saying why not.
-;; The connect does not wait: a host that does not answer would hold the
-;; caller for the kernel's minutes of retries, not for its timeout.  So it
-;; looks every millisecond whether the connection is up or has failed.
-(define (open-socket host port seconds)
-  (let ((addr (get-address-info host port)))
-    (if (not addr)
-        "no such host"
-        (let ((sock (socket (address-info-family addr)
-                            (address-info-socket-type addr)
-                            (address-info-protocol addr)))
-              (deadline (+ (current-second) seconds)))
-          (set-file-descriptor-status!
-           sock (bitwise-ior (get-file-descriptor-status sock) open/non-block))
-          (connect sock (address-info-address addr)
-                   (address-info-address-length addr))
-          (let wait ()
-            (let ((fault (get-socket-option sock level/socket socket-opt/error)))
-              (cond
-               ((and (integer? fault) (positive? fault))
-                (close-socket sock)
-                (integer->error-string fault))
-               ((get-peer-name sock (address-info-address addr))
-                (list sock (open-input-file-descriptor sock #t)
-                      (open-output-file-descriptor sock #t)))
-               ((> (current-second) deadline)
-                (close-socket sock)
-                "no connection in time")
-               (else (thread-sleep! 0.001) (wait)))))))))
-
-(define socket-opt/error 4)             ; SO_ERROR, which (chibi net) lacks
-
-;; Closed through a port: close-file-descriptor would leave the fileno
-;; marked open, and the collector would close its number again later,
-;; whatever socket had taken the number by then.
-(define (close-socket sock)
-  (close-port (open-input-file-descriptor sock)))
+(define (open-socket host port)
+  (let ((io (guard (e (#t #f)) (open-net-io host port))))
+    (and (pair? io) io)))
 
 ;; The open connection to uid, made (and greeted) if there is none.
 (define (connection-to a seconds)
@@ -323,11 +289,11 @@
                 c)))))))
 
 (define (connect! a seconds)
-  (let ((io (open-socket (aspace-host a) (aspace-port a) seconds)))
-    (if (string? io)
+  (let ((io (open-socket (aspace-host a) (aspace-port a))))
+    (if (not io)
         (remote-error (aspace-uid a) 'connect
                       (string-append "cannot connect to " (aspace-host a) ":"
-                                     (number->string (aspace-port a)) ": " io)))
+                                     (number->string (aspace-port a)))))
     (let ((c (make-connection (aspace-uid a) (car io) (cadr io) (car (cddr io))
                               (make-mutex) (make-hash-table eqv?)))
           (nonce (random-hex 16))

@@ -16,11 +16,7 @@
                 exception-kind exception-irritants
                 strip-syntactic-closures)
           (only (chibi filesystem) open-input-file-descriptor
-                open-output-file-descriptor
-                get-file-descriptor-status set-file-descriptor-status!
-                open/non-block)
-          (only (chibi ast) integer->error-string)
-          (srfi 151)
+                open-output-file-descriptor)
           (chibi net)
           (murdoch scheduler) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
   (include "../remote.scm" "../multicast.scm"))
