@@ -8,6 +8,7 @@
 
 #include <chibi/eval.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 /* The first 32 bits of the fractional parts of the cube roots of the
@@ -114,19 +115,38 @@ static int bytes_of (sexp x, const unsigned char **p, size_t *n) {
   return 1;
 }
 
-/* (hmac-sha256 key message): the MAC of message (a bytevector or string)
- * under key (likewise), as a lowercase hex string. */
-static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp key, sexp message) {
+/* Hashes one part of a message: its bytes, or a fixnum's decimal digits,
+ * which saves the caller number->string (a string port in Chibi, 25 us). */
+static int hash_part (struct sha256 *s, sexp part) {
+  const unsigned char *p;
+  size_t n;
+  char digits[32];
+  if (sexp_fixnump(part)) {
+    n = snprintf(digits, sizeof digits, "%ld", (long)sexp_unbox_fixnum(part));
+    sha256_update(s, (const unsigned char *)digits, n);
+    return 1;
+  }
+  if (!bytes_of(part, &p, &n)) return 0;
+  sha256_update(s, p, n);
+  return 1;
+}
+
+/* (hmac-sha256 key part ...): the MAC under key (a bytevector or string)
+ * of the parts one after the other (bytevectors, strings as UTF-8, and
+ * fixnums in decimal), as a lowercase hex string. */
+static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   static const char hex[] = "0123456789abcdef";
-  const unsigned char *kp, *mp;
-  size_t kn, mn, i;
+  const unsigned char *kp;
+  size_t kn, i;
   unsigned char block[64], digest[32];
   char text[64];
   struct sha256 s;
+  sexp key, ls;
+  if (!sexp_pairp(args))
+    return sexp_user_exception(ctx, self, "no key", args);
+  key = sexp_car(args);
   if (!bytes_of(key, &kp, &kn))
     return sexp_type_exception(ctx, self, SEXP_BYTES, key);
-  if (!bytes_of(message, &mp, &mn))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, message);
   memset(block, 0, sizeof block);
   if (kn > 64) {                 /* a long key is hashed first */
     sha256_init(&s); sha256_update(&s, kp, kn); sha256_final(&s, block);
@@ -134,7 +154,10 @@ static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp key, sexp mess
     memcpy(block, kp, kn);
   }
   for (i = 0; i < 64; i++) block[i] ^= 0x36;
-  sha256_init(&s); sha256_update(&s, block, 64); sha256_update(&s, mp, mn);
+  sha256_init(&s); sha256_update(&s, block, 64);
+  for (ls = sexp_cdr(args); sexp_pairp(ls); ls = sexp_cdr(ls))
+    if (!hash_part(&s, sexp_car(ls)))
+      return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(ls));
   sha256_final(&s, digest);
   for (i = 0; i < 64; i++) block[i] ^= 0x36 ^ 0x5c;
   sha256_init(&s); sha256_update(&s, block, 64); sha256_update(&s, digest, 32);
@@ -151,6 +174,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   if (!(sexp_version_compatible(ctx, version, sexp_version)
         && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
     return SEXP_ABI_ERROR;
-  sexp_define_foreign(ctx, env, "hmac-sha256", 2, hmac_sha256);
+  sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256", 0, hmac_sha256);
   return SEXP_VOID;
 }

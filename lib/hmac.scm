@@ -5,7 +5,6 @@
 ;; a time; the remote layer MACs every frame twice, so it is C.
 
 ;;> Returns a procedure that computes HMAC-SHA256 under \var{key} (a
-;;> bytevector) of its argument, a bytevector or a string (its UTF-8
-;;> bytes), as a lowercase hex string.
+;;> bytevector) of the parts it is given, as hmac-sha256 does.
 (define (make-hmac-sha256 key)
-  (lambda (message) (hmac-sha256 key message)))
+  (lambda parts (apply hmac-sha256 key parts)))

@@ -51,7 +51,7 @@
 
 ;;; Sending
 
-(define (datagram-mac text) (*mac* (string-append "mcast:" text)))
+(define (datagram-mac text) (*mac* "mcast:" text))
 
 ;; Sends body to the group; #f when it is too large for a datagram.
 (define (send-datagram! body)

@@ -3,8 +3,7 @@
 ;; A netstring is "LENGTH:PAYLOAD," with LENGTH in decimal (D. J. Bernstein).
 ;; The reader is strict, because a frame comes from the network: digits
 ;; only, no leading zero but for the empty payload, at most MAX bytes of
-;; payload, and the comma.  It reads the payload into one bytevector, not
-;; byte by byte.
+;; payload, and the comma.
 
 ;;> Raised when a peer sends something that is not a netstring; the
 ;;> message says what was wrong, for the log.
@@ -19,36 +18,40 @@
 (define (digit-byte? b) (and (>= b 48) (<= b 57)))
 
 ;; The length prefix, read one byte at a time: it is a few bytes long, and
-;; reading no further than the colon keeps the payload for read-bytevector.
+;; reading no further than the colon leaves the payload in the buffer.  A
+;; length already over max takes no more digits.
 (define (read-netstring-length in max)
-  (let ((max-digits (string-length (number->string max))))
-    (let loop ((n 0) (digits 0))
-      (let ((b (read-u8 in)))
-        (cond
-         ((eof-object? b)
-          (if (zero? digits) b (netstring-fail "truncated length")))
-         ((= b 58)                      ; #\:
-          (if (zero? digits) (netstring-fail "empty length") n))
-         ((not (digit-byte? b))
-          (netstring-fail "non-digit byte " (number->string b)
-                          " in length"))
-         ((and (= digits 1) (zero? n))
-          (netstring-fail "leading zero in length"))
-         ((>= digits max-digits)
-          (netstring-fail "length over " (number->string max) " bytes"))
-         (else (loop (+ (* n 10) (- b 48)) (+ digits 1))))))))
+  (let loop ((n 0) (digits 0))
+    (let ((b (read-u8 in)))
+      (cond
+       ((eof-object? b)
+        (if (zero? digits) b (netstring-fail "truncated length")))
+       ((= b 58)                      ; #\:
+        (if (zero? digits) (netstring-fail "empty length") n))
+       ((not (digit-byte? b))
+        (netstring-fail "non-digit byte " (number->string b)
+                        " in length"))
+       ((and (= digits 1) (zero? n))
+        (netstring-fail "leading zero in length"))
+       ((> n max)
+        (netstring-fail "length over " (number->string max) " bytes"))
+       (else (loop (+ (* n 10) (- b 48)) (+ digits 1)))))))
 
-;; A socket hands over what has arrived, so a large payload may take
-;; several reads; the end of the port before the last byte is a fault.
+;; What the port's buffer holds is copied at once (lib/netstring.c); when
+;; it is empty, read-u8 waits for more and refills it.  The end of the port
+;; before the last byte is a fault.
 (define (read-payload in n)
   (let ((payload (make-bytevector n)))
     (let loop ((have 0))
       (if (= have n)
           payload
-          (let ((got (read-bytevector! payload in have n)))
-            (if (eof-object? got)
-                (netstring-fail "truncated payload")
-                (loop (+ have got))))))))
+          (let ((got (read-buffered-bytes! in payload have n)))
+            (if (positive? got)
+                (loop (+ have got))
+                (let ((b (read-u8 in)))
+                  (if (eof-object? b) (netstring-fail "truncated payload"))
+                  (bytevector-u8-set! payload have b)
+                  (loop (+ have 1)))))))))
 
 ;;> Reads one netstring from the binary port \var{in} and returns its
 ;;> payload as a bytevector, or an eof object when the port ends cleanly
@@ -68,17 +71,18 @@
         payload)))))
 
 ;;> Writes \var{payload}, a bytevector or a string (its UTF-8 bytes), to
-;;> \var{out} as one netstring.  A string goes out with one write-string,
+;;> \var{out} as one netstring.  A string goes out with write-string,
 ;;> which Chibi does in C; write-bytevector is a loop in Scheme.  Does not
 ;;> flush: the caller knows when a batch of frames is complete.
 (define (write-netstring payload out)
   (if (string? payload)
-      (write-string (string-append
-                     (number->string (bytevector-length (string->utf8 payload)))
-                     ":" payload ",")
-                    out)
       (begin
-        (write-string (number->string (bytevector-length payload)) out)
+        (write-string (fixnum->decimal (string-size payload)) out)
+        (write-char #\: out)
+        (write-string payload out)
+        (write-char #\, out))
+      (begin
+        (write-string (fixnum->decimal (bytevector-length payload)) out)
         (write-u8 58 out)
         (write-bytevector payload out)
         (write-u8 44 out))))

@@ -167,8 +167,7 @@
 (define *mac* #f)                       ; HMAC under the lab's key
 (define *max-frame* 1048576)
 
-(define (frame-mac nonce count text)
-  (*mac* (string-append nonce ":" (number->string count) ":" text)))
+(define (frame-mac nonce count text) (*mac* nonce ":" count ":" text))
 
 (define (write-frame! out nonce count message)
   (let* ((text (call-with-output-string (lambda (o) (write-simple message o))))

@@ -39,5 +39,13 @@
 (test "a non-ASCII message as a string hashes its UTF-8 bytes"
   (hmac-sha256 (text "Jefe") (text "caf\xe9;"))
   (hmac-sha256 (text "Jefe") "caf\xe9;"))
+(test "the parts of a message are hashed one after the other"
+    "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843"
+  (hmac-sha256 (text "Jefe") "what do " (text "ya want") " for nothing?"))
+(test "a fixnum part stands for its decimal digits"
+  (hmac-sha256 (text "Jefe") "nonce:1234567:-5")
+  (hmac-sha256 (text "Jefe") "nonce:" 1234567 ":" -5))
+(test-error "a part that is neither bytes, text nor a fixnum"
+  (hmac-sha256 (text "Jefe") 'what))
 (test-end)
 (test-exit)

@@ -1,5 +1,6 @@
 (define-library (murdoch netstring)
   (export read-netstring write-netstring
           netstring-error? netstring-error-message)
-  (import (scheme base))
+  (import (scheme base) (only (chibi) string-size))
+  (include-shared "netstring")
   (include "../netstring.scm"))

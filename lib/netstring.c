@@ -1,0 +1,63 @@
+/*  netstring.c -- the C of (murdoch netstring)
+ *
+ *  Chibi's read-bytevector! is a Scheme loop of read-u8, about a third of
+ *  a microsecond a byte: 50 us for a small frame, more than the rest of a
+ *  remote-apply's reading.  The bytes are already in the port's buffer in
+ *  C; this copies them out at once.  It never reads the descriptor itself:
+ *  when the buffer is empty the Scheme side calls read-u8, which refills
+ *  it and, on a socket with nothing to read, blocks only its own green
+ *  thread, as every Chibi port read does.
+ */
+
+#include <chibi/eval.h>
+#include <stdio.h>
+#include <string.h>
+
+/* (read-buffered-bytes! port bytevector start end): copies what the
+ * port's buffer holds, up to end - start bytes, into bytevector from
+ * start; answers how many (0 when the buffer is empty or the port has
+ * none). */
+static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
+                                 sexp port, sexp bv, sexp start, sexp end) {
+  sexp_sint_t from, to, have;
+  if (!sexp_iportp(port))
+    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
+  if (!sexp_bytesp(bv))
+    return sexp_type_exception(ctx, self, SEXP_BYTES, bv);
+  if (!sexp_fixnump(start) || !sexp_fixnump(end))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM,
+                               sexp_fixnump(start) ? end : start);
+  from = sexp_unbox_fixnum(start);
+  to = sexp_unbox_fixnum(end);
+  if (from < 0 || to < from || (sexp_uint_t)to > sexp_bytes_length(bv))
+    return sexp_user_exception(ctx, self, "bad range", sexp_list2(ctx, start, end));
+  if (!sexp_port_buf(port) || sexp_port_offset(port) >= sexp_port_size(port))
+    return SEXP_ZERO;
+  have = sexp_port_size(port) - sexp_port_offset(port);
+  if (have > to - from) have = to - from;
+  memcpy(sexp_bytes_data(bv) + from,
+         sexp_port_buf(port) + sexp_port_offset(port), have);
+  sexp_port_offset(port) += have;
+  return sexp_make_fixnum(have);
+}
+
+/* (fixnum->decimal n): n in decimal.  Chibi's number->string writes to
+ * a string port, which costs 25 us; a frame's length needs it each time. */
+static sexp fixnum_to_decimal (sexp ctx, sexp self, sexp_sint_t n, sexp x) {
+  char digits[32];
+  if (!sexp_fixnump(x))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, x);
+  return sexp_c_string(ctx, digits,
+                       snprintf(digits, sizeof digits, "%ld",
+                                (long)sexp_unbox_fixnum(x)));
+}
+
+sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
+                        const char *version, const sexp_abi_identifier_t abi) {
+  if (!(sexp_version_compatible(ctx, version, sexp_version)
+        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
+    return SEXP_ABI_ERROR;
+  sexp_define_foreign(ctx, env, "read-buffered-bytes!", 4, read_buffered_bytes);
+  sexp_define_foreign(ctx, env, "fixnum->decimal", 1, fixnum_to_decimal);
+  return SEXP_VOID;
+}
