@@ -183,3 +183,80 @@
              (begin (close-input-port (cadr io))
                     (close-output-port (car (cddr io)))
                     #t))))))
+
+;;> A loopback TCP listener on a port of its own, for a test or bench
+;;> that serves on one socket without a lab; answers (listener . port).
+;;> The listener is a fileno for \scheme{accept}, non-blocking as Chibi's
+;;> threads want (the \scheme{bind} and \scheme{listen} of (chibi net)
+;;> make it so).  Keep the listener itself, not only its port, for as
+;;> long as it is used: the collector closes a fileno nothing refers to.
+;;>
+;;> The port is drawn at random between the test labs' port bases and
+;;> the kernel's ephemeral range (see \scheme{spare-ports}); one that
+;;> another process holds is stepped over, so that runs at once each get
+;;> a port of their own.
+(define (listen-on-free-port)
+  (let-values (((low high) (spare-ports)))
+    (let ((n (- high low)))
+      (let try ((tries 0) (port (+ low (random-below n))))
+        (cond
+         ((= tries n) (error "listen-on-free-port: every port taken" low high))
+         ((listener-on port) => (lambda (sock) (cons sock port)))
+         (else (try (+ tries 1) (+ low (modulo (- (+ port 1) low) n)))))))))
+
+;; The ports [low, high) that nothing else of ours, nor the kernel, hands
+;; out: tools/free-port-base puts lab port bases at 10000 + 200k, each
+;; taking 200 ports, for as many k as fit below the ephemeral range, where
+;; the kernel picks the local ports of outgoing connections.  From the top
+;; lab's end to the start of that range are 200 to 399 spare ports.
+(define (spare-ports)
+  (let* ((high (ephemeral-port-start))
+         (low (+ 10000 (* 200 (quotient (- high 10200) 200)))))
+    (if (< high 10200)
+        (error "the ephemeral port range starts too low for test labs" high))
+    (values low high)))
+
+(define (ephemeral-port-start)
+  (let ((n (guard (e (#t #f))
+             (call-with-input-file "/proc/sys/net/ipv4/ip_local_port_range"
+               read))))
+    (if (exact-integer? n) n 32768)))
+
+(define (random-below n)
+  (call-with-port (open-binary-input-file "/dev/urandom")
+    (lambda (in)
+      (let ((b (read-bytevector 2 in)))
+        (modulo (+ (* 256 (bytevector-u8-ref b 0)) (bytevector-u8-ref b 1))
+                n)))))
+
+(define eaddrinuse 98)          ; Linux's EADDRINUSE, which Chibi does not name
+
+;; A listener on 127.0.0.1:port, or #f when another socket has the port.
+;; (chibi net)'s make-listener-socket will not do for trying ports: when
+;; bind fails it closes the socket with close-file-descriptor, which leaves
+;; the fileno marked open, and the collector later closes that number
+;; again -- by then the number of the next socket made, the listener that
+;; did bind, and accept on it answers #f.  Here a socket that fails is
+;; closed through a port, which marks its fileno closed.
+(define (listener-on port)
+  (let* ((addr (get-address-info "127.0.0.1" port))
+         (sock (socket (address-info-family addr)
+                       (address-info-socket-type addr)
+                       (address-info-protocol addr))))
+    (if (not sock)
+        (error "listen-on-free-port: no socket" (integer->error-string (errno))))
+    (let* ((ok (and (set-socket-option! sock level/socket socket-opt/reuseaddr 1)
+                    (bind sock (address-info-address addr)
+                          (address-info-address-length addr))
+                    ;; Two sockets with SO_REUSEADDR may both bind a port
+                    ;; that neither listens on yet; the second listen fails.
+                    (listen sock 128)))
+           (err (errno)))
+      (cond
+       (ok sock)
+       (else
+        (close-port (open-input-file-descriptor sock))
+        (if (= err eaddrinuse)
+            #f
+            (error "listen-on-free-port: cannot listen on" port
+                   (integer->error-string err))))))))

@@ -4,12 +4,13 @@
           start-lab-aspace! start-murdoch-lab! median-seconds
           wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
-          text-contains?)
+          text-contains? listen-on-free-port)
   (import (scheme base) (scheme time) (scheme write) (scheme file)
-          (scheme process-context)
+          (scheme read) (scheme process-context)
           (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
-          (only (chibi ast) unsetenv)
+          (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab)
-          (only (chibi filesystem) delete-file-hierarchy current-directory))
+          (only (chibi filesystem) delete-file-hierarchy current-directory
+                open-input-file-descriptor))
   (include "testing.scm"))
