@@ -16,7 +16,8 @@
         (srfi 18) (srfi 132)
         (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
-        (murdoch netstring))
+        (murdoch netstring)
+        (only (murdoch testing) listen-on-free-port))
 
 (define payload (bytevector 112 105 110 103))   ; "ping"
 (define max-frame 64)
@@ -28,20 +29,6 @@
 (define (microseconds)
   (let ((tv (car (get-time-of-day))))
     (+ (* (timeval-seconds tv) 1000000) (timeval-microseconds tv))))
-
-;; A listener on some free loopback port: start from a port that depends
-;; on the process and the clock, so that two runs at once rarely try the
-;; same one, and step on while the port is taken.
-(define (listen-somewhere)
-  (let try ((port (+ 20000 (modulo (+ (* 7919 (current-process-id))
-                                       (microseconds))
-                                    40000)))
-            (tries 0))
-    (let ((sock (guard (e ((< tries 100) #f))
-                  (make-listener-socket (get-address-info "127.0.0.1" port)))))
-      (if sock
-          (cons sock port)
-          (try (+ 20000 (modulo (+ port 1 -20000) 40000)) (+ tries 1))))))
 
 ;; A forked child must not leave through exit: Chibi's exit and
 ;; emergency-exit both call libc's exit, which moves the file offset the
@@ -78,7 +65,7 @@
           (loop (+ i 1) (cons (- (microseconds) start) times))))))
 
 (define (measure mode)
-  (let* ((listener+port (listen-somewhere))
+  (let* ((listener+port (listen-on-free-port))
          (pid (begin (flush-output-port) (fork))))
     (cond
      ((zero? pid)

@@ -9,7 +9,8 @@
 (import (scheme base) (srfi 18) (srfi 132) (srfi 151)
         (chibi test) (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
-        (murdoch scheduler))
+        (murdoch scheduler)
+        (only (murdoch testing) listen-on-free-port))
 
 ;; A scheduler that never wakes fails the run instead of stalling it.
 (alarm 120)
@@ -23,24 +24,15 @@
 (define (channel)
   (map nonblocking! (open-socket-pair address-family/unix socket-type/stream 0)))
 
-;; A loopback listener on no fixed port: start from one derived from the
-;; process id, so that runs at once start apart, and step on while taken.
-(define (listen-somewhere)
-  (let try ((port (+ 20000 (modulo (* 7919 (current-process-id)) 40000)))
-            (tries 0))
-    (let ((sock (guard (e ((< tries 100) #f))
-                  (make-listener-socket (get-address-info "127.0.0.1" port)))))
-      (if sock
-          (cons sock port)
-          (try (+ 20000 (modulo (+ port 1 -20000) 40000)) (+ tries 1))))))
-
 ;; ctl carries orders to the peer; d1 and d2 carry its data back; nothing is
 ;; ever written to quiet, so a thread reading it stays blocked on it.
 (define ctl (channel))
 (define d1 (channel))
 (define d2 (channel))
 (define quiet (channel))
-(define listener (listen-somewhere))
+;; (socket . port): kept whole for the whole run, so that the collector
+;; never closes the listener.
+(define listener (listen-on-free-port))
 
 ;;; The peer
 
