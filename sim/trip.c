@@ -137,10 +137,21 @@ static int base_stop(request *q) { robot_stop(q->w, q->r); return 0; }
 static int base_set_position(request *q) { robot_set_position(q->w, q->r, q->arg[0], q->arg[1]); return 0; }
 static int base_set_heading(request *q) { robot_set_heading(q->w, q->r, q->arg[0]); return 0; }
 
+/* A heading in (-180, 180], to two decimals.  The range must hold for the
+ * text, not only for the number: wrap180 keeps -179.999 as it is, and
+ * that prints as -180.00, which is 180. */
+static void put_heading(request *q, double h)
+{
+    char text[32];
+    snprintf(text, sizeof text, "%.2f", h);
+    put(q, " %s", strcmp(text, "-180.00") == 0 ? "180.00" : text);
+}
+
 static int base_reckon(request *q)
 {
     pose p = robot_reckon(q->w, q->r);
-    put(q, " %.1f %.1f %.2f", p.x, p.y, p.heading);
+    put(q, " %.1f %.1f", p.x, p.y);
+    put_heading(q, p.heading);
     return 0;
 }
 

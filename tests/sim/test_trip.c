@@ -314,6 +314,54 @@ static void test_motion(void)
     close(c.fd);
 }
 
+/* The heading field of a reckon reply. */
+static const char *heading_of(const char *reply)
+{
+    static char h[32];
+    char tag[16];
+    double x, y;
+    if (sscanf(reply, "%15s ok %lf %lf %31s", tag, &x, &y, h) != 4)
+        return "";
+    return h;
+}
+
+/* Headings are answered in (-180, 180] as printed: one just above -180
+ * that rounds to -180 at two decimals is 180. */
+static void test_heading_range(void)
+{
+    conn c;
+    int k, ok = 0;
+    dial(&c, 0);
+    for (k = 0; k < 100 && !ok; k++) {     /* test_motion's client may still hold it */
+        ok = strcmp(ask(&c, "1 open base"), "1 ok") == 0;
+        if (!ok)
+            usleep(50000);
+    }
+    CHECK("open base for the heading range", ok);
+    ask(&c, "2 base set-heading -179.999");
+    CHECK("a heading that rounds to -180 is answered as 180",
+          strcmp(heading_of(ask(&c, "3 base reckon")), "180.00") == 0);
+    ask(&c, "4 base set-heading -180");
+    CHECK("set-heading -180 is answered as 180",
+          strcmp(heading_of(ask(&c, "5 base reckon")), "180.00") == 0);
+    ask(&c, "6 base set-heading 180");
+    CHECK("set-heading 180 is answered as 180",
+          strcmp(heading_of(ask(&c, "7 base reckon")), "180.00") == 0);
+    ask(&c, "8 base set-heading -179.99");
+    CHECK("a heading that rounds above -180 stays negative",
+          strcmp(heading_of(ask(&c, "9 base reckon")), "-179.99") == 0);
+    ask(&c, "10 base set-heading -179.999");
+    {
+        char h[32] = "";
+        double x, y, rv;
+        int tv, moving, stalled;
+        sscanf(ask(&c, "11 base status"), "11 ok %lf %lf %31s %d %lf %d %d",
+               &x, &y, h, &tv, &rv, &moving, &stalled);
+        CHECK("status answers the heading in range too", strcmp(h, "180.00") == 0);
+    }
+    close(c.fd);
+}
+
 int main(int argc, char **argv)
 {
     int ready[2], status;
@@ -362,6 +410,7 @@ int main(int argc, char **argv)
         test_killed_client();
         test_stream();
         test_motion();
+        test_heading_range();
         kill(server, SIGTERM);
         waitpid(server, &status, 0);
         CHECK("SIGTERM ends the server with status 0", WIFEXITED(status) && WEXITSTATUS(status) == 0);
