@@ -25,7 +25,7 @@
 (define *multicast* #f)                 ; (socket . group address), or #f
 (define *sequence* 0)
 (define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
-(define *last-heard* (make-hash-table eq?))     ; uid -> current-second
+(define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
 (define max-datagram 60000)
 (define beacon-seconds 1)
 (define silence-seconds 3)
@@ -65,7 +65,7 @@
 (define (send-beacons)
   (send-datagram! `(beacon ,(aspace-uid *local*) ,(aspace-host *local*)
                            ,(aspace-port *local*)))
-  (let ((now (current-second)))
+  (let ((now (monotonic-seconds)))
     (for-each (lambda (uid)
                 (if (< (hash-table-ref/default *last-heard* uid now)
                        (- now silence-seconds))
@@ -107,7 +107,7 @@
          (if (send-datagram! (list 'call id kind proc-code args-code))
              (let* ((here (capture (local-aspace-uid)
                                    (lambda () (local-call kind proc args))))
-                    (deadline (+ (current-second) seconds))
+                    (deadline (+ (monotonic-seconds) seconds))
                     (there (map (lambda (w) (await-answer w deadline seconds proc))
                                 waiting)))
                (forget!)
@@ -119,7 +119,7 @@
     (capture uid
              (lambda ()
                (let ((answer (mailbox-take
-                              (cdr w) (max 0 (- deadline (current-second)))
+                              (cdr w) (max 0 (- deadline (monotonic-seconds)))
                               (lambda ()
                                 (note-unreachable! uid)
                                 (remote-error uid (describe-procedure proc)
@@ -160,7 +160,7 @@
 (define (serve-datagram d)
   (let ((sender (car d)) (body (car (cddr d))))
     (with-lock *peers-lock*
-      (lambda () (hash-table-set! *last-heard* sender (current-second))))
+      (lambda () (hash-table-set! *last-heard* sender (monotonic-seconds))))
     (cond
      ((eq? sender (aspace-uid *local*)) #f)   ; our own, looped back
      ((and (pair? body) (eq? (car body) 'beacon) (= (length body) 4))

@@ -294,7 +294,7 @@
 
 (define (new-reservation! task exclusive shared)
   (let ((r (make-reservation task exclusive shared
-                             (+ (current-second) *lease*) 'reserved)))
+                             (+ (monotonic-seconds) *lease*) 'reserved)))
     (set! *reservations* (cons r *reservations*))
     r))
 
@@ -362,7 +362,7 @@
             (with-subscriptions
               (lambda ()
                 (filter (lambda (r)
-                          (< (reservation-deadline r) (current-second)))
+                          (< (reservation-deadline r) (monotonic-seconds)))
                         *reservations*))))
   (lease-keeper))
 
@@ -435,14 +435,14 @@
 ;; The lab's (load L) or (load ((SECONDS L) ...)): a fixed load, or one
 ;; that steps to each L at SECONDS after start; else /proc/loadavg.
 (define (load-source clause)
-  (let ((start (current-second)))
+  (let ((start (monotonic-seconds)))
     (cond
      ((not clause) read-loadavg)
      ((number? (cadr clause)) (lambda () (cadr clause)))
      (else
       (let ((steps (cadr clause)))
         (lambda ()
-          (let ((now (- (current-second) start)))
+          (let ((now (- (monotonic-seconds) start)))
             (fold (lambda (step load) (if (>= now (car step)) (cadr step) load))
                   (cadr (car steps))
                   steps))))))))

@@ -234,23 +234,23 @@
   (condition-variable-broadcast! (mailbox-condvar mb))
   (mutex-unlock! (mailbox-mutex mb)))
 
-;; Chibi's SRFI-18 time objects count whole seconds, so the deadline is
-;; kept with current-second and each wait is given as seconds left.
+;; Chibi's SRFI-18 time objects count whole seconds, so each wait is given
+;; as the seconds left until a deadline on the monotonic clock.
 (define (mailbox-take mb seconds timed-out)
-  (let ((deadline (+ (current-second) seconds)))
+  (let ((deadline (+ (monotonic-seconds) seconds)))
     (let loop ()
       (mutex-lock! (mailbox-mutex mb))
-      (cond
-       ((mailbox-full? mb)
-        (mutex-unlock! (mailbox-mutex mb))
-        (mailbox-value mb))
-       ((and (> deadline (current-second))
-             (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb)
-                            (inexact (- deadline (current-second)))))
-        (loop))
-       (else
-        (mutex-unlock! (mailbox-mutex mb))
-        (timed-out))))))
+      (if (mailbox-full? mb)
+          (begin (mutex-unlock! (mailbox-mutex mb))
+                 (mailbox-value mb))
+          (let ((left (- deadline (monotonic-seconds))))
+            (cond
+             ((and (positive? left)
+                   (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
+              (loop))
+             (else
+              (mutex-unlock! (mailbox-mutex mb))
+              (timed-out))))))))
 
 ;;; Connections to other address spaces
 
@@ -390,7 +390,7 @@
     (finish-call
      (start-call a kind (encode proc *environment* "the procedure")
                  (encode-arguments args) seconds)
-     (+ (current-second) seconds) seconds proc)))
+     (+ (monotonic-seconds) seconds) seconds proc)))
 
 ;; A call on its way: where it went, and the mailbox its answer will reach.
 (define-record-type pending-call
@@ -407,13 +407,13 @@
            (sent (send-call! c kind proc-code args-code)))
       (make-pending-call (aspace-uid a) c (car sent) (cdr sent)))))
 
-;; The answer to a pending call, by the deadline (in current-second's
-;; terms), which is \var{seconds} after the call began: the value, or a
+;; The answer to a pending call, by the deadline (on the monotonic
+;; clock), which is \var{seconds} after the call began: the value, or a
 ;; remote-error.
 (define (finish-call p deadline seconds proc)
   (let* ((uid (pending-call-uid p))
          (answer (mailbox-take
-                  (pending-call-mailbox p) (max 0 (- deadline (current-second)))
+                  (pending-call-mailbox p) (max 0 (- deadline (monotonic-seconds)))
                   (lambda ()
                     (forget-call! (pending-call-connection p) (pending-call-id p))
                     (note-unreachable! uid)
@@ -464,7 +464,7 @@
             (current-timeout)))
 
 (define (send-all aspaces kind proc args proc-code args-code seconds)
-  (let* ((deadline (+ (current-second) seconds))
+  (let* ((deadline (+ (monotonic-seconds) seconds))
          (started
           (map (lambda (a)
                  (capture (aspace-uid a)
@@ -615,7 +615,7 @@
   (if (eof-object? (peek-u8 (serving-in s)))
       (eof-object)
       (begin
-        (serving-deadline-set! s (+ (current-second) *frame-timeout*))
+        (serving-deadline-set! s (+ (monotonic-seconds) *frame-timeout*))
         (let ((message (read-frame (serving-in s) nonce count)))
           (serving-deadline-set! s #f)
           message))))
@@ -631,7 +631,7 @@
               (lambda ()
                 (filter (lambda (s)
                           (let ((d (serving-deadline s)))
-                            (and d (< d (current-second)))))
+                            (and d (< d (monotonic-seconds)))))
                         *serving*))))
   (janitor))
 

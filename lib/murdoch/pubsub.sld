@@ -9,7 +9,7 @@
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
           initialize-subscriptions!)
-  (import (scheme base) (scheme read) (scheme file) (scheme time)
+  (import (scheme base) (scheme read) (scheme file) (only (murdoch scheduler) monotonic-seconds)
           (srfi 1) (srfi 18)
           (murdoch log) (murdoch lab) (murdoch remote) (murdoch trip-client))
   (include "../pubsub.scm"))

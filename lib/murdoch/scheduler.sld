@@ -11,9 +11,14 @@
 ;;> \procedure{(poll-scheduler-installed?)}
 ;;> Returns \scheme{#t} once the wrapper is in place, which importing
 ;;> the library does.
+;;>
+;;> \procedure{(monotonic-seconds)}
+;;> Seconds since a fixed moment, as a flonum, from a clock that only goes
+;;> forward: for deadlines.  (scheme time)'s \scheme{current-second} costs
+;;> some microseconds a call and jumps when the wall clock is set.
 
 (define-library (murdoch scheduler)
-  (export poll-scheduler-installed?)
+  (export poll-scheduler-installed? monotonic-seconds)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
   (import (srfi 18))
   (include-shared "scheduler"))
