@@ -78,11 +78,14 @@ write_wrappers() {
     root=$deps/chibi
     lib=$root/usr/lib/x86_64-linux-gnu
     mkdir -p "$deps/bin"
-    modules=$(ls -d "$root"/usr/share/chibi "$lib"/chibi 2>/dev/null | tr '\n' ':')
     cat > "$deps/bin/chibi-scheme" <<W
 #!/bin/sh
+# Chibi makes its heap at the first -I, so a heap size given first stays
+# in front of the module folders.
+heap=
+if [ "\$1" = -h ]; then heap="-h \$2"; shift 2; fi
 exec "$lib/ld-linux-x86-64.so.2" --library-path "$lib" \\
-    "$root/usr/bin/chibi-scheme" -I "$root/usr/share/chibi" -I "$lib/chibi" "\$@"
+    "$root/usr/bin/chibi-scheme" \$heap -I "$root/usr/share/chibi" -I "$lib/chibi" "\$@"
 W
     cat > "$deps/bin/chibi-ffi" <<W
 #!/bin/sh
@@ -99,7 +102,7 @@ install_debian_packages
 if chibi_on_path_is_enough; then
     say "using $(command -v chibi-scheme)"
 elif [ -x "$deps/bin/chibi-scheme" ] && "$deps/bin/chibi-scheme" -V >/dev/null 2>&1; then
-    :
+    write_wrappers                      # cheap; keeps older installs current
 else
     install_private_chibi
     "$deps/bin/chibi-scheme" -V >&2
