@@ -18,14 +18,14 @@
   (let ((fd (connect-start host port)))
     (if (string? fd)
         fd
-        (await-connect fd (+ (current-second) seconds) seconds))))
+        (await-connect fd (+ (monotonic-seconds) seconds) seconds))))
 
 ;; A millisecond is little next to the timeouts of a remote call, and the
 ;; first look comes early enough for a connect on the loopback or a LAN.
 (define (await-connect fd deadline seconds)
   (cond
    ((connect-poll fd))
-   ((> (current-second) deadline)
+   ((> (monotonic-seconds) deadline)
     (connect-abandon fd)
     (string-append "no connection within " (number->string seconds) " s"))
    (else

@@ -5,6 +5,6 @@
 
 (define-library (murdoch connect)
   (export open-connection)
-  (import (scheme base) (scheme time) (srfi 18))
+  (import (scheme base) (srfi 18) (only (murdoch scheduler) monotonic-seconds))
   (include-shared "connect")
   (include "../connect.scm"))
