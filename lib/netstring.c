@@ -41,6 +41,30 @@ static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
   return sexp_make_fixnum(have);
 }
 
+/* (buffered-byte-count port): how many bytes the input port's buffer
+ * holds, read from the descriptor but not yet from the port.  Lets a
+ * reader see that more frames have arrived without waiting for them. */
+static sexp buffered_byte_count (sexp ctx, sexp self, sexp_sint_t n, sexp port) {
+  if (!sexp_iportp(port))
+    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
+  if (!sexp_port_buf(port) || sexp_port_offset(port) >= sexp_port_size(port))
+    return SEXP_ZERO;
+  return sexp_make_fixnum(sexp_port_size(port) - sexp_port_offset(port));
+}
+
+/* (reset-output-string! port): empties a string output port, keeping its
+ * buffer, so that one port can build frame after frame.  A new string
+ * port costs a 4 KB buffer from Chibi's heap, and allocating that much
+ * at a time, a frame at a time, was a good part of a message's cost. */
+static sexp reset_output_string (sexp ctx, sexp self, sexp_sint_t n, sexp port) {
+  if (!sexp_oportp(port) || !sexp_pairp(sexp_port_cookie(port))
+      || sexp_filenop(sexp_port_fd(port)))
+    return sexp_xtype_exception(ctx, self, "not a string output port", port);
+  sexp_port_offset(port) = 0;
+  sexp_cdr(sexp_port_cookie(port)) = SEXP_NULL;
+  return SEXP_VOID;
+}
+
 /* (fixnum->decimal n): n in decimal.  Chibi's number->string writes to
  * a string port, which costs 25 us; a frame's length needs it each time. */
 static sexp fixnum_to_decimal (sexp ctx, sexp self, sexp_sint_t n, sexp x) {
@@ -59,5 +83,7 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
     return SEXP_ABI_ERROR;
   sexp_define_foreign(ctx, env, "read-buffered-bytes!", 4, read_buffered_bytes);
   sexp_define_foreign(ctx, env, "fixnum->decimal", 1, fixnum_to_decimal);
+  sexp_define_foreign(ctx, env, "buffered-byte-count", 1, buffered_byte_count);
+  sexp_define_foreign(ctx, env, "reset-output-string!", 1, reset_output_string);
   return SEXP_VOID;
 }

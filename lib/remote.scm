@@ -169,11 +169,18 @@
 
 (define (frame-mac nonce count text) (*mac* nonce ":" count ":" text))
 
-(define (write-frame! out nonce count message)
-  (let* ((text (call-with-output-string (lambda (o) (write-simple message o))))
-         (payload (string-append (frame-mac nonce count text) text)))
-    (write-netstring payload out)
-    (flush-output-port out)))
+;; Each connection writes its frames' text to a string port of its own,
+;; emptied after each frame (its writer holds the connection's lock): a
+;; new string port per frame costs Chibi a 4 KB allocation.
+(define (write-frame! out text-port nonce count message)
+  (write-simple message text-port)
+  (let ((text (get-output-string text-port)))
+    (reset-output-string! text-port)
+    (write-netstring (string-append (frame-mac nonce count text) text) out)))
+
+(define (send-frame! out text-port nonce count message)
+  (write-frame! out text-port nonce count message)
+  (flush-output-port out))
 
 ;;> Raised for a frame that breaks the protocol; the connection closes.
 (define-record-type frame-error
@@ -255,12 +262,13 @@
 ;;; Connections to other address spaces
 
 (define-record-type connection
-  (make-connection uid socket in out write-lock pending)
+  (make-connection uid socket in out text write-lock pending)
   connection?
   (uid connection-uid)
   (socket connection-socket)
   (in connection-in)
   (out connection-out)
+  (text connection-text)                       ; see write-frame!
   (write-lock connection-write-lock)
   (pending connection-pending)                 ; id -> mailbox
   (nonce connection-nonce connection-nonce-set!) ; the callee's
@@ -294,13 +302,14 @@
                       (string-append "cannot connect to " (aspace-host a) ":"
                                      (number->string (aspace-port a)))))
     (let ((c (make-connection (aspace-uid a) (car io) (cadr io) (car (cddr io))
+                              (open-output-string)
                               (make-mutex) (make-hash-table eqv?)))
           (nonce (random-hex 16))
           (welcome (make-mailbox)))
       (connection-sent-set! c 0)
       (connection-next-id-set! c 0)
       (connection-open?-set! c #t)
-      (write-frame! (connection-out c) "hello" 0
+      (send-frame! (connection-out c) (connection-text c) "hello" 0
                     `(hello ,(aspace-uid *local*) ,(aspace-host *local*)
                             ,(aspace-port *local*) ,nonce))
       (thread-start! (make-thread (lambda () (read-answers c nonce welcome))
@@ -375,8 +384,9 @@
         (connection-sent-set! c count)
         (hash-table-set! (connection-pending c) id mb)
         (guard (e (#t (connection-open?-set! c #f) (raise e)))
-          (write-frame! (connection-out c) (connection-nonce c) count
-                        (list kind id proc-code args-code)))
+          (send-frame! (connection-out c) (connection-text c)
+                       (connection-nonce c) count
+                       (list kind id proc-code args-code)))
         (cons id mb)))))
 
 (define (forget-call! c id)
@@ -638,20 +648,31 @@
 (define (serve-calls s hello)
   (let* ((caller-nonce (greet! hello))
          (nonce (random-hex 16))
+         (out (serving-out s))
+         (text (open-output-string))
          (write-lock (make-mutex))
          (sent 0))
+    ;; The reader's own answers, the acks, wait in the port's buffer until
+    ;; it has read every call that has arrived: a burst of remote-run!s is
+    ;; acknowledged in one write.  Answers from workers go at once.
     (define (answer! message)
       (with-lock write-lock
         (lambda ()
           (set! sent (+ sent 1))
           (guard (e (#t #f))           ; the caller left; nothing to tell
-            (write-frame! (serving-out s) caller-nonce sent message)))))
-    (write-frame! (serving-out s) caller-nonce 0
-                  `(welcome ,(aspace-uid *local*) ,nonce))
+            (write-frame! out text caller-nonce sent message)
+            (if (not (eq? (current-thread) (serving-thread s)))
+                (flush-output-port out))))))
+    (define (flush-if-idle!)
+      (if (zero? (buffered-byte-count (serving-in s)))
+          (with-lock write-lock
+            (lambda () (guard (e (#t #f)) (flush-output-port out))))))
+    (send-frame! out text caller-nonce 0 `(welcome ,(aspace-uid *local*) ,nonce))
     (let loop ((count 1))
       (let ((message (read-served-frame s nonce count)))
         (if (not (eof-object? message))
             (begin (serve-call message answer!)
+                   (flush-if-idle!)
                    (loop (+ count 1))))))))
 
 ;; Check a hello and learn where its sender listens; answers its nonce.
