@@ -4,11 +4,13 @@
 ;; Prints, one line each, medians over many calls after a warm-up:
 ;;   bench: remote-apply-rtt VALUE us       a trivial closure
 ;;   bench: remote-apply-rtt-1k VALUE us    a closure capturing 1 KB
-;;   bench: remote-run-throughput VALUE per-s
+;;   bench: remote-run-throughput VALUE per-s          16 sender threads
+;;   bench: remote-run-throughput-serial VALUE per-s   one, each call waiting
+;;                                                      for its ack
 ;; The C floor (bench/c-pingpong) and the ratio are printed by bench/run.
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time)
-        (srfi 132)
+        (srfi 1) (srfi 18) (srfi 132)
         (murdoch) (murdoch command) (murdoch testing))
 
 (define lab (make-test-lab '((aspace bencher) (aspace troy))))
@@ -40,11 +42,24 @@
                             (remote-apply troy
                                           (lambda () (string-length kilobyte)))))
           "us"))
-(let* ((n 5000)
-       (t0 (current-second)))
-  (do ((i 0 (+ i 1))) ((= i n))
-    (remote-run! troy (lambda () #t)))
-  (report "remote-run-throughput" (/ n (- (current-second) t0)) "per-s"))
+;; remote-run! returns once the target has acknowledged, so one thread's
+;; calls are a round trip each; a sender with work to hand out keeps
+;; several on the way, and the acks of a burst come back in one write.
+(define (run-throughput threads calls)
+  (let ((t0 (current-second)))
+    (for-each thread-join!
+              (map (lambda (i)
+                     (thread-start!
+                      (make-thread
+                       (lambda ()
+                         (do ((i 0 (+ i 1))) ((= i calls))
+                           (remote-run! troy (lambda () #t)))))))
+                   (iota threads)))
+    (/ (* threads calls) (- (current-second) t0))))
+
+(run-throughput 16 100)                                          ; warm-up
+(report "remote-run-throughput" (run-throughput 16 500) "per-s")
+(report "remote-run-throughput-serial" (run-throughput 1 5000) "per-s")
 
 (stop-all-processes!)
 (remove-test-lab! lab)

@@ -174,17 +174,14 @@
           (thunk)
           (loop (+ i 1) (cons (- (current-second) t0) times))))))
 
-;;> Waits until something accepts connections on \var{port}.  Not with
-;;> (chibi net)'s open-net-io: on a refused connect it closes the socket
-;;> by number, and the collector closes that number again later, by then
-;;> perhaps one of this process's connections.
+;;> Waits until something accepts connections on \var{port}.
 (define (wait-for-port port seconds)
   (wait-until seconds
     (lambda ()
-      (let ((io (open-connection "127.0.0.1" port seconds)))
+      (let ((io (guard (e (#t #f)) (open-net-io "127.0.0.1" port))))
         (and (pair? io)
-             (begin (close-input-port (car io))
-                    (close-output-port (cadr io))
+             (begin (close-input-port (cadr io))
+                    (close-output-port (car (cddr io)))
                     #t))))))
 
 ;;> A loopback TCP listener on a port of its own, for a test or bench
