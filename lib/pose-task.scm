@@ -57,17 +57,22 @@
   (let ((dx (- (car p) (car q))) (dy (- (cadr p) (cadr q))))
     (sqrt (+ (* dx dx) (* dy dy)))))
 
+;; What candidate uid answers to proc, sent point to point.
+(define (ask uid proc)
+  (let ((answers (request uid proc)))
+    (if (null? answers)
+        (error "the candidate did not answer" uid)
+        (cadar answers))))
+
 ;;> Prefers the candidate closest to \var{target}, (x y theta 0) as reckon
 ;;> answers, by each candidate's safe-reckon.
 (define (location-metric-maker target)
   (metric-by (lambda (uid)
-               (reckon-distance-between target
-                                        (cadar (request uid safe-reckon))))))
+               (reckon-distance-between target (ask uid safe-reckon)))))
 
 ;;> Prefers the candidate with the lowest system load.
 (define (load-metric-maker)
-  (metric-by (lambda (uid)
-               (string->number (cadar (request uid get-system-load))))))
+  (metric-by (lambda (uid) (string->number (ask uid get-system-load)))))
 
 ;;> The load metric of Figure 4.6.
 (define load-metric (load-metric-maker))
@@ -92,10 +97,14 @@
            (map cdr (list-sort (lambda (a b) (< (car a) (car b))) measured)))))
    (else (list-sort metric response))))
 
-;; Measures every candidate at once: the answers' round trips overlap.
+;; Measures every candidate at once: the answers' round trips overlap.  A
+;; candidate that cannot be measured (it died, or did not answer in time)
+;; measures +inf.0, and so comes last.
 (define (measure-all measure uids)
   (map thread-join!
-       (map (lambda (uid) (thread-start! (make-thread (lambda () (measure uid)))))
+       (map (lambda (uid)
+              (thread-start!
+               (make-thread (lambda () (guard (e (#t +inf.0)) (measure uid))))))
             uids)))
 
 (define (shuffle ls)

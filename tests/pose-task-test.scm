@@ -61,6 +61,12 @@
              (list (reverse-metric (location-metric-maker '(0 0 0 0))))
              (list who-am-i)))
 
+(test "a candidate that cannot be measured comes last" '(far)
+  (pose-task 'unmeasured 1 (list '((mobile) ()))
+             (list (metric-by (lambda (uid)
+                                (if (eq? uid 'near) (error "no answer") 1))))
+             (list who-am-i)))
+
 (test "a one-robot task frees its robot" #t
   (begin (pose-task 'one 1 (list '((mobile) ())) (list #f) (list who-am-i))
          (all-free?)))
