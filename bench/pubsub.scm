@@ -55,21 +55,26 @@
                 (if (eq? type 'exclusive) ((cadr winner) #f)))
               (car team) (cadr team))))
 
+(define (measure-lab lab n)
+  (join-lab (test-lab-file lab) 'bencher)
+  (let ((task (eval '(dual-sonar-task) (lab-environment))))
+    (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
+    (report "request-latency" n
+            (median-ms 50 (lambda ()
+                            (let ((answers (request 'all (lambda () #t))))
+                              (if (< (length answers) n)
+                                  (error "not every address space answered"
+                                         (length answers)))))))
+    (report "pose-task-negotiation" n
+            (median-ms 20 (lambda () (negotiate-and-release task))))))
+
+;; The lab's address spaces are stopped however the measuring ends.
 (define (bench-lab n delivery)
-  (let ((lab (start-lab n delivery)))
-    (join-lab (test-lab-file lab) 'bencher)
-    (let ((task (eval '(dual-sonar-task) (lab-environment))))
-      (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
-      (report "request-latency" n
-              (median-ms 50 (lambda ()
-                              (let ((answers (request 'all (lambda () #t))))
-                                (if (< (length answers) n)
-                                    (error "not every address space answered"
-                                           (length answers)))))))
-      (report "pose-task-negotiation" n
-              (median-ms 20 (lambda () (negotiate-and-release task)))))
-    (stop-all-processes!)
-    (remove-test-lab! lab)))
+  (let* ((lab (start-lab n delivery))
+         (done (lambda () (stop-all-processes!) (remove-test-lab! lab))))
+    (guard (e (#t (done) (raise e)))
+      (measure-lab lab n))
+    (done)))
 
 (define multicast? (and (pair? (cddr (command-line)))
                        (equal? (car (cddr (command-line))) "multicast")))

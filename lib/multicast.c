@@ -28,7 +28,7 @@ static sexp open_multicast_socket (sexp ctx, sexp self, sexp_sint_t n,
   struct sockaddr_in addr;
   struct ip_mreq mreq;
   struct in_addr ifaddr;
-  int fd, one = 1;
+  int fd, one = 1, rcvbuf = 1 << 20;
   unsigned char loop = 1, ttl = 1;
   sexp_assert_type(ctx, sexp_stringp, SEXP_STRING, group);
   sexp_assert_type(ctx, sexp_fixnump, SEXP_FIXNUM, port);
@@ -42,6 +42,11 @@ static sexp open_multicast_socket (sexp ctx, sexp self, sexp_sint_t n,
   fd = socket(AF_INET, SOCK_DGRAM, 0);
   if (fd < 0)
     return fail(ctx, self, strerror(errno), group);
+  /* A call to the lab reaches every address space at once, and each
+   * answers and beacons: with dozens on one machine the default receive
+   * buffer overflows and datagrams are lost.  Best effort: the kernel caps
+   * it at net.core.rmem_max. */
+  setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
   memset(&addr, 0, sizeof addr);
   addr.sin_family = AF_INET;
   addr.sin_port = htons((unsigned short)sexp_unbox_fixnum(port));
