@@ -198,15 +198,21 @@
                    (read-netstring in *max-frame*))))
     (if (eof-object? payload)
         payload
-        (let ((text (guard (e (#t (frame-fail "payload is not UTF-8")))
-                      (utf8->string payload))))
-          (if (or (< (string-length text) 64)
-                  (not (string=? (substring text 0 64)
-                                 (frame-mac nonce count
-                                            (substring text 64
-                                                       (string-length text))))))
-              (frame-fail "bad MAC"))
-          (parse-message (substring text 64 (string-length text)))))))
+        (parse-message
+         (authentic-text payload (bytevector-length payload)
+                         (lambda (text) (frame-mac nonce count text)))))))
+
+;; The text after the MAC in the first end bytes of bytes, once (mac-of
+;; text) matches the MAC.  Cut as bytes: Chibi's strings are UTF-8, where
+;; string-length and substring walk the string.
+(define (authentic-text bytes end mac-of)
+  (if (< end 64) (frame-fail "bad MAC"))
+  (let ((mac (guard (e (#t (frame-fail "bad MAC"))) (utf8->string bytes 0 64)))
+        (text (guard (e (#t (frame-fail "payload is not UTF-8")))
+                (utf8->string bytes 64 end))))
+    (if (not (string=? mac (mac-of text)))
+        (frame-fail "bad MAC"))
+    text))
 
 ;; Chibi's own reader, in C: (scheme read) is SRFI 38's, with datum
 ;; labels, written in Scheme and a hundred times slower.  Messages have no
