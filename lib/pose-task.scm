@@ -30,11 +30,6 @@
        out)
       (flush-output-port out))))
 
-;; A value written short enough for one progress line.
-(define (abridged value)
-  (let ((s (call-with-output-string (lambda (out) (write value out)))))
-    (if (> (string-length s) 50) (string-append (substring s 0 47) "...") s)))
-
 ;;; Metrics
 
 ;; A metric compares two candidates, (uid promise-or-result) entries, and
@@ -148,7 +143,7 @@
                       (car team) (cadr team))
             (for-each (lambda (i uid result)
                         (progress "  component " i " done on " uid ": "
-                                  (abridged result)))
+                                  (abridged result 50)))
                       (iota (length uids) 1) uids results)
             results)))))
 

@@ -203,16 +203,20 @@
                            (enc value (lambda ()
                                         (string-append
                                          "variable " (symbol->string name)
-                                         " of " (short-source source))))))
+                                         " of " (abridged source 60))))))
                    (cdr source+names)
                    ((sendable-info-values info))))))
   (enc x what))
 
-(define (short-source source)
+;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters,
+;;> ending in "...", when it is longer: for messages and progress lines.
+(define (abridged x width)
   (let ((s (let ((out (open-output-string)))
-             (write source out)
+             (write x out)
              (get-output-string out))))
-    (if (> (string-length s) 60) (string-append (substring s 0 57) "...") s)))
+    (if (> (string-length s) width)
+        (string-append (substring s 0 (- width 3)) "...")
+        s)))
 
 ;;; Decoding
 
