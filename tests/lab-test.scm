@@ -27,13 +27,6 @@
              (number->string pid) file)
     (map string->number (read-lines file))))
 
-(define (read-lines file)
-  (call-with-input-file file
-    (lambda (in)
-      (let loop ((acc '()))
-        (let ((l (read-line in)))
-          (if (eof-object? l) (reverse acc) (loop (cons l acc))))))))
-
 ;; The lines `bin/murdoch pose` prints for the task file `task`.
 (define (pose-output task)
   (let ((out (in-dir "pose.out")))

@@ -46,6 +46,14 @@
         (lambda (in) (let ((s (read-string 10000000 in))) (if (eof-object? s) "" s))))
       ""))
 
+;;> The lines of \var{file}, without their newlines.
+(define (read-lines file)
+  (call-with-input-file file
+    (lambda (in)
+      (let loop ((acc '()))
+        (let ((line (read-line in)))
+          (if (eof-object? line) (reverse acc) (loop (cons line acc))))))))
+
 ;;> True when \var{word} occurs in \var{text}.
 (define (text-contains? text word)
   (let ((n (string-length word)))

@@ -20,13 +20,6 @@
           ((and (< i j) (char-whitespace? (string-ref s (- j 1)))) (loop i (- j 1)))
           (else (substring s i j)))))
 
-(define (read-lines file)
-  (call-with-input-file file
-    (lambda (in)
-      (let loop ((acc '()))
-        (let ((line (read-line in)))
-          (if (eof-object? line) (reverse acc) (loop (cons line acc))))))))
-
 ;;> Reads the transcript \var{file}.  Comments (";;") and blank lines are
 ;;> dropped; "lab:" and "as:" lines are the header; "> " lines are input,
 ;;> and the lines after each are what it should print.

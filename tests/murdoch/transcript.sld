@@ -3,5 +3,6 @@
 (define-library (murdoch transcript)
   (export read-transcript transcript-lab transcript-as transcript-steps
           transcript-input transcript-mismatches line-matches?)
-  (import (scheme base) (scheme char) (scheme file) (srfi 1))
+  (import (scheme base) (scheme char) (scheme file) (srfi 1)
+          (only (murdoch testing) read-lines))
   (include "transcript.scm"))
