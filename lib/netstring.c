@@ -13,6 +13,14 @@
 #include <stdio.h>
 #include <string.h>
 
+/* How many bytes the input port's buffer holds, read from the descriptor
+ * but not yet from the port. */
+static sexp_sint_t buffered (sexp port) {
+  if (!sexp_port_buf(port) || sexp_port_offset(port) >= sexp_port_size(port))
+    return 0;
+  return sexp_port_size(port) - sexp_port_offset(port);
+}
+
 /* (read-buffered-bytes! port bytevector start end): copies what the
  * port's buffer holds, up to end - start bytes, into bytevector from
  * start; answers how many (0 when the buffer is empty or the port has
@@ -31,9 +39,8 @@ static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
   to = sexp_unbox_fixnum(end);
   if (from < 0 || to < from || (sexp_uint_t)to > sexp_bytes_length(bv))
     return sexp_user_exception(ctx, self, "bad range", sexp_list2(ctx, start, end));
-  if (!sexp_port_buf(port) || sexp_port_offset(port) >= sexp_port_size(port))
-    return SEXP_ZERO;
-  have = sexp_port_size(port) - sexp_port_offset(port);
+  have = buffered(port);
+  if (have == 0) return SEXP_ZERO;
   if (have > to - from) have = to - from;
   memcpy(sexp_bytes_data(bv) + from,
          sexp_port_buf(port) + sexp_port_offset(port), have);
@@ -41,15 +48,12 @@ static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
   return sexp_make_fixnum(have);
 }
 
-/* (buffered-byte-count port): how many bytes the input port's buffer
- * holds, read from the descriptor but not yet from the port.  Lets a
- * reader see that more frames have arrived without waiting for them. */
+/* (buffered-byte-count port): what the buffer holds (see buffered).  Lets
+ * a reader see that more frames have arrived without waiting for them. */
 static sexp buffered_byte_count (sexp ctx, sexp self, sexp_sint_t n, sexp port) {
   if (!sexp_iportp(port))
     return sexp_type_exception(ctx, self, SEXP_IPORT, port);
-  if (!sexp_port_buf(port) || sexp_port_offset(port) >= sexp_port_size(port))
-    return SEXP_ZERO;
-  return sexp_make_fixnum(sexp_port_size(port) - sexp_port_offset(port));
+  return sexp_make_fixnum(buffered(port));
 }
 
 /* (reset-output-string! port): empties a string output port, keeping its
