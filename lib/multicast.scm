@@ -137,7 +137,7 @@
 ;; each, dozens a second, cost more than serving them.
 (define (receive-datagrams buffer)
   (let ((n (receive! (car *multicast*) buffer)))
-    (if (positive? n)
+    (if (>= n 0)
         (guard (e (#t (log-warn "datagram dropped: "
                                 (if (frame-error? e) (frame-error-message e)
                                     (error-message e)))))

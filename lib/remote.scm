@@ -170,12 +170,13 @@
 (define (frame-mac nonce count text) (*mac* nonce ":" count ":" text))
 
 ;; Each connection writes its frames' text to a string port of its own,
-;; emptied after each frame (its writer holds the connection's lock): a
-;; new string port per frame costs Chibi a 4 KB allocation.
+;; emptied before each frame, so that a write that failed half-way leaves
+;; nothing behind (its writer holds the connection's lock): a new string
+;; port per frame costs Chibi a 4 KB allocation.
 (define (write-frame! out text-port nonce count message)
+  (reset-output-string! text-port)
   (write-simple message text-port)
   (let ((text (get-output-string text-port)))
-    (reset-output-string! text-port)
     (write-netstring (string-append (frame-mac nonce count text) text) out)))
 
 (define (send-frame! out text-port nonce count message)
