@@ -20,13 +20,28 @@
   (directory test-lab-directory)
   (port-base test-lab-port-base))
 
+;; The first line \var{cmd} prints; an error when it prints none.
+;; (chibi process)'s call-with-process-io will not do: it closes the
+;; parent's ends of its pipes with close-file-descriptor, which leaves
+;; their filenos marked open, and the collector later closes those
+;; numbers again -- by then another pipe's or a live socket's.  Closing
+;; through a port marks the fileno closed.
 (define (command-output cmd)
-  (call-with-process-io cmd
-    (lambda (pid in out err)
-      (close-output-port in)
-      (let ((line (read-line out)))
+  (let* ((pipe (open-pipe))
+         (pid (fork)))
+    (cond
+     ((zero? pid)
+      (duplicate-file-descriptor-to (cadr pipe) 1)
+      (execute (car cmd) cmd)
+      (exit 127))
+     (else
+      (close-port (open-output-file-descriptor (cadr pipe)))
+      (let* ((out (open-input-file-descriptor (car pipe)))
+             (line (read-line out)))
+        (close-port out)
         (waitpid pid 0)
-        line))))
+        (if (eof-object? line) (error "a command printed nothing" cmd))
+        line)))))
 
 ;;> A fresh folder of its own under $TMPDIR, made with mktemp -d.
 (define (temporary-directory)

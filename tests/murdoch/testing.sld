@@ -12,5 +12,6 @@
           (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab)
           (only (chibi filesystem) delete-file-hierarchy current-directory
-                open-input-file-descriptor))
+                open-input-file-descriptor open-output-file-descriptor
+                open-pipe duplicate-file-descriptor-to))
   (include "testing.scm"))
