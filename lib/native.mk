@@ -1,9 +1,10 @@
 # Murdoch's C outside the simulator, for the top Makefile to include; paths
 # are from the top of the repository.
 #   make native         builds lib/murdoch/scheduler.so, multicast.so,
-#                       hmac.so and netstring.so, the C of (murdoch
-#                       scheduler), (murdoch multicast), (murdoch hmac) and
-#                       (murdoch netstring), and bench/c-pingpong
+#                       hmac.so, netstring.so and connect.so, the C of
+#                       (murdoch scheduler), (murdoch multicast), (murdoch
+#                       hmac), (murdoch netstring) and (murdoch connect),
+#                       and bench/c-pingpong
 #   make native-clean   removes them
 
 # tools/chibi-cflags names the directory of Chibi's headers, which in the
@@ -16,7 +17,7 @@ NATIVE_CHIBI_HEADERS = $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)
 NATIVE_CFLAGS ?= -O2 -g -Wall
 
 NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
-                  lib/murdoch/hmac.so lib/murdoch/netstring.so
+                  lib/murdoch/hmac.so lib/murdoch/netstring.so lib/murdoch/connect.so
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 

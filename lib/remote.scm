@@ -269,10 +269,9 @@
 ;;; Connections to other address spaces
 
 (define-record-type connection
-  (make-connection uid socket in out text write-lock pending)
+  (make-connection uid in out text write-lock pending)
   connection?
   (uid connection-uid)
-  (socket connection-socket)
   (in connection-in)
   (out connection-out)
   (text connection-text)                       ; see write-frame!
@@ -283,32 +282,46 @@
   (next-id connection-next-id connection-next-id-set!)
   (open? connection-open? connection-open?-set!))
 
+;; The open connections, and a lock for each uid that one thread holds
+;; while it connects to that uid: a peer that does not answer holds up the
+;; calls to it for their timeout, and no call to another peer.
 (define *connections* (make-hash-table eq?))  ; uid -> connection
+(define *connecting* (make-hash-table eq?))   ; uid -> mutex
 (define *connections-lock* (make-mutex 'connections))
-
-(define (open-socket host port)
-  (let ((io (guard (e (#t #f)) (open-net-io host port))))
-    (and (pair? io) io)))
 
 ;; The open connection to uid, made (and greeted) if there is none.
 (define (connection-to a seconds)
   (let ((uid (aspace-uid a)))
-    (with-lock *connections-lock*
-      (lambda ()
-        (let ((c (hash-table-ref/default *connections* uid #f)))
-          (if (and c (connection-open? c))
-              c
-              (let ((c (connect! a seconds)))
-                (hash-table-set! *connections* uid c)
-                c)))))))
+    (or (live-connection-to uid)
+        (with-lock (connecting-lock uid)
+          (lambda ()
+            (or (live-connection-to uid)
+                (let ((c (connect! a seconds)))
+                  (with-lock *connections-lock*
+                    (lambda () (hash-table-set! *connections* uid c)))
+                  c)))))))
+
+(define (live-connection-to uid)
+  (with-lock *connections-lock*
+    (lambda ()
+      (let ((c (hash-table-ref/default *connections* uid #f)))
+        (and c (connection-open? c) c)))))
+
+(define (connecting-lock uid)
+  (with-lock *connections-lock*
+    (lambda ()
+      (or (hash-table-ref/default *connecting* uid #f)
+          (let ((m (make-mutex uid)))
+            (hash-table-set! *connecting* uid m)
+            m)))))
 
 (define (connect! a seconds)
-  (let ((io (open-socket (aspace-host a) (aspace-port a))))
-    (if (not io)
+  (let ((io (open-connection (aspace-host a) (aspace-port a) seconds)))
+    (if (string? io)
         (remote-error (aspace-uid a) 'connect
                       (string-append "cannot connect to " (aspace-host a) ":"
-                                     (number->string (aspace-port a)))))
-    (let ((c (make-connection (aspace-uid a) (car io) (cadr io) (car (cddr io))
+                                     (number->string (aspace-port a)) ": " io)))
+    (let ((c (make-connection (aspace-uid a) (car io) (cadr io)
                               (open-output-string)
                               (make-mutex) (make-hash-table eqv?)))
           (nonce (random-hex 16))

@@ -109,11 +109,10 @@
 ;;; Connections
 
 (define-record-type trip-connection
-  (make-trip-connection host port socket in out lock opened)
+  (make-trip-connection host port in out lock opened)
   trip-connection?
   (host trip-connection-host)
   (port trip-connection-port)
-  (socket trip-connection-socket)
   (in trip-connection-in)
   (out trip-connection-out)
   (lock trip-connection-lock)              ; held from request to reply
@@ -130,11 +129,11 @@
 ;;> Connects to the trip server of one robot and returns the connection;
 ;;> its name is the robot's, as the server says.
 (define (trip-connect host port)
-  (let ((io (guard (e (#t #f)) (open-net-io host port))))
-    (if (not (pair? io))
+  (let ((io (open-connection host port (trip-timeout))))
+    (if (string? io)
         (trip-error (string-append host ":" (number->string port)) "connect"
-                    "closed" "cannot connect"))
-    (let ((c (make-trip-connection host port (car io) (cadr io) (car (cddr io))
+                    "closed" (string-append "cannot connect: " io)))
+    (let ((c (make-trip-connection host port (car io) (cadr io)
                                    (make-mutex 'trip) '())))
       (trip-connection-name-set! c #f)
       (trip-connection-tag-set! c 0)

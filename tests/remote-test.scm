@@ -2,7 +2,7 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme file)
         (scheme eval) (scheme read)
         (srfi 18) (chibi test) (chibi net)
-        (only (chibi filesystem) close-file-descriptor)
+        (only (chibi filesystem) open-input-file-descriptor)
         (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
         (murdoch netstring) (murdoch hmac) (murdoch testing))
 
@@ -14,7 +14,7 @@
 
 (define lab
   (make-test-lab '((code "shared.scm") (frame-timeout 1)
-                   (aspace tester) (aspace troy)
+                   (aspace tester) (aspace troy) (aspace ghost)
                    (aspace praline))
                  `(("shared.scm" . ,shared-code))))
 
@@ -105,6 +105,23 @@
   (set! praline-pid (start-lab-aspace! lab 'praline))
   (test "a restarted target is reached again" 7
     (remote-apply (uid->aspace 'praline) (lambda () 7))))
+
+(test-group "an address space that does not answer the connect"
+  ;; A listener that never accepts, its queue filled: the next connect
+  ;; hangs, as for a robot that was switched off.
+  (let* ((addr (get-address-info "127.0.0.1" (aspace-port (uid->aspace 'ghost))))
+         (listener (make-listener-socket addr 0))
+         (filler (open-net-io "127.0.0.1" (aspace-port (uid->aspace 'ghost)))))
+    (test "raises within the timeout, saying so"
+        (string-append "cannot connect to 127.0.0.1:"
+                       (number->string (aspace-port (uid->aspace 'ghost)))
+                       ": no connection within 1 s")
+      (parameterize ((remote-timeout 1))
+        (error-text (lambda ()
+                      (remote-apply (uid->aspace 'ghost) (lambda () 1))))))
+    (test "and another address space answers meanwhile" 2
+      (remote-apply (uid->aspace 'troy) (lambda () 2)))
+    (close-port (open-input-file-descriptor listener))))
 
 (test-group "the sandbox"
   (let ((victim (string-append (test-lab-directory lab) "/victim")))

@@ -13,5 +13,5 @@
   (import (scheme base) (scheme write) (srfi 18) (srfi 151)
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
-          (chibi net))
+          (murdoch connect))
   (include "../trip-client.scm"))

@@ -201,10 +201,10 @@
 (define (wait-for-port port seconds)
   (wait-until seconds
     (lambda ()
-      (let ((io (guard (e (#t #f)) (open-net-io "127.0.0.1" port))))
+      (let ((io (open-connection "127.0.0.1" port seconds)))
         (and (pair? io)
-             (begin (close-input-port (cadr io))
-                    (close-output-port (car (cddr io)))
+             (begin (close-input-port (car io))
+                    (close-output-port (cadr io))
                     #t))))))
 
 ;;> A loopback TCP listener on a port of its own, for a test or bench

@@ -10,7 +10,7 @@
           (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
           (only (chibi ast) unsetenv errno integer->error-string)
-          (murdoch lab)
+          (murdoch lab) (murdoch connect)
           (only (chibi filesystem) delete-file-hierarchy current-directory
                 open-input-file-descriptor open-output-file-descriptor
                 open-pipe duplicate-file-descriptor-to))

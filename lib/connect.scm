@@ -1,0 +1,51 @@
+;;;; A TCP connect that gives up at a timeout without holding the process.
+;;
+;; The socket is made and closed here, as (chibi net) makes and closes
+;; its own; lib/connect.c starts its connect, non-blocking, and says when
+;; the connect is done.  This side looks every millisecond and sleeps its
+;; own green thread in between, so the process's other threads run on.
+
+;;> \procedure{(open-connection host port seconds)}
+;;> Connects to TCP \var{port} of \var{host} (an IPv4 address or a name
+;;> such as "localhost"), waiting at most \var{seconds} and blocking no
+;;> other thread meanwhile.  Answers \scheme{(list in out)}, an input and
+;;> an output port on the connected socket, which closing both closes; or,
+;;> when there is no connection, a string saying why, such as
+;;> "connection refused", "no such host" or "no connection within 0.3 s",
+;;> for the caller to put after the peer's name.  Only wrong arguments
+;;> raise.  Resolving a name that is not an address nor in /etc/hosts may
+;;> ask DNS, which blocks the process.
+(define (open-connection host port seconds)
+  (let ((sock (socket address-family/inet socket-type/stream 0)))
+    (if (not (fileno? sock))
+        "no socket to connect with"
+        (begin
+          (set-file-descriptor-status!
+           sock (bitwise-ior open/non-block (get-file-descriptor-status sock)))
+          (let ((started (connect-start sock host port)))
+            (if (string? started)
+                (close-socket sock started)
+                (await-connect sock (+ (monotonic-seconds) seconds) seconds)))))))
+
+;; A millisecond is little next to the timeouts of a remote call, and the
+;; first look comes at once, soon enough for a connect on the loopback.
+(define (await-connect sock deadline seconds)
+  (let ((done (connect-poll sock)))
+    (cond
+     ((string? done) (close-socket sock done))
+     (done (list (open-input-file-descriptor sock #t)
+                 (open-output-file-descriptor sock #t)))
+     ((> (monotonic-seconds) deadline)
+      (close-socket sock (string-append "no connection within "
+                                        (number->string seconds) " s")))
+     (else
+      (thread-sleep! 0.001)
+      (await-connect sock deadline seconds)))))
+
+;; Closes a socket that has no ports yet, through one: that marks its
+;; fileno closed, where close-file-descriptor would leave it marked open
+;; for the collector to close the number again, whoever has it by then.
+;; Answers why.
+(define (close-socket sock why)
+  (close-port (open-input-file-descriptor sock))
+  why)

@@ -1,0 +1,16 @@
+;;> A TCP connect that gives up at a timeout: \scheme{open-connection},
+;;> the non-blocking replacement of (chibi net)'s \scheme{open-net-io}.
+;;> The C is lib/connect.c, built into lib/murdoch/connect.so by
+;;> \scheme{make native}; the waiting is lib/connect.scm.
+
+(define-library (murdoch connect)
+  (export open-connection)
+  (import (scheme base) (srfi 18) (srfi 151)
+          (only (chibi net) socket address-family/inet socket-type/stream)
+          (only (chibi) fileno?)
+          (only (chibi filesystem) open-input-file-descriptor
+                open-output-file-descriptor get-file-descriptor-status
+                set-file-descriptor-status! open/non-block)
+          (only (murdoch scheduler) monotonic-seconds))
+  (include-shared "connect")
+  (include "../connect.scm"))
