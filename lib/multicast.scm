@@ -138,9 +138,7 @@
 (define (receive-datagrams buffer)
   (let ((n (receive! (car *multicast*) buffer)))
     (if (>= n 0)
-        (guard (e (#t (log-warn "datagram dropped: "
-                                (if (frame-error? e) (frame-error-message e)
-                                    (error-message e)))))
+        (guard (e (#t (log-warn "datagram dropped: " (fault-message e))))
           (serve-datagram (open-datagram buffer n))))
     (receive-datagrams buffer)))
 

@@ -103,6 +103,16 @@
 (define (with-lock m thunk)
   (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
 
+;; Calls thunk; when it leaves by raising, calls undo on the way out.  A
+;; dynamic-wind, not a guard: a guard takes a continuation, which costs
+;; Chibi a copy of the stack, 25 KB, each time, and these are on the path
+;; of every call.
+(define (undo-on-raise undo thunk)
+  (let ((done #f))
+    (dynamic-wind (lambda () #f)
+                  (lambda () (let ((value (thunk))) (set! done #t) value))
+                  (lambda () (if (not done) (undo))))))
+
 ;;; Settings
 
 (define *default-timeout* 5)
@@ -192,11 +202,12 @@
 (define (frame-fail . parts)
   (raise (make-frame-error (apply string-append parts))))
 
-;; The next frame's message, or an eof object when the peer closed.
+;; The next frame's message, or an eof object when the peer closed.  A
+;; bad frame raises (see fault-message), and the connection's one handler
+;; closes it: a handler of its own for each frame would cost Chibi a
+;; continuation, 25 KB copied, on every message.
 (define (read-frame in nonce count)
-  (let ((payload (guard (e ((netstring-error? e)
-                            (frame-fail (netstring-error-message e))))
-                   (read-netstring in *max-frame*))))
+  (let ((payload (read-netstring in *max-frame*)))
     (if (eof-object? payload)
         payload
         (parse-message
@@ -205,26 +216,32 @@
 
 ;; The text after the MAC in the first end bytes of bytes, once (mac-of
 ;; text) matches the MAC.  Cut as bytes: Chibi's strings are UTF-8, where
-;; string-length and substring walk the string.
+;; string-length and substring walk the string.  Chibi's utf8->string
+;; takes any bytes; bytes that are not UTF-8 fail the MAC or the reader.
 (define (authentic-text bytes end mac-of)
   (if (< end 64) (frame-fail "bad MAC"))
-  (let ((mac (guard (e (#t (frame-fail "bad MAC"))) (utf8->string bytes 0 64)))
-        (text (guard (e (#t (frame-fail "payload is not UTF-8")))
-                (utf8->string bytes 64 end))))
-    (if (not (string=? mac (mac-of text)))
+  (let ((text (utf8->string bytes 64 end)))
+    (if (not (string=? (utf8->string bytes 0 64) (mac-of text)))
         (frame-fail "bad MAC"))
     text))
 
 ;; Chibi's own reader, in C: (scheme read) is SRFI 38's, with datum
 ;; labels, written in Scheme and a hundred times slower.  Messages have no
-;; labels: encode sends no cycles.
+;; labels: encode sends no cycles.  Text that is no datum raises a read
+;; error; our writer puts nothing after the datum.
 (define (parse-message text)
-  (let ((in (open-input-string text)))
-    (let ((message (guard (e (#t (frame-fail "unreadable message")))
-                     (read-datum in))))
-      (if (not (eof-object? (guard (e (#t #f)) (read-datum in))))
-          (frame-fail "trailing data"))
-      message)))
+  (let* ((in (open-input-string text))
+         (message (read-datum in)))
+    (cond ((eof-object? message) (frame-fail "empty message"))
+          ((not (eof-object? (peek-char in))) (frame-fail "trailing data"))
+          (else message))))
+
+;; What was wrong with a frame or datagram that raised e, for the log.
+(define (fault-message e)
+  (cond ((frame-error? e) (frame-error-message e))
+        ((netstring-error? e) (netstring-error-message e))
+        ((read-error? e) (string-append "unreadable message: " (error-message e)))
+        (else (error-message e))))
 
 ;;; Waiting with a deadline
 
@@ -403,10 +420,12 @@
         (connection-next-id-set! c id)
         (connection-sent-set! c count)
         (hash-table-set! (connection-pending c) id mb)
-        (guard (e (#t (connection-open?-set! c #f) (raise e)))
-          (send-frame! (connection-out c) (connection-text c)
-                       (connection-nonce c) count
-                       (list kind id proc-code args-code)))
+        (undo-on-raise
+         (lambda () (connection-open?-set! c #f))
+         (lambda ()
+           (send-frame! (connection-out c) (connection-text c)
+                        (connection-nonce c) count
+                        (list kind id proc-code args-code))))
         (cons id mb)))))
 
 (define (forget-call! c id)
@@ -432,10 +451,12 @@
   (mailbox pending-call-mailbox))
 
 (define (start-call a kind proc-code args-code seconds)
-  (guard (e ((remote-error? e) (note-unreachable! (aspace-uid a)) (raise e)))
-    (let* ((c (connection-to a seconds))
-           (sent (send-call! c kind proc-code args-code)))
-      (make-pending-call (aspace-uid a) c (car sent) (cdr sent)))))
+  (undo-on-raise
+   (lambda () (note-unreachable! (aspace-uid a)))
+   (lambda ()
+     (let* ((c (connection-to a seconds))
+            (sent (send-call! c kind proc-code args-code)))
+       (make-pending-call (aspace-uid a) c (car sent) (cdr sent))))))
 
 ;; The answer to a pending call, by the deadline (on the monotonic
 ;; clock), which is \var{seconds} after the call began: the value, or a
@@ -584,23 +605,32 @@
         (spawn (lambda () (work thunk)) 'worker))))
 
 (define (work thunk)
-  (run-logged thunk 'worker)
+  ;; One handler for the worker's whole life, entered again only after a
+  ;; procedure raised: a handler per procedure would cost a continuation
+  ;; each (see undo-on-raise).
+  (guard (e (#t (log-warn "worker: " (error-message e))
+                (let ((next (next-job))) (if next (work next)))))
+    (let loop ((thunk thunk))
+      (thunk)
+      (let ((next (next-job))) (if next (loop next))))))
+
+;; The next procedure for this worker to run, or #f when none came within
+;; worker-idle-seconds.
+(define (next-job)
   (let ((mb (make-mailbox)))
     (with-lock *workers-lock*
       (lambda () (set! *idle-workers* (cons mb *idle-workers*))))
-    (let ((next (mailbox-take mb worker-idle-seconds (lambda () #f))))
-      (cond
-       (next (work next))
-       ;; Timed out; but a caller may have taken this worker meanwhile, in
-       ;; which case its procedure is on the way.
-       ((with-lock *workers-lock*
-          (lambda ()
-            (and (memq mb *idle-workers*)
-                 (begin (set! *idle-workers* (delete mb *idle-workers* eq?))
-                        #t))))
-        #f)
-       ;; The job is on its way; an hour is only a bound.
-       (else (work (mailbox-take mb 3600 (lambda () (lambda () #f)))))))))
+    (or (mailbox-take mb worker-idle-seconds (lambda () #f))
+        ;; Timed out; but a caller may have taken this worker meanwhile, in
+        ;; which case its procedure is on the way.
+        (and (not (with-lock *workers-lock*
+                    (lambda ()
+                      (and (memq mb *idle-workers*)
+                           (begin (set! *idle-workers*
+                                        (delete mb *idle-workers* eq?))
+                                  #t)))))
+             ;; The job is on its way; an hour is only a bound.
+             (mailbox-take mb 3600 (lambda () (lambda () #f)))))))
 
 ;;; Serving calls
 
@@ -679,14 +709,14 @@
       (with-lock write-lock
         (lambda ()
           (set! sent (+ sent 1))
-          (guard (e (#t #f))           ; the caller left; nothing to tell
-            (write-frame! out text caller-nonce sent message)
-            (if (not (eq? (current-thread) (serving-thread s)))
-                (flush-output-port out))))))
+          ;; A caller that left makes this raise: in the reader, which
+          ;; then ends the connection, or in a worker, which logs it.
+          (write-frame! out text caller-nonce sent message)
+          (if (not (eq? (current-thread) (serving-thread s)))
+              (flush-output-port out)))))
     (define (flush-if-idle!)
       (if (zero? (buffered-byte-count (serving-in s)))
-          (with-lock write-lock
-            (lambda () (guard (e (#t #f)) (flush-output-port out))))))
+          (with-lock write-lock (lambda () (flush-output-port out)))))
     (send-frame! out text caller-nonce 0 `(welcome ,(aspace-uid *local*) ,nonce))
     (let loop ((count 1))
       (let ((message (read-served-frame s nonce count)))
@@ -714,29 +744,40 @@
       (frame-fail "expected a call"))
   (let ((kind (car message))
         (id (cadr message)))
-    (guard (e (#t (answer! `(error ,id ,(error-message e)))))
-      (let ((proc (*decode* (list-ref message 2)))
-            (args (*decode* (list-ref message 3))))
-        (if (not (procedure? proc))
-            (error "not a procedure" proc))
-        (if (eq? kind 'run)
-            (begin (answer! `(ack ,id))
-                   (run-in-worker (lambda () (apply proc args))))
-            (run-in-worker
-             (lambda () (answer! (apply-and-encode id proc args)))))))))
+    ;; A run is acknowledged once its procedure is decoded, so that one
+    ;; that cannot be is reported to its caller; an apply is decoded in
+    ;; its worker, under the handler that reports its errors.
+    (if (eq? kind 'run)
+        (let ((thunk (guard (e (#t (answer! `(error ,id ,(error-message e)))
+                                   #f))
+                       (decode-call (list-ref message 2) (list-ref message 3)))))
+          (if thunk
+              (begin (answer! `(ack ,id))
+                     (run-in-worker thunk))))
+        (run-in-worker
+         (lambda ()
+           (answer! (apply-and-encode id (list-ref message 2)
+                                      (list-ref message 3))))))))
 
-(define (apply-and-encode id proc args)
+;; The application a call asks for, as a thunk.
+(define (decode-call proc-code args-code)
+  (let ((proc (*decode* proc-code))
+        (args (*decode* args-code)))
+    (if (not (procedure? proc))
+        (error "not a procedure" proc))
+    (lambda () (apply proc args))))
+
+(define (apply-and-encode id proc-code args-code)
   (guard (e (#t `(error ,id ,(error-message e))))
-    `(value ,id ,(encode (apply proc args) *environment* "the result"))))
+    `(value ,id ,(encode ((decode-call proc-code args-code))
+                         *environment* "the result"))))
 
 (define (peer-name sockaddr)
   (string-append (sockaddr-name sockaddr) ":"
                  (number->string (sockaddr-port sockaddr))))
 
 (define (log-fault peer e)
-  (log-warn "connection with " peer " closed: "
-            (cond ((frame-error? e) (frame-error-message e))
-                  (else (error-message e)))))
+  (log-warn "connection with " peer " closed: " (fault-message e)))
 
 (define (accept-loop listener)
   (let ((addr (get-address-info (aspace-host *local*) (aspace-port *local*))))
