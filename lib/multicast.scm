@@ -109,27 +109,27 @@
              (let* ((here (capture (local-aspace-uid)
                                    (lambda () (local-call kind proc args))))
                     (deadline (+ (monotonic-seconds) seconds))
-                    (there (map (lambda (w) (await-answer w deadline seconds proc))
-                                waiting)))
+                    (there (capture-each car
+                                         (lambda (w)
+                                           (list (car w) #t
+                                                 (await-answer w deadline seconds proc)))
+                                         waiting)))
                (forget!)
                (cons here there))
              (begin (forget!) #f)))))
 
 (define (await-answer w deadline seconds proc)
-  (let ((uid (car w)))
-    (capture uid
-             (lambda ()
-               (let ((answer (mailbox-take
-                              (cdr w) (max 0 (- deadline (monotonic-seconds)))
-                              (lambda ()
-                                (note-unreachable! uid)
-                                (remote-error uid (describe-procedure proc)
-                                              (string-append
-                                               "no answer within "
-                                               (number->string seconds) " s"))))))
-                 (if (eq? (car answer) 'error)
-                     (remote-error uid (describe-procedure proc) (car (cddr answer)))
-                     (car (cddr answer))))))))
+  (let* ((uid (car w))
+         (answer (mailbox-take
+                  (cdr w) (max 0 (- deadline (monotonic-seconds)))
+                  (lambda ()
+                    (note-unreachable! uid)
+                    (remote-error uid (describe-procedure proc)
+                                  (string-append "no answer within "
+                                                 (number->string seconds) " s"))))))
+    (if (eq? (car answer) 'error)
+        (remote-error uid (describe-procedure proc) (car (cddr answer)))
+        (car (cddr answer)))))
 
 ;;; Receiving
 

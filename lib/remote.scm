@@ -517,21 +517,21 @@
 (define (send-all aspaces kind proc args proc-code args-code seconds)
   (let* ((deadline (+ (monotonic-seconds) seconds))
          (started
-          (map (lambda (a)
-                 (capture (aspace-uid a)
-                          (lambda ()
-                            (if (local? a)
-                                (local-call kind proc args)
-                                (start-call a kind proc-code args-code
-                                            seconds)))))
-               aspaces)))
-    (map (lambda (s)
-           (if (and (cadr s) (pending-call? (car (cddr s))))
-               (capture (car s)
-                        (lambda ()
-                          (finish-call (car (cddr s)) deadline seconds proc)))
-               s))
-         started)))
+          (capture-each aspace-uid
+                        (lambda (a)
+                          (list (aspace-uid a) #t
+                                (if (local? a)
+                                    (local-call kind proc args)
+                                    (start-call a kind proc-code args-code
+                                                seconds))))
+                        aspaces)))
+    (capture-each car
+                  (lambda (s)
+                    (if (and (cadr s) (pending-call? (car (cddr s))))
+                        (list (car s) #t
+                              (finish-call (car (cddr s)) deadline seconds proc))
+                        s))
+                  started)))
 
 (define (local-call kind proc args)
   (if (eq? kind 'run)
@@ -539,9 +539,28 @@
       (apply-here (local-aspace-uid) proc args)))
 
 (define (capture uid thunk)
-  (guard (e ((remote-error? e) (list uid #f (remote-error-message e)))
-            (#t (list uid #f (error-message e))))
+  (guard (e (#t (failure-entry uid e)))
     (list uid #t (thunk))))
+
+(define (failure-entry uid e)
+  (list uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
+
+;; (map entry items), where (entry item) answers (uid #t value); an item
+;; whose entry raised gives (uid #f message), uid being (uid-of item).
+;; The handler is entered once, and again after each failure only: one
+;; per item would cost a continuation each (see undo-on-raise).
+(define (capture-each uid-of entry items)
+  (let ((done '()) (rest items))
+    (let run ()
+      (guard (e (#t (set! done (cons (failure-entry (uid-of (car rest)) e) done))
+                    (set! rest (cdr rest))
+                    (run)))
+        (let loop ()
+          (when (pair? rest)
+            (set! done (cons (entry (car rest)) done))
+            (set! rest (cdr rest))
+            (loop)))))
+    (reverse done)))
 
 (define (encode-arguments args)
   (let loop ((args args) (i 1) (acc '()))
