@@ -23,7 +23,7 @@
           ;; pose-task and dynamic teams (lib/pose-task.scm)
           pose-task negotiate pose-task-progress
           location-metric-maker load-metric-maker load-metric reverse-metric
-          metric-by reckon-distance-between resolve-conflicts
+          metric-by metric-by-asking reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
           ;; the robot (lib/trip-client.scm)

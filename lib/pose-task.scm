@@ -36,9 +36,31 @@
 ;; answers #t when the first is better, as in the thesis.  Those made by
 ;; metric-by also carry their measure, so that pose-task can ask each
 ;; candidate once, not once per comparison: the same choice, fewer messages.
+;; A measure is a procedure of a uid, or an asking: what a candidate
+;; answers to one procedure, scored here, which pose-task sends to every
+;; candidate at once.
+(define-record-type asking
+  (make-asking proc score)
+  asking?
+  (proc asking-proc)
+  (score asking-score))
+
+;;> A metric that prefers the candidate with the smaller
+;;> \scheme{(measure uid)}: a number for a candidate's uid.
 (define (metric-by measure)
   (lambda (entry1 entry2)
-    (< (measure (car entry1)) (measure (car entry2)))))
+    (< (measure-one measure (car entry1)) (measure-one measure (car entry2)))))
+
+;;> A metric that prefers the candidate whose answer to \var{proc},
+;;> applied there, has the smaller \scheme{(score answer)}.  pose-task
+;;> asks all of a component's candidates with one message each.
+(define (metric-by-asking proc score)
+  (metric-by (make-asking proc score)))
+
+(define (measure-one measure uid)
+  (if (asking? measure)
+      ((asking-score measure) (ask uid (asking-proc measure)))
+      (measure uid)))
 
 (define metric-by-code (procedure-code (metric-by #f)))
 
@@ -52,22 +74,19 @@
   (let ((dx (- (car p) (car q))) (dy (- (cadr p) (cadr q))))
     (sqrt (+ (* dx dx) (* dy dy)))))
 
-;; What candidate uid answers to proc, sent point to point.
+;; What candidate uid answers to proc, asked point to point.
 (define (ask uid proc)
-  (let ((answers (request uid proc)))
-    (if (null? answers)
-        (error "the candidate did not answer" uid)
-        (cadar answers))))
+  (remote-apply (uid->aspace uid) proc))
 
 ;;> Prefers the candidate closest to \var{target}, (x y theta 0) as reckon
 ;;> answers, by each candidate's safe-reckon.
 (define (location-metric-maker target)
-  (metric-by (lambda (uid)
-               (reckon-distance-between target (ask uid safe-reckon)))))
+  (metric-by-asking safe-reckon
+                    (lambda (position) (reckon-distance-between target position))))
 
 ;;> Prefers the candidate with the lowest system load.
 (define (load-metric-maker)
-  (metric-by (lambda (uid) (string->number (ask uid get-system-load)))))
+  (metric-by-asking get-system-load string->number))
 
 ;;> The load metric of Figure 4.6.
 (define load-metric (load-metric-maker))
@@ -75,9 +94,11 @@
 ;;> The opposite preference: the worst candidate by \var{metric} first.
 (define (reverse-metric metric)
   (let ((measure (metric-measure metric)))
-    (if measure
-        (metric-by (lambda (uid) (- (measure uid))))
-        (lambda (a b) (metric b a)))))
+    (cond ((asking? measure)
+           (let ((score (asking-score measure)))
+             (metric-by-asking (asking-proc measure) (lambda (a) (- (score a))))))
+          (measure (metric-by (lambda (uid) (- (measure uid)))))
+          (else (lambda (a b) (metric b a))))))
 
 ;; Sorts a component's candidates by its metric; no metric: at random.
 (define (sort-response response metric)
@@ -93,14 +114,21 @@
    (else (list-sort metric response))))
 
 ;; Measures every candidate at once: the answers' round trips overlap.  A
-;; candidate that cannot be measured (it died, or did not answer in time)
-;; measures +inf.0, and so comes last.
+;; candidate that cannot be measured (it died, did not answer in time, or
+;; its answer does not score) measures +inf.0, and so comes last.
 (define (measure-all measure uids)
-  (map thread-join!
-       (map (lambda (uid)
-              (thread-start!
-               (make-thread (lambda () (guard (e (#t +inf.0)) (measure uid))))))
-            uids)))
+  (if (asking? measure)
+      (map (lambda (answer)
+             (let ((score (and (cadr answer)
+                               (guard (e (#t #f))
+                                 ((asking-score measure) (car (cddr answer)))))))
+               (if (real? score) score +inf.0)))
+           (remote-apply-all (map uid->aspace uids) (asking-proc measure)))
+      (map thread-join!
+           (map (lambda (uid)
+                  (thread-start!
+                   (make-thread (lambda () (guard (e (#t +inf.0)) (measure uid))))))
+                uids))))
 
 (define (shuffle ls)
   (map cdr (list-sort (lambda (a b) (< (car a) (car b)))

@@ -67,6 +67,19 @@
                                 (if (eq? uid 'near) (error "no answer") 1))))
              (list who-am-i)))
 
+(test "a candidate whose answer fails there comes last, when asked" '(far)
+  (pose-task 'unanswered 1 (list '((mobile) ()))
+             (list (metric-by-asking
+                    (lambda () (if (eq? (local-aspace-uid) 'near) (error "no") 1))
+                    (lambda (answer) answer)))
+             (list who-am-i)))
+
+(test "a candidate whose answer does not score comes last, when asked" '(far)
+  (pose-task 'unscored 1 (list '((mobile) ()))
+             (list (metric-by-asking local-aspace-uid
+                                     (lambda (uid) (if (eq? uid 'near) 'none 1))))
+             (list who-am-i)))
+
 (test "a one-robot task frees its robot" #t
   (begin (pose-task 'one 1 (list '((mobile) ())) (list #f) (list who-am-i))
          (all-free?)))

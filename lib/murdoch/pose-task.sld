@@ -1,7 +1,7 @@
 (define-library (murdoch pose-task)
   (export pose-task negotiate pose-task-progress
           location-metric-maker load-metric-maker load-metric reverse-metric
-          metric-by reckon-distance-between sort-response resolve-conflicts
+          metric-by metric-by-asking reckon-distance-between sort-response resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t
           sort-list make-maxrandom)
   (import (scheme base) (scheme write) (scheme inexact) (scheme cxr)
