@@ -9,7 +9,7 @@
           aspace? aspace-uid local-aspace local-aspace-uid uid->aspace
           known-uids remote-run! remote-apply remote-timeout
           remote-error? remote-error-uid remote-error-message
-          remote-apply-all remote-run-all! live-uids multicast-answer delivery-mode
+          remote-apply-all remote-run-all! live-uids delivery-mode
           encap var-ref var-set! display-remote
           ;; publish/subscribe (lib/pubsub.scm)
           subscribe unsubscribe subscriptions topic-status set-topic-status!

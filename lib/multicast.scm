@@ -5,9 +5,9 @@
 ;; (delivery multicast GROUP [PORT]) in the lab file, publish and the query
 ;; phase of request and request-exclusive go out as one datagram to the
 ;; lab's group; each address space answers the sender point to point over
-;; its TCP connection, as remote-run! of multicast-answer, so the
-;; semantics are the broadcast's.  A message too large for a datagram goes
-;; the broadcast way.
+;; its TCP connection, with an answer frame (send-multicast-answer!), so
+;; the semantics are the broadcast's.  A message too large for a datagram
+;; goes the broadcast way.
 ;;
 ;; A datagram is 64 hex digits of HMAC-SHA256 under the lab's key over
 ;; "mcast:" and the text, then the text: (SENDER SEQUENCE BODY).  SEQUENCE
@@ -80,14 +80,20 @@
 (define *multicast-calls* (make-hash-table eqv?)) ; id -> ((uid . mailbox) ...)
 (define *next-multicast-id* 0)
 
-;;> Delivers an answer to a multicast call: what each address space that
-;;> received the call runs, here, through remote-run!.
-(define (multicast-answer id uid kind value)
-  (let ((waiting (with-lock *peers-lock*
-                   (lambda () (hash-table-ref/default *multicast-calls* id '())))))
+;; Hands an (answer ID KIND VALUE) frame from address space uid to the
+;; call that waits for it; one for a call no longer waited for is dropped.
+(define (take-multicast-answer! uid message)
+  (if (not (and (list? message) (= (length message) 4)
+                (exact-integer? (list-ref message 1))
+                (memq (list-ref message 2) '(ack value error))))
+      (frame-fail "expected an answer"))
+  (let* ((id (list-ref message 1))
+         (waiting (with-lock *peers-lock*
+                    (lambda () (hash-table-ref/default *multicast-calls* id '())))))
     (cond ((assq uid waiting)
-           => (lambda (w) (mailbox-put! (cdr w) (list kind id value))))))
-  #t)
+           => (lambda (w)
+                (mailbox-put! (cdr w)
+                              (list (list-ref message 2) id (list-ref message 3))))))))
 
 ;; call-all over multicast, when it is on and the message fits a
 ;; datagram: answers call-all's list, or #f to send the broadcast way.
@@ -127,9 +133,10 @@
                     (remote-error uid (describe-procedure proc)
                                   (string-append "no answer within "
                                                  (number->string seconds) " s"))))))
-    (if (eq? (car answer) 'error)
-        (remote-error uid (describe-procedure proc) (car (cddr answer)))
-        (car (cddr answer)))))
+    (case (car answer)
+      ((error) (remote-error uid (describe-procedure proc) (car (cddr answer))))
+      ((value) (*decode* (car (cddr answer))))
+      (else #t))))
 
 ;;; Receiving
 
@@ -169,17 +176,15 @@
       (serve-multicast-call sender (cdr body)))
      (else (frame-fail "not a beacon or a call")))))
 
-;; Runs a call that came by datagram, and answers its sender by remote-run!.
+;; Runs a call that came by datagram, and answers its sender over TCP: an
+;; ack before a run, the value after an apply, or the error.
 (define (serve-multicast-call sender call)
-  (let ((id (car call)) (kind (cadr call)))
-    (define (answer! kind value)
-      (remote-run! (uid->aspace sender) multicast-answer id
-                   (local-aspace-uid) kind value))
+  (let ((id (car call)) (kind (cadr call)) (to (uid->aspace sender)))
     (run-in-worker
      (lambda ()
-       (guard (e (#t (answer! 'error (error-message e))))
-         (let ((proc (*decode* (car (cddr call))))
-               (args (*decode* (cadr (cddr call)))))
+       (guard (e (#t (send-multicast-answer! to id 'error (error-message e))))
+         (let ((thunk (decode-call (car (cddr call)) (cadr (cddr call)))))
            (if (eq? kind 'run)
-               (begin (answer! 'ack #t) (apply proc args))
-               (answer! 'value (apply proc args)))))))))
+               (begin (send-multicast-answer! to id 'ack #t) (thunk))
+               (send-multicast-answer!
+                to id 'value (encode (thunk) *environment* "the result")))))))))

@@ -22,7 +22,10 @@
 ;;  3. Caller -> callee, any number, pipelined:
 ;;       (run ID PROC ARGS)    apply in a new thread, answer at once
 ;;       (apply ID PROC ARGS)  apply in a new thread, answer with the value
-;;     PROC and ARGS are encoded values (sendable.scm); ID is the caller's.
+;;       (answer ID KIND VALUE)  not answered: the answer to call ID of a
+;;                             multicast datagram from the callee (multicast.scm)
+;;     PROC, ARGS and VALUE are encoded values (sendable.scm); ID is the
+;;     caller's, or for an answer the datagram sender's.
 ;;  4. Callee -> caller, in any order:
 ;;       (ack ID)  (value ID VALUE)  (error ID MESSAGE)
 ;;
@@ -412,21 +415,33 @@
 (define (send-call! c kind proc-code args-code)
   (with-lock (connection-write-lock c)
     (lambda ()
-      (if (not (connection-open? c))
-          (remote-error (connection-uid c) 'send "connection lost"))
       (let ((id (+ 1 (connection-next-id c)))
-            (count (+ 1 (connection-sent c)))
             (mb (make-mailbox)))
         (connection-next-id-set! c id)
-        (connection-sent-set! c count)
         (hash-table-set! (connection-pending c) id mb)
-        (undo-on-raise
-         (lambda () (connection-open?-set! c #f))
-         (lambda ()
-           (send-frame! (connection-out c) (connection-text c)
-                        (connection-nonce c) count
-                        (list kind id proc-code args-code))))
+        (send-counted! c (list kind id proc-code args-code))
         (cons id mb)))))
+
+;; Sends message as the connection's next frame; the caller holds its
+;; write lock.  A frame that fails to go out leaves the connection closed.
+(define (send-counted! c message)
+  (if (not (connection-open? c))
+      (remote-error (connection-uid c) 'send "connection lost"))
+  (let ((count (+ 1 (connection-sent c))))
+    (connection-sent-set! c count)
+    (undo-on-raise
+     (lambda () (connection-open?-set! c #f))
+     (lambda ()
+       (send-frame! (connection-out c) (connection-text c)
+                    (connection-nonce c) count message)))))
+
+;; Sends the answer to call id of a multicast datagram that a, its sender,
+;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
+;; -- no acknowledgement, no worker -- since a waits for it anyway.
+(define (send-multicast-answer! a id kind value)
+  (let ((c (connection-to a (current-timeout))))
+    (with-lock (connection-write-lock c)
+      (lambda () (send-counted! c (list 'answer id kind value))))))
 
 (define (forget-call! c id)
   (with-lock (connection-write-lock c)
@@ -740,7 +755,9 @@
     (let loop ((count 1))
       (let ((message (read-served-frame s nonce count)))
         (if (not (eof-object? message))
-            (begin (serve-call message answer!)
+            (begin (if (and (pair? message) (eq? (car message) 'answer))
+                       (take-multicast-answer! (list-ref hello 1) message)
+                       (serve-call message answer!))
                    (flush-if-idle!)
                    (loop (+ count 1))))))))
 

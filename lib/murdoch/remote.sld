@@ -4,7 +4,7 @@
           learn-aspace! live-uids current-lab lab-environment
           remote-run! remote-apply remote-timeout set-remote-timeout!
           remote-apply-all remote-run-all! broadcast-apply broadcast-run!
-          multicast-answer delivery-mode
+          delivery-mode
           remote-error? remote-error-uid remote-error-message
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote)
