@@ -15,20 +15,26 @@
 ;; restarted sender does not go back), and a receiver drops a datagram
 ;; whose sequence it has passed: a recorded datagram cannot be replayed.
 ;; BODY is one of
-;;   (beacon UID HOST PORT)         every second: here I am
+;;   (beacon UID HOST PORT)         every beacon period: here I am
 ;;   (call ID KIND PROC ARGS)       KIND run or apply, as on a connection
 ;;
 ;; Beacons are live membership without a registry: an address space not
-;; heard from for three seconds leaves the live set, and its next beacon
-;; brings it back.
+;; heard from for three beacon periods leaves the live set, and its next
+;; beacon brings it back.  The period is a second in a lab of up to 16
+;; address spaces and grows with the lab beyond (as RTCP's report interval
+;; grows with a session), so that the lab as a whole sends about 16
+;; beacons a second: with every one beaconing each second, each address
+;; space of a lab of N would receive N a second, and the lab N squared.
 
 (define *multicast* #f)                 ; (socket . group address), or #f
 (define *sequence* 0)
 (define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
 (define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
 (define max-datagram 60000)
-(define beacon-seconds 1)
-(define silence-seconds 3)
+(define lab-beacons-per-second 16)
+
+(define (beacon-seconds)
+  (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
 
 (define (start-multicast! lab)
   (let ((clause (assq 'delivery (lab-settings lab))))
@@ -66,13 +72,14 @@
 (define (send-beacons)
   (send-datagram! `(beacon ,(aspace-uid *local*) ,(aspace-host *local*)
                            ,(aspace-port *local*)))
-  (let ((now (monotonic-seconds)))
+  (let ((now (monotonic-seconds))
+        (period (beacon-seconds)))
     (for-each (lambda (uid)
                 (if (< (hash-table-ref/default *last-heard* uid now)
-                       (- now silence-seconds))
+                       (- now (* 3 period)))
                     (note-unreachable! uid)))
-              (known-uids)))
-  (thread-sleep! beacon-seconds)
+              (known-uids))
+    (thread-sleep! period))
   (send-beacons))
 
 ;;; The calls of one datagram, awaiting their answers
