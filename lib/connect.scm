@@ -37,10 +37,16 @@
                  (open-output-file-descriptor sock #t)))
      ((> (monotonic-seconds) deadline)
       (close-socket sock (string-append "no connection within "
-                                        (number->string seconds) " s")))
+                                        (seconds-text seconds) " s")))
      (else
       (thread-sleep! 0.001)
       (await-connect sock deadline seconds)))))
+
+;; Seconds to the millisecond, as a person would write them: a caller's
+;; remaining time of 0.99996 s is 1 s.
+(define (seconds-text seconds)
+  (let ((rounded (/ (round (* 1000 seconds)) 1000)))
+    (number->string (if (integer? rounded) (exact rounded) rounded))))
 
 ;; Closes a socket that has no ports yet, through one: that marks its
 ;; fileno closed, where close-file-descriptor would leave it marked open

@@ -134,7 +134,7 @@
 (define (await-answer w deadline seconds proc)
   (let* ((uid (car w))
          (answer (mailbox-take
-                  (cdr w) (max 0 (- deadline (monotonic-seconds)))
+                  (cdr w) (seconds-until deadline)
                   (lambda ()
                     (note-unreachable! uid)
                     (remote-error uid (describe-procedure proc)

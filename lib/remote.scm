@@ -106,6 +106,17 @@
 (define (with-lock m thunk)
   (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
 
+;; As with-lock, giving up with (too-late) when m is not free by the
+;; deadline, on the monotonic clock.
+(define (with-lock-by m deadline too-late thunk)
+  (if (mutex-lock! m (seconds-until deadline))
+      (dynamic-wind (lambda () #f) thunk (lambda () (mutex-unlock! m)))
+      (too-late)))
+
+;; Seconds from now to deadline, none if it has passed.
+(define (seconds-until deadline)
+  (max 0 (- deadline (monotonic-seconds))))
+
 ;; Calls thunk; when it leaves by raising, calls undo on the way out.  A
 ;; dynamic-wind, not a guard: a guard takes a continuation, which costs
 ;; Chibi a copy of the stack, 25 KB, each time, and these are on the path
@@ -309,14 +320,17 @@
 (define *connecting* (make-hash-table eq?))   ; uid -> mutex
 (define *connections-lock* (make-mutex 'connections))
 
-;; The open connection to uid, made (and greeted) if there is none.
-(define (connection-to a seconds)
+;; The open connection to uid, made (and greeted) if there is none, by
+;; the deadline (on the monotonic clock).
+(define (connection-to a deadline)
   (let ((uid (aspace-uid a)))
     (or (live-connection-to uid)
-        (with-lock (connecting-lock uid)
+        (with-lock-by (connecting-lock uid) deadline
+          (lambda ()
+            (remote-error uid 'connect "another call's connect did not end in time"))
           (lambda ()
             (or (live-connection-to uid)
-                (let ((c (connect! a seconds)))
+                (let ((c (connect! a deadline)))
                   (with-lock *connections-lock*
                     (lambda () (hash-table-set! *connections* uid c)))
                   c)))))))
@@ -335,8 +349,9 @@
             (hash-table-set! *connecting* uid m)
             m)))))
 
-(define (connect! a seconds)
-  (let ((io (open-connection (aspace-host a) (aspace-port a) seconds)))
+(define (connect! a deadline)
+  (let ((io (open-connection (aspace-host a) (aspace-port a)
+                             (seconds-until deadline))))
     (if (string? io)
         (remote-error (aspace-uid a) 'connect
                       (string-append "cannot connect to " (aspace-host a) ":"
@@ -354,7 +369,7 @@
                             ,(aspace-port *local*) ,nonce))
       (thread-start! (make-thread (lambda () (read-answers c nonce welcome))
                                   'answers))
-      (mailbox-take welcome seconds
+      (mailbox-take welcome (seconds-until deadline)
                     (lambda ()
                       (close-connection! c)
                       (remote-error (aspace-uid a) 'connect "no welcome")))
@@ -439,7 +454,7 @@
 ;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
 ;; -- no acknowledgement, no worker -- since a waits for it anyway.
 (define (send-multicast-answer! a id kind value)
-  (let ((c (connection-to a (current-timeout))))
+  (let ((c (connection-to a (+ (monotonic-seconds) (current-timeout)))))
     (with-lock (connection-write-lock c)
       (lambda () (send-counted! c (list 'answer id kind value))))))
 
@@ -450,11 +465,12 @@
 ;;; remote-run! and remote-apply
 
 (define (call a kind proc args)
-  (let ((seconds (current-timeout)))
-    (finish-call
-     (start-call a kind (encode proc *environment* "the procedure")
-                 (encode-arguments args) seconds)
-     (+ (monotonic-seconds) seconds) seconds proc)))
+  (let* ((seconds (current-timeout))
+         (proc-code (encode proc *environment* "the procedure"))
+         (args-code (encode-arguments args))
+         (deadline (+ (monotonic-seconds) seconds)))
+    (finish-call (start-call a kind proc-code args-code deadline)
+                 deadline seconds proc)))
 
 ;; A call on its way: where it went, and the mailbox its answer will reach.
 (define-record-type pending-call
@@ -465,11 +481,11 @@
   (id pending-call-id)
   (mailbox pending-call-mailbox))
 
-(define (start-call a kind proc-code args-code seconds)
+(define (start-call a kind proc-code args-code deadline)
   (undo-on-raise
    (lambda () (note-unreachable! (aspace-uid a)))
    (lambda ()
-     (let* ((c (connection-to a seconds))
+     (let* ((c (connection-to a deadline))
             (sent (send-call! c kind proc-code args-code)))
        (make-pending-call (aspace-uid a) c (car sent) (cdr sent))))))
 
@@ -479,7 +495,7 @@
 (define (finish-call p deadline seconds proc)
   (let* ((uid (pending-call-uid p))
          (answer (mailbox-take
-                  (pending-call-mailbox p) (max 0 (- deadline (monotonic-seconds)))
+                  (pending-call-mailbox p) (seconds-until deadline)
                   (lambda ()
                     (forget-call! (pending-call-connection p) (pending-call-id p))
                     (note-unreachable! uid)
@@ -538,7 +554,7 @@
                                 (if (local? a)
                                     (local-call kind proc args)
                                     (start-call a kind proc-code args-code
-                                                seconds))))
+                                                deadline))))
                         aspaces)))
     (capture-each car
                   (lambda (s)

@@ -4,7 +4,7 @@
         (srfi 18) (chibi test) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor)
         (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
-        (murdoch netstring) (murdoch hmac) (murdoch testing))
+        (murdoch netstring) (murdoch hmac) (murdoch connect) (murdoch testing))
 
 (define shared-code "
 (define *counter* 0)
@@ -106,12 +106,26 @@
   (test "a restarted target is reached again" 7
     (remote-apply (uid->aspace 'praline) (lambda () 7))))
 
+(define ghost-address
+  (get-address-info "127.0.0.1" (aspace-port (uid->aspace 'ghost))))
+
+(test-group "an address space that takes the connection and never greets"
+  ;; A listener that never accepts: the kernel completes the connect, and
+  ;; the hello waits in its queue unread.
+  (let ((listener (make-listener-socket ghost-address 5)))
+    (test "raises within the timeout, saying so" "no welcome"
+      (parameterize ((remote-timeout 1))
+        (error-text (lambda ()
+                      (remote-apply (uid->aspace 'ghost) (lambda () 1))))))
+    (close-port (open-input-file-descriptor listener))))
+
 (test-group "an address space that does not answer the connect"
-  ;; A listener that never accepts, its queue filled: the next connect
-  ;; hangs, as for a robot that was switched off.
-  (let* ((addr (get-address-info "127.0.0.1" (aspace-port (uid->aspace 'ghost))))
-         (listener (make-listener-socket addr 0))
-         (filler (open-net-io "127.0.0.1" (aspace-port (uid->aspace 'ghost)))))
+  ;; A listener that never accepts, its queue filled (by the filler, or
+  ;; by this address space's prober, which looks for ghost every second):
+  ;; the next connect hangs, as for a robot that was switched off.
+  (let* ((listener (make-listener-socket ghost-address 0))
+         (filler (open-connection "127.0.0.1" (aspace-port (uid->aspace 'ghost))
+                                  1)))
     (test "raises within the timeout, saying so"
         (string-append "cannot connect to 127.0.0.1:"
                        (number->string (aspace-port (uid->aspace 'ghost)))
@@ -121,6 +135,8 @@
                       (remote-apply (uid->aspace 'ghost) (lambda () 1))))))
     (test "and another address space answers meanwhile" 2
       (remote-apply (uid->aspace 'troy) (lambda () 2)))
+    ;; Closed only here: collected earlier, the filler would free the queue.
+    (if (pair? filler) (for-each close-port filler))
     (close-port (open-input-file-descriptor listener))))
 
 (test-group "the sandbox"
