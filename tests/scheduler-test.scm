@@ -305,6 +305,25 @@
       (tell-peer #\a)
       (list n (thread-join! reader)))))
 
+;; A loop of a few instructions, counted by another thread at each of
+;; its turns: Chibi's own slice of 500 instructions lets it round about 30
+;; times a turn, the wrapper's 5000 about 300.
+(test-assert "a thread runs ten times Chibi's slice before the next one's turn"
+  (let* ((count 0)
+         (stop #f)
+         (busy (start (lambda ()
+                        (let loop ()
+                          (set! count (+ count 1))
+                          (if (not stop) (loop))))))
+         (gaps (let turn ((i 0) (last count) (gaps '()))
+                 (if (= i 20)
+                     gaps
+                     (begin (thread-yield!)
+                            (turn (+ i 1) count (cons (- count last) gaps)))))))
+    (set! stop #t)
+    (thread-join! busy)
+    (> (apply min (cdr (reverse gaps))) 150)))
+
 (test "a signal is handled while every thread waits" signal/user1
   (let ((gate (make-mutex))
         (caught #f))
