@@ -101,24 +101,29 @@
   (let ((levels (subject-levels subject)))
     (or (member "*" levels) (member ">" levels))))
 
-;;> True when the address subject \var{pattern} reaches \var{topic}.
-(define (subject-matches? pattern topic)
-  (or (eq? pattern topic)
-      (and (wildcard? pattern)
-           (let loop ((p (subject-levels pattern)) (t (subject-levels topic)))
-             (cond ((null? p) (null? t))
-                   ((equal? (car p) ">") (pair? t))
-                   ((null? t) #f)
-                   ((or (equal? (car p) "*") (equal? (car p) (car t)))
-                    (loop (cdr p) (cdr t)))
-                   (else #f))))))
+;; A predicate true of the topics the address subject pattern reaches.
+;; Made once per message: splitting a subject into its levels copies its
+;; name (Chibi's symbol->string), and most subjects have no wildcard.
+(define (subject-matcher pattern)
+  (if (wildcard? pattern)
+      (let ((levels (subject-levels pattern)))
+        (lambda (topic) (levels-match? levels (subject-levels topic))))
+      (lambda (topic) (eq? pattern topic))))
+
+(define (levels-match? p t)
+  (cond ((null? p) (null? t))
+        ((equal? (car p) ">") (pair? t))
+        ((null? t) #f)
+        ((or (equal? (car p) "*") (equal? (car p) (car t)))
+         (levels-match? (cdr p) (cdr t)))
+        (else #f)))
 
 ;; True when every subject of the address is among the subscriptions
 ;; (the thesis says "proper subset"; it means subset).  Caller holds the lock.
 (define (addressed-here? topic)
   (every (lambda (pattern)
-           (any (lambda (s) (subject-matches? pattern (subscription-topic s)))
-                *subscriptions*))
+           (let ((matches? (subject-matcher pattern)))
+             (any (lambda (s) (matches? (subscription-topic s))) *subscriptions*)))
          (subject-list topic)))
 
 ;;; Sending
@@ -197,12 +202,14 @@
 
 ;;> The (subject status) of the subscriptions here that match \var{topic}.
 (define (subscription-statuses topic)
-  (with-subscriptions
-    (lambda ()
-      (filter-map (lambda (s)
-                    (and (subject-matches? topic (subscription-topic s))
-                         (list (subscription-topic s) (subscription-status s))))
-                  *subscriptions*))))
+  (let ((matches? (subject-matcher topic)))
+    (with-subscriptions
+      (lambda ()
+        (filter-map (lambda (s)
+                      (and (matches? (subscription-topic s))
+                           (list (subscription-topic s)
+                                 (subscription-status s))))
+                    *subscriptions*)))))
 
 ;;; Receiving: what the senders above run in each address space
 

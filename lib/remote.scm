@@ -598,8 +598,11 @@
     (if (null? args)
         (reverse acc)
         (loop (cdr args) (+ i 1)
+              ;; Named only for an error: number->string costs Chibi a
+              ;; string port, 4 KB, and this is every argument of every call.
               (cons (encode (car args) *environment*
-                            (string-append "argument " (number->string i)))
+                            (lambda () (string-append "argument "
+                                                      (number->string i))))
                     acc)))))
 
 (define (local? a) (eq? (aspace-uid a) (aspace-uid (local-aspace))))

@@ -1,6 +1,6 @@
 (define-library (murdoch pubsub)
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
-          subscribe-remote unsubscribe-remote subject-matches?
+          subscribe-remote unsubscribe-remote
           publish request request-exclusive request-non-exclusive
           capability-layout
           request-status subscription-statuses
