@@ -2,8 +2,13 @@
 ;;;; on this machine (simulated broadcast):
 ;;;;   bench: request-latency-NN VALUE ms          a request to all, answered
 ;;;;                                                by every address space
+;;;;   bench: request-cpu-NN VALUE us              the CPU time that request
+;;;;                                                took in all the lab's
+;;;;                                                processes, per address space
 ;;;;   bench: pose-task-negotiation-NN VALUE ms    pose-task's negotiation of
 ;;;;                                                the dual-sonar task
+;; The latency of a lab larger than the machine's cores is its CPU time
+;; shared out; request-cpu shows whether the work grows with N.
 ;; Two address spaces stand in for the robots (workstations with mobile
 ;; and sonar, at the thesis's robot positions), so that the figure is the
 ;; negotiation's, not the simulator's; the rest are workstations.
@@ -12,7 +17,8 @@
 ;; and 64, by simulated broadcast and by multicast (NAME-mcast-NN).
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
-        (scheme process-context) (srfi 1) (srfi 132)
+        (scheme process-context) (scheme file) (srfi 1) (srfi 132)
+        (only (chibi process) current-process-id)
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define (aspace-clause i)
@@ -22,18 +28,21 @@
       ((2) `(aspace ,name (position -1800 -600 90) (capabilities mobile sonar) (load 0.5)))
       (else `(aspace ,name (position 0 0 0) (load ,(/ i 100.)))))))
 
+(define lab-pids '())
+
 (define (start-lab n delivery)
   (let ((lab (make-test-lab
               `((code ,(tool-path "examples/dual-sonar.scm")) ,@delivery
                 (aspace bencher)
                 ,@(map aspace-clause (iota n 1))))))
-    (for-each (lambda (i)
-                (start-process!
-                 (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
-                       (string-append "w" (number->string i)))
-                 (string-append (test-lab-directory lab) "/w"
-                                (number->string i) ".log")))
-              (iota n 1))
+    (set! lab-pids
+          (map (lambda (i)
+                 (start-process!
+                  (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
+                        (string-append "w" (number->string i)))
+                  (string-append (test-lab-directory lab) "/w"
+                                 (number->string i) ".log")))
+               (iota n 1)))
     (for-each (lambda (i)
                 (if (not (wait-for-port (+ (test-lab-port-base lab) i) 60))
                     (begin (stop-all-processes!)
@@ -44,9 +53,41 @@
 
 (define (median-ms runs thunk) (* 1000 (median-seconds runs thunk)))
 
-(define (report name n value)
+(define (report name n value unit)
   (display "bench: ") (display name) (display suffix) (display n) (display " ")
-  (display (/ (round (* 100 value)) 100.)) (display " ms") (newline))
+  (display (/ (round (* 100 value)) 100.)) (display " ") (display unit)
+  (newline))
+
+;; Seconds of CPU, user and system, that process pid has used (Linux's
+;; /proc/PID/stat, in clock ticks of 1/100 s).
+(define (cpu-seconds pid)
+  (let* ((text (call-with-input-file (string-append "/proc/" (number->string pid)
+                                                    "/stat")
+                 (lambda (in) (read-line in))))
+         (fields (let after-name ((i (- (string-length text) 1)))
+                   (if (char=? (string-ref text i) #\))
+                       (words (substring text (+ i 2) (string-length text)))
+                       (after-name (- i 1))))))
+    ;; utime and stime are fields 14 and 15; the list starts at field 3.
+    (/ (+ (string->number (list-ref fields 11)) (string->number (list-ref fields 12)))
+       100.)))
+
+(define (words s)
+  (let loop ((i 0) (start 0) (acc '()))
+    (cond ((= i (string-length s))
+           (reverse (if (< start i) (cons (substring s start i) acc) acc)))
+          ((char=? (string-ref s i) #\space)
+           (loop (+ i 1) (+ i 1) (if (< start i) (cons (substring s start i) acc) acc)))
+          (else (loop (+ i 1) start acc)))))
+
+(define (lab-cpu-seconds)
+  (apply + (cpu-seconds (current-process-id)) (map cpu-seconds lab-pids)))
+
+;; Microseconds of CPU, in the whole lab, per request per address space.
+(define (request-cpu-us n runs)
+  (let ((before (lab-cpu-seconds)))
+    (do ((i 0 (+ i 1))) ((= i runs)) (request 'all (lambda () #t)))
+    (/ (* 1000000 (- (lab-cpu-seconds) before)) runs n)))
 
 (define (negotiate-and-release task)
   (let ((team (apply negotiate task)))
@@ -64,9 +105,12 @@
                             (let ((answers (request 'all (lambda () #t))))
                               (if (< (length answers) n)
                                   (error "not every address space answered"
-                                         (length answers)))))))
+                                         (length answers))))))
+            "ms")
+    (report "request-cpu" n (request-cpu-us n (quotient 4000 n)) "us")
     (report "pose-task-negotiation" n
-            (median-ms 20 (lambda () (negotiate-and-release task))))))
+            (median-ms 20 (lambda () (negotiate-and-release task)))
+            "ms")))
 
 ;; The lab's address spaces are stopped however the measuring ends.
 (define (bench-lab n delivery)
