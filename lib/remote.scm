@@ -623,7 +623,8 @@
 ;;> Applies \var{proc} to \var{args} in address space \var{a} and returns
 ;;> the result.  Raises a remote-error naming \var{a}, the procedure and
 ;;> the message when the application raised, the connection broke, or no
-;;> answer came within (remote-timeout) seconds.
+;;> answer came within (remote-timeout) seconds, counted from the call:
+;;> connecting and greeting, when there is no connection yet, count too.
 (define (remote-apply a proc . args)
   (if (local? a)
       (local-call 'apply proc args)
