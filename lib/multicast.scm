@@ -189,9 +189,9 @@
   (let ((id (car call)) (kind (cadr call)) (to (uid->aspace sender)))
     (run-in-worker
      (lambda ()
-       (guard (e (#t (send-multicast-answer! to id 'error (error-message e))))
-         (let ((thunk (decode-call (car (cddr call)) (cadr (cddr call)))))
-           (if (eq? kind 'run)
-               (begin (send-multicast-answer! to id 'ack #t) (thunk))
-               (send-multicast-answer!
-                to id 'value (encode (thunk) *environment* "the result")))))))))
+       (let ((thunk (decode-call (car (cddr call)) (cadr (cddr call)))))
+         (if (eq? kind 'run)
+             (begin (send-multicast-answer! to id 'ack #t) (thunk))
+             (send-multicast-answer!
+              to id 'value (encode (thunk) *environment* "the result")))))
+     (lambda (e) (send-multicast-answer! to id 'error (error-message e))))))

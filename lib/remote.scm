@@ -647,28 +647,39 @@
 (define *workers-lock* (make-mutex 'workers))
 (define worker-idle-seconds 10)
 
-(define (run-in-worker thunk)
-  (let ((idle (with-lock *workers-lock*
+;; Runs thunk in a worker; if it raises, (on-error condition) runs there,
+;; by default a warning in the log.  A job is (thunk . on-error).
+(define (run-in-worker thunk . on-error)
+  (let ((job (cons thunk (if (pair? on-error) (car on-error) log-worker-error)))
+        (idle (with-lock *workers-lock*
                 (lambda ()
                   (and (pair? *idle-workers*)
                        (let ((mb (car *idle-workers*)))
                          (set! *idle-workers* (cdr *idle-workers*))
                          mb))))))
     (if idle
-        (mailbox-put! idle thunk)
-        (spawn (lambda () (work thunk)) 'worker))))
+        (mailbox-put! idle job)
+        (spawn (lambda () (work job)) 'worker))))
 
-(define (work thunk)
-  ;; One handler for the worker's whole life, entered again only after a
-  ;; procedure raised: a handler per procedure would cost a continuation
-  ;; each (see undo-on-raise).
-  (guard (e (#t (log-warn "worker: " (error-message e))
-                (let ((next (next-job))) (if next (work next)))))
-    (let loop ((thunk thunk))
-      (thunk)
-      (let ((next (next-job))) (if next (loop next))))))
+(define (log-worker-error e)
+  (log-warn "worker: " (error-message e)))
 
-;; The next procedure for this worker to run, or #f when none came within
+;; One handler for the worker's whole life, entered again only after a job
+;; raised: a handler per job would cost a continuation each (see
+;; undo-on-raise).  The job's own on-error says what the failure means.
+(define (work job)
+  (let ((current job))
+    (let serve ()
+      (guard (e (#t (guard (e2 (#t (log-worker-error e2)))
+                      ((cdr current) e))
+                    (let ((next (next-job)))
+                      (when next (set! current next) (serve)))))
+        (let loop ()
+          ((car current))
+          (let ((next (next-job)))
+            (when next (set! current next) (loop))))))))
+
+;; The next job for this worker, or #f when none came within
 ;; worker-idle-seconds.
 (define (next-job)
   (let ((mb (make-mailbox)))
@@ -684,7 +695,7 @@
                                         (delete mb *idle-workers* eq?))
                                   #t)))))
              ;; The job is on its way; an hour is only a bound.
-             (mailbox-take mb 3600 (lambda () (lambda () #f)))))))
+             (mailbox-take mb 3600 (lambda () #f))))))
 
 ;;; Serving calls
 
@@ -802,7 +813,7 @@
         (id (cadr message)))
     ;; A run is acknowledged once its procedure is decoded, so that one
     ;; that cannot be is reported to its caller; an apply is decoded in
-    ;; its worker, under the handler that reports its errors.
+    ;; its worker, where any error becomes its answer.
     (if (eq? kind 'run)
         (let ((thunk (guard (e (#t (answer! `(error ,id ,(error-message e)))
                                    #f))
@@ -812,8 +823,10 @@
                      (run-in-worker thunk))))
         (run-in-worker
          (lambda ()
-           (answer! (apply-and-encode id (list-ref message 2)
-                                      (list-ref message 3))))))))
+           (answer! `(value ,id ,(encode ((decode-call (list-ref message 2)
+                                                        (list-ref message 3)))
+                                         *environment* "the result"))))
+         (lambda (e) (answer! `(error ,id ,(error-message e))))))))
 
 ;; The application a call asks for, as a thunk.
 (define (decode-call proc-code args-code)
@@ -822,11 +835,6 @@
     (if (not (procedure? proc))
         (error "not a procedure" proc))
     (lambda () (apply proc args))))
-
-(define (apply-and-encode id proc-code args-code)
-  (guard (e (#t `(error ,id ,(error-message e))))
-    `(value ,id ,(encode ((decode-call proc-code args-code))
-                         *environment* "the result"))))
 
 (define (peer-name sockaddr)
   (string-append (sockaddr-name sockaddr) ":"

@@ -64,6 +64,11 @@
       '(troy (lambda () (car '())) "car: not a pair ()")
     (guard (e ((remote-error? e) (error-object-irritants e)))
       (remote-apply (troy) (lambda () (car '())))))
+  (test "a result that cannot travel back is an error, saying why"
+      "cannot send the result: it is a mutex"
+    (error-text (lambda () (remote-apply (troy) (lambda () (make-mutex))))))
+  (test "and the address space answers the next call" 3
+    (remote-apply (troy) (lambda () (+ 1 2))))
   (test "an unsendable value is refused here, naming the variable"
       "cannot send variable port of (lambda () port): it is an output port"
     (let ((port (current-output-port)))
