@@ -97,18 +97,14 @@
              (loop (+ i 1) (+ i 1) (cons (substring s start i) acc)))
             (else (loop start (+ i 1) acc))))))
 
-(define (wildcard? subject)
-  (let ((levels (subject-levels subject)))
-    (or (member "*" levels) (member ">" levels))))
-
 ;; A predicate true of the topics the address subject pattern reaches.
 ;; Made once per message: splitting a subject into its levels copies its
 ;; name (Chibi's symbol->string), and most subjects have no wildcard.
 (define (subject-matcher pattern)
-  (if (wildcard? pattern)
-      (let ((levels (subject-levels pattern)))
-        (lambda (topic) (levels-match? levels (subject-levels topic))))
-      (lambda (topic) (eq? pattern topic))))
+  (let ((levels (subject-levels pattern)))
+    (if (or (member "*" levels) (member ">" levels))
+        (lambda (topic) (levels-match? levels (subject-levels topic)))
+        (lambda (topic) (eq? pattern topic)))))
 
 (define (levels-match? p t)
   (cond ((null? p) (null? t))
