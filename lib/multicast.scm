@@ -134,7 +134,7 @@
 (define (await-answer w deadline seconds proc)
   (let* ((uid (car w))
          (answer (mailbox-take
-                  (cdr w) (seconds-until deadline)
+                  (cdr w) deadline
                   (lambda ()
                     (note-unreachable! uid)
                     (remote-error uid (describe-procedure proc)
@@ -186,12 +186,14 @@
 ;; Runs a call that came by datagram, and answers its sender over TCP: an
 ;; ack before a run, the value after an apply, or the error.
 (define (serve-multicast-call sender call)
-  (let ((id (car call)) (kind (cadr call)) (to (uid->aspace sender)))
+  (let ((id (car call)) (kind (cadr call)) (to (uid->aspace sender))
+        (proc-code (car (cddr call))) (args-code (cadr (cddr call))))
     (run-in-worker
      (lambda ()
-       (let ((thunk (decode-call (car (cddr call)) (cadr (cddr call)))))
-         (if (eq? kind 'run)
-             (begin (send-multicast-answer! to id 'ack #t) (thunk))
-             (send-multicast-answer!
-              to id 'value (encode (thunk) *environment* "the result")))))
+       (if (eq? kind 'run)
+           (let ((thunk (decode-call proc-code args-code)))
+             (send-multicast-answer! to id 'ack #t)
+             (thunk))
+           (send-multicast-answer! to id 'value
+                                   (encoded-result proc-code args-code))))
      (lambda (e) (send-multicast-answer! to id 'error (error-message e))))))

@@ -279,23 +279,23 @@
   (condition-variable-broadcast! (mailbox-condvar mb))
   (mutex-unlock! (mailbox-mutex mb)))
 
-;; Chibi's SRFI-18 time objects count whole seconds, so each wait is given
-;; as the seconds left until a deadline on the monotonic clock.
-(define (mailbox-take mb seconds timed-out)
-  (let ((deadline (+ (monotonic-seconds) seconds)))
-    (let loop ()
-      (mutex-lock! (mailbox-mutex mb))
-      (if (mailbox-full? mb)
-          (begin (mutex-unlock! (mailbox-mutex mb))
-                 (mailbox-value mb))
-          (let ((left (- deadline (monotonic-seconds))))
-            (cond
-             ((and (positive? left)
-                   (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
-              (loop))
-             (else
-              (mutex-unlock! (mailbox-mutex mb))
-              (timed-out))))))))
+;; The mailbox's value, or (timed-out) once the deadline, on the monotonic
+;; clock, has passed.  Chibi's SRFI-18 time objects count whole seconds, so
+;; each wait is given as the seconds left.
+(define (mailbox-take mb deadline timed-out)
+  (let loop ()
+    (mutex-lock! (mailbox-mutex mb))
+    (if (mailbox-full? mb)
+        (begin (mutex-unlock! (mailbox-mutex mb))
+               (mailbox-value mb))
+        (let ((left (seconds-until deadline)))
+          (cond
+           ((and (positive? left)
+                 (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
+            (loop))
+           (else
+            (mutex-unlock! (mailbox-mutex mb))
+            (timed-out)))))))
 
 ;;; Connections to other address spaces
 
@@ -369,7 +369,7 @@
                             ,(aspace-port *local*) ,nonce))
       (thread-start! (make-thread (lambda () (read-answers c nonce welcome))
                                   'answers))
-      (mailbox-take welcome (seconds-until deadline)
+      (mailbox-take welcome deadline
                     (lambda ()
                       (close-connection! c)
                       (remote-error (aspace-uid a) 'connect "no welcome")))
@@ -495,7 +495,7 @@
 (define (finish-call p deadline seconds proc)
   (let* ((uid (pending-call-uid p))
          (answer (mailbox-take
-                  (pending-call-mailbox p) (seconds-until deadline)
+                  (pending-call-mailbox p) deadline
                   (lambda ()
                     (forget-call! (pending-call-connection p) (pending-call-id p))
                     (note-unreachable! uid)
@@ -685,7 +685,8 @@
   (let ((mb (make-mailbox)))
     (with-lock *workers-lock*
       (lambda () (set! *idle-workers* (cons mb *idle-workers*))))
-    (or (mailbox-take mb worker-idle-seconds (lambda () #f))
+    (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds)
+                      (lambda () #f))
         ;; Timed out; but a caller may have taken this worker meanwhile, in
         ;; which case its procedure is on the way.
         (and (not (with-lock *workers-lock*
@@ -695,7 +696,7 @@
                                         (delete mb *idle-workers* eq?))
                                   #t)))))
              ;; The job is on its way; an hour is only a bound.
-             (mailbox-take mb 3600 (lambda () #f))))))
+             (mailbox-take mb (+ (monotonic-seconds) 3600) (lambda () #f))))))
 
 ;;; Serving calls
 
@@ -823,9 +824,8 @@
                      (run-in-worker thunk))))
         (run-in-worker
          (lambda ()
-           (answer! `(value ,id ,(encode ((decode-call (list-ref message 2)
-                                                        (list-ref message 3)))
-                                         *environment* "the result"))))
+           (answer! `(value ,id ,(encoded-result (list-ref message 2)
+                                                 (list-ref message 3)))))
          (lambda (e) (answer! `(error ,id ,(error-message e))))))))
 
 ;; The application a call asks for, as a thunk.
@@ -835,6 +835,10 @@
     (if (not (procedure? proc))
         (error "not a procedure" proc))
     (lambda () (apply proc args))))
+
+;; What the application a call asks for answers, encoded to go back.
+(define (encoded-result proc-code args-code)
+  (encode ((decode-call proc-code args-code)) *environment* "the result"))
 
 (define (peer-name sockaddr)
   (string-append (sockaddr-name sockaddr) ":"
