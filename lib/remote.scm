@@ -20,8 +20,9 @@
 ;;  2. Callee -> caller: (welcome UID NONCE), MAC'd with the caller's nonce
 ;;     and count 0.  From here on each side uses the other's nonce.
 ;;  3. Caller -> callee, any number, pipelined:
-;;       (run ID PROC ARGS)    apply in a new thread, answer at once
-;;       (apply ID PROC ARGS)  apply in a new thread, answer with the value
+;;       (run ID PROC ARGS)    apply in a worker thread, answer at once
+;;       (apply ID PROC ARGS)  apply, answer with the value (see Serving
+;;                             calls for which thread applies it)
 ;;       (answer ID KIND VALUE)  not answered: the answer to call ID of a
 ;;                             multicast datagram from the callee (multicast.scm)
 ;;     PROC, ARGS and VALUE are encoded values (sendable.scm); ID is the
@@ -699,6 +700,13 @@
              (mailbox-take mb (+ (monotonic-seconds) 3600) (lambda () #f))))))
 
 ;;; Serving calls
+;;
+;; Each connection has one reader thread, and the reader runs an apply
+;; itself: handing it to a worker cost a thread switch, a third of a
+;; receiver's time once a lab of 16 no longer fits the machine's caches.
+;; So that a long apply holds up the calls behind it on its connection
+;; for takeover-seconds at most, the janitor then gives the connection a
+;; new reader; the old one answers its call and ends.
 
 ;; A connection being served.  Its deadline is set while a frame is half
 ;; read: a peer that stalls mid-frame would otherwise hold a thread and a
@@ -707,27 +715,41 @@
   (make-serving peer thread in out)
   serving?
   (peer serving-peer)
-  (thread serving-thread)
+  (thread serving-thread serving-thread-set!)  ; the reader
   (in serving-in)
   (out serving-out)
-  (deadline serving-deadline serving-deadline-set!))
+  (deadline serving-deadline serving-deadline-set!)
+  (busy-since serving-busy-since serving-busy-since-set!) ; of an inline apply
+  (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
 
 (define *serving* '())
 (define *serving-lock* (make-mutex 'serving))
 (define *frame-timeout* 5)
+(define janitor-seconds 0.05)
+(define takeover-seconds 0.05)
 
 (define (serve-connection fd peer)
   (let ((s (make-serving peer (current-thread)
                          (open-input-file-descriptor fd #t)
                          (open-output-file-descriptor fd #t))))
     (serving-deadline-set! s #f)
+    (serving-busy-since-set! s #f)
     (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
-    (guard (e (#t (log-fault peer e)))
-      (let ((hello (read-served-frame s "hello" 0)))
-        ;; A peer that connects and leaves at once is probing the port.
-        (if (not (eof-object? hello))
-            (serve-calls s hello))))
-    (end-serving! s)))
+    (read-as-reader s (lambda ()
+                        (let ((hello (read-served-frame s "hello" 0)))
+                          ;; A peer that connects and leaves at once is
+                          ;; probing the port.
+                          (if (not (eof-object? hello))
+                              (serve-calls s hello)))))))
+
+;; Runs a reader's loop; the connection ends with it, unless the janitor
+;; has given it a new reader meanwhile.
+(define (read-as-reader s thunk)
+  (guard (e (#t (log-fault (serving-peer s) e)))
+    (thunk))
+  (if (reader? s) (end-serving! s)))
+
+(define (reader? s) (eq? (current-thread) (serving-thread s)))
 
 (define (end-serving! s)
   (with-lock *serving-lock*
@@ -747,19 +769,48 @@
           message))))
 
 (define (janitor)
-  (thread-sleep! 0.5)
-  (for-each (lambda (s)
-              (log-warn "connection with " (serving-peer s)
-                        " closed: stalled in the middle of a frame")
-              (thread-terminate! (serving-thread s))
-              (end-serving! s))
-            (with-lock *serving-lock*
-              (lambda ()
-                (filter (lambda (s)
-                          (let ((d (serving-deadline s)))
-                            (and d (< d (monotonic-seconds)))))
-                        *serving*))))
+  (thread-sleep! janitor-seconds)
+  (let ((now (monotonic-seconds)))
+    (for-each end-stalled! (serving-where (lambda (s) (serving-deadline s))
+                                          now))
+    (for-each take-over! (serving-where (lambda (s) (serving-busy-since s))
+                                        (- now takeover-seconds))))
   (janitor))
+
+;; The connections whose (moment s) is before time.
+(define (serving-where moment time)
+  (with-lock *serving-lock*
+    (lambda ()
+      (filter (lambda (s) (let ((t (moment s))) (and t (< t time))))
+              *serving*))))
+
+(define (end-stalled! s)
+  (log-warn "connection with " (serving-peer s)
+            " closed: stalled in the middle of a frame")
+  (thread-terminate! (serving-thread s))
+  (end-serving! s))
+
+(define (take-over! s)
+  (mutex-lock! *serving-lock*)
+  (when (serving-busy-since s)          ; its apply may just have ended
+    (let ((t (make-thread (lambda () (read-as-reader s (serving-read-on s)))
+                          'connection)))
+      (serving-busy-since-set! s #f)
+      (serving-thread-set! s t)
+      (thread-start! t)))
+  (mutex-unlock! *serving-lock*))
+
+;; Marks the start and the end of the reader's inline apply; ending
+;; answers whether this thread is still the reader.
+(define (inline-apply-begins! s)
+  (serving-busy-since-set! s (monotonic-seconds)))
+
+(define (inline-apply-ends! s)
+  (mutex-lock! *serving-lock*)
+  (let ((still (reader? s)))
+    (if still (serving-busy-since-set! s #f))
+    (mutex-unlock! *serving-lock*)
+    still))
 
 (define (serve-calls s hello)
   (let* ((caller-nonce (greet! hello))
@@ -767,31 +818,46 @@
          (out (serving-out s))
          (text (open-output-string))
          (write-lock (make-mutex))
-         (sent 0))
-    ;; The reader's own answers, the acks, wait in the port's buffer until
-    ;; it has read every call that has arrived: a burst of remote-run!s is
-    ;; acknowledged in one write.  Answers from workers go at once.
+         (sent 0)
+         (count 0))
+    ;; The reader's own answers wait in the port's buffer until it has
+    ;; read every call that has arrived: a burst of calls is answered in
+    ;; one write.  Answers from workers and former readers go at once.
     (define (answer! message)
       (with-lock write-lock
         (lambda ()
           (set! sent (+ sent 1))
-          ;; A caller that left makes this raise: in the reader, which
-          ;; then ends the connection, or in a worker, which logs it.
+          ;; A caller that left makes this raise, and the connection end.
           (write-frame! out text caller-nonce sent message)
-          (if (not (eq? (current-thread) (serving-thread s)))
-              (flush-output-port out)))))
+          (if (not (reader? s)) (flush-output-port out)))))
     (define (flush-if-idle!)
       (if (zero? (buffered-byte-count (serving-in s)))
           (with-lock write-lock (lambda () (flush-output-port out)))))
+    ;; Serves frames while this thread is the reader.  The car of call
+    ;; holds the id of the apply the thread runs, if any: one that raises
+    ;; is answered with its error by serve's one handler.
+    (define (read-on call)
+      (let ((message (read-served-frame s nonce (+ count 1))))
+        (unless (eof-object? message)
+          (set! count (+ count 1))
+          (if (and (pair? message) (eq? (car message) 'answer))
+              (take-multicast-answer! (list-ref hello 1) message)
+              (serve-call s call message answer!))
+          (flush-if-idle!)
+          (if (reader? s) (read-on call)))))
+    (define (serve)
+      (let ((call (list #f)))
+        (let again ()
+          (guard (e ((car call)
+                     => (lambda (id)
+                          (set-car! call #f)
+                          (let ((still (inline-apply-ends! s)))
+                            (answer! `(error ,id ,(error-message e)))
+                            (when still (flush-if-idle!) (again))))))
+            (read-on call)))))
     (send-frame! out text caller-nonce 0 `(welcome ,(aspace-uid *local*) ,nonce))
-    (let loop ((count 1))
-      (let ((message (read-served-frame s nonce count)))
-        (if (not (eof-object? message))
-            (begin (if (and (pair? message) (eq? (car message) 'answer))
-                       (take-multicast-answer! (list-ref hello 1) message)
-                       (serve-call message answer!))
-                   (flush-if-idle!)
-                   (loop (+ count 1))))))))
+    (serving-read-on-set! s serve)
+    (serve)))
 
 ;; Check a hello and learn where its sender listens; answers its nonce.
 (define (greet! hello)
@@ -804,7 +870,7 @@
                               (list-ref hello 3)))
   (list-ref hello 4))
 
-(define (serve-call message answer!)
+(define (serve-call s call message answer!)
   (if (not (and (list? message) (= (length message) 4)
                 (memq (car message) '(run apply))
                 (exact-integer? (cadr message))
@@ -812,21 +878,27 @@
       (frame-fail "expected a call"))
   (let ((kind (car message))
         (id (cadr message)))
-    ;; A run is acknowledged once its procedure is decoded, so that one
-    ;; that cannot be is reported to its caller; an apply is decoded in
-    ;; its worker, where any error becomes its answer.
+    ;; Until the call is answered, an error in it is its answer (see
+    ;; serve-calls).  A run is acknowledged once its procedure is decoded,
+    ;; so that one that cannot be is reported to its caller, and runs in a
+    ;; worker; an apply runs here.
+    (set-car! call id)
     (if (eq? kind 'run)
-        (let ((thunk (guard (e (#t (answer! `(error ,id ,(error-message e)))
-                                   #f))
-                       (decode-call (list-ref message 2) (list-ref message 3)))))
-          (if thunk
-              (begin (answer! `(ack ,id))
-                     (run-in-worker thunk))))
-        (run-in-worker
-         (lambda ()
-           (answer! `(value ,id ,(encoded-result (list-ref message 2)
-                                                 (list-ref message 3)))))
-         (lambda (e) (answer! `(error ,id ,(error-message e))))))))
+        (let ((thunk (decode-call (list-ref message 2) (list-ref message 3))))
+          (set-car! call #f)
+          (answer! `(ack ,id))
+          (run-in-worker thunk))
+        (apply-inline s call id (list-ref message 2) (list-ref message 3)
+                      answer!))))
+
+;; The reader's apply, in this thread until the janitor gives the
+;; connection a new reader.
+(define (apply-inline s call id proc-code args-code answer!)
+  (inline-apply-begins! s)
+  (let ((value (encoded-result proc-code args-code)))
+    (set-car! call #f)
+    (inline-apply-ends! s)
+    (answer! `(value ,id ,value))))
 
 ;; The application a call asks for, as a thunk.
 (define (decode-call proc-code args-code)

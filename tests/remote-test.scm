@@ -80,6 +80,32 @@
   (test "the connection still works after a timeout" 3
     (remote-apply (troy) (lambda () 3))))
 
+(test-group "a long apply does not hold up the calls behind it"
+  ;; The connection's reader runs an apply itself; one that runs long has
+  ;; the connection handed to a new reader, so that the quick call behind
+  ;; it is answered well before the slow one ends.
+  (let ((long (make-thread (lambda () (remote-apply (troy) slow 3))))
+        (failing (make-thread
+                  (lambda ()
+                    (error-text
+                     (lambda ()
+                       (remote-apply (troy) (lambda ()
+                                              (thread-sleep! 2)
+                                              (car '())))))))))
+    (thread-start! long)
+    (thread-start! failing)
+    (thread-sleep! 1/5)
+    (test "a quick call behind it is answered" 'quick
+      (parameterize ((remote-timeout 1))
+        (remote-apply (troy) (lambda () 'quick))))
+    (test "the long one is answered by its own thread" 'done
+      (thread-join! long))
+    (test "one that fails meanwhile is answered with its error"
+        "car: not a pair ()"
+      (thread-join! failing))
+    (test "the connection serves on" 3
+      (remote-apply (troy) (lambda () 3)))))
+
 (test-group "remote-run!"
   (test "acknowledged" #t (remote-run! (troy) bump!))
   (test "applied there in a thread of its own" 1
