@@ -725,8 +725,8 @@
 (define *serving* '())
 (define *serving-lock* (make-mutex 'serving))
 (define *frame-timeout* 5)
-(define janitor-seconds 0.05)
-(define takeover-seconds 0.05)
+(define janitor-seconds 0.1)
+(define takeover-seconds 0.1)
 
 (define (serve-connection fd peer)
   (let ((s (make-serving peer (current-thread)
