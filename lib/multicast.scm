@@ -48,8 +48,7 @@
               (cons (open-multicast-socket group port (aspace-host *local*))
                     (get-address-info group port)))
         (set! *sequence* (exact (round (* 1000000 (current-second)))))
-        (spawn (lambda () (receive-datagrams (make-bytevector 65536)))
-               'multicast)
+        (spawn listen-to-group 'multicast)
         (spawn send-beacons 'beacon)))))
 
 ;;> How publish and request reach the lab: \scheme{multicast} or
@@ -146,15 +145,43 @@
       (else #t))))
 
 ;;; Receiving
+;;
+;; The group is read as a connection is (see Serving calls in remote.scm):
+;; its listener applies a call itself, and the janitor gives the group a
+;; new listener when an apply runs long.
 
-;; Datagrams are received into one buffer: a new 64 KB bytevector for
-;; each, dozens a second, cost more than serving them.
-(define (receive-datagrams buffer)
-  (let ((n (receive! (car *multicast*) buffer)))
-    (if (>= n 0)
-        (guard (e (#t (log-warn "datagram dropped: " (fault-message e))))
-          (serve-datagram (open-datagram buffer n))))
-    (receive-datagrams buffer)))
+(define (listen-to-group)
+  (let ((s (make-serving "the multicast group" (current-thread) #f #f)))
+    (serving-deadline-set! s #f)
+    (serving-busy-since-set! s #f)
+    ;; Datagrams are received into one buffer: a new 64 KB bytevector for
+    ;; each, dozens a second, cost more than serving them.
+    (serving-read-on-set! s (lambda ()
+                              (receive-datagrams s (make-bytevector 65536))))
+    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
+    (read-as-reader s (serving-read-on s))))
+
+;; Serves datagrams while this thread is the group's listener.  One
+;; handler: the car of call holds the sender and id of the call being
+;; run, whose error is its answer; any other failure drops the datagram.
+(define (receive-datagrams s buffer)
+  (let ((call (list #f)))
+    (let again ()
+      (guard (e ((car call)
+                 => (lambda (to+id)
+                      (set-car! call #f)
+                      (let ((still (inline-apply-ends! s)))
+                        (guard (e2 (#t (log-warn "multicast: " (fault-message e2))))
+                          (send-multicast-answer! (car to+id) (cdr to+id) 'error
+                                                  (error-message e)))
+                        (if still (again)))))
+                (#t (log-warn "multicast: " (fault-message e))
+                    (if (reader? s) (again))))
+        (let loop ()
+          (let ((n (receive! (car *multicast*) buffer)))
+            (if (>= n 0)
+                (serve-datagram s call (open-datagram buffer n))))
+          (if (reader? s) (loop)))))))
 
 ;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
 ;; bytes of buffer.
@@ -168,7 +195,7 @@
     (hash-table-set! *last-sequence* (car d) (cadr d))
     d))
 
-(define (serve-datagram d)
+(define (serve-datagram s call d)
   (let ((sender (car d)) (body (car (cddr d))))
     (with-lock *peers-lock*
       (lambda () (hash-table-set! *last-heard* sender (monotonic-seconds))))
@@ -180,20 +207,24 @@
       (with-lock *peers-lock*
         (lambda () (hash-table-delete! *unreachable* sender))))
      ((and (pair? body) (eq? (car body) 'call) (= (length body) 5))
-      (serve-multicast-call sender (cdr body)))
+      (serve-multicast-call s call sender (cdr body)))
      (else (frame-fail "not a beacon or a call")))))
 
 ;; Runs a call that came by datagram, and answers its sender over TCP: an
-;; ack before a run, the value after an apply, or the error.
-(define (serve-multicast-call sender call)
-  (let ((id (car call)) (kind (cadr call)) (to (uid->aspace sender))
-        (proc-code (car (cddr call))) (args-code (cadr (cddr call))))
-    (run-in-worker
-     (lambda ()
-       (if (eq? kind 'run)
-           (let ((thunk (decode-call proc-code args-code)))
-             (send-multicast-answer! to id 'ack #t)
-             (thunk))
-           (send-multicast-answer! to id 'value
-                                   (encoded-result proc-code args-code))))
-     (lambda (e) (send-multicast-answer! to id 'error (error-message e))))))
+;; ack before a run, which then goes to a worker, or the value after an
+;; apply, which runs here.  An error is answered by receive-datagrams.
+(define (serve-multicast-call s call sender message)
+  (let ((id (car message)) (kind (cadr message)) (to (uid->aspace sender))
+        (proc-code (car (cddr message))) (args-code (cadr (cddr message))))
+    (set-car! call (cons to id))
+    (if (eq? kind 'run)
+        (let ((thunk (decode-call proc-code args-code)))
+          (set-car! call #f)
+          (send-multicast-answer! to id 'ack #t)
+          (run-in-worker thunk))
+        (begin
+          (inline-apply-begins! s)
+          (let ((value (encoded-result proc-code args-code)))
+            (set-car! call #f)
+            (inline-apply-ends! s)
+            (send-multicast-answer! to id 'value value))))))

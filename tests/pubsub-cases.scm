@@ -49,6 +49,7 @@
 (define (status uid topic) (at uid topic-status topic))
 (define (evaluated uid) (at uid (eval '(lambda () *evaluated*) (lab-environment))))
 (define (sorted-uids ls) (list-sort (lambda (x y) (string<? (symbol->string x) (symbol->string y))) ls))
+(define (by-uid answers) (list-sort (lambda (x y) (string<? (symbol->string (car x)) (symbol->string (car y)))) answers))
 (define (lab-proc name) (eval name (lab-environment)))
 
 (test-begin (if (null? delivery) "pubsub" "pubsub over multicast"))
@@ -83,14 +84,27 @@
 
 (test-group "Figure 4.2: request"
   (test "A and C answer with their uids" '((a a) (c c))
-    (list-sort (lambda (x y) (string<? (symbol->string (car x)) (symbol->string (car y))))
-               (request '(foo bar) (lambda () (local-aspace-uid)))))
+    (by-uid (request '(foo bar) (lambda () (local-aspace-uid)))))
   (test "a subject nobody has: no answers" '()
     (request 'nobody-has-this (lambda () 1)))
   (test "one subject, not a list" '((b 2))
     (request 'wheel (lambda () 2)))
   (test "point to point through the uid subject" '((c 9))
     (request 'c (lambda () 9))))
+
+(test-group "a long request does not hold up the one behind it"
+  ;; A and C run the long one in the thread that reads the lab's messages
+  ;; to them; the quick one behind it gets a new reader.
+  (let ((long (make-thread
+               (lambda ()
+                 (request '(foo bar) (lambda () (thread-sleep! 2) 'slow))))))
+    (thread-start! long)
+    (thread-sleep! 1/5)
+    (test "the quick one is answered by A and C" '((a quick) (c quick))
+      (parameterize ((remote-timeout 1))
+        (by-uid (request '(foo bar) (lambda () 'quick)))))
+    (test "and so is the long one" '((a slow) (c slow))
+      (by-uid (thread-join! long)))))
 
 (test-group "Figure 4.3: request-exclusive and promises"
   (let ((promises (request-exclusive '((foo bar) ()) 'task1 (lambda () 'done))))
