@@ -640,10 +640,11 @@
 
 ;;; Workers
 
-;; Received procedures run in threads of their own, so that a long task
-;; does not hold up the calls behind it.  Making a thread costs Chibi more
-;; than the rest of a call, so a thread that is done waits a while for the
-;; next procedure to run instead of ending.
+;; A remote-run!'s procedure runs in a thread of its own, since its caller
+;; does not wait for it (an apply runs in the thread that read it: see
+;; Serving calls).  Making a thread costs Chibi more than the rest of a
+;; call, so a thread that is done waits a while for the next procedure to
+;; run instead of ending.
 (define *idle-workers* '())             ; mailboxes of waiting workers
 (define *workers-lock* (make-mutex 'workers))
 (define worker-idle-seconds 10)
