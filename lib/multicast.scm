@@ -161,27 +161,22 @@
     (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
     (read-as-reader s (serving-read-on s))))
 
-;; Serves datagrams while this thread is the group's listener.  One
-;; handler: the car of call holds the sender and id of the call being
-;; run, whose error is its answer; any other failure drops the datagram.
+;; Serves datagrams while this thread is the group's listener (see
+;; read-calls): a call's error is its answer; any other failure drops the
+;; datagram.
 (define (receive-datagrams s buffer)
-  (let ((call (list #f)))
-    (let again ()
-      (guard (e ((car call)
-                 => (lambda (to+id)
-                      (set-car! call #f)
-                      (let ((still (inline-apply-ends! s)))
-                        (guard (e2 (#t (log-warn "multicast: " (fault-message e2))))
-                          (send-multicast-answer! (car to+id) (cdr to+id) 'error
-                                                  (error-message e)))
-                        (if still (again)))))
-                (#t (log-warn "multicast: " (fault-message e))
-                    (if (reader? s) (again))))
-        (let loop ()
-          (let ((n (receive! (car *multicast*) buffer)))
-            (if (>= n 0)
-                (serve-datagram s call (open-datagram buffer n))))
-          (if (reader? s) (loop)))))))
+  (define (read-on call)
+    (let ((n (receive! (car *multicast*) buffer)))
+      (if (>= n 0)
+          (serve-datagram s call (open-datagram buffer n))))
+    (if (reader? s) (read-on call)))
+  (read-calls s read-on
+              (lambda (to+id e)
+                (guard (e2 (#t (log-warn "an answer was lost: "
+                                         (fault-message e2))))
+                  (send-multicast-answer! (car to+id) (cdr to+id) 'error
+                                          (error-message e))))
+              (lambda (e) (log-warn "datagram dropped: " (fault-message e)))))
 
 ;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
 ;; bytes of buffer.
@@ -222,9 +217,6 @@
           (set-car! call #f)
           (send-multicast-answer! to id 'ack #t)
           (run-in-worker thunk))
-        (begin
-          (inline-apply-begins! s)
-          (let ((value (encoded-result proc-code args-code)))
-            (set-car! call #f)
-            (inline-apply-ends! s)
-            (send-multicast-answer! to id 'value value))))))
+        (apply-inline s call proc-code args-code
+                      (lambda (value)
+                        (send-multicast-answer! to id 'value value))))))

@@ -703,8 +703,8 @@
 ;;; Serving calls
 ;;
 ;; Each connection has one reader thread, and the reader runs an apply
-;; itself: handing it to a worker cost a thread switch, a third of a
-;; receiver's time once a lab of 16 no longer fits the machine's caches.
+;; itself: handing it to a worker cost a thread switch, about a seventh of
+;; a receiver's CPU a request.
 ;; So that a long apply holds up the calls behind it on its connection
 ;; for takeover-seconds at most, the janitor then gives the connection a
 ;; new reader; the old one answers its call and ends.
@@ -813,6 +813,33 @@
     (mutex-unlock! *serving-lock*)
     still))
 
+;; Runs (read-on call) while this thread is s's reader, under one handler
+;; for the thread's life: a handler per call would cost a continuation
+;; each (see undo-on-raise).  The car of call says which call the thread
+;; is running, if any; an error in it is answered by (answer-error call
+;; e), any other by (other-failure e), which may raise to end the reader.
+(define (read-calls s read-on answer-error other-failure)
+  (let ((call (list #f)))
+    (let again ()
+      (guard (e ((car call)
+                 => (lambda (c)
+                      (set-car! call #f)
+                      (let ((still (inline-apply-ends! s)))
+                        (answer-error c e)
+                        (if still (again)))))
+                (#t (other-failure e)
+                    (if (reader? s) (again))))
+        (read-on call)))))
+
+;; The reader's apply, in this thread until the janitor gives s a new
+;; reader; (answer value) sends the result.
+(define (apply-inline s call proc-code args-code answer)
+  (inline-apply-begins! s)
+  (let ((value (encoded-result proc-code args-code)))
+    (set-car! call #f)
+    (inline-apply-ends! s)
+    (answer value)))
+
 (define (serve-calls s hello)
   (let* ((caller-nonce (greet! hello))
          (nonce (random-hex 16))
@@ -834,9 +861,7 @@
     (define (flush-if-idle!)
       (if (zero? (buffered-byte-count (serving-in s)))
           (with-lock write-lock (lambda () (flush-output-port out)))))
-    ;; Serves frames while this thread is the reader.  The car of call
-    ;; holds the id of the apply the thread runs, if any: one that raises
-    ;; is answered with its error by serve's one handler.
+    ;; Serves frames while this thread is the reader; see read-calls.
     (define (read-on call)
       (let ((message (read-served-frame s nonce (+ count 1))))
         (unless (eof-object? message)
@@ -847,15 +872,11 @@
           (flush-if-idle!)
           (if (reader? s) (read-on call)))))
     (define (serve)
-      (let ((call (list #f)))
-        (let again ()
-          (guard (e ((car call)
-                     => (lambda (id)
-                          (set-car! call #f)
-                          (let ((still (inline-apply-ends! s)))
-                            (answer! `(error ,id ,(error-message e)))
-                            (when still (flush-if-idle!) (again))))))
-            (read-on call)))))
+      (read-calls s read-on
+                  (lambda (id e)
+                    (answer! `(error ,id ,(error-message e)))
+                    (flush-if-idle!))
+                  raise))
     (send-frame! out text caller-nonce 0 `(welcome ,(aspace-uid *local*) ,nonce))
     (serving-read-on-set! s serve)
     (serve)))
@@ -889,17 +910,8 @@
           (set-car! call #f)
           (answer! `(ack ,id))
           (run-in-worker thunk))
-        (apply-inline s call id (list-ref message 2) (list-ref message 3)
-                      answer!))))
-
-;; The reader's apply, in this thread until the janitor gives the
-;; connection a new reader.
-(define (apply-inline s call id proc-code args-code answer!)
-  (inline-apply-begins! s)
-  (let ((value (encoded-result proc-code args-code)))
-    (set-car! call #f)
-    (inline-apply-ends! s)
-    (answer! `(value ,id ,value))))
+        (apply-inline s call (list-ref message 2) (list-ref message 3)
+                      (lambda (value) (answer! `(value ,id ,value)))))))
 
 ;; The application a call asks for, as a thunk.
 (define (decode-call proc-code args-code)
