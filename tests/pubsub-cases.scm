@@ -106,6 +106,17 @@
     (test "and so is the long one" '((a slow) (c slow))
       (by-uid (thread-join! long)))))
 
+(test-group "an error in a message"
+  ;; Each address space answers with the error at once, rather than
+  ;; leaving its sender to time out.
+  (test "is each address space's answer" '("car: not a pair ()")
+    (delete-duplicates
+     (map (lambda (r) (if (cadr r) 'no-error (car (cddr r))))
+          (parameterize ((remote-timeout 2))
+            (broadcast-apply (lambda () (car '())))))))
+  (test "and every address space serves on" '(a b c d tester)
+    (sorted-uids (map car (request 'all (lambda () 1))))))
+
 (test-group "Figure 4.3: request-exclusive and promises"
   (let ((promises (request-exclusive '((foo bar) ()) 'task1 (lambda () 'done))))
     (test "A and C reserve and promise" '(a c) (sorted-uids (map car promises)))
