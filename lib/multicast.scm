@@ -121,28 +121,17 @@
              (let* ((here (capture (local-aspace-uid)
                                    (lambda () (local-call kind proc args))))
                     (deadline (+ (monotonic-seconds) seconds))
-                    (there (capture-each car
-                                         (lambda (w)
-                                           (list (car w) #t
-                                                 (await-answer w deadline seconds proc)))
-                                         waiting)))
+                    (there (capture-each
+                            car
+                            (lambda (w)
+                              (list (car w) #t
+                                    (await-answer (car w) (cdr w) deadline
+                                                  seconds proc (lambda () #f))))
+                            waiting)))
                (forget!)
                (cons here there))
              (begin (forget!) #f)))))
 
-(define (await-answer w deadline seconds proc)
-  (let* ((uid (car w))
-         (answer (mailbox-take
-                  (cdr w) deadline
-                  (lambda ()
-                    (note-unreachable! uid)
-                    (remote-error uid (describe-procedure proc)
-                                  (string-append "no answer within "
-                                                 (number->string seconds) " s"))))))
-    (case (car answer)
-      ((error) (remote-error uid (describe-procedure proc) (car (cddr answer))))
-      ((value) (*decode* (car (cddr answer))))
-      (else #t))))
 
 ;;; Receiving
 ;;
@@ -151,14 +140,11 @@
 ;; new listener when an apply runs long.
 
 (define (listen-to-group)
-  (let ((s (make-serving "the multicast group" (current-thread) #f #f)))
-    (serving-deadline-set! s #f)
-    (serving-busy-since-set! s #f)
+  (let ((s (new-serving! "the multicast group" #f #f)))
     ;; Datagrams are received into one buffer: a new 64 KB bytevector for
     ;; each, dozens a second, cost more than serving them.
     (serving-read-on-set! s (lambda ()
                               (receive-datagrams s (make-bytevector 65536))))
-    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
     (read-as-reader s (serving-read-on s))))
 
 ;; Serves datagrams while this thread is the group's listener (see
@@ -205,18 +191,10 @@
       (serve-multicast-call s call sender (cdr body)))
      (else (frame-fail "not a beacon or a call")))))
 
-;; Runs a call that came by datagram, and answers its sender over TCP: an
-;; ack before a run, which then goes to a worker, or the value after an
-;; apply, which runs here.  An error is answered by receive-datagrams.
+;; Runs a call that came by datagram (see serve-call), and answers its
+;; sender over TCP; an error is answered by receive-datagrams.
 (define (serve-multicast-call s call sender message)
-  (let ((id (car message)) (kind (cadr message)) (to (uid->aspace sender))
-        (proc-code (car (cddr message))) (args-code (cadr (cddr message))))
-    (set-car! call (cons to id))
-    (if (eq? kind 'run)
-        (let ((thunk (decode-call proc-code args-code)))
-          (set-car! call #f)
-          (send-multicast-answer! to id 'ack #t)
-          (run-in-worker thunk))
-        (apply-inline s call proc-code args-code
-                      (lambda (value)
-                        (send-multicast-answer! to id 'value value))))))
+  (let ((id (car message)) (to (uid->aspace sender)))
+    (serve-call s call (cons to id) (cadr message)
+                (car (cddr message)) (cadr (cddr message))
+                (lambda (kind value) (send-multicast-answer! to id kind value)))))

@@ -494,16 +494,24 @@
 ;; clock), which is \var{seconds} after the call began: the value, or a
 ;; remote-error.
 (define (finish-call p deadline seconds proc)
-  (let* ((uid (pending-call-uid p))
-         (answer (mailbox-take
-                  (pending-call-mailbox p) deadline
-                  (lambda ()
-                    (forget-call! (pending-call-connection p) (pending-call-id p))
-                    (note-unreachable! uid)
-                    (remote-error uid (describe-procedure proc)
-                                  (string-append "no answer within "
-                                                 (number->string seconds)
-                                                 " s"))))))
+  (await-answer (pending-call-uid p) (pending-call-mailbox p) deadline seconds
+                proc
+                (lambda ()
+                  (forget-call! (pending-call-connection p) (pending-call-id p)))))
+
+;; The answer that uid puts in mailbox mb to a call of proc, by the
+;; deadline: the value, or a remote-error.  (forget) runs when none came.
+;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
+(define (await-answer uid mb deadline seconds proc forget)
+  (let ((answer (mailbox-take
+                 mb deadline
+                 (lambda ()
+                   (forget)
+                   (note-unreachable! uid)
+                   (remote-error uid (describe-procedure proc)
+                                 (string-append "no answer within "
+                                                (number->string seconds)
+                                                " s"))))))
     (case (car answer)
       ((ack) #t)
       ((value) (*decode* (car (cddr answer))))
@@ -649,37 +657,30 @@
 (define *workers-lock* (make-mutex 'workers))
 (define worker-idle-seconds 10)
 
-;; Runs thunk in a worker; if it raises, (on-error condition) runs there,
-;; by default a warning in the log.  A job is (thunk . on-error).
-(define (run-in-worker thunk . on-error)
-  (let ((job (cons thunk (if (pair? on-error) (car on-error) log-worker-error)))
-        (idle (with-lock *workers-lock*
+;; Runs thunk in a worker; if it raises, the log says so.
+(define (run-in-worker thunk)
+  (let ((idle (with-lock *workers-lock*
                 (lambda ()
                   (and (pair? *idle-workers*)
                        (let ((mb (car *idle-workers*)))
                          (set! *idle-workers* (cdr *idle-workers*))
                          mb))))))
     (if idle
-        (mailbox-put! idle job)
-        (spawn (lambda () (work job)) 'worker))))
-
-(define (log-worker-error e)
-  (log-warn "worker: " (error-message e)))
+        (mailbox-put! idle thunk)
+        (spawn (lambda () (work thunk)) 'worker))))
 
 ;; One handler for the worker's whole life, entered again only after a job
 ;; raised: a handler per job would cost a continuation each (see
-;; undo-on-raise).  The job's own on-error says what the failure means.
+;; undo-on-raise).
 (define (work job)
-  (let ((current job))
-    (let serve ()
-      (guard (e (#t (guard (e2 (#t (log-worker-error e2)))
-                      ((cdr current) e))
-                    (let ((next (next-job)))
-                      (when next (set! current next) (serve)))))
-        (let loop ()
-          ((car current))
-          (let ((next (next-job)))
-            (when next (set! current next) (loop))))))))
+  (let serve ((job job))
+    (guard (e (#t (log-warn "worker: " (error-message e))
+                  (let ((next (next-job)))
+                    (if next (serve next)))))
+      (let loop ((job job))
+        (job)
+        (let ((next (next-job)))
+          (if next (loop next)))))))
 
 ;; The next job for this worker, or #f when none came within
 ;; worker-idle-seconds.
@@ -704,10 +705,10 @@
 ;;
 ;; Each connection has one reader thread, and the reader runs an apply
 ;; itself: handing it to a worker cost a thread switch, about a seventh of
-;; a receiver's CPU a request.
-;; So that a long apply holds up the calls behind it on its connection
-;; for takeover-seconds at most, the janitor then gives the connection a
-;; new reader; the old one answers its call and ends.
+;; a receiver's CPU a request.  So that a long apply holds up the calls
+;; behind it on its connection for takeover-seconds at most, the janitor
+;; then gives the connection a new reader; the old one answers its call
+;; and ends.
 
 ;; A connection being served.  Its deadline is set while a frame is half
 ;; read: a peer that stalls mid-frame would otherwise hold a thread and a
@@ -730,18 +731,23 @@
 (define takeover-seconds 0.1)
 
 (define (serve-connection fd peer)
-  (let ((s (make-serving peer (current-thread)
-                         (open-input-file-descriptor fd #t)
+  (let ((s (new-serving! peer (open-input-file-descriptor fd #t)
                          (open-output-file-descriptor fd #t))))
-    (serving-deadline-set! s #f)
-    (serving-busy-since-set! s #f)
-    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
     (read-as-reader s (lambda ()
                         (let ((hello (read-served-frame s "hello" 0)))
                           ;; A peer that connects and leaves at once is
                           ;; probing the port.
                           (if (not (eof-object? hello))
                               (serve-calls s hello)))))))
+
+;; A connection (or the multicast group: no ports) that this thread reads,
+;; among those the janitor watches.
+(define (new-serving! peer in out)
+  (let ((s (make-serving peer (current-thread) in out)))
+    (serving-deadline-set! s #f)
+    (serving-busy-since-set! s #f)
+    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
+    s))
 
 ;; Runs a reader's loop; the connection ends with it, unless the janitor
 ;; has given it a new reader meanwhile.
@@ -831,14 +837,25 @@
                     (if (reader? s) (again))))
         (read-on call)))))
 
-;; The reader's apply, in this thread until the janitor gives s a new
-;; reader; (answer value) sends the result.
-(define (apply-inline s call proc-code args-code answer)
-  (inline-apply-begins! s)
-  (let ((value (encoded-result proc-code args-code)))
-    (set-car! call #f)
-    (inline-apply-ends! s)
-    (answer value)))
+;; Runs a call that s's reader has read; (reply KIND VALUE) answers it.
+;; Until then the car of call is marker, for read-calls to answer an error
+;; with.  A run is acknowledged once its procedure is decoded, so that one
+;; that cannot be is reported to its caller, and runs in a worker; an apply
+;; runs here, until the janitor gives s a new reader, and its value goes
+;; back.
+(define (serve-call s call marker kind proc-code args-code reply)
+  (set-car! call marker)
+  (if (eq? kind 'run)
+      (let ((thunk (decode-call proc-code args-code)))
+        (set-car! call #f)
+        (reply 'ack #t)
+        (run-in-worker thunk))
+      (begin
+        (inline-apply-begins! s)
+        (let ((value (encoded-result proc-code args-code)))
+          (set-car! call #f)
+          (inline-apply-ends! s)
+          (reply 'value value)))))
 
 (define (serve-calls s hello)
   (let* ((caller-nonce (greet! hello))
@@ -850,7 +867,7 @@
          (count 0))
     ;; The reader's own answers wait in the port's buffer until it has
     ;; read every call that has arrived: a burst of calls is answered in
-    ;; one write.  Answers from workers and former readers go at once.
+    ;; one write.  Answers from former readers go at once.
     (define (answer! message)
       (with-lock write-lock
         (lambda ()
@@ -868,7 +885,7 @@
           (set! count (+ count 1))
           (if (and (pair? message) (eq? (car message) 'answer))
               (take-multicast-answer! (list-ref hello 1) message)
-              (serve-call s call message answer!))
+              (serve-frame s call message answer!))
           (flush-if-idle!)
           (if (reader? s) (read-on call)))))
     (define (serve)
@@ -892,26 +909,16 @@
                               (list-ref hello 3)))
   (list-ref hello 4))
 
-(define (serve-call s call message answer!)
+(define (serve-frame s call message answer!)
   (if (not (and (list? message) (= (length message) 4)
                 (memq (car message) '(run apply))
                 (exact-integer? (cadr message))
                 (list? (list-ref message 3))))
       (frame-fail "expected a call"))
-  (let ((kind (car message))
-        (id (cadr message)))
-    ;; Until the call is answered, an error in it is its answer (see
-    ;; serve-calls).  A run is acknowledged once its procedure is decoded,
-    ;; so that one that cannot be is reported to its caller, and runs in a
-    ;; worker; an apply runs here.
-    (set-car! call id)
-    (if (eq? kind 'run)
-        (let ((thunk (decode-call (list-ref message 2) (list-ref message 3))))
-          (set-car! call #f)
-          (answer! `(ack ,id))
-          (run-in-worker thunk))
-        (apply-inline s call (list-ref message 2) (list-ref message 3)
-                      (lambda (value) (answer! `(value ,id ,value)))))))
+  (let ((id (cadr message)))
+    (serve-call s call id (car message) (list-ref message 2) (list-ref message 3)
+                (lambda (kind value)
+                  (answer! (if (eq? kind 'ack) `(ack ,id) `(value ,id ,value)))))))
 
 ;; The application a call asks for, as a thunk.
 (define (decode-call proc-code args-code)
