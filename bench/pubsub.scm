@@ -19,6 +19,7 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
         (scheme process-context) (scheme file) (srfi 1) (srfi 132)
         (only (chibi process) current-process-id)
+        (only (murdoch trip-client) split-words)
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define (aspace-clause i)
@@ -66,19 +67,11 @@
                  (lambda (in) (read-line in))))
          (fields (let after-name ((i (- (string-length text) 1)))
                    (if (char=? (string-ref text i) #\))
-                       (words (substring text (+ i 2) (string-length text)))
+                       (split-words (substring text (+ i 2) (string-length text)))
                        (after-name (- i 1))))))
     ;; utime and stime are fields 14 and 15; the list starts at field 3.
     (/ (+ (string->number (list-ref fields 11)) (string->number (list-ref fields 12)))
        100.)))
-
-(define (words s)
-  (let loop ((i 0) (start 0) (acc '()))
-    (cond ((= i (string-length s))
-           (reverse (if (< start i) (cons (substring s start i) acc) acc)))
-          ((char=? (string-ref s i) #\space)
-           (loop (+ i 1) (+ i 1) (if (< start i) (cons (substring s start i) acc) acc)))
-          (else (loop (+ i 1) start acc)))))
 
 (define (lab-cpu-seconds)
   (apply + (cpu-seconds (current-process-id)) (map cpu-seconds lab-pids)))

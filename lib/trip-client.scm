@@ -155,6 +155,7 @@
   (guard (e (#t #f)) (close-input-port (trip-connection-in c)))
   (guard (e (#t #f)) (close-output-port (trip-connection-out c))))
 
+;;> The words of \var{s}, separated by spaces.
 (define (split-words s)
   (let loop ((i 0) (start 0) (acc '()))
     (define (word) (if (= start i) acc (cons (substring s start i) acc)))

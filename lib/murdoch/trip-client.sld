@@ -9,7 +9,8 @@
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether!
-          safe-im safe-battery-voltage safe-reckon workstation-position)
+          safe-im safe-battery-voltage safe-reckon workstation-position
+          split-words)
   (import (scheme base) (scheme write) (srfi 18) (srfi 151)
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
