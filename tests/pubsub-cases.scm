@@ -171,7 +171,12 @@
     (begin (subscribe-remote 'b 'arm.left.gripper)
            (map car (request '(arm.> wheel) (lambda () #t)))))
   (test "but not nothing" '()
-    (request 'wheel.> (lambda () #t))))
+    (request 'wheel.> (lambda () #t)))
+  (test "a subject subscribed with its wildcard matches itself" '(b c)
+    (begin (subscribe-remote 'c 'arm.*)
+           (let ((uids (sorted-uids (map car (request 'arm.* (lambda () #t))))))
+             (unsubscribe-remote 'c 'arm.*)
+             uids))))
 
 (test-group "a race for one subject"
   ;; a and c each take b's wheel 200 times, at once.
