@@ -15,6 +15,9 @@
 ;; Medians over many runs.  Usage: tools/chibi bench/pubsub.scm N [multicast]
 ;; (one lab a process: an address space joins one lab); bench/run runs 4, 16
 ;; and 64, by simulated broadcast and by multicast (NAME-mcast-NN).
+;; With "busy SECONDS" after N it measures nothing: it prints "busy" and the
+;; lab's pids, sends requests to all back to back for that long, then prints
+;; "requests K in SECONDS s", for bench/profile to sample the lab meanwhile.
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
         (scheme process-context) (scheme file) (srfi 1) (srfi 132)
@@ -89,8 +92,7 @@
                 (if (eq? type 'exclusive) ((cadr winner) #f)))
               (car team) (cadr team))))
 
-(define (measure-lab lab n)
-  (join-lab (test-lab-file lab) 'bencher)
+(define (measure-lab n)
   (let ((task (eval '(dual-sonar-task) (lab-environment))))
     (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
     (report "request-latency" n
@@ -105,16 +107,33 @@
             (median-ms 20 (lambda () (negotiate-and-release task)))
             "ms")))
 
+(define (keep-busy seconds)
+  (do ((i 0 (+ i 1))) ((= i 20)) (request 'all (lambda () #t)))  ; warm-up
+  (display "busy")
+  (for-each (lambda (pid) (display " ") (display pid)) lab-pids)
+  (newline)
+  (flush-output-port)
+  (let ((end (+ (current-second) seconds)))
+    (let loop ((k 0))
+      (cond ((< (current-second) end)
+             (request 'all (lambda () #t))
+             (loop (+ k 1)))
+            (else (display "requests ") (display k) (display " in ")
+                  (display seconds) (display " s") (newline))))))
+
 ;; The lab's address spaces are stopped however the measuring ends.
-(define (bench-lab n delivery)
+(define (bench-lab n delivery busy-seconds)
   (let* ((lab (start-lab n delivery))
          (done (lambda () (stop-all-processes!) (remove-test-lab! lab))))
     (guard (e (#t (done) (raise e)))
-      (measure-lab lab n))
+      (join-lab (test-lab-file lab) 'bencher)
+      (if busy-seconds (keep-busy busy-seconds) (measure-lab n)))
     (done)))
 
-(define multicast? (and (pair? (cddr (command-line)))
-                       (equal? (car (cddr (command-line))) "multicast")))
+(define options (cddr (command-line)))
+(define multicast? (member "multicast" options))
 (define suffix (if multicast? "-mcast-N" "-N"))
 (bench-lab (string->number (cadr (command-line)))
-           (if multicast? '((delivery multicast "239.255.77.7")) '()))
+           (if multicast? '((delivery multicast "239.255.77.7")) '())
+           (let ((busy (member "busy" options)))
+             (and busy (pair? (cdr busy)) (string->number (cadr busy)))))
