@@ -57,6 +57,10 @@
 ;;> payload as a bytevector, or an eof object when the port ends cleanly
 ;;> between frames.  Raises a \scheme{netstring-error} on anything else.
 (define (read-netstring in max)
+  (or (take-buffered-netstring in max)  ; lib/netstring.c: a whole frame
+      (read-netstring-bytewise in max)))
+
+(define (read-netstring-bytewise in max)
   (let ((n (read-netstring-length in max)))
     (cond
      ((eof-object? n) n)

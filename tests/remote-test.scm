@@ -245,6 +245,21 @@
     (test "the address space still answers calls" 5
       (remote-apply (troy) (lambda () 5)))))
 
+(test-group "a frame that arrives in pieces"
+  ;; The reader takes a frame at once when its port's buffer holds all of
+  ;; it; this one arrives in three writes, cut in its length and payload.
+  (let* ((conn (raw-connect))
+         (bytes (framed (mac "hello" 0 (hello-text "n4")) (hello-text "n4")))
+         (n (bytevector-length bytes)))
+    (raw-send! conn (bytevector-copy bytes 0 1))
+    (thread-sleep! 0.05)
+    (raw-send! conn (bytevector-copy bytes 1 (- n 10)))
+    (thread-sleep! 0.05)
+    (raw-send! conn (bytevector-copy bytes (- n 10) n))
+    (test "is read whole, and answered with a welcome" 'welcome
+      (let ((w (utf8->string (read-netstring (car conn) 100000))))
+        (car (read (open-input-string (substring w 64 (string-length w)))))))))
+
 (test-group "nothing is evaluated without the key"
   (let ((before (var-ref 'troy *counter*))
         (conn (raw-connect))
