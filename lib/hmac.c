@@ -9,6 +9,7 @@
 #include <chibi/eval.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The first 32 bits of the fractional parts of the cube roots of the
@@ -131,42 +132,132 @@ static int hash_part (struct sha256 *s, sexp part) {
   return 1;
 }
 
-/* (hmac-sha256 key part ...): the MAC under key (a bytevector or string)
- * of the parts one after the other (bytevectors, strings as UTF-8, and
- * fixnums in decimal), as a lowercase hex string. */
-static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
-  static const char hex[] = "0123456789abcdef";
+/* The inner hash of HMAC under key, begun: the caller adds the message
+ * and passes the state to hmac_end.  0 when the key is neither bytes nor
+ * text. */
+static int hmac_begin (struct sha256 *s, unsigned char block[64], sexp key) {
   const unsigned char *kp;
   size_t kn, i;
-  unsigned char block[64], digest[32];
-  char text[64];
-  struct sha256 s;
-  sexp key, ls;
-  if (!sexp_pairp(args))
-    return sexp_user_exception(ctx, self, "no key", args);
-  key = sexp_car(args);
-  if (!bytes_of(key, &kp, &kn))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, key);
-  memset(block, 0, sizeof block);
+  if (!bytes_of(key, &kp, &kn)) return 0;
+  memset(block, 0, 64);
   if (kn > 64) {                 /* a long key is hashed first */
-    sha256_init(&s); sha256_update(&s, kp, kn); sha256_final(&s, block);
+    sha256_init(s); sha256_update(s, kp, kn); sha256_final(s, block);
   } else {
     memcpy(block, kp, kn);
   }
   for (i = 0; i < 64; i++) block[i] ^= 0x36;
-  sha256_init(&s); sha256_update(&s, block, 64);
-  for (ls = sexp_cdr(args); sexp_pairp(ls); ls = sexp_cdr(ls))
-    if (!hash_part(&s, sexp_car(ls)))
-      return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(ls));
-  sha256_final(&s, digest);
+  sha256_init(s); sha256_update(s, block, 64);
+  return 1;
+}
+
+/* Hashes the parts of a Scheme list; the first that is not bytes, text or
+ * a fixnum, or SEXP_NULL when all are. */
+static sexp hash_parts (struct sha256 *s, sexp ls) {
+  for ( ; sexp_pairp(ls); ls = sexp_cdr(ls))
+    if (!hash_part(s, sexp_car(ls)))
+      return sexp_car(ls);
+  return SEXP_NULL;
+}
+
+/* The MAC, as 64 lowercase hex digits, from the state hmac_begin began. */
+static void hmac_end (struct sha256 *s, unsigned char block[64], char text[64]) {
+  static const char hex[] = "0123456789abcdef";
+  unsigned char digest[32];
+  size_t i;
+  sha256_final(s, digest);
   for (i = 0; i < 64; i++) block[i] ^= 0x36 ^ 0x5c;
-  sha256_init(&s); sha256_update(&s, block, 64); sha256_update(&s, digest, 32);
-  sha256_final(&s, digest);
+  sha256_init(s); sha256_update(s, block, 64); sha256_update(s, digest, 32);
+  sha256_final(s, digest);
   for (i = 0; i < 32; i++) {
     text[2*i] = hex[digest[i] >> 4];
     text[2*i+1] = hex[digest[i] & 15];
   }
+}
+
+/* (hmac-sha256 key part ...): the MAC under key (a bytevector or string)
+ * of the parts one after the other (bytevectors, strings as UTF-8, and
+ * fixnums in decimal), as a lowercase hex string. */
+static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
+  unsigned char block[64];
+  char text[64];
+  struct sha256 s;
+  sexp bad;
+  if (!sexp_pairp(args))
+    return sexp_user_exception(ctx, self, "no key", args);
+  if (!hmac_begin(&s, block, sexp_car(args)))
+    return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(args));
+  if ((bad = hash_parts(&s, sexp_cdr(args))) != SEXP_NULL)
+    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  hmac_end(&s, block, text);
   return sexp_c_string(ctx, text, 64);
+}
+
+/* (hmac-sha256-sign key text part ...): text signed, a string of the MAC
+ * under key of the parts followed by text, then text itself.  One call
+ * where a frame took a MAC and a string-append. */
+static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
+  unsigned char block[64];
+  char mac[64];
+  struct sha256 s;
+  const unsigned char *tp;
+  char *signed_text;
+  size_t tn;
+  sexp bad, res;
+  if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args)))
+    return sexp_user_exception(ctx, self, "expected a key and a text", args);
+  if (!sexp_stringp(sexp_cadr(args)))
+    return sexp_type_exception(ctx, self, SEXP_STRING, sexp_cadr(args));
+  if (!hmac_begin(&s, block, sexp_car(args)))
+    return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(args));
+  if ((bad = hash_parts(&s, sexp_cddr(args))) != SEXP_NULL)
+    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  tp = (const unsigned char *)sexp_string_data(sexp_cadr(args));
+  tn = sexp_string_size(sexp_cadr(args));
+  sha256_update(&s, tp, tn);
+  hmac_end(&s, block, mac);
+  if (!(signed_text = malloc(64 + tn)))
+    return sexp_global(ctx, SEXP_G_OOM_ERROR);
+  memcpy(signed_text, mac, 64);
+  memcpy(signed_text + 64, tp, tn);
+  res = sexp_c_string(ctx, signed_text, 64 + tn);
+  free(signed_text);
+  return res;
+}
+
+/* (hmac-sha256-open key bytes end part ...): the text that follows the 64
+ * hex digits of a MAC in the first end bytes of bytes, as a string, when
+ * the MAC is that under key of the parts followed by the text; #f when it
+ * is not, or there are fewer than 64 bytes.  The text's bytes are taken as
+ * they are: bytes that are not UTF-8 fail the MAC or the reader. */
+static sexp hmac_sha256_open (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
+  unsigned char block[64], diff = 0;
+  char mac[64];
+  struct sha256 s;
+  sexp bytes, end, bad;
+  sexp_sint_t e, i;
+  if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args))
+      || !sexp_pairp(sexp_cddr(args)))
+    return sexp_user_exception(ctx, self, "expected a key, bytes and an end", args);
+  bytes = sexp_cadr(args);
+  end = sexp_car(sexp_cddr(args));
+  if (!sexp_bytesp(bytes))
+    return sexp_type_exception(ctx, self, SEXP_BYTES, bytes);
+  if (!sexp_fixnump(end))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, end);
+  e = sexp_unbox_fixnum(end);
+  if (e < 0 || (sexp_uint_t)e > sexp_bytes_length(bytes))
+    return sexp_user_exception(ctx, self, "end out of range", end);
+  if (e < 64) return SEXP_FALSE;
+  if (!hmac_begin(&s, block, sexp_car(args)))
+    return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(args));
+  if ((bad = hash_parts(&s, sexp_cdr(sexp_cddr(args)))) != SEXP_NULL)
+    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  sha256_update(&s, (const unsigned char *)sexp_bytes_data(bytes) + 64, e - 64);
+  hmac_end(&s, block, mac);
+  for (i = 0; i < 64; i++)
+    diff |= mac[i] ^ sexp_bytes_data(bytes)[i];
+  if (diff) return SEXP_FALSE;
+  return sexp_c_string(ctx, sexp_bytes_data(bytes) + 64, e - 64);
 }
 
 sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
@@ -175,5 +266,7 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
         && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
     return SEXP_ABI_ERROR;
   sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256", 0, hmac_sha256);
+  sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256-sign", 0, hmac_sha256_sign);
+  sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256-open", 0, hmac_sha256_open);
   return SEXP_VOID;
 }

@@ -57,14 +57,12 @@
 
 ;;; Sending
 
-(define (datagram-mac text) (*mac* "mcast:" text))
-
 ;; Sends body to the group; #f when it is too large for a datagram.
 (define (send-datagram! body)
   (set! *sequence* (+ *sequence* 1))
   (let* ((text (call-with-output-string
                  (lambda (o) (write-simple (list (aspace-uid *local*) *sequence* body) o))))
-         (bytes (string->utf8 (string-append (datagram-mac text) text))))
+         (bytes (string->utf8 (hmac-sha256-sign *key* text "mcast:"))))
     (and (<= (bytevector-length bytes) max-datagram)
          (begin (send (car *multicast*) bytes 0 (cdr *multicast*)) #t))))
 
@@ -167,7 +165,7 @@
 ;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
 ;; bytes of buffer.
 (define (open-datagram buffer n)
-  (let ((d (parse-message (authentic-text buffer n datagram-mac))))
+  (let ((d (parse-message (authentic-text buffer n "mcast:"))))
     (if (not (and (list? d) (= (length d) 3) (symbol? (car d))
                   (exact-integer? (cadr d))))
         (frame-fail "not a datagram"))

@@ -189,10 +189,8 @@
 
 ;;; Frames
 
-(define *mac* #f)                       ; HMAC under the lab's key
+(define *key* #f)                       ; the lab's, for HMAC
 (define *max-frame* 1048576)
-
-(define (frame-mac nonce count text) (*mac* nonce ":" count ":" text))
 
 ;; Each connection writes its frames' text to a string port of its own,
 ;; emptied before each frame, so that a write that failed half-way leaves
@@ -202,7 +200,7 @@
   (reset-output-string! text-port)
   (write-simple message text-port)
   (let ((text (get-output-string text-port)))
-    (write-netstring (string-append (frame-mac nonce count text) text) out)))
+    (write-netstring (hmac-sha256-sign *key* text nonce ":" count ":") out)))
 
 (define (send-frame! out text-port nonce count message)
   (write-frame! out text-port nonce count message)
@@ -227,18 +225,13 @@
         payload
         (parse-message
          (authentic-text payload (bytevector-length payload)
-                         (lambda (text) (frame-mac nonce count text)))))))
+                         nonce ":" count ":")))))
 
-;; The text after the MAC in the first end bytes of bytes, once (mac-of
-;; text) matches the MAC.  Cut as bytes: Chibi's strings are UTF-8, where
-;; string-length and substring walk the string.  Chibi's utf8->string
-;; takes any bytes; bytes that are not UTF-8 fail the MAC or the reader.
-(define (authentic-text bytes end mac-of)
-  (if (< end 64) (frame-fail "bad MAC"))
-  (let ((text (utf8->string bytes 64 end)))
-    (if (not (string=? (utf8->string bytes 0 64) (mac-of text)))
-        (frame-fail "bad MAC"))
-    text))
+;; The text after the MAC in the first end bytes of bytes, once the MAC is
+;; that of the parts followed by the text.
+(define (authentic-text bytes end . parts)
+  (or (apply hmac-sha256-open *key* bytes end parts)
+      (frame-fail "bad MAC")))
 
 ;; Chibi's own reader, in C: (scheme read) is SRFI 38's, with datum
 ;; labels, written in Scheme and a hundred times slower.  Messages have no
@@ -1022,7 +1015,7 @@
     (set-log-name! (string-append "murdoch " (symbol->string uid)))
     (set! *environment* environment)
     (set! *decode* (make-decoder environment decode-proxy))
-    (set! *mac* (make-hmac-sha256 (lab-key lab)))
+    (set! *key* (lab-key lab))
     (set! *max-frame* (lab-setting lab 'max-frame 1048576))
     (set! *default-timeout* (lab-setting lab 'timeout 5))
     (set! *frame-timeout* (lab-setting lab 'frame-timeout 5))

@@ -47,5 +47,34 @@
   (hmac-sha256 (text "Jefe") "nonce:" 1234567 ":" -5))
 (test-error "a part that is neither bytes, text nor a fixnum"
   (hmac-sha256 (text "Jefe") 'what))
+
+;; Signed texts, as frames carry them: the MAC, then the text.
+(define key (text "Jefe"))
+(define (signed t . parts) (string->utf8 (apply hmac-sha256-sign key t parts)))
+(define (open-all bytes . parts)
+  (apply hmac-sha256-open key bytes (bytevector-length bytes) parts))
+(test "a signature is the MAC of the parts and the text, then the text"
+  (string-append (hmac-sha256 key "n:" 7 ":" "(hello)") "(hello)")
+  (hmac-sha256-sign key "(hello)" "n:" 7 ":"))
+(test "a signed text opens with the same parts" "(hello)"
+  (open-all (signed "(hello)" "n:" 7 ":") "n:" 7 ":"))
+(test "a non-ASCII text opens as it was" "caf\xe9;"
+  (open-all (signed "caf\xe9;" "n:") "n:"))
+(test "not with other parts" #f
+  (open-all (signed "(hello)" "n:" 7 ":") "n:" 8 ":"))
+(test "not with a byte of the text changed" #f
+  (let ((b (signed "(hello)" "n:")))
+    (bytevector-u8-set! b 65 (char->integer #\j))
+    (open-all b "n:")))
+(test "not under another key" #f
+  (hmac-sha256-open (text "other") (signed "(hello)") 71))
+(test "fewer than 64 bytes do not open" #f
+  (hmac-sha256-open key (bytevector 1 2 3) 3))
+(test "only the first end bytes are the message" "(hello)"
+  (let ((b (signed "(hello)")))
+    (hmac-sha256-open key (bytevector-append b (bytevector 0 0))
+                      (bytevector-length b))))
+(test-error "an end past the bytes"
+  (hmac-sha256-open key (signed "(hello)") 100))
 (test-end)
 (test-exit)

@@ -2,11 +2,22 @@
 ;;> HMAC-SHA256 under \var{key} of the message made of the \var{part}s one
 ;;> after the other, as a lowercase hex string.  The key and each part are
 ;;> a bytevector or a string (its UTF-8 bytes); a part may also be a
-;;> fixnum, which stands for its decimal digits.  The body is
-;;> lib/hmac.c, built into lib/murdoch/hmac.so by \scheme{make native}.
+;;> fixnum, which stands for its decimal digits.
+;;>
+;;> \procedure{(hmac-sha256-sign key text part ...)}
+;;> \var{text} signed: a string of the MAC under \var{key} of the
+;;> \var{part}s followed by \var{text}, then \var{text}.
+;;>
+;;> \procedure{(hmac-sha256-open key bytes end part ...)}
+;;> The text of a signed message, the first \var{end} bytes of the
+;;> bytevector \var{bytes}, as a string, when its MAC is that of the
+;;> \var{part}s followed by the text; #f when it is not.
+;;>
+;;> The body is lib/hmac.c, built into lib/murdoch/hmac.so by
+;;> \scheme{make native}: over Chibi's SHA-256 in Scheme a frame's MAC
+;;> cost 40 us.
 
 (define-library (murdoch hmac)
-  (export hmac-sha256 make-hmac-sha256)
+  (export hmac-sha256 hmac-sha256-sign hmac-sha256-open)
   (import (scheme base))
-  (include-shared "hmac")
-  (include "../hmac.scm"))
+  (include-shared "hmac"))
