@@ -1,5 +1,5 @@
 ;;; The strict netstring reader: good frames, and each kind of bad one.
-(import (scheme base) (chibi test) (murdoch netstring))
+(import (scheme base) (chibi test) (chibi io) (murdoch netstring))
 
 (define (bytes s) (string->utf8 s))
 (define (read-all s max)
@@ -43,5 +43,55 @@
 (test "missing comma" "missing comma after payload" (fault "3:abc;" 100))
 (test "missing comma at end" "missing comma after payload" (fault "3:abc" 100))
 (test "minus sign" "non-digit byte 45 in length" (fault "-1:" 100))
+;; read-netstring takes a frame that its port's buffer holds whole in one
+;; C call, and reads anything else byte by byte.  A port that hands over a
+;; byte at a time never holds a whole frame, so it is read byte by byte;
+;; the two must agree on every input, frames and faults alike.
+(define (trickle bytes)
+  (let ((i 0))
+    (make-custom-binary-input-port
+     (lambda (buf start end)            ; answers the new end of buf
+       (if (>= i (bytevector-length bytes))
+           start
+           (begin (bytevector-u8-set! buf start (bytevector-u8-ref bytes i))
+                  (set! i (+ i 1))
+                  (+ start 1)))))))
+
+;; The payloads read before the end or the first fault, and the fault.
+(define (outcome in max)
+  (let loop ((acc '()))
+    (let ((x (guard (e ((netstring-error? e) (netstring-error-message e)))
+               (read-netstring in max))))
+      (cond ((bytevector? x) (loop (cons x acc)))
+            ((eof-object? x) (list (reverse acc) 'end))
+            (else (list (reverse acc) x))))))
+
+;; Inputs made mostly of the pieces netstrings are made of, from a fixed
+;; seed: the same inputs every run.
+(define seed 12345)
+(define (random-below n)
+  (set! seed (modulo (+ (* seed 1103515245) 12345) 2147483648))
+  (modulo (quotient seed 65536) n))
+(define pieces
+  '#("0" "1" "2" "3" "9" "10" "12" ":" "," "a" "bc" "3:abc," "0:," "01:" "-"))
+(define (random-input)
+  (let loop ((k (random-below 8)) (acc ""))
+    (if (zero? k)
+        (string->utf8 acc)
+        (loop (- k 1)
+              (string-append acc (vector-ref pieces
+                                             (random-below (vector-length pieces))))))))
+
+(test "the whole-frame and the byte-wise reader agree on 3000 inputs" '()
+  (let loop ((i 0) (disagreements '()))
+    (if (= i 3000)
+        disagreements
+        (let ((input (random-input)))
+          (loop (+ i 1)
+                (if (equal? (outcome (open-input-bytevector input) 10)
+                            (outcome (trickle input) 10))
+                    disagreements
+                    (cons (utf8->string input) disagreements)))))))
+
 (test-end)
 (test-exit)
