@@ -70,6 +70,7 @@ static sexp take_buffered_netstring (sexp ctx, sexp self, sexp_sint_t n,
   end = (const unsigned char *)sexp_port_buf(port) + sexp_port_size(port);
   if (*p == '0' && p + 1 < end && p[1] != ':') return SEXP_FALSE;
   for ( ; p < end && *p >= '0' && *p <= '9'; p++) {
+    if (len > most / 10) return SEXP_FALSE;   /* before it can overflow */
     len = len * 10 + (*p - '0');
     if (len > most) return SEXP_FALSE;
   }
