@@ -159,6 +159,19 @@ static sexp hash_parts (struct sha256 *s, sexp ls) {
   return SEXP_NULL;
 }
 
+/* Begins HMAC under key and hashes the parts: SEXP_VOID, or the type
+ * exception that names the key or the first part that is neither bytes,
+ * text nor a fixnum.  Every primitive below starts so. */
+static sexp hmac_begin_parts (sexp ctx, sexp self, struct sha256 *s,
+                              unsigned char block[64], sexp key, sexp parts) {
+  sexp bad;
+  if (!hmac_begin(s, block, key))
+    return sexp_type_exception(ctx, self, SEXP_BYTES, key);
+  if ((bad = hash_parts(s, parts)) != SEXP_NULL)
+    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  return SEXP_VOID;
+}
+
 /* The MAC, as 64 lowercase hex digits, from the state hmac_begin began. */
 static void hmac_end (struct sha256 *s, unsigned char block[64], char text[64]) {
   static const char hex[] = "0123456789abcdef";
@@ -181,13 +194,11 @@ static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   unsigned char block[64];
   char text[64];
   struct sha256 s;
-  sexp bad;
+  sexp res;
   if (!sexp_pairp(args))
     return sexp_user_exception(ctx, self, "no key", args);
-  if (!hmac_begin(&s, block, sexp_car(args)))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(args));
-  if ((bad = hash_parts(&s, sexp_cdr(args))) != SEXP_NULL)
-    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  res = hmac_begin_parts(ctx, self, &s, block, sexp_car(args), sexp_cdr(args));
+  if (res != SEXP_VOID) return res;
   hmac_end(&s, block, text);
   return sexp_c_string(ctx, text, 64);
 }
@@ -202,15 +213,13 @@ static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   const unsigned char *tp;
   char *signed_text;
   size_t tn;
-  sexp bad, res;
+  sexp res;
   if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args)))
     return sexp_user_exception(ctx, self, "expected a key and a text", args);
   if (!sexp_stringp(sexp_cadr(args)))
     return sexp_type_exception(ctx, self, SEXP_STRING, sexp_cadr(args));
-  if (!hmac_begin(&s, block, sexp_car(args)))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(args));
-  if ((bad = hash_parts(&s, sexp_cddr(args))) != SEXP_NULL)
-    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  res = hmac_begin_parts(ctx, self, &s, block, sexp_car(args), sexp_cddr(args));
+  if (res != SEXP_VOID) return res;
   tp = (const unsigned char *)sexp_string_data(sexp_cadr(args));
   tn = sexp_string_size(sexp_cadr(args));
   sha256_update(&s, tp, tn);
@@ -233,7 +242,7 @@ static sexp hmac_sha256_open (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   unsigned char block[64], diff = 0;
   char mac[64];
   struct sha256 s;
-  sexp bytes, end, bad;
+  sexp bytes, end, res;
   sexp_sint_t e, i;
   if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args))
       || !sexp_pairp(sexp_cddr(args)))
@@ -248,10 +257,9 @@ static sexp hmac_sha256_open (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   if (e < 0 || (sexp_uint_t)e > sexp_bytes_length(bytes))
     return sexp_user_exception(ctx, self, "end out of range", end);
   if (e < 64) return SEXP_FALSE;
-  if (!hmac_begin(&s, block, sexp_car(args)))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(args));
-  if ((bad = hash_parts(&s, sexp_cdr(sexp_cddr(args)))) != SEXP_NULL)
-    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+  res = hmac_begin_parts(ctx, self, &s, block, sexp_car(args),
+                         sexp_cdr(sexp_cddr(args)));
+  if (res != SEXP_VOID) return res;
   sha256_update(&s, (const unsigned char *)sexp_bytes_data(bytes) + 64, e - 64);
   hmac_end(&s, block, mac);
   for (i = 0; i < 64; i++)
