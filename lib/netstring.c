@@ -57,7 +57,7 @@ static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
  * Scheme. */
 static sexp take_buffered_netstring (sexp ctx, sexp self, sexp_sint_t n,
                                      sexp port, sexp max) {
-  const unsigned char *p, *end;
+  const unsigned char *start, *p, *end;
   sexp_sint_t len = 0, most;
   sexp payload;
   if (!sexp_iportp(port))
@@ -66,7 +66,7 @@ static sexp take_buffered_netstring (sexp ctx, sexp self, sexp_sint_t n,
     return sexp_type_exception(ctx, self, SEXP_FIXNUM, max);
   most = sexp_unbox_fixnum(max);
   if (buffered(port) == 0) return SEXP_FALSE;
-  p = (const unsigned char *)sexp_port_buf(port) + sexp_port_offset(port);
+  p = start = (const unsigned char *)sexp_port_buf(port) + sexp_port_offset(port);
   end = (const unsigned char *)sexp_port_buf(port) + sexp_port_size(port);
   if (*p == '0' && p + 1 < end && p[1] != ':') return SEXP_FALSE;
   for ( ; p < end && *p >= '0' && *p <= '9'; p++) {
@@ -74,8 +74,7 @@ static sexp take_buffered_netstring (sexp ctx, sexp self, sexp_sint_t n,
     len = len * 10 + (*p - '0');
     if (len > most) return SEXP_FALSE;
   }
-  if (p == end || *p != ':'
-      || p == (const unsigned char *)sexp_port_buf(port) + sexp_port_offset(port)
+  if (p == end || *p != ':' || p == start
       || end - (p + 1) < len + 1 || p[1 + len] != ',')
     return SEXP_FALSE;
   payload = sexp_make_bytes(ctx, sexp_make_fixnum(len), SEXP_ZERO);
