@@ -9,7 +9,6 @@
 #include <chibi/eval.h>
 #include <stdint.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 /* The first 32 bits of the fractional parts of the cube roots of the
@@ -211,7 +210,6 @@ static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   char mac[64];
   struct sha256 s;
   const unsigned char *tp;
-  char *signed_text;
   size_t tn;
   sexp res;
   if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args)))
@@ -224,12 +222,14 @@ static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   tn = sexp_string_size(sexp_cadr(args));
   sha256_update(&s, tp, tn);
   hmac_end(&s, block, mac);
-  if (!(signed_text = malloc(64 + tn)))
-    return sexp_global(ctx, SEXP_G_OOM_ERROR);
-  memcpy(signed_text, mac, 64);
-  memcpy(signed_text + 64, tp, tn);
-  res = sexp_c_string(ctx, signed_text, 64 + tn);
-  free(signed_text);
+  /* Built in place, as sexp_c_string builds a string: the collector does
+   * not move the text, so tp stays good. */
+  res = sexp_make_string(ctx, sexp_make_fixnum(64 + tn), SEXP_VOID);
+  if (sexp_exceptionp(res)) return res;
+  memcpy(sexp_string_data(res), mac, 64);
+  memcpy(sexp_string_data(res) + 64, tp, tn);
+  sexp_string_data(res)[64 + tn] = '\0';
+  sexp_update_string_index_lookup(ctx, res);
   return res;
 }
 
