@@ -8,12 +8,12 @@
  *  wait on, until the nearest thread's deadline, and only then hands over to
  *  Chibi's scheduler, which finds something ready and so never naps.
  *
- *  The wrapper changes two things only, after Chibi's scheduler has picked
- *  the next thread: it takes out of the run queue any second copy of a
- *  thread (see unqueue_twins), and it gives the thread a longer time slice
- *  (QUANTUM).  Everything it reads or writes -- the paused list, the run
- *  queue, each thread's wait flag, deadline, event and fuel -- is public in
- *  sexp.h.
+ *  The wrapper changes three things besides: it takes out of the run queue
+ *  any second copy of a thread (see unqueue_twins), it gives the thread it
+ *  hands over a longer time slice (QUANTUM), and it resumes a context
+ *  inside a call from C only in that call's own run of the VM (see Homes).
+ *  Everything it reads or writes -- the paused list, the run queue, each
+ *  thread's wait flag, deadline, event and fuel -- is public in sexp.h.
  */
 
 #include <chibi/eval.h>
@@ -215,17 +215,225 @@ static void unqueue_twins (sexp previous, sexp next) {
   sexp_global(previous, SEXP_G_THREADS_BACK) = prev;
 }
 
-/* The scheduler the VM calls at the end of every time slice.  Only a
- * current thread in a timed wait can be swept into the queue, so the queue
- * is walked only then, and a runnable thread costs a few loads. */
-static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
-  sexp chibi = sexp_opcode_data(self), next;
-  int may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
-  if (nothing_runnable(ctx))
-    wait_for_wakeup(ctx);
-  next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+/* Homes.
+ *
+ * Scheme that C calls -- eval, a sort's comparator -- runs in a new run of
+ * the VM, on the C stack above the caller's, whose root is the context
+ * making the call (eval makes a fresh one).  Threads are switched inside
+ * it as anywhere, and Chibi resumes any context in whatever run of the VM
+ * is innermost.  A root resumed in a run not its own goes wrong when its
+ * call returns: that VM takes it for a thread that has ended, so the C
+ * caller never gets its value, the thread waiting on it is lost, and the
+ * root's own run, lower on the C stack, never returns.  Chibi's own
+ * scheduler does the same: four threads that sort with a Scheme
+ * comparator hang within seconds.
+ *
+ * So a context switched away from while it is the root of the innermost
+ * run is homed: it runs again only when the scheduler is called from its
+ * own run, i.e. with it as root.  A homed context made runnable meanwhile
+ * is parked on the paused list, waiting on the scheduler itself, where
+ * nothing of Chibi's wakes it, until its run is innermost again.  Threads
+ * not inside a call from C hold no C state and run in any run of the VM. */
+static sexp *homes;
+static size_t homes_count, homes_size;
+static size_t parked_count;
+
+static int homed (sexp c) {
+  size_t i;
+  for (i = 0; i < homes_count; i++)
+    if (homes[i] == c) return 1;
+  return 0;
+}
+
+/* A context that cannot be homed, for want of memory, runs anywhere, as
+ * under Chibi's own scheduler. */
+static void home (sexp c) {
+  sexp *grown;
+  if (homed(c)) return;
+  if (homes_count == homes_size) {
+    grown = realloc(homes, (homes_size ? 2 * homes_size : 8) * sizeof(*grown));
+    if (!grown) return;
+    homes = grown;
+    homes_size = homes_size ? 2 * homes_size : 8;
+  }
+  homes[homes_count++] = c;
+}
+
+static void unhome (sexp c) {
+  size_t i;
+  for (i = 0; i < homes_count; i++)
+    if (homes[i] == c) {
+      homes[i] = homes[--homes_count];
+      return;
+    }
+}
+
+/* Whether c may run in the run of the VM whose root is root.  An ended
+ * context only ends, which it can do anywhere. */
+static int may_run_in (sexp c, sexp root) {
+  return c == root || sexp_context_refuel(c) <= 0 || !homed(c);
+}
+
+/* Wakes the first paused context waiting on event, as a mutex's unlock or
+ * a condition variable's signal would have, had it not woken one that is
+ * being parked: a woken thread only tries again, so a wake too many is
+ * harmless, and one too few could leave a mutex free and its waiters
+ * asleep.  Chibi leaves a woken context's event as it was. */
+static void pass_on (sexp ctx, sexp self, sexp event) {
+  sexp prev = SEXP_NULL, ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED);
+  if (!sexp_pointerp(event) || event == self || sexp_portp(event)
+      || sexp_contextp(event))
+    return;
+  for ( ; sexp_pairp(ls); prev = ls, ls = sexp_cdr(ls))
+    if (sexp_context_event(sexp_car(ls)) == event) {
+      if (sexp_pairp(prev))
+        sexp_cdr(prev) = sexp_cdr(ls);
+      else
+        sexp_global(ctx, SEXP_G_THREADS_PAUSED) = sexp_cdr(ls);
+      sexp_context_waitp(sexp_car(ls)) = 0;
+      sexp_context_timeoutp(sexp_car(ls)) = 0;
+      sexp_cdr(ls) = SEXP_NULL;
+      if (sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_BACK)))
+        sexp_cdr(sexp_global(ctx, SEXP_G_THREADS_BACK)) = ls;
+      else
+        sexp_global(ctx, SEXP_G_THREADS_FRONT) = ls;
+      sexp_global(ctx, SEXP_G_THREADS_BACK) = ls;
+      return;
+    }
+}
+
+/* Parks the context of cell, taken out of the run queue: it waits on the
+ * scheduler (self), with no deadline, at the end of the paused list. */
+static void park (sexp ctx, sexp self, sexp cell) {
+  sexp ls, c = sexp_car(cell);
+  pass_on(ctx, self, sexp_context_event(c));
+  ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED);
+  sexp_context_waitp(c) = 1;
+  sexp_context_event(c) = self;
+  sexp_context_timeval(c).tv_sec = 0;
+  sexp_context_timeval(c).tv_usec = 0;
+  sexp_cdr(cell) = SEXP_NULL;
+  if (!sexp_pairp(ls)) {
+    sexp_global(ctx, SEXP_G_THREADS_PAUSED) = cell;
+  } else {
+    while (sexp_pairp(sexp_cdr(ls))) ls = sexp_cdr(ls);
+    sexp_cdr(ls) = cell;
+  }
+  parked_count++;
+}
+
+/* Parks every context of the run queue that may not run in root's run;
+ * a second copy of one already parked is dropped.  They are taken out of
+ * the queue first, since parking one may wake another into it. */
+static void park_strangers (sexp ctx, sexp self, sexp root) {
+  sexp prev = SEXP_NULL, ls = sexp_global(ctx, SEXP_G_THREADS_FRONT), next;
+  sexp strangers = SEXP_NULL;
+  for ( ; sexp_pairp(ls); ls = next) {
+    next = sexp_cdr(ls);
+    if (may_run_in(sexp_car(ls), root)) {
+      prev = ls;
+      continue;
+    }
+    if (sexp_pairp(prev))
+      sexp_cdr(prev) = next;
+    else
+      sexp_global(ctx, SEXP_G_THREADS_FRONT) = next;
+    sexp_cdr(ls) = strangers;
+    strangers = ls;
+  }
+  sexp_global(ctx, SEXP_G_THREADS_BACK) = prev;
+  for (ls = strangers; sexp_pairp(ls); ls = next) {
+    next = sexp_cdr(ls);
+    if (sexp_context_event(sexp_car(ls)) != self)
+      park(ctx, self, ls);
+  }
+}
+
+/* Puts the contexts parked for root's run at the head of the run queue:
+ * its root is the one whose return lets the runs below it go on. */
+static void unpark_home (sexp ctx, sexp self, sexp root) {
+  sexp prev = SEXP_NULL, ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED), next;
+  size_t still = 0;
+  for ( ; sexp_pairp(ls); ls = next) {
+    next = sexp_cdr(ls);
+    if (sexp_context_event(sexp_car(ls)) != self) {
+      prev = ls;
+    } else if (sexp_car(ls) != root) {
+      still++;
+      prev = ls;
+    } else {
+      if (sexp_pairp(prev))
+        sexp_cdr(prev) = next;
+      else
+        sexp_global(ctx, SEXP_G_THREADS_PAUSED) = next;
+      sexp_context_waitp(root) = 0;
+      sexp_context_event(root) = SEXP_FALSE;
+      sexp_cdr(ls) = sexp_global(ctx, SEXP_G_THREADS_FRONT);
+      if (!sexp_pairp(sexp_cdr(ls)))
+        sexp_global(ctx, SEXP_G_THREADS_BACK) = ls;
+      sexp_global(ctx, SEXP_G_THREADS_FRONT) = ls;
+    }
+  }
+  parked_count = still;
+}
+
+/* Chibi's scheduler, then the twins out of the queue; see unqueue_twins. */
+static sexp chibi_next (sexp ctx, sexp chibi, sexp_sint_t n, sexp root,
+                        int may_twin) {
+  sexp next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
   if (may_twin && sexp_contextp(next))
     unqueue_twins(ctx, next);
+  return next;
+}
+
+/* Chibi's pick, unless it belongs to another run of the VM: then the
+ * first that may run here, waiting for one if need be.  A waiting pick is
+ * let through: the VM only calls the scheduler again at once. */
+static sexp next_here (sexp ctx, sexp self, sexp_sint_t n, sexp root,
+                       int may_twin) {
+  sexp chibi = sexp_opcode_data(self), front;
+  sexp_gc_var1(next);
+  sexp_gc_preserve1(ctx, next);
+  next = chibi_next(ctx, chibi, n, root, may_twin);
+  while (sexp_contextp(next) && !sexp_context_waitp(next)
+         && !may_run_in(next, root)) {
+    park(ctx, self, sexp_cons(ctx, next, SEXP_NULL));
+    park_strangers(ctx, self, root);
+    front = sexp_global(ctx, SEXP_G_THREADS_FRONT);
+    if (sexp_pairp(front)) {
+      next = sexp_car(front);
+      unqueue_twins(ctx, next);
+    } else {
+      wait_for_wakeup(ctx);
+      next = chibi_next(ctx, chibi, n, root, may_twin);
+    }
+  }
+  sexp_gc_release1(ctx);
+  return next;
+}
+
+/* The scheduler the VM calls at the end of every time slice.  Only a
+ * current thread in a timed wait can be swept into the queue, so the queue
+ * is walked for twins only then; with nothing homed, a runnable thread
+ * costs a few loads. */
+static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
+  sexp next;
+  int may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
+  if (parked_count > 0)
+    unpark_home(ctx, self, root);
+  if (homes_count > 0)
+    park_strangers(ctx, self, root);
+  if (nothing_runnable(ctx))
+    wait_for_wakeup(ctx);
+  next = homes_count > 0
+    ? next_here(ctx, self, n, root, may_twin)
+    : chibi_next(ctx, sexp_opcode_data(self), n, root, may_twin);
+  if (sexp_context_refuel(ctx) <= 0)
+    unhome(ctx);
+  else if (ctx == root && next != ctx)
+    home(ctx);
+  if (next == root)
+    unhome(root);
   /* No fuel marks a thread that has ended; it keeps none. */
   if (sexp_contextp(next) && sexp_context_refuel(next) > 0)
     sexp_context_refuel(next) = QUANTUM;

@@ -6,7 +6,7 @@
 ;;; The data comes from a forked peer process that writes when told, so that
 ;;; it arrives while every thread of this process is blocked: that is the
 ;;; case where the wrapper, not Chibi's own scheduler, does the waiting.
-(import (scheme base) (srfi 18) (srfi 132) (srfi 151)
+(import (scheme base) (scheme eval) (srfi 18) (srfi 132) (srfi 151)
         (chibi test) (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
         (murdoch scheduler)
@@ -323,6 +323,72 @@
     (set! stop #t)
     (thread-join! busy)
     (> (apply min (cdr (reverse gaps))) 150)))
+
+;; Scheme that C calls runs in a run of the VM of its own: each comparator
+;; of list-sort, and each eval.  Threads switched inside those runs, with
+;; comparators that compute, sleep and wait on a mutex, must each come
+;; back in their own run; resumed in another, a thread was lost, and
+;; Chibi's own scheduler lost one within seconds.  A lost thread makes
+;; its join time out (30 s: only a bound, far above the second it takes).
+(define (nested-caller k shared)
+  (lambda ()
+    (let loop ((i 0) (sorted '()))
+      (if (= i 40)
+          (list k (car sorted) (length sorted))
+          (loop (+ i 1)
+                (cons (list-sort
+                       (lambda (a b)
+                         (let spin ((j 0)) (if (< j 30) (spin (+ j 1))))
+                         (if (zero? (modulo (+ a b i) 7)) (thread-sleep! 0.001))
+                         (mutex-lock! shared)
+                         (mutex-unlock! shared)
+                         (< a b))
+                       (list 5 3 9 1 7 2 8 (+ i 10)))
+                      sorted))))))
+
+(define (evaluator k)
+  (lambda ()
+    (let loop ((i 0) (sum 0))
+      (if (= i 40)
+          (list k sum)
+          (loop (+ i 1)
+                (+ sum ((eval `(lambda (x)
+                                 (let spin ((j 0)) (if (< j 300) (spin (+ j 1)) (+ x ,k))))
+                              (environment '(scheme base)))
+                        i)))))))
+
+(test "threads that sort and eval at once all come back"
+    '((1 (1 2 3 5 7 8 9 49) 40) (2 (1 2 3 5 7 8 9 49) 40)
+      (3 (1 2 3 5 7 8 9 49) 40) (4 (1 2 3 5 7 8 9 49) 40)
+      (1 820) (2 860) (3 900))
+  (let* ((shared (make-mutex))
+         (threads (append (map (lambda (k) (start (nested-caller k shared)))
+                               '(1 2 3 4))
+                          (map (lambda (k) (start (evaluator k))) '(1 2 3)))))
+    (map (lambda (t) (thread-join! t 30 'lost)) threads)))
+
+;; This test's body waits for the mutex first, with a deadline, which puts
+;; it first in line; then a thread waits for it inside a comparator.  The
+;; unlock wakes the body, which may not run until the comparator's run of
+;; the VM returns: the wake must go on to the comparator's thread, or
+;; neither ever runs again.
+(test "a mutex that wakes a waiter who must wait goes to the next" '(locked (1 2))
+  (let* ((m (make-mutex))
+         (holder (start (lambda ()
+                          (mutex-lock! m)
+                          (thread-sleep! 0.2)
+                          (mutex-unlock! m))))
+         (sorter (start (lambda ()
+                          (thread-sleep! 0.05)
+                          (list-sort (lambda (a b)
+                                       (mutex-lock! m)
+                                       (mutex-unlock! m)
+                                       (< a b))
+                                     '(2 1))))))
+    (wait-until-owned m holder)
+    (let ((locked (mutex-lock! m 60)))
+      (mutex-unlock! m)
+      (list (if locked 'locked 'timed-out) (thread-join! sorter)))))
 
 (test "a signal is handled while every thread waits" signal/user1
   (let ((gate (make-mutex))
