@@ -134,6 +134,33 @@
              (append mine theirs)))
     (test "and afterwards every subject is free" #t (all-free?))))
 
+;; A metric as the thesis writes one: a comparison that asks both
+;; candidates where they are, so that each call of the sort's comparator,
+;; which Chibi runs from C, waits on the network.  Three threads here pose
+;; with it at once, five times each: every pose ends.
+(define (closer-to-origin e1 e2)
+  (let ((distance (lambda (entry)
+                    (reckon-distance-between
+                     '(0 0 0 0)
+                     (remote-apply (uid->aspace (car entry)) safe-reckon)))))
+    (< (distance e1) (distance e2))))
+
+(let* ((poser (lambda (name)
+                (make-thread
+                 (lambda ()
+                   (map (lambda (i)
+                          (pose-task name 1 (list '((mobile) ()))
+                                     (list closer-to-origin) (list who-am-i)))
+                        (iota 5))))))
+       (threads (map poser '(asker-1 asker-2 asker-3))))
+  (for-each thread-start! threads)
+  (let ((results (append-map (lambda (t) (thread-join! t 120 '(lost))) threads)))
+    (test "poses whose comparator asks the robots, three at once, all end" 15
+      (length (filter (lambda (r) (or (eq? r 'not-enough-takers)
+                                      (equal? r '(near)) (equal? r '(far))))
+                      results)))
+    (test "and afterwards every subject is free" #t (all-free?))))
+
 (test-end)
 (stop-all-processes!)
 (remove-test-lab! lab)
