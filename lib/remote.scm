@@ -363,30 +363,42 @@
                             ,(aspace-port *local*) ,nonce))
       (thread-start! (make-thread (lambda () (read-answers c nonce welcome))
                                   'answers))
-      (mailbox-take welcome deadline
-                    (lambda ()
-                      (close-connection! c)
-                      (remote-error (aspace-uid a) 'connect "no welcome")))
-      (if (not (connection-nonce c))
-          (remote-error (aspace-uid a) 'connect "refused the greeting"))
+      (let ((greeted (mailbox-take
+                      welcome deadline
+                      (lambda ()
+                        (close-connection! c)
+                        (remote-error (aspace-uid a) 'connect "no welcome")))))
+        (if (string? greeted)
+            (remote-error (aspace-uid a) 'connect greeted)))
       c)))
 
 ;; The reader of one outgoing connection: the welcome, then answers, each
-;; handed to the mailbox of the call that waits for it.
+;; handed to the mailbox of the call that waits for it.  The welcome
+;; mailbox gets #t, or what was wrong with the welcome, which the call
+;; reports: only faults after the welcome are logged, so that the prober,
+;; trying a gone peer every second, does not fill the log.
 (define (read-answers c nonce welcome)
-  (guard (e (#t (log-fault (connection-uid c) e)))
+  (guard (e (#t (mailbox-put! welcome (fault-message e))
+                (if (connection-nonce c) (log-fault (connection-uid c) e))))
     (let ((w (read-frame (connection-in c) nonce 0)))
-      (if (not (and (pair? w) (eq? (car w) 'welcome) (= (length w) 3)
-                    (string? (car (cddr w)))))
-          (frame-fail "expected a welcome"))
+      (check-welcome w (connection-uid c))
       (connection-nonce-set! c (car (cddr w)))
       (mailbox-put! welcome #t)
       (let loop ((count 1))
         (let ((answer (read-frame (connection-in c) nonce count)))
           (if (not (eof-object? answer))
               (begin (deliver-answer! c answer) (loop (+ count 1))))))))
-  (mailbox-put! welcome #f)
   (close-connection! c))
+
+;; A welcome from another address space than uid is refused: one that
+;; came after uid left, on the port it had, would answer in its name, and
+;; uid would never drop out of the lab.
+(define (check-welcome w uid)
+  (if (not (and (list? w) (= (length w) 3) (eq? (car w) 'welcome)
+                (symbol? (cadr w)) (string? (car (cddr w)))))
+      (frame-fail "expected a welcome"))
+  (if (not (eq? (cadr w) uid))
+      (frame-fail "found " (symbol->string (cadr w)) " at its address")))
 
 (define (deliver-answer! c answer)
   (if (not (and (pair? answer) (memq (car answer) '(ack value error))

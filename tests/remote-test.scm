@@ -135,7 +135,14 @@
                      (remote-apply (uid->aspace 'praline) (lambda () 1)))))
   (set! praline-pid (start-lab-aspace! lab 'praline))
   (test "a restarted target is reached again" 7
-    (remote-apply (uid->aspace 'praline) (lambda () 7))))
+    (remote-apply (uid->aspace 'praline) (lambda () 7)))
+  ;; As when a guest left and the next one listens on its port.
+  (test "another address space on a gone one's port does not answer for it"
+      "found troy at its address"
+    (error-text (lambda ()
+                  (remote-apply (make-aspace 'gone "127.0.0.1"
+                                             (aspace-port (troy)))
+                                (lambda () (local-aspace-uid)))))))
 
 (define ghost-address
   (get-address-info "127.0.0.1" (aspace-port (uid->aspace 'ghost))))
