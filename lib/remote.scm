@@ -355,6 +355,7 @@
                               (make-mutex) (make-hash-table eqv?)))
           (nonce (random-hex 16))
           (welcome (make-mailbox)))
+      (connection-nonce-set! c #f)
       (connection-sent-set! c 0)
       (connection-next-id-set! c 0)
       (connection-open?-set! c #t)
