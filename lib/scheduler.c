@@ -388,16 +388,20 @@ static sexp chibi_next (sexp ctx, sexp chibi, sexp_sint_t n, sexp root,
 
 /* Chibi's pick, unless it belongs to another run of the VM: then the
  * first that may run here, waiting for one if need be.  A waiting pick is
- * let through: the VM only calls the scheduler again at once. */
+ * let through: the VM only calls the scheduler again at once.  Out of
+ * memory for parking, the pick runs where it is, as under Chibi. */
 static sexp next_here (sexp ctx, sexp self, sexp_sint_t n, sexp root,
                        int may_twin) {
   sexp chibi = sexp_opcode_data(self), front;
-  sexp_gc_var1(next);
-  sexp_gc_preserve1(ctx, next);
+  sexp_gc_var2(next, cell);
+  sexp_gc_preserve2(ctx, next, cell);
   next = chibi_next(ctx, chibi, n, root, may_twin);
   while (sexp_contextp(next) && !sexp_context_waitp(next)
          && !may_run_in(next, root)) {
-    park(ctx, self, sexp_cons(ctx, next, SEXP_NULL));
+    cell = sexp_cons(ctx, next, SEXP_NULL);
+    if (!sexp_pairp(cell))
+      break;
+    park(ctx, self, cell);
     park_strangers(ctx, self, root);
     front = sexp_global(ctx, SEXP_G_THREADS_FRONT);
     if (sexp_pairp(front)) {
@@ -408,7 +412,7 @@ static sexp next_here (sexp ctx, sexp self, sexp_sint_t n, sexp root,
       next = chibi_next(ctx, chibi, n, root, may_twin);
     }
   }
-  sexp_gc_release1(ctx);
+  sexp_gc_release2(ctx);
   return next;
 }
 
