@@ -329,7 +329,9 @@
 ;; comparators that compute, sleep and wait on a mutex, must each come
 ;; back in their own run; resumed in another, a thread was lost, and
 ;; Chibi's own scheduler lost one within seconds.  A lost thread makes
-;; its join time out (30 s: only a bound, far above the second it takes).
+;; its join time out (30 s: only a bound, far above the second it takes),
+;; or, when the lost one is this body's own, the file stall until the
+;; alarm ends it, which tests/run counts as a failure.
 (define (nested-caller k shared)
   (lambda ()
     (let loop ((i 0) (sorted '()))
