@@ -191,6 +191,16 @@ static void wait_for_wakeup (sexp ctx) {
   sigprocmask(SIG_SETMASK, &old, NULL);
 }
 
+/* Takes cell, which follows prev (SEXP_NULL when cell is first), out of
+ * the list that the global slot list holds: the run queue or the paused
+ * list.  The caller sees to the run queue's back and to cell's cdr. */
+static void unlink_cell (sexp ctx, int list, sexp prev, sexp cell) {
+  if (sexp_pairp(prev))
+    sexp_cdr(prev) = sexp_cdr(cell);
+  else
+    sexp_global(ctx, list) = sexp_cdr(cell);
+}
+
 /* Chibi's timeout sweep queues every paused thread whose deadline has
  * passed, the current one too, although the current one then goes on
  * running, or is put in the queue a second time: it would be resumed twice,
@@ -204,10 +214,7 @@ static void unqueue_twins (sexp previous, sexp next) {
   int seen = 0;
   for ( ; sexp_pairp(ls); ls = sexp_cdr(ls)) {
     if (sexp_car(ls) == next || (sexp_car(ls) == previous && seen++)) {
-      if (sexp_pairp(prev))
-        sexp_cdr(prev) = sexp_cdr(ls);
-      else
-        sexp_global(previous, SEXP_G_THREADS_FRONT) = sexp_cdr(ls);
+      unlink_cell(previous, SEXP_G_THREADS_FRONT, prev, ls);
     } else {
       prev = ls;
     }
@@ -286,10 +293,7 @@ static void pass_on (sexp ctx, sexp self, sexp event) {
     return;
   for ( ; sexp_pairp(ls); prev = ls, ls = sexp_cdr(ls))
     if (sexp_context_event(sexp_car(ls)) == event) {
-      if (sexp_pairp(prev))
-        sexp_cdr(prev) = sexp_cdr(ls);
-      else
-        sexp_global(ctx, SEXP_G_THREADS_PAUSED) = sexp_cdr(ls);
+      unlink_cell(ctx, SEXP_G_THREADS_PAUSED, prev, ls);
       sexp_context_waitp(sexp_car(ls)) = 0;
       sexp_context_timeoutp(sexp_car(ls)) = 0;
       sexp_cdr(ls) = SEXP_NULL;
@@ -334,10 +338,7 @@ static void park_strangers (sexp ctx, sexp self, sexp root) {
       prev = ls;
       continue;
     }
-    if (sexp_pairp(prev))
-      sexp_cdr(prev) = next;
-    else
-      sexp_global(ctx, SEXP_G_THREADS_FRONT) = next;
+    unlink_cell(ctx, SEXP_G_THREADS_FRONT, prev, ls);
     sexp_cdr(ls) = strangers;
     strangers = ls;
   }
@@ -362,10 +363,7 @@ static void unpark_home (sexp ctx, sexp self, sexp root) {
       still++;
       prev = ls;
     } else {
-      if (sexp_pairp(prev))
-        sexp_cdr(prev) = next;
-      else
-        sexp_global(ctx, SEXP_G_THREADS_PAUSED) = next;
+      unlink_cell(ctx, SEXP_G_THREADS_PAUSED, prev, ls);
       sexp_context_waitp(root) = 0;
       sexp_context_event(root) = SEXP_FALSE;
       sexp_cdr(ls) = sexp_global(ctx, SEXP_G_THREADS_FRONT);
