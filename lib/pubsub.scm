@@ -146,24 +146,37 @@
 ;;> which says nothing of who evaluated it.
 (define (publish topic proc . args)
   (filter-map (lambda (r) (and (cadr r) (car r)))
-              (deliver 'run topic receive-publication topic
-                       (local-aspace-uid) proc args)))
+              (told-failures 'publish
+                             (deliver 'run topic receive-publication topic
+                                      (local-aspace-uid) proc args))))
 
 ;;> Publishes and waits for the results (synchronous, Figure 4.2): answers
 ;;> ((uid result) ...) for the address spaces that evaluated the message,
-;;> possibly none.  One that dies or stalls is left out after
-;;> (remote-timeout) seconds.
+;;> possibly none.  One where the procedure raises is left out, and one
+;;> that dies or stalls after (remote-timeout) seconds; the log tells of
+;;> each.
 (define (request topic proc . args)
-  (answers (deliver 'apply topic receive-request topic
-                    (local-aspace-uid) proc args)))
+  (answers 'request (deliver 'apply topic receive-request topic
+                             (local-aspace-uid) proc args)))
 
 ;; The evaluators' (uid value) from the receivers' (#t uid value) and
-;; (#f uid) answers.
-(define (answers results)
+;; (#f uid) answers; the failures are told (see told-failures).
+(define (answers what results)
   (filter-map (lambda (r)
                 (and (cadr r) (car (car (cddr r)))
                      (cdr (car (cddr r)))))
-              results))
+              (told-failures what results)))
+
+;; A receiver whose evaluation raised, or that did not answer, is left out
+;; of what publish and request answer; the log says which and why, so that
+;; a mistake in the procedure does not pass for a lab where nobody is
+;; subscribed.  Answers results.
+(define (told-failures what results)
+  (for-each (lambda (r)
+              (if (not (cadr r))
+                  (log-warn what " on " (car r) " failed: " (car (cddr r)))))
+            results)
+  results)
 
 ;; A capability list in the ((exclusive ...) (non-exclusive ...)) layout,
 ;; from any of the appendix's forms: a bare subject or a flat list of
@@ -182,17 +195,19 @@
 ;;> returns the result; applied to #f it only frees them.  A promise never
 ;;> applied is freed after the lab's lease.
 (define (request-exclusive topic task-name proc . args)
-  (answers (broadcast-apply receive-request-exclusive
-                           (capability-layout topic) task-name
-                           (local-aspace-uid) proc args)))
+  (answers 'request-exclusive
+           (broadcast-apply receive-request-exclusive
+                            (capability-layout topic) task-name
+                            (local-aspace-uid) proc args)))
 
 ;;> As request-exclusive, but the subjects of \var{topic} are reserved for
 ;;> sharing: other non-exclusive requests still get them, exclusive ones
 ;;> are refused until every promise is applied (the thesis's chapter 6).
 (define (request-non-exclusive topic task-name proc . args)
-  (answers (broadcast-apply receive-request-non-exclusive
-                           (subject-list topic) task-name
-                           (local-aspace-uid) proc args)))
+  (answers 'request-non-exclusive
+           (broadcast-apply receive-request-non-exclusive
+                            (subject-list topic) task-name
+                            (local-aspace-uid) proc args)))
 
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).

@@ -51,6 +51,11 @@
 (define (sorted-uids ls) (list-sort (lambda (x y) (string<? (symbol->string x) (symbol->string y))) ls))
 (define (by-uid answers) (list-sort (lambda (x y) (string<? (symbol->string (car x)) (symbol->string (car y)))) answers))
 (define (lab-proc name) (eval name (lab-environment)))
+(define (lines text)
+  (let ((in (open-input-string text)))
+    (let loop ((acc '()))
+      (let ((line (read-line in)))
+        (if (eof-object? line) (reverse acc) (loop (cons line acc)))))))
 
 (test-begin (if (null? delivery) "pubsub" "pubsub over multicast"))
 
@@ -114,6 +119,14 @@
      (map (lambda (r) (if (cadr r) 'no-error (car (cddr r))))
           (parameterize ((remote-timeout 2))
             (broadcast-apply (lambda () (car '())))))))
+  (let* ((log (open-output-string))
+         (answers (parameterize ((current-error-port log))
+                    (request '(foo bar) (lambda () (car '()))))))
+    (test "request leaves out the address spaces it raised in" '() answers)
+    (test "and warns of each, naming it and the error"
+        '("murdoch tester: warning: request on a failed: car: not a pair ()"
+          "murdoch tester: warning: request on c failed: car: not a pair ()")
+      (list-sort string<? (lines (get-output-string log)))))
   (test "and every address space serves on" '(a b c d tester)
     (sorted-uids (map car (request 'all (lambda () 1))))))
 
