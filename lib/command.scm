@@ -44,6 +44,21 @@
             (aspace-port (local-aspace)))
   (let wait () (thread-sleep! 3600) (wait)))
 
+;;> Warns of the lab's address spaces that do not answer: a guest that
+;;> joins before the lab is up, or on another port base, would otherwise
+;;> find out only from tasks that nobody takes.
+(define (tell-who-is-away lab)
+  (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
+                         (map lab-aspace-uid (lab-aspaces lab))))
+         (away (filter-map (lambda (r) (and (not (cadr r)) (car r)))
+                           (parameterize ((remote-timeout 2))
+                             (apply remote-apply-all (map uid->aspace others)
+                                    local-aspace-uid '())))))
+    (if (pair? away)
+        (log-warn (if (= (length away) (length others)) "no" "not every")
+                  " address space of the lab answers; away: " away
+                  " (is the lab running, with the same MURDOCH_PORT_BASE?)"))))
+
 ;;> `murdoch repl LAB [NAME]`: join the lab and read-eval-print.
 (define (run-repl lab-file uid)
   (let* ((lab (read-lab lab-file))
@@ -53,6 +68,7 @@
                                                 (current-process-id))))))
          (lab-env (join-read-lab lab uid
                                  (if guest? (list (lab-guest-port lab)) '()))))
+    (tell-who-is-away lab)
     ;; (chibi repl) is loaded here, not imported: it costs seconds, and
     ;; only a person at a REPL needs it.
     ((eval 'repl (environment '(chibi repl)))

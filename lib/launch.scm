@@ -60,6 +60,7 @@
                                "pose-" (number->string (current-process-id)))))
          (env (make-repl-environment lab (join-lab lab-file uid
                                                    (lab-guest-port lab)))))
+    (tell-who-is-away lab)
     (eval `(pose-task-progress (current-output-port)) env)
     (write (apply (eval 'pose-task env) (task-of task-file env)))
     (newline)

@@ -72,7 +72,11 @@
       (if (not (zero? status)) (display (file-text (in-dir "lab.out"))))
       (test "SIGTERM: the lab exits 0" 0 status))
     (test "and nothing listens any more" '(#f #f)
-      (map listening? (list base (+ base 1))))))
+      (map listening? (list base (+ base 1))))
+    (let ((output (pose-output "task.scm")))
+      (test "pose with the lab gone says that nobody answers" #t
+        (text-contains? (car output) "no address space of the lab answers; away: (troy praline)"))
+      (test "and nobody takes the task" "not-enough-takers" (last output)))))
 
 (test-group "a child that dies takes the lab down"
   (let ((pid (start-lab! (in-dir "lab2.out"))))

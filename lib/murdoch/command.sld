@@ -1,5 +1,5 @@
 (define-library (murdoch command)
-  (export join-lab run-aspace run-repl make-lab-environment
+  (export join-lab run-aspace run-repl tell-who-is-away make-lab-environment
           make-repl-environment)
   (import (scheme base) (scheme read) (scheme eval) (scheme file)
           (scheme process-context)
