@@ -21,7 +21,7 @@
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
           ;; pose-task and dynamic teams (lib/pose-task.scm)
-          pose-task negotiate pose-task-progress
+          pose-task negotiate pose-task-progress task-timeout
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t

@@ -262,7 +262,7 @@
 ;;> Runs each procedure of \var{procs} on a robot of the team, all at once,
 ;;> with MOVER's options: (fixed UIDS) pairs the procedures with UIDS;
 ;;> (all) with the whole team; (arbitrary N [from UIDS]) with N picked at
-;;> random; (timeout SECONDS), 0 for the lab's default; (collect PROC) to
+;;> random; (timeout SECONDS), 0 for (task-timeout); (collect PROC) to
 ;;> combine the results (default: the list, in order); (on-error PROC),
 ;;> applied to the uid and the error, whose value stands for the result;
 ;;> (debug #t) to tell each start and end.
@@ -295,7 +295,11 @@
       (with-team uids
         (on-list ((fixed uids)) proclist)))))
 
-(define *task-timeout* 600)
+;;> Seconds a component may run before its caller gives up on it, when
+;;> on-list is not given a timeout: pose-task's components, for one.  The
+;;> component is told as failed (see on-error); it is not stopped on its
+;;> robot, and an exclusive one holds its subjects until it ends.
+(define task-timeout (make-parameter 600))
 
 (define (select-robots options)
   (cond
@@ -310,7 +314,7 @@
 (define (exec-on options procs)
   (let* ((uids (select-robots options))
          (seconds (let ((s (option options 'timeout 0)))
-                    (if (and (number? s) (positive? s)) s *task-timeout*)))
+                    (if (and (number? s) (positive? s)) s (task-timeout))))
          (on-error (option options 'on-error team-error))
          (collect (option options 'collect list))
          (debug? (option options 'debug #f))

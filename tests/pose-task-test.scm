@@ -10,6 +10,7 @@
 ;; A component that says who ran it, holding its robot a moment.
 (define (who-am-i) (thread-sleep! 0.2) (local-aspace-uid))
 (define (fail) (error \"the component broke\"))
+(define (linger) (thread-sleep! 2) 'lingered)
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
          (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects)))))
@@ -34,8 +35,10 @@
 (define (lab-proc name) (eval name (lab-environment)))
 (define who-am-i #f)
 (define fail #f)
+(define linger #f)
 (set! who-am-i (lab-proc 'who-am-i))
 (set! fail (lab-proc 'fail))
+(set! linger (lab-proc 'linger))
 (define (all-free?) ((lab-proc 'free-everywhere?) '(mobile sonar idle)))
 
 (test-begin "pose-task")
@@ -102,6 +105,14 @@
                    (location-metric-maker '(0 0 0 0)))
              (list who-am-i fail)))
 (test "and nothing stays reserved" #t (all-free?))
+
+;; Its caller gives up; the component runs on, holding its robot.
+(test "a component that outlives (task-timeout) is told as failed"
+    '((error near "no answer within 1 s"))
+  (parameterize ((task-timeout 1))
+    (pose-task 'slow 1 (list '((mobile) ()))
+               (list (location-metric-maker '(0 0 0 0))) (list linger))))
+(test "and its robot is freed when it ends" #t (wait-until 10 all-free?))
 
 (test "a wrong number of components is a clear error"
     "pose-task: num-robots, capabilities, metrics and procedures do not agree"

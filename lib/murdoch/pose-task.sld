@@ -1,5 +1,5 @@
 (define-library (murdoch pose-task)
-  (export pose-task negotiate pose-task-progress
+  (export pose-task negotiate pose-task-progress task-timeout
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking reckon-distance-between sort-response resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t
