@@ -8,12 +8,14 @@
  *  wait on, until the nearest thread's deadline, and only then hands over to
  *  Chibi's scheduler, which finds something ready and so never naps.
  *
- *  The wrapper changes three things besides: it takes out of the run queue
+ *  The wrapper changes four things besides: it takes out of the run queue
  *  any second copy of a thread (see unqueue_twins), it gives the thread it
- *  hands over a longer time slice (QUANTUM), and it resumes a context
- *  inside a call from C only in that call's own run of the VM (see Homes).
+ *  hands over a longer time slice (QUANTUM), it resumes a context inside a
+ *  call from C only in that call's own run of the VM (see Homes), and it
+ *  wakes a blocked thread that is interrupted (see Interrupts).
  *  Everything it reads or writes -- the paused list, the run queue, each
- *  thread's wait flag, deadline, event and fuel -- is public in sexp.h.
+ *  thread's wait flag, deadline, event, fuel and interrupt mark -- is
+ *  public in sexp.h.
  */
 
 #include <chibi/eval.h>
@@ -180,17 +182,6 @@ static enum wait_result wait_once (sexp ctx, const sigset_t *mask) {
   }
 }
 
-static void wait_for_wakeup (sexp ctx) {
-  enum wait_result result = WAIT_AGAIN;
-  sigset_t all, old;
-  sigfillset(&all);
-  if (sigprocmask(SIG_BLOCK, &all, &old) != 0)
-    return;
-  while (result == WAIT_AGAIN && nothing_runnable(ctx))
-    result = wait_once(ctx, &old);
-  sigprocmask(SIG_SETMASK, &old, NULL);
-}
-
 /* Takes cell, which follows prev (SEXP_NULL when cell is first), out of
  * the list that the global slot list holds: the run queue or the paused
  * list.  The caller sees to the run queue's back and to cell's cdr. */
@@ -199,6 +190,77 @@ static void unlink_cell (sexp ctx, int list, sexp prev, sexp cell) {
     sexp_cdr(prev) = sexp_cdr(cell);
   else
     sexp_global(ctx, list) = sexp_cdr(cell);
+}
+
+/* Wakes the context of cell, taken out of the paused list, as Chibi wakes
+ * a thread whose mutex was unlocked: it runs again at the back of the run
+ * queue, and only tries again what it was waiting for. */
+static void queue_cell (sexp ctx, sexp cell) {
+  sexp_context_waitp(sexp_car(cell)) = 0;
+  sexp_context_timeoutp(sexp_car(cell)) = 0;
+  sexp_cdr(cell) = SEXP_NULL;
+  if (sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_BACK)))
+    sexp_cdr(sexp_global(ctx, SEXP_G_THREADS_BACK)) = cell;
+  else
+    sexp_global(ctx, SEXP_G_THREADS_FRONT) = cell;
+  sexp_global(ctx, SEXP_G_THREADS_BACK) = cell;
+}
+
+/* Interrupts.  Chibi's thread-interrupt! -- the REPL's answer to Ctrl-C --
+ * only marks a thread, and the VM raises the interrupt in it when its time
+ * slice ends.  A blocked thread has no slice: the REPL waiting for a
+ * pose-task went on waiting, and raised only once the task was done.  So
+ * before the process sleeps, each paused thread so marked is woken.
+ *
+ * The VM looks at the mark only before an instruction, when the fuel has
+ * run out, and a woken thread resumes at the instruction that blocked,
+ * which a read tries again at once, and blocks again, before the look.
+ * So an interrupted thread is handed over as if it still waited, with one
+ * instruction of fuel: the VM then looks before anything else, and raises
+ * inside the call that blocked.  One instruction later the scheduler sees
+ * it back and takes the wait off (see interrupt_raised). */
+static void wake_interrupted (sexp ctx) {
+  sexp prev = SEXP_NULL, ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED), next;
+  for ( ; sexp_pairp(ls); ls = next) {
+    next = sexp_cdr(ls);
+    if (sexp_context_interruptp(sexp_car(ls))
+        && sexp_context_refuel(sexp_car(ls)) > 0) {
+      unlink_cell(ctx, SEXP_G_THREADS_PAUSED, prev, ls);
+      queue_cell(ctx, ls);
+    } else {
+      prev = ls;
+    }
+  }
+}
+
+/* Gives a thread it hands over its fuel: a whole slice, or for one marked
+ * for an interrupt the one instruction of wake_interrupted. */
+static void hand_over (sexp c) {
+  if (sexp_context_interruptp(c)) {
+    sexp_context_waitp(c) = 1;
+    sexp_context_refuel(c) = 1;
+  } else {
+    sexp_context_refuel(c) = QUANTUM;
+  }
+}
+
+/* A thread back from raising its interrupt was handed over as waiting;
+ * no other keeps a fuel of one. */
+static void interrupt_raised (sexp ctx) {
+  if (sexp_context_refuel(ctx) == 1 && !sexp_context_interruptp(ctx))
+    sexp_context_waitp(ctx) = 0;
+}
+
+static void wait_for_wakeup (sexp ctx) {
+  enum wait_result result = WAIT_AGAIN;
+  sigset_t all, old;
+  sigfillset(&all);
+  wake_interrupted(ctx);
+  if (sigprocmask(SIG_BLOCK, &all, &old) != 0)
+    return;
+  while (result == WAIT_AGAIN && nothing_runnable(ctx))
+    result = wait_once(ctx, &old);
+  sigprocmask(SIG_SETMASK, &old, NULL);
 }
 
 /* Chibi's timeout sweep queues every paused thread whose deadline has
@@ -294,14 +356,7 @@ static void pass_on (sexp ctx, sexp self, sexp event) {
   for ( ; sexp_pairp(ls); prev = ls, ls = sexp_cdr(ls))
     if (sexp_context_event(sexp_car(ls)) == event) {
       unlink_cell(ctx, SEXP_G_THREADS_PAUSED, prev, ls);
-      sexp_context_waitp(sexp_car(ls)) = 0;
-      sexp_context_timeoutp(sexp_car(ls)) = 0;
-      sexp_cdr(ls) = SEXP_NULL;
-      if (sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_BACK)))
-        sexp_cdr(sexp_global(ctx, SEXP_G_THREADS_BACK)) = ls;
-      else
-        sexp_global(ctx, SEXP_G_THREADS_FRONT) = ls;
-      sexp_global(ctx, SEXP_G_THREADS_BACK) = ls;
+      queue_cell(ctx, ls);
       return;
     }
 }
@@ -420,7 +475,9 @@ static sexp next_here (sexp ctx, sexp self, sexp_sint_t n, sexp root,
  * costs a few loads. */
 static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   sexp next;
-  int may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
+  int may_twin;
+  interrupt_raised(ctx);
+  may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
   if (parked_count > 0)
     unpark_home(ctx, self, root);
   if (homes_count > 0)
@@ -438,7 +495,7 @@ static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
     unhome(root);
   /* No fuel marks a thread that has ended; it keeps none. */
   if (sexp_contextp(next) && sexp_context_refuel(next) > 0)
-    sexp_context_refuel(next) = QUANTUM;
+    hand_over(next);
   return next;
 }
 

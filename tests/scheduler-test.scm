@@ -9,6 +9,7 @@
 (import (scheme base) (scheme eval) (srfi 18) (srfi 132) (srfi 151)
         (chibi test) (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
+        (only (chibi ast) thread-interrupt!)
         (murdoch scheduler)
         (only (murdoch testing) listen-on-free-port))
 
@@ -402,6 +403,35 @@
     (tell-peer #\s)
     (mutex-lock! gate)
     caught))
+
+;; As the REPL's Ctrl-C does: a blocked thread raises at once, inside the
+;; call that blocked, and has not taken what it waited for.  Without the
+;; wake-up each join below gives up after 60 s instead.
+(define (interrupted thunk)
+  (let ((t (start (lambda ()
+                    (guard (e ((error-object? e) (error-object-message e)))
+                      (thunk))))))
+    (thread-sleep! 0.1)
+    (thread-interrupt! t)
+    (thread-join! t 60 'still-blocked)))
+
+(test-group "an interrupt reaches a blocked thread at once"
+  (test "in a sleep" "interrupt" (interrupted (lambda () (thread-sleep! 3600))))
+  (test "waiting on a condition variable" "interrupt"
+    (let ((m (make-mutex)))
+      (interrupted (lambda ()
+                     (mutex-lock! m)
+                     (mutex-unlock! m (make-condition-variable) 3600)))))
+  (let ((m (make-mutex)))
+    (mutex-lock! m)
+    (test "waiting for a mutex" "interrupt"
+      (interrupted (lambda () (mutex-lock! m))))
+    (test "which it has not taken" #t (eq? (current-thread) (mutex-state m)))
+    (mutex-unlock! m))
+  (test "joining a thread" "interrupt"
+    (interrupted (lambda () (thread-join! (start block-forever)))))
+  (test "reading a socket" "interrupt"
+    (interrupted (lambda () (block-forever)))))
 
 (test-end)
 
