@@ -215,7 +215,20 @@
               (length procs)))
       (error "pose-task: num-robots, capabilities, metrics and procedures do not agree"
              num-robots (length capability-list) (length metrics)
-             (length procs))))
+             (length procs)))
+  ;; Checked before anything is reserved, so that a bad component late in
+  ;; the list leaves no reservation behind for the ones before it.
+  (for-each (lambda (c)
+              (check-subjects "pose-task" (apply append (capability-layout c))))
+            capability-list)
+  (for-each (lambda (m)
+              (if (and m (not (procedure? m)))
+                  (error "pose-task: a metric is a procedure or #f" m)))
+            metrics)
+  (for-each (lambda (p)
+              (if (not (procedure? p))
+                  (error "pose-task: a component's procedure is not a procedure" p)))
+            procs))
 
 ;; Frees every promise but the winners' and answers not-enough-takers.
 (define (give-up responses type-list winners)

@@ -48,11 +48,13 @@
 
 ;;> Starts listening to \var{topic}; does nothing if already listening.
 (define (subscribe topic)
+  (check-subjects "subscribe" (list topic))
   (with-subscriptions (lambda () (add-subscription! topic)))
   #t)
 
 ;;> Stops listening to \var{topic}; does nothing if not listening.
 (define (unsubscribe topic)
+  (check-subjects "unsubscribe" (list topic))
   (with-subscriptions (lambda () (remove-subscription! topic)))
   #t)
 
@@ -87,6 +89,19 @@
 ;;; Addresses
 
 (define (subject-list topic) (if (list? topic) topic (list topic)))
+
+;; Wrong arguments are refused where the call is made, naming the call,
+;; rather than answered by every receiver with an error of its own.
+(define (check-subjects who subjects)
+  (for-each (lambda (s)
+              (if (not (symbol? s))
+                  (error (string-append who ": a subject is a symbol") s)))
+            subjects))
+
+(define (check-message who subjects proc)
+  (check-subjects who subjects)
+  (if (not (procedure? proc))
+      (error (string-append who ": not a procedure") proc)))
 
 (define (subject-levels subject)
   (let ((s (symbol->string subject)))
@@ -145,6 +160,7 @@
 ;;> \var{args}.  Answers the uids of the address spaces that acknowledged,
 ;;> which says nothing of who evaluated it.
 (define (publish topic proc . args)
+  (check-message "publish" (subject-list topic) proc)
   (filter-map (lambda (r) (and (cadr r) (car r)))
               (told-failures 'publish
                              (deliver 'run topic receive-publication topic
@@ -156,6 +172,7 @@
 ;;> that dies or stalls after (remote-timeout) seconds; the log tells of
 ;;> each.
 (define (request topic proc . args)
+  (check-message "request" (subject-list topic) proc)
   (answers 'request (deliver 'apply topic receive-request topic
                              (local-aspace-uid) proc args)))
 
@@ -195,15 +212,17 @@
 ;;> returns the result; applied to #f it only frees them.  A promise never
 ;;> applied is freed after the lab's lease.
 (define (request-exclusive topic task-name proc . args)
-  (answers 'request-exclusive
-           (broadcast-apply receive-request-exclusive
-                            (capability-layout topic) task-name
-                            (local-aspace-uid) proc args)))
+  (let ((layout (capability-layout topic)))
+    (check-message "request-exclusive" (apply append layout) proc)
+    (answers 'request-exclusive
+             (broadcast-apply receive-request-exclusive layout task-name
+                              (local-aspace-uid) proc args))))
 
 ;;> As request-exclusive, but the subjects of \var{topic} are reserved for
 ;;> sharing: other non-exclusive requests still get them, exclusive ones
 ;;> are refused until every promise is applied (the thesis's chapter 6).
 (define (request-non-exclusive topic task-name proc . args)
+  (check-message "request-non-exclusive" (subject-list topic) proc)
   (answers 'request-non-exclusive
            (broadcast-apply receive-request-non-exclusive
                             (subject-list topic) task-name

@@ -532,10 +532,12 @@
 ;;> and every call is sent before the first answer is awaited, so the time
 ;;> taken is about that of the slowest answer, not their sum.
 (define (remote-apply-all aspaces proc . args)
+  (for-each (lambda (a) (check-aspace "remote-apply-all" a)) aspaces)
   (call-all aspaces 'apply proc args))
 
 ;;> As remote-apply-all, with remote-run!: the values are #t.
 (define (remote-run-all! aspaces proc . args)
+  (for-each (lambda (a) (check-aspace "remote-run-all!" a)) aspaces)
   (call-all aspaces 'run proc args))
 
 ;;> remote-apply-all to every live address space (here too): by one
@@ -622,6 +624,13 @@
 
 (define (local? a) (eq? (aspace-uid a) (aspace-uid (local-aspace))))
 
+;; A uid where an address space belongs is the usual slip at the REPL.
+(define (check-aspace who a)
+  (if (not (aspace? a))
+      (error (string-append who ": not an address space;"
+                            " (uid->aspace UID) gives one")
+             a)))
+
 (define (apply-here uid proc args)
   (guard (e ((remote-error? e) (raise e))
             (#t (remote-error uid (describe-procedure proc) (error-message e))))
@@ -631,6 +640,7 @@
 ;;> \var{a}; returns #t once \var{a} has acknowledged.  The result is
 ;;> discarded.
 (define (remote-run! a proc . args)
+  (check-aspace "remote-run!" a)
   (if (local? a)
       (local-call 'run proc args)
       (call a 'run proc args)))
@@ -641,6 +651,7 @@
 ;;> answer came within (remote-timeout) seconds, counted from the call:
 ;;> connecting and greeting, when there is no connection yet, count too.
 (define (remote-apply a proc . args)
+  (check-aspace "remote-apply" a)
   (if (local? a)
       (local-call 'apply proc args)
       (call a 'apply proc args)))

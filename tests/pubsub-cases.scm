@@ -111,6 +111,20 @@
     (test "and so is the long one" '((a slow) (c slow))
       (by-uid (thread-join! long)))))
 
+(define (refusal thunk)
+  (guard (e ((error-object? e) (error-object-message e))) (thunk) 'accepted))
+
+(test-group "wrong arguments are refused at the call"
+  (test "a procedure that is not one" "request: not a procedure"
+    (refusal (lambda () (request 'all 5))))
+  (test "a subject that is not a symbol" "publish: a subject is a symbol"
+    (refusal (lambda () (publish '(foo "bar") (lambda () 1)))))
+  (test "in request-exclusive's layout too" "request-exclusive: a subject is a symbol"
+    (refusal (lambda () (request-exclusive '((wheel) ("foo")) 'task (lambda () 1)))))
+  (test "subscribe" "subscribe: a subject is a symbol"
+    (refusal (lambda () (subscribe "foo"))))
+  (test "and nothing was reserved" '() (status 'b 'wheel)))
+
 (test-group "an error in a message"
   ;; Each address space answers with the error at once, rather than
   ;; leaving its sender to time out.

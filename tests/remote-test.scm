@@ -73,6 +73,14 @@
       "cannot send variable port of (lambda () port): it is an output port"
     (let ((port (current-output-port)))
       (error-text (lambda () (remote-apply (troy) (lambda () port))))))
+  (test "a uid where an address space belongs is refused, saying what to do"
+      "remote-apply: not an address space; (uid->aspace UID) gives one"
+    (error-text (lambda () (remote-apply 'troy (lambda () 1)))))
+  (test "by remote-run! and the -all forms too"
+      '("remote-run!: not an address space; (uid->aspace UID) gives one"
+        "remote-apply-all: not an address space; (uid->aspace UID) gives one")
+    (list (error-text (lambda () (remote-run! 'troy (lambda () 1))))
+          (error-text (lambda () (remote-apply-all (list (troy) 'troy) (lambda () 1))))))
   (test "a timeout, set per call"
       "no answer within 1/2 s"
     (parameterize ((remote-timeout 1/2))

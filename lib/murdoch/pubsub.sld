@@ -2,7 +2,7 @@
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote
           publish request request-exclusive request-non-exclusive
-          capability-layout
+          capability-layout check-subjects
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive set-lease!
