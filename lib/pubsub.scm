@@ -222,11 +222,11 @@
 ;;> sharing: other non-exclusive requests still get them, exclusive ones
 ;;> are refused until every promise is applied (the thesis's chapter 6).
 (define (request-non-exclusive topic task-name proc . args)
-  (check-message "request-non-exclusive" (subject-list topic) proc)
-  (answers 'request-non-exclusive
-           (broadcast-apply receive-request-non-exclusive
-                            (subject-list topic) task-name
-                            (local-aspace-uid) proc args)))
+  (let ((subjects (subject-list topic)))
+    (check-message "request-non-exclusive" subjects proc)
+    (answers 'request-non-exclusive
+             (broadcast-apply receive-request-non-exclusive subjects task-name
+                              (local-aspace-uid) proc args))))
 
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).

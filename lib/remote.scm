@@ -532,12 +532,10 @@
 ;;> and every call is sent before the first answer is awaited, so the time
 ;;> taken is about that of the slowest answer, not their sum.
 (define (remote-apply-all aspaces proc . args)
-  (for-each (lambda (a) (check-aspace "remote-apply-all" a)) aspaces)
   (call-all aspaces 'apply proc args))
 
 ;;> As remote-apply-all, with remote-run!: the values are #t.
 (define (remote-run-all! aspaces proc . args)
-  (for-each (lambda (a) (check-aspace "remote-run-all!" a)) aspaces)
   (call-all aspaces 'run proc args))
 
 ;;> remote-apply-all to every live address space (here too): by one
@@ -557,6 +555,10 @@
                   proc-code args-code seconds))))
 
 (define (call-all aspaces kind proc args)
+  (for-each (lambda (a)
+              (check-aspace (if (eq? kind 'run) "remote-run-all!" "remote-apply-all")
+                            a))
+            aspaces)
   (send-all aspaces kind proc args
             (encode proc *environment* "the procedure")
             (encode-arguments args)
