@@ -114,25 +114,22 @@
                (list (location-metric-maker '(0 0 0 0))) (list linger))))
 (test "and its robot is freed when it ends" #t (wait-until 10 all-free?))
 
-(define (refusal thunk)
-  (guard (e ((error-object? e) (error-object-message e))) (thunk) 'accepted))
 (test "a metric that is neither a procedure nor #f is a clear error"
     "pose-task: a metric is a procedure or #f"
-  (refusal (lambda () (pose-task 'bad 1 (list 'idle) (list 'nearest) (list who-am-i)))))
+  (error-text (lambda () (pose-task 'bad 1 (list 'idle) (list 'nearest) (list who-am-i)))))
 (test "so is a component that is not a procedure"
     "pose-task: a component's procedure is not a procedure"
-  (refusal (lambda () (pose-task 'bad 1 (list 'idle) (list #f) (list 42)))))
+  (error-text (lambda () (pose-task 'bad 1 (list 'idle) (list #f) (list 42)))))
 (test "and a bad subject in a later component, before anything is reserved"
     '("pose-task: a subject is a symbol" #t)
-  (list (refusal (lambda ()
+  (list (error-text (lambda ()
                    (pose-task 'bad 2 (list '((mobile) ()) '(("sonar") ()))
                               (list #f #f) (list who-am-i who-am-i))))
         (all-free?)))
 
 (test "a wrong number of components is a clear error"
     "pose-task: num-robots, capabilities, metrics and procedures do not agree"
-  (guard (e ((error-object? e) (error-object-message e)))
-    (pose-task 'wrong 2 (list 'idle) (list #f) (list who-am-i))))
+  (error-text (lambda () (pose-task 'wrong 2 (list 'idle) (list #f) (list who-am-i)))))
 
 ;; Two address spaces pose a one-robot task each, at once, ten times:
 ;; they never get the same robot at once, and never deadlock.

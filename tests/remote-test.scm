@@ -31,11 +31,6 @@
 (set! slow (lab-procedure 'slow))
 
 (define (troy) (uid->aspace 'troy))
-(define (error-text thunk)
-  (guard (e ((remote-error? e) (remote-error-message e))
-            ((error-object? e) (error-object-message e)))
-    (thunk)
-    'no-error))
 
 (test-begin "remote")
 

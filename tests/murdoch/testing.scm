@@ -63,11 +63,24 @@
 
 ;;> The lines of \var{file}, without their newlines.
 (define (read-lines file)
-  (call-with-input-file file
-    (lambda (in)
-      (let loop ((acc '()))
-        (let ((line (read-line in)))
-          (if (eof-object? line) (reverse acc) (loop (cons line acc))))))))
+  (call-with-input-file file port-lines))
+
+;;> The lines of the string \var{text}, without their newlines.
+(define (text-lines text)
+  (port-lines (open-input-string text)))
+
+(define (port-lines in)
+  (let loop ((acc '()))
+    (let ((line (read-line in)))
+      (if (eof-object? line) (reverse acc) (loop (cons line acc))))))
+
+;;> The message of the error \var{thunk} raises -- of a remote-error, the
+;;> one it carries from the other address space -- or no-error.
+(define (error-text thunk)
+  (guard (e ((remote-error? e) (remote-error-message e))
+            ((error-object? e) (error-object-message e)))
+    (thunk)
+    'no-error))
 
 ;;> True when \var{word} occurs in \var{text}.
 (define (text-contains? text word)

@@ -4,13 +4,14 @@
           start-lab-aspace! start-murdoch-lab! median-seconds
           wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
-          text-contains? listen-on-free-port read-lines)
+          text-contains? listen-on-free-port read-lines text-lines error-text)
   (import (scheme base) (scheme time) (scheme write) (scheme file)
           (scheme read) (scheme process-context)
           (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
           (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab) (murdoch connect)
+          (only (murdoch remote) remote-error? remote-error-message)
           (only (chibi filesystem) delete-file-hierarchy current-directory
                 open-input-file-descriptor open-output-file-descriptor
                 open-pipe duplicate-file-descriptor-to))
