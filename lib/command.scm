@@ -52,8 +52,8 @@
                          (map lab-aspace-uid (lab-aspaces lab))))
          (away (filter-map (lambda (r) (and (not (cadr r)) (car r)))
                            (parameterize ((remote-timeout 2))
-                             (apply remote-apply-all (map uid->aspace others)
-                                    local-aspace-uid '())))))
+                             (remote-apply-all (map uid->aspace others)
+                                               local-aspace-uid)))))
     (if (pair? away)
         (log-warn (if (= (length away) (length others)) "no" "not every")
                   " address space of the lab answers; away: " away
