@@ -7,6 +7,12 @@
  *  that a few trips delayed by the machine's other work do not move it:
  *
  *      bench: c-pingpong-rtt VALUE us
+ *
+ *  With an argument N it fans out instead, the floor of a request to a lab
+ *  of N: N forked echo servers, the frame written to each in turn, then
+ *  each echo read; the median time of that round:
+ *
+ *      bench: c-fanout-NN VALUE us
  */
 
 #include <arpa/inet.h>
@@ -21,7 +27,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#define TRIPS 20000
+#define TRIPS 20000     /* frames echoed; a fan-out to N times TRIPS / N */
+#define MAX_SERVERS 256
 #define WARM_UP 1000
 #define MAX_PAYLOAD 64
 
@@ -97,15 +104,18 @@ static double now_us (void) {
   return ts.tv_sec * 1e6 + ts.tv_nsec / 1e3;
 }
 
-static void round_trip (int sock) {
+static void round_trip (const int *socks, int n) {
   char buf[MAX_PAYLOAD];
-  if (write_netstring(sock, payload, sizeof(payload) - 1) < 0)
-    die("write");
-  if (read_netstring(sock, buf, sizeof(buf)) != (long)sizeof(payload) - 1
-      || memcmp(buf, payload, sizeof(payload) - 1) != 0) {
-    fprintf(stderr, "c-pingpong: bad echo\n");
-    exit(1);
-  }
+  int i;
+  for (i = 0; i < n; i++)
+    if (write_netstring(socks[i], payload, sizeof(payload) - 1) < 0)
+      die("write");
+  for (i = 0; i < n; i++)
+    if (read_netstring(socks[i], buf, sizeof(buf)) != (long)sizeof(payload) - 1
+        || memcmp(buf, payload, sizeof(payload) - 1) != 0) {
+      fprintf(stderr, "c-pingpong: bad echo\n");
+      exit(1);
+    }
 }
 
 static int compare_doubles (const void *a, const void *b) {
@@ -113,17 +123,17 @@ static int compare_doubles (const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-static double median_round_trip (int sock) {
+static double median_round_trip (const int *socks, int n) {
   static double times[TRIPS];
-  int i;
-  for (i = 0; i < WARM_UP; i++) round_trip(sock);
-  for (i = 0; i < TRIPS; i++) {
+  int i, trips = TRIPS / n;
+  for (i = 0; i < WARM_UP / n; i++) round_trip(socks, n);
+  for (i = 0; i < trips; i++) {
     double start = now_us();
-    round_trip(sock);
+    round_trip(socks, n);
     times[i] = now_us() - start;
   }
-  qsort(times, TRIPS, sizeof(times[0]), compare_doubles);
-  return times[TRIPS / 2];
+  qsort(times, trips, sizeof(times[0]), compare_doubles);
+  return times[trips / 2];
 }
 
 /* A listener on a port the kernel picks, so that runs never collide. */
@@ -141,13 +151,16 @@ static int listen_loopback (struct sockaddr_in *addr) {
   return fd;
 }
 
-int main (void) {
+/* A connection to a forked echo server; its pid in *pid.  The server
+ * closes its copies of the n connections made before, so that each sees
+ * end of file when the parent closes its own. */
+static int start_echo_server (const int *before, int n, pid_t *pid) {
   struct sockaddr_in addr;
-  int listener = listen_loopback(&addr), sock, status;
-  double rtt;
-  pid_t pid = fork();
-  if (pid < 0) die("fork");
-  if (pid == 0) {
+  int listener = listen_loopback(&addr), sock, i;
+  *pid = fork();
+  if (*pid < 0) die("fork");
+  if (*pid == 0) {
+    for (i = 0; i < n; i++) close(before[i]);
     sock = accept(listener, NULL, NULL);
     if (sock < 0) die("accept");
     close(listener);
@@ -157,12 +170,28 @@ int main (void) {
   close(listener);
   sock = socket(AF_INET, SOCK_STREAM, 0);
   if (sock < 0 || connect(sock, (struct sockaddr *)&addr, sizeof(addr)) < 0) {
-    kill(pid, SIGKILL);
+    kill(*pid, SIGKILL);
     die("connect");
   }
-  rtt = median_round_trip(sock);
-  close(sock);    /* the server sees end of file and exits */
-  waitpid(pid, &status, 0);
-  printf("bench: c-pingpong-rtt %.1f us\n", rtt);
+  return sock;
+}
+
+int main (int argc, char **argv) {
+  int n = argc > 1 ? atoi(argv[1]) : 1, i, status;
+  int socks[MAX_SERVERS];
+  pid_t pids[MAX_SERVERS];
+  double median;
+  if (n < 1 || n > MAX_SERVERS) {
+    fprintf(stderr, "usage: c-pingpong [N], N from 1 to %d\n", MAX_SERVERS);
+    return 2;
+  }
+  for (i = 0; i < n; i++) socks[i] = start_echo_server(socks, i, &pids[i]);
+  median = median_round_trip(socks, n);
+  for (i = 0; i < n; i++) {
+    close(socks[i]);    /* the server sees end of file and exits */
+    waitpid(pids[i], &status, 0);
+  }
+  if (argc > 1) printf("bench: c-fanout-N%d %.1f us\n", n, median);
+  else printf("bench: c-pingpong-rtt %.1f us\n", median);
   return 0;
 }

@@ -11,13 +11,25 @@
 ;; Prints, per mode, the MEDIAN round trip in microseconds:
 ;;   bench: chibi-pingpong-rtt-nap VALUE us
 ;;   bench: chibi-pingpong-rtt VALUE us
+;;
+;; Usage: tools/chibi bench/scheme-pingpong.scm fanout N [poll]
+;;
+;; The floor of a request to a lab of N, in Chibi: N echo servers, each a
+;; Chibi process of its own as an address space is, get the netstring in
+;; turn, then each echo is read; prints the MEDIAN round in microseconds:
+;;   bench: chibi-fanout-NN VALUE us       the servers block in read(2)
+;;   bench: chibi-fanout-poll-NN VALUE us  they wait in ppoll through
+;;                                         (murdoch scheduler), as an
+;;                                         address space waits
+;; The sender waits in ppoll in both.  bench/c-pingpong N is the same in C.
 
 (import (scheme base) (scheme write) (scheme eval) (scheme process-context)
-        (srfi 18) (srfi 132)
+        (srfi 1) (srfi 18) (srfi 132) (srfi 151)
         (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
         (murdoch netstring)
-        (only (murdoch testing) listen-on-free-port))
+        (only (murdoch testing) listen-on-free-port free-port-base tool-path
+              start-process! stop-all-processes!))
 
 (define payload (bytevector 112 105 110 103))   ; "ping"
 (define max-frame 64)
@@ -36,12 +48,18 @@
 (define (vanish)
   (kill (current-process-id) signal/kill))
 
-(define (echo-server listener port)
+(define (echo-server listener port blocking?)
   (let* ((addr (get-address-info "127.0.0.1" port))
          (sock (accept listener (address-info-address addr)
                        (address-info-address-length addr)))
          (in (open-input-file-descriptor sock))
          (out (open-output-file-descriptor sock)))
+    ;; Then a read that finds nothing waits in the kernel, as in C, not in
+    ;; Chibi's scheduler.
+    (if blocking?
+        (set-file-descriptor-status!
+         sock (bitwise-and (get-file-descriptor-status sock)
+                           (bitwise-not open/non-block))))
     (let loop ()
       (let ((frame (read-netstring in max-frame)))
         (unless (eof-object? frame)
@@ -50,26 +68,37 @@
           (loop))))))
 
 (define (round-trip in out)
-  (write-netstring payload out)
-  (flush-output-port out)
-  (unless (equal? (read-netstring in max-frame) payload)
-    (error "echo server sent back something else")))
+  (fan-out (list (list #f in out))))
 
-(define (median-round-trip in out trips warm-up)
-  (do ((i 0 (+ i 1))) ((= i warm-up)) (round-trip in out))
+;; One frame to each (_ in out) of ios in turn, then each echo read.
+(define (fan-out ios)
+  (for-each (lambda (io)
+              (write-netstring payload (car (cddr io)))
+              (flush-output-port (car (cddr io))))
+            ios)
+  (for-each (lambda (io)
+              (unless (equal? (read-netstring (cadr io) max-frame) payload)
+                (error "echo server sent back something else")))
+            ios))
+
+(define (median-time thunk trips warm-up)
+  (do ((i 0 (+ i 1))) ((= i warm-up)) (thunk))
   (let loop ((i 0) (times '()))
     (if (= i trips)
         (list-ref (list-sort < times) (quotient trips 2))
         (let ((start (microseconds)))
-          (round-trip in out)
+          (thunk)
           (loop (+ i 1) (cons (- (microseconds) start) times))))))
+
+(define (median-round-trip in out trips warm-up)
+  (median-time (lambda () (round-trip in out)) trips warm-up))
 
 (define (measure mode)
   (let* ((listener+port (listen-on-free-port))
          (pid (begin (flush-output-port) (fork))))
     (cond
      ((zero? pid)
-      (echo-server (car listener+port) (cdr listener+port))
+      (echo-server (car listener+port) (cdr listener+port) #f)
       (vanish))
      (else
       ;; The listener stays open here: close-file-descriptor would leave its
@@ -99,9 +128,50 @@
      (report "chibi-pingpong-rtt" (measure mode)))
     (else (error "unknown mode; expected nap or poll" mode))))
 
+(define (serve port wait)
+  (if (equal? wait "poll") (environment '(murdoch scheduler)))
+  (echo-server (make-listener-socket (get-address-info "127.0.0.1" port))
+               port
+               (not (equal? wait "poll"))))
+
+;; A server serves the first connection it takes, so it is not probed
+;; before (wait-for-port would be that first connection): connecting is
+;; tried again for as long as a server may take to start.
+(define (connect-to-server port)
+  (let try ((tries 600))
+    (or (guard (e ((> tries 0) #f)) (open-net-io "127.0.0.1" port))
+        (begin (thread-sleep! 0.1) (try (- tries 1))))))
+
+;; The fan-out to n echo servers started as processes of their own.
+(define (measure-fan-out n wait)
+  (environment '(murdoch scheduler))
+  (let ((base (free-port-base)))
+    (for-each (lambda (i)
+                (start-process! (list (tool-path "tools/chibi")
+                                      (tool-path "bench/scheme-pingpong.scm")
+                                      "serve" (number->string (+ base i)) wait)
+                                "/dev/null"))
+              (iota n))
+    (guard (e (#t (stop-all-processes!) (raise e)))
+      (let ((ios (map (lambda (i) (connect-to-server (+ base i))) (iota n))))
+        (let ((median (median-time (lambda () (fan-out ios))
+                                   (quotient 20000 n) (quotient 1000 n))))
+          (stop-all-processes!)
+          median)))))
+
 (define (report name value)
   (display "bench: ") (display name) (display " ")
   (display value) (display " us") (newline))
 
-(let ((modes (map string->symbol (cdr (command-line)))))
-  (for-each run (if (null? modes) '(nap poll) modes)))
+(let ((args (cdr (command-line))))
+  (cond
+   ((and (pair? args) (equal? (car args) "serve"))
+    (serve (string->number (cadr args)) (car (cddr args))))
+   ((and (pair? args) (equal? (car args) "fanout"))
+    (let* ((n (string->number (cadr args)))
+           (poll? (pair? (cddr args))))
+      (report (string-append (if poll? "chibi-fanout-poll-N" "chibi-fanout-N")
+                             (number->string n))
+              (measure-fan-out n (if poll? "poll" "block")))))
+   (else
+    (for-each run (if (null? args) '(nap poll) (map string->symbol args))))))
