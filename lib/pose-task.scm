@@ -310,8 +310,9 @@
 
 ;;> Seconds a component may run before its caller gives up on it, when
 ;;> on-list is not given a timeout: pose-task's components, for one.  The
-;;> component is told as failed (see on-error); it is not stopped on its
-;;> robot, and an exclusive one holds its subjects until it ends.
+;;> component is told as failed (see on-error), and stops on its robot at
+;;> its next robot command or remote call (abandon.scm); until then an
+;;> exclusive one holds its subjects.
 (define task-timeout (make-parameter 600))
 
 (define (select-robots options)

@@ -25,6 +25,9 @@
 ;;                             calls for which thread applies it)
 ;;       (answer ID KIND VALUE)  not answered: the answer to call ID of a
 ;;                             multicast datagram from the callee (multicast.scm)
+;;       (abandon ID)          not answered: the caller gave up waiting for
+;;                             apply ID; the thread running it stops at its
+;;                             next remote call or robot command (abandon.scm)
 ;;     PROC, ARGS and VALUE are encoded values (sendable.scm); ID is the
 ;;     caller's, or for an answer the datagram sender's.
 ;;  4. Callee -> caller, in any order:
@@ -465,13 +468,20 @@
     (with-lock (connection-write-lock c)
       (lambda () (send-counted! c (list 'answer id kind value))))))
 
-(define (forget-call! c id)
-  (with-lock (connection-write-lock c)
-    (lambda () (hash-table-delete! (connection-pending c) id))))
+;; Forgets call id, and tells the callee, if the connection still stands,
+;; that nobody waits for it (see abandon.scm).
+(define (give-up-call! c id)
+  (guard (e (#t #f))                    ; the connection broke: no matter
+    (with-lock (connection-write-lock c)
+      (lambda ()
+        (hash-table-delete! (connection-pending c) id)
+        (when (connection-open? c)
+          (send-counted! c (list 'abandon id)))))))
 
 ;;; remote-run! and remote-apply
 
 (define (call a kind proc args)
+  (check-not-abandoned (if (eq? kind 'run) "remote-run!" "remote-apply"))
   (let* ((seconds (current-timeout))
          (proc-code (encode proc *environment* "the procedure"))
          (args-code (encode-arguments args))
@@ -503,7 +513,7 @@
   (await-answer (pending-call-uid p) (pending-call-mailbox p) deadline seconds
                 proc
                 (lambda ()
-                  (forget-call! (pending-call-connection p) (pending-call-id p)))))
+                  (give-up-call! (pending-call-connection p) (pending-call-id p)))))
 
 ;; The answer that uid puts in mailbox mb to a call of proc, by the
 ;; deadline: the value, or a remote-error.  (forget) runs when none came.
@@ -547,6 +557,7 @@
 (define (broadcast-run! proc . args) (broadcast 'run proc args))
 
 (define (broadcast kind proc args)
+  (check-not-abandoned (if (eq? kind 'run) "broadcast-run!" "broadcast-apply"))
   (let ((seconds (current-timeout))
         (proc-code (encode proc *environment* "the procedure"))
         (args-code (encode-arguments args)))
@@ -555,10 +566,9 @@
                   proc-code args-code seconds))))
 
 (define (call-all aspaces kind proc args)
-  (for-each (lambda (a)
-              (check-aspace (if (eq? kind 'run) "remote-run-all!" "remote-apply-all")
-                            a))
-            aspaces)
+  (let ((who (if (eq? kind 'run) "remote-run-all!" "remote-apply-all")))
+    (check-not-abandoned who)
+    (for-each (lambda (a) (check-aspace who a)) aspaces))
   (send-all aspaces kind proc args
             (encode proc *environment* "the procedure")
             (encode-arguments args)
@@ -741,6 +751,7 @@
   (out serving-out)
   (deadline serving-deadline serving-deadline-set!)
   (busy-since serving-busy-since serving-busy-since-set!) ; of an inline apply
+  (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
   (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
 
 (define *serving* '())
@@ -765,6 +776,7 @@
   (let ((s (make-serving peer (current-thread) in out)))
     (serving-deadline-set! s #f)
     (serving-busy-since-set! s #f)
+    (serving-applying-set! s '())
     (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
     s))
 
@@ -855,18 +867,35 @@
       (thread-start! t)))
   (mutex-unlock! *serving-lock*))
 
-;; Marks the start and the end of the reader's inline apply; ending
-;; answers whether this thread is still the reader.
-(define (inline-apply-begins! s)
+;; Marks the start and the end of the reader's inline apply of call id;
+;; ending answers whether this thread is still the reader.  Until it ends,
+;; the thread is found by id when its caller gives up.
+(define (inline-apply-begins! s id)
+  (mutex-lock! *serving-lock*)
+  (serving-applying-set! s (cons (cons id (current-thread))
+                                 (serving-applying s)))
   (serving-busy-since-set! s (monotonic-seconds))
+  (mutex-unlock! *serving-lock*)
   (janitor-wanted!))
 
 (define (inline-apply-ends! s)
   (mutex-lock! *serving-lock*)
   (let ((still (reader? s)))
+    (serving-applying-set! s (remove (lambda (a) (eq? (cdr a) (current-thread)))
+                                     (serving-applying s)))
     (if still (serving-busy-since-set! s #f))
     (mutex-unlock! *serving-lock*)
+    (if (abandoned?) (forget-abandoned! (current-thread)))
     still))
+
+;; The caller of apply id gave up on it: its thread is marked, to stop
+;; where it next calls out (abandon.scm).  An apply already done is let be.
+(define (abandon-call! s id)
+  (let ((a (with-lock *serving-lock* (lambda () (assv id (serving-applying s))))))
+    (when a
+      (log-note "call " id " from " (serving-peer s) " abandoned by its caller;"
+                " it stops at its next remote call or robot command")
+      (abandon-thread! (cdr a)))))
 
 ;; Runs (read-on call) while this thread is s's reader, under one handler
 ;; for the thread's life: a handler per call would cost a continuation
@@ -900,7 +929,7 @@
         (reply 'ack #t)
         (run-in-worker thunk))
       (begin
-        (inline-apply-begins! s)
+        (inline-apply-begins! s marker)
         (let ((value (encoded-result proc-code args-code)))
           (set-car! call #f)
           (inline-apply-ends! s)
@@ -932,9 +961,11 @@
       (let ((message (read-served-frame s nonce (+ count 1))))
         (unless (eof-object? message)
           (set! count (+ count 1))
-          (if (and (pair? message) (eq? (car message) 'answer))
-              (take-multicast-answer! (list-ref hello 1) message)
-              (serve-frame s call message answer!))
+          (cond ((not (pair? message)) (frame-fail "expected a call"))
+                ((eq? (car message) 'answer)
+                 (take-multicast-answer! (list-ref hello 1) message))
+                ((eq? (car message) 'abandon) (take-abandon! s message))
+                (else (serve-frame s call message answer!)))
           (flush-if-idle!)
           (if (reader? s) (read-on call)))))
     (define (serve)
@@ -957,6 +988,12 @@
   (learn-aspace! (make-aspace (list-ref hello 1) (list-ref hello 2)
                               (list-ref hello 3)))
   (list-ref hello 4))
+
+(define (take-abandon! s message)
+  (if (not (and (list? message) (= (length message) 2)
+                (exact-integer? (cadr message))))
+      (frame-fail "expected (abandon ID)"))
+  (abandon-call! s (cadr message)))
 
 (define (serve-frame s call message answer!)
   (if (not (and (list? message) (= (length message) 4)

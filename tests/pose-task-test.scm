@@ -11,6 +11,13 @@
 (define (who-am-i) (thread-sleep! 0.2) (local-aspace-uid))
 (define (fail) (error \"the component broke\"))
 (define (linger) (thread-sleep! 2) 'lingered)
+;; A component that never ends by itself, calling out all the time.
+(define spins 0)
+(define (spin)
+  (set! spins (+ spins 1))
+  (remote-apply (uid->aspace 'quiet) (lambda () #t))
+  (thread-sleep! 0.05)
+  (spin))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
          (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects)))))
@@ -36,7 +43,9 @@
 (define who-am-i #f)
 (define fail #f)
 (define linger #f)
+(define spin #f)
 (set! who-am-i (lab-proc 'who-am-i))
+(set! spin (lab-proc 'spin))
 (set! fail (lab-proc 'fail))
 (set! linger (lab-proc 'linger))
 (define (all-free?) ((lab-proc 'free-everywhere?) '(mobile sonar idle)))
@@ -113,6 +122,24 @@
     (pose-task 'slow 1 (list '((mobile) ()))
                (list (location-metric-maker '(0 0 0 0))) (list linger))))
 (test "and its robot is freed when it ends" #t (wait-until 10 all-free?))
+
+;; One that would never end is stopped where it next calls out.  Its
+;; robot is asked directly: a request leaves out one that counts as away,
+;; as one whose caller gave up does for a moment.
+(define endless
+  (parameterize ((task-timeout 1))
+    (pose-task 'endless 1 (list '((mobile) ()))
+               (list (location-metric-maker '(0 0 0 0))) (list spin))))
+(define (on-spinner proc) (remote-apply (uid->aspace (cadr (car endless))) proc))
+(test "a component that never ends is told as failed too"
+    '(error "no answer within 1 s")
+  (list (car (car endless)) (car (cddr (car endless)))))
+(test "then stops at its next remote call, freeing its robot" #t
+  (wait-until 10 (lambda () (null? (on-spinner (lambda () (topic-status 'mobile)))))))
+(test "and calls out no more" #t
+  (let ((before (on-spinner (lambda () spins))))
+    (thread-sleep! 0.3)
+    (= before (on-spinner (lambda () spins)))))
 
 (test "a metric that is neither a procedure nor #f is a clear error"
     "pose-task: a metric is a procedure or #f"

@@ -10,6 +10,7 @@
 (define *counter* 0)
 (define (bump!) (set! *counter* (+ *counter* 1)) *counter*)
 (define (slow seconds) (thread-sleep! seconds) 'done)
+(define *last-abandoned* #f)
 ")
 
 (define lab
@@ -229,6 +230,26 @@
                                                (number->string count) ":"
                                                text))))
 
+(define (text-of datum)
+  (let ((out (open-output-string)))
+    (write datum out)
+    (get-output-string out)))
+
+;; The count-th frame of a raw connection, MAC'd for the callee's nonce.
+(define (counted nonce count datum)
+  (framed (mac nonce count (text-of datum)) (text-of datum)))
+
+;; A raw connection that has said hello as nonce-name and been welcomed:
+;; (connection . the callee's nonce).
+(define (welcomed-raw-connect nonce-name)
+  (let ((conn (raw-connect)))
+    (raw-send! conn (framed (mac "hello" 0 (hello-text nonce-name))
+                            (hello-text nonce-name)))
+    (let* ((text (utf8->string (read-netstring (car conn) 100000)))
+           (welcome (read (open-input-string
+                           (substring text 64 (string-length text))))))
+      (cons conn (list-ref welcome 2)))))
+
 (test-group "bad frames close only their own connection"
   (let ((bystander (raw-connect)))
     (raw-send! bystander (framed (mac "hello" 0 (hello-text "n1"))
@@ -286,19 +307,11 @@
       (test "and bump! never ran" before (var-ref 'troy *counter*)))))
 
 (test-group "a recorded frame cannot be replayed"
-  (let ((before (var-ref 'troy *counter*))
-        (call-text (let ((out (open-output-string)))
-                     (write '(run 1 #(murdoch:global bump!) ()) out)
-                     (get-output-string out))))
+  (let ((before (var-ref 'troy *counter*)))
     ;; First a genuine exchange, recorded.
-    (let* ((conn (raw-connect))
-           (_ (raw-send! conn (framed (mac "hello" 0 (hello-text "n4"))
-                                      (hello-text "n4"))))
-           (welcome (read (open-input-string
-                           (let ((t (utf8->string (read-netstring (car conn) 100000))))
-                             (substring t 64 (string-length t))))))
-           (nonce (list-ref welcome 2))
-           (call (framed (mac nonce 1 call-text) call-text)))
+    (let* ((welcomed (welcomed-raw-connect "n4"))
+           (conn (car welcomed))
+           (call (counted (cdr welcomed) 1 '(run 1 #(murdoch:global bump!) ()))))
       (raw-send! conn call)
       (test "the genuine call runs" (+ before 1)
         (wait-until 5 (lambda () (let ((n (var-ref 'troy *counter*)))
@@ -307,13 +320,37 @@
         (begin (read-netstring (car conn) 100000)   ; the ack
                (raw-send! conn call)
                (closed? conn)))
-      (let ((again (raw-connect)))
-        (raw-send! again (framed (mac "hello" 0 (hello-text "n4"))
-                                 (hello-text "n4")))
-        (read-netstring (car again) 100000)
+      (let ((again (car (welcomed-raw-connect "n4"))))
         (raw-send! again call)
         (test "replayed on a new connection, it is refused" #t (closed? again)))
       (test "bump! ran once only" (+ before 1) (var-ref 'troy *counter*)))))
+
+(test-group "a caller that gives up says so"
+  (let* ((welcomed (welcomed-raw-connect "n5"))
+         (conn (car welcomed))
+         (before (var-ref 'troy *counter*)))
+    (raw-send! conn (counted (cdr welcomed) 1 '(abandon 999)))
+    (raw-send! conn (counted (cdr welcomed) 2 '(run 1 #(murdoch:global bump!) ())))
+    (test "an abandon for no running call is let be, and calls go on"
+        (+ before 1)
+      (wait-until 5 (lambda () (let ((n (var-ref 'troy *counter*)))
+                                 (and (= n (+ before 1)) n)))))
+    (read-netstring (car conn) 100000)         ; the ack
+    (raw-send! conn (counted (cdr welcomed) 3 '(abandon "1")))
+    (test "a malformed abandon closes the connection" #t (closed? conn)))
+  (test "an apply that takes too long is stopped at its next remote call"
+      "remote-apply: stopped, its caller gave up"
+    (begin
+      (guard (e (#t #f))
+        (parameterize ((remote-timeout 0.5))
+          (remote-apply (troy)
+                        (lambda ()
+                          (thread-sleep! 1)
+                          (set! *last-abandoned*
+                                (guard (e (#t (error-object-message e)))
+                                  (remote-apply (uid->aspace 'tester)
+                                                (lambda () 'too-late))))))))
+      (wait-until 5 (lambda () (var-ref 'troy *last-abandoned*))))))
 
 (test-end)
 (stop-all-processes!)

@@ -18,5 +18,5 @@
           (only (chibi filesystem) open-input-file-descriptor
                 open-output-file-descriptor)
           (chibi net)
-          (murdoch scheduler) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
+          (murdoch scheduler) (murdoch abandon) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
   (include "../remote.scm" "../multicast.scm"))

@@ -1,0 +1,50 @@
+;;;; Abandoned calls: a procedure stops when nobody waits for it any more.
+;;
+;; A caller that gives up on a remote-apply tells the callee (remote.scm,
+;; the abandon frame), and the callee marks the thread that runs the call.
+;; Chibi stops a thread from outside only at whatever instruction it has
+;; reached, which can leave a lock taken for good; so a marked thread stops
+;; itself, where it waits on something of Murdoch's: each robot command
+;; (trip-client.scm) and each remote call (remote.scm) raises in it.  A
+;; procedure that calls neither runs to its end.
+
+(define *abandoned* '())                ; the marked threads
+(define *abandoned-lock* (make-mutex 'abandoned))
+
+(define (update-abandoned! change)
+  (mutex-lock! *abandoned-lock*)
+  (set! *abandoned* (change *abandoned*))
+  (mutex-unlock! *abandoned-lock*))
+
+;;> Marks \var{thread}: the call it runs has been given up by its caller.
+(define (abandon-thread! thread)
+  (update-abandoned! (lambda (ls) (if (memq thread ls) ls (cons thread ls)))))
+
+;;> Takes the mark off \var{thread}, whose call has ended.
+(define (forget-abandoned! thread)
+  (update-abandoned! (lambda (ls) (delete thread ls eq?))))
+
+;;> Whether the current thread runs a call that its caller gave up.
+(define (abandoned?)
+  (and (pair? *abandoned*) (memq (current-thread) *abandoned*) #t))
+
+;;> Raises, in a thread marked abandoned, an error saying that \var{who}
+;;> was not done because the caller gave up.
+(define (check-not-abandoned who)
+  (if (abandoned?)
+      (raise (make-exception 'abandoned
+                             (string-append who ": stopped, its caller gave up")
+                             '() #f #f))))
+
+(define (abandoned-error? e)
+  (and (exception? e) (eq? (exception-kind e) 'abandoned)))
+
+;;> Runs \var{thunk} unmarked, then marks the thread again if it was: to
+;;> tidy up on the way out of an abandoned call, e.g. stop the robot.
+(define (despite-abandonment thunk)
+  (if (abandoned?)
+      (let ((me (current-thread)))
+        (dynamic-wind (lambda () (forget-abandoned! me))
+                      thunk
+                      (lambda () (abandon-thread! me))))
+      (thunk)))

@@ -1,0 +1,8 @@
+;;> Abandoned calls: a thread whose caller gave up stops at its next robot
+;;> command or remote call.
+(define-library (murdoch abandon)
+  (export abandon-thread! forget-abandoned! abandoned? check-not-abandoned
+          abandoned-error? despite-abandonment)
+  (import (scheme base) (only (srfi 1) delete) (srfi 18)
+          (only (chibi) make-exception exception? exception-kind))
+  (include "../abandon.scm"))
