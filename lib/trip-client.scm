@@ -183,7 +183,8 @@
 (define (reply-value w) (or (string->number w) w))
 
 ;; Send one request and return the values of its ok reply; raise a trip
-;; error for an err reply, a lost connection or no reply in time.
+;; error for an err reply, a lost connection or no reply in time.  In a
+;; call whose caller gave up, raise instead of sending (abandon.scm).
 (define (request c . words)
   (let ((command (join (map ->word words)))
         (lock (trip-connection-lock c))
@@ -191,6 +192,7 @@
     (define (fail code text)
       (mutex-unlock! lock)
       (trip-error (robot-name c) command code text))
+    (check-not-abandoned command)
     (mutex-lock! lock)
     (if (not (trip-connection-open? c))
         (fail "closed" "connection closed"))
@@ -253,10 +255,14 @@
 
 (define (sleep-a-little) (thread-sleep! 0.05))
 
-;; Wait until the base's motion is over; the final odometry pose.
+;; Wait until the base's motion is over; the final odometry pose.  In a
+;; call whose caller gave up, the robot is stopped where it is.
 (define (await-motion what)
   (let ((deadline (+ (time->seconds (current-time)) (trip-motion-timeout))))
     (let loop ()
+      (if (abandoned?)
+          (begin (despite-abandonment (lambda () (device 'base "stop")))
+                 (check-not-abandoned what)))
       (let ((status (device 'base "status")))
         (cond
          ((zero? (list-ref status 5))

@@ -4,7 +4,7 @@
         (scheme process-context)
         (only (chibi process) system? kill signal/term current-process-id)
         (chibi net) (only (chibi filesystem) open-input-file-descriptor)
-        (murdoch trip-client))
+        (murdoch abandon) (murdoch trip-client))
 
 ;; Start b14 in the background on free ports in a fresh folder, wait
 ;; (boundedly) for its ready line, and leave "(DIR PORT-BASE PID)" in a file.
@@ -162,6 +162,28 @@ LAB
     (for-each thread-start! workers)
     (for-each thread-join! workers)
     (test "every call got its own reply" #t (equal? (make-list 60 4) results))))
+
+(test-group "a call whose caller gave up"
+  ;; Ten turns take the simulated robot a minute, six seconds here.
+  (let ((turner (make-thread
+                 (lambda ()
+                   (guard (e ((abandoned-error? e) (error-object-message e)))
+                     (rotate 'by 3600))))))
+    (thread-start! turner)
+    (thread-sleep! 0.3)
+    (abandon-thread! turner)
+    (test "a motion stops, saying why" "rotate: stopped, its caller gave up"
+          (thread-join! turner))
+    (forget-abandoned! turner))
+  (let ((heading (car (cddr (reckon)))))
+    (thread-sleep! 0.3)
+    (test-assert "and the robot stands still"
+      (near? (car (cddr (reckon))) heading 0.5)))
+  (abandon-thread! (current-thread))
+  (test "any other command raises in it" #t
+        (guard (e ((abandoned-error? e) #t)) (reckon) #f))
+  (forget-abandoned! (current-thread))
+  (test "and works again once the call is over" 4 (length (reckon))))
 
 (test-group "safe.scm"
   (test-assert "safe-reckon on a robot is reckon" (= 4 (length (safe-reckon '(1 2 3)))))

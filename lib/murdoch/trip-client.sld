@@ -14,5 +14,5 @@
   (import (scheme base) (scheme write) (srfi 18) (srfi 151)
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
-          (murdoch connect))
+          (murdoch abandon) (murdoch connect))
   (include "../trip-client.scm"))
