@@ -72,8 +72,23 @@
     ;; (chibi repl) is loaded here, not imported: it costs seconds, and
     ;; only a person at a REPL needs it.
     ((eval 'repl (environment '(chibi repl)))
+          'in: (waiting-input-port)
           'environment: (make-repl-environment lab lab-env)
           'raw?: (not (is-a-tty? (current-input-port)))
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))
     (exit 0)))
+
+;; Standard input, read so that the REPL's wait for a line lets the other
+;; threads run: they serve the lab's calls to this peer, and a task's
+;; components that Ctrl-C gave up.  A read of descriptor 0 would stop the
+;; whole process until a line came.  Its own description of the same file,
+;; not descriptor 0's, is made non-blocking, so that the shell's is left
+;; as it was.  Standard input that cannot be opened again (a socket) is
+;; read as it is.
+(define (waiting-input-port)
+  (let ((fd (guard (e (#t #f))
+              (open "/proc/self/fd/0" (bitwise-ior open/read open/non-block)))))
+    (if fd
+        (open-input-file-descriptor fd #t)
+        (current-input-port))))

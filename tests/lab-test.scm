@@ -86,6 +86,29 @@
       (text-contains? (file-text (in-dir "lab2.out")) "troy died"))
     (test "and stops the others" #f (listening? (+ base 1)))))
 
+(test-group "a REPL waiting for a line still serves the lab"
+  ;; praline is a REPL whose input never comes: a peer all the same.
+  (let ((pid (start-murdoch-lab! (list (test-lab-file lab) "--except" "praline")
+                                 (in-dir "lab3.out")))
+        ;; Its input is a FIFO it holds open itself, for writing too.
+        (repl (start-process!
+               (list "/bin/sh" "-c"
+                     "mkfifo \"$2\" && exec 3<>\"$2\" && exec \"$0\" repl \"$1\" praline <&3 3<&-"
+                     (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "fifo"))
+               (in-dir "repl.out"))))
+    (call-with-output-file (in-dir "asks-praline.scm")
+      (lambda (out)
+        (write-string "(list 'who 1 (list (list '() (list 'praline))) (list #f)
+                              (list (lambda () (local-aspace-uid))))\n"
+                      out)))
+    (test "the REPL waits for a line" #t
+      (wait-until 60 (lambda () (text-contains? (file-text (in-dir "repl.out"))
+                                                "praline> "))))
+    (test "and takes a task posed from elsewhere" "(praline)"
+      (last (pose-output "asks-praline.scm")))
+    (stop-process! repl)
+    (stop-process! pid)))
+
 (test-end)
 (stop-all-processes!)
 (remove-test-lab! lab)

@@ -5,7 +5,9 @@
           (scheme process-context)
           (srfi 1) (srfi 18)
           (only (chibi process) current-process-id)
-          (only (chibi filesystem) is-a-tty?)
+          (only (chibi filesystem) is-a-tty? open open/read open/non-block
+                open-input-file-descriptor)
+          (only (srfi 151) bitwise-ior)
           (murdoch log)
           (only (meta) mutable-environment)
           (murdoch lab) (murdoch remote) (murdoch pubsub)
