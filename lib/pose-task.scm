@@ -337,14 +337,24 @@
         (error "on-list: the team and the procedures do not pair up"
                uids (length procs)))
     (apply collect
-           (map thread-join!
-                (map (lambda (uid proc)
-                       (thread-start!
-                        (make-thread
-                         (lambda ()
-                           (parameterize ((pose-task-progress port))
-                             (run-on uid proc seconds on-error debug?))))))
-                     uids procs)))))
+           (join-or-interrupt
+            (map (lambda (uid proc)
+                   (thread-start!
+                    (make-thread
+                     (lambda ()
+                       (parameterize ((pose-task-progress port))
+                         (run-on uid proc seconds on-error debug?))))))
+                 uids procs)))))
+
+;; The threads' results, in order.  Left before they are all done (Ctrl-C
+;; at the REPL interrupts the join), the threads are interrupted too: each
+;; gives up its component, which stops on its robot (abandon.scm).
+(define (join-or-interrupt threads)
+  (let ((results #f))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda () (set! results (map thread-join! threads)) results)
+     (lambda () (if (not results) (for-each thread-interrupt! threads))))))
 
 ;; Runs one component on its robot; an error or a timeout goes to on-error.
 (define (run-on uid proc seconds on-error debug?)

@@ -516,24 +516,32 @@
                   (give-up-call! (pending-call-connection p) (pending-call-id p)))))
 
 ;; The answer that uid puts in mailbox mb to a call of proc, by the
-;; deadline: the value, or a remote-error.  (forget) runs when none came.
+;; deadline: the value, or a remote-error.  (forget) runs when none came,
+;; by the deadline or because the wait was interrupted (Ctrl-C).
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
 (define (await-answer uid mb deadline seconds proc forget)
-  (let ((answer (mailbox-take
-                 mb deadline
-                 (lambda ()
-                   (forget)
-                   (note-unreachable! uid)
-                   (remote-error uid (describe-procedure proc)
-                                 (string-append "no answer within "
-                                                (number->string seconds)
-                                                " s"))))))
+  (let* ((answered #f)
+         (answer (dynamic-wind
+                  (lambda () #f)
+                  (lambda ()
+                    (let ((a (mailbox-take
+                              mb deadline
+                              (lambda () (timed-out uid proc seconds)))))
+                      (set! answered #t)
+                      a))
+                  (lambda () (if (not answered) (forget))))))
     (case (car answer)
       ((ack) #t)
       ((value) (*decode* (car (cddr answer))))
       ((error) (remote-error uid (describe-procedure proc) (car (cddr answer))))
       (else (note-unreachable! uid)
             (remote-error uid (describe-procedure proc) "connection lost")))))
+
+;; The call of proc to uid has had no answer within seconds.
+(define (timed-out uid proc seconds)
+  (note-unreachable! uid)
+  (remote-error uid (describe-procedure proc)
+                (string-append "no answer within " (number->string seconds) " s")))
 
 ;;> Applies \var{proc} to \var{args} in each address space of
 ;;> \var{aspaces} at once, and answers, in their order, (uid #t value) for

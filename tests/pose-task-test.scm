@@ -4,6 +4,7 @@
 ;;; come from the lab file); tests/transcripts drive the simulated robots.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (srfi 132) (chibi test)
+        (only (chibi ast) thread-interrupt!)
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define lab-code "
@@ -13,6 +14,8 @@
 (define (linger) (thread-sleep! 2) 'lingered)
 ;; A component that never ends by itself, calling out all the time.
 (define spins 0)
+(define started #f)
+(define (start-spinning) (set! started #t) (spin))
 (define (spin)
   (set! spins (+ spins 1))
   (remote-apply (uid->aspace 'quiet) (lambda () #t))
@@ -44,7 +47,9 @@
 (define fail #f)
 (define linger #f)
 (define spin #f)
+(define start-spinning #f)
 (set! who-am-i (lab-proc 'who-am-i))
+(set! start-spinning (lab-proc 'start-spinning))
 (set! spin (lab-proc 'spin))
 (set! fail (lab-proc 'fail))
 (set! linger (lab-proc 'linger))
@@ -140,6 +145,26 @@
   (let ((before (on-spinner (lambda () spins))))
     (thread-sleep! 0.3)
     (= before (on-spinner (lambda () spins)))))
+
+;; Ctrl-C at the REPL interrupts the thread that poses: its components
+;; are given up at once, not after (task-timeout).
+(define (on-robot uid proc) (remote-apply (uid->aspace uid) proc))
+(define (robots-where what) (filter (lambda (uid) (on-robot uid what)) '(near far)))
+(test "an interrupted pose-task raises the interrupt" 'interrupted
+  (let ((poser (make-thread
+                (lambda ()
+                  (guard (e (#t 'interrupted))
+                    (pose-task 'interrupted 1 (list '((mobile) ())) (list #f)
+                               (list start-spinning)))))))
+    (thread-start! poser)
+    (wait-until 10 (lambda () (pair? (robots-where (lambda () started)))))
+    (thread-interrupt! poser)
+    (thread-join! poser)))
+(test "and its component stops, freeing the robot" '()
+  (begin
+    (wait-until 10 (lambda ()
+                     (null? (robots-where (lambda () (not (null? (topic-status 'mobile))))))))
+    (robots-where (lambda () (not (null? (topic-status 'mobile)))))))
 
 (test "a metric that is neither a procedure nor #f is a clear error"
     "pose-task: a metric is a procedure or #f"

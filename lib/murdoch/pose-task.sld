@@ -6,7 +6,7 @@
           sort-list make-maxrandom)
   (import (scheme base) (scheme write) (scheme inexact) (scheme cxr)
           (srfi 1) (srfi 18) (srfi 27) (srfi 132)
-          (only (chibi ast) procedure-code procedure-vars opcode?)
+          (only (chibi ast) procedure-code procedure-vars opcode? thread-interrupt!)
           (only (chibi) call-with-output-string)
           (murdoch log) (murdoch sendable) (murdoch remote) (murdoch pubsub)
           (murdoch trip-client))
