@@ -360,10 +360,32 @@
 (define (run-on uid proc seconds on-error debug?)
   (if debug? (progress "  " uid " starts"))
   (let ((result (guard (e (#t (on-error uid e)))
-                  (parameterize ((remote-timeout seconds))
-                    (remote-apply (uid->aspace uid) proc)))))
+                  (if (eq? uid (local-aspace-uid))
+                      (apply-here-by proc seconds)
+                      (parameterize ((remote-timeout seconds))
+                        (remote-apply (uid->aspace uid) proc))))))
     (if debug? (progress "  " uid " done: " result))
     result))
+
+;; A component that this address space won runs here, in a thread of its
+;; own, so that seconds bound it as they bound one elsewhere: the wait
+;; ends, by timeout or interrupt, and the component is given up
+;; (abandon.scm).
+(define (apply-here-by proc seconds)
+  (let* ((outcome #f)
+         (runner (make-thread
+                  (lambda ()
+                    (set! outcome
+                          (guard (e (#t (cons 'raised e)))
+                            (cons 'value (remote-apply (local-aspace) proc))))))))
+    (thread-start! runner)
+    (dynamic-wind (lambda () #f)
+                  (lambda () (thread-join! runner seconds #f))
+                  (lambda () (if (not outcome) (abandon-thread! runner))))
+    (cond ((not outcome)
+           (error (string-append "no answer within " (number->string seconds) " s")))
+          ((eq? (car outcome) 'raised) (raise (cdr outcome)))
+          (else (cdr outcome)))))
 
 ;; The default on-error: tell, and let (error UID MESSAGE) stand for the
 ;; result, so the other components' results still come back.

@@ -146,6 +146,19 @@
     (thread-sleep! 0.3)
     (= before (on-spinner (lambda () spins)))))
 
+;; A component that the posing address space wins itself runs here, and
+;; (task-timeout) bounds it all the same.
+(test "a component run where it was posed is told as failed on time"
+    '((error tester "no answer within 1 s"))
+  (parameterize ((task-timeout 1))
+    (pose-task 'at-home 1 (list '(() (tester))) (list #f) (list spin))))
+(test "and stops at its next remote call" #t
+  (begin
+    (thread-sleep! 0.2)                 ; it counts once more, then calls
+    (let ((before (lab-proc 'spins)))
+      (thread-sleep! 0.3)
+      (= before (lab-proc 'spins)))))
+
 ;; Ctrl-C at the REPL interrupts the thread that poses: its components
 ;; are given up at once, not after (task-timeout).
 (define (on-robot uid proc) (remote-apply (uid->aspace uid) proc))
