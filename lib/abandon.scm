@@ -36,6 +36,7 @@
                              (string-append who ": stopped, its caller gave up")
                              '() #f #f))))
 
+;;> Whether \var{e} is the error that check-not-abandoned raises.
 (define (abandoned-error? e)
   (and (exception? e) (eq? (exception-kind e) 'abandoned)))
 
