@@ -345,12 +345,12 @@
         (parameterize ((remote-timeout 0.5))
           (remote-apply (troy)
                         (lambda ()
-                          (thread-sleep! 1)
+                          (thread-sleep! 3) ; the abandon comes meanwhile
                           (set! *last-abandoned*
                                 (guard (e (#t (error-object-message e)))
                                   (remote-apply (uid->aspace 'tester)
                                                 (lambda () 'too-late))))))))
-      (wait-until 5 (lambda () (var-ref 'troy *last-abandoned*))))))
+      (wait-until 10 (lambda () (var-ref 'troy *last-abandoned*))))))
 
 (test-end)
 (stop-all-processes!)
