@@ -350,11 +350,8 @@
 ;; at the REPL interrupts the join), the threads are interrupted too: each
 ;; gives up its component, which stops on its robot (abandon.scm).
 (define (join-or-interrupt threads)
-  (let ((results #f))
-    (dynamic-wind
-     (lambda () #f)
-     (lambda () (set! results (map thread-join! threads)) results)
-     (lambda () (if (not results) (for-each thread-interrupt! threads))))))
+  (undo-on-raise (lambda () (for-each thread-interrupt! threads))
+                 (lambda () (map thread-join! threads))))
 
 ;; Runs one component on its robot; an error or a timeout goes to on-error.
 (define (run-on uid proc seconds on-error debug?)

@@ -121,7 +121,7 @@
 (define (seconds-until deadline)
   (max 0 (- deadline (monotonic-seconds))))
 
-;; Calls thunk; when it leaves by raising, calls undo on the way out.  A
+;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
 ;; dynamic-wind, not a guard: a guard takes a continuation, which costs
 ;; Chibi a copy of the stack, 25 KB, each time, and these are on the path
 ;; of every call.
@@ -520,16 +520,11 @@
 ;; by the deadline or because the wait was interrupted (Ctrl-C).
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
 (define (await-answer uid mb deadline seconds proc forget)
-  (let* ((answered #f)
-         (answer (dynamic-wind
-                  (lambda () #f)
-                  (lambda ()
-                    (let ((a (mailbox-take
-                              mb deadline
-                              (lambda () (timed-out uid proc seconds)))))
-                      (set! answered #t)
-                      a))
-                  (lambda () (if (not answered) (forget))))))
+  (let ((answer (undo-on-raise
+                 forget
+                 (lambda ()
+                   (mailbox-take mb deadline
+                                 (lambda () (timed-out uid proc seconds)))))))
     (case (car answer)
       ((ack) #t)
       ((value) (*decode* (car (cddr answer))))

@@ -7,7 +7,7 @@
           delivery-mode
           remote-error? remote-error-uid remote-error-message
           encap release-proxy! start-aspace!
-          var-ref var-set! display-remote)
+          var-ref var-set! display-remote undo-on-raise)
   (import (scheme base) (scheme write) (scheme char)
           (scheme time)
           (srfi 1) (srfi 18) (srfi 69)
