@@ -136,15 +136,18 @@
     (pose-task 'endless 1 (list '((mobile) ()))
                (list (location-metric-maker '(0 0 0 0))) (list spin))))
 (define (on-spinner proc) (remote-apply (uid->aspace (cadr (car endless))) proc))
+;; Whether what (read) counts stays the same for 0.3 s.
+(define (settles? read)
+  (let ((before (read)))
+    (thread-sleep! 0.3)
+    (= before (read))))
 (test "a component that never ends is told as failed too"
     '(error "no answer within 1 s")
   (list (car (car endless)) (car (cddr (car endless)))))
 (test "then stops at its next remote call, freeing its robot" #t
   (wait-until 10 (lambda () (null? (on-spinner (lambda () (topic-status 'mobile)))))))
 (test "and calls out no more" #t
-  (let ((before (on-spinner (lambda () spins))))
-    (thread-sleep! 0.3)
-    (= before (on-spinner (lambda () spins)))))
+  (settles? (lambda () (on-spinner (lambda () spins)))))
 
 ;; A component that the posing address space wins itself runs here, and
 ;; (task-timeout) bounds it all the same.
@@ -152,16 +155,14 @@
     '((error tester "no answer within 1 s"))
   (parameterize ((task-timeout 1))
     (pose-task 'at-home 1 (list '(() (tester))) (list #f) (list spin))))
-(define (spins-settle?)
-  (let ((before (lab-proc 'spins)))
-    (thread-sleep! 0.3)
-    (= before (lab-proc 'spins))))
-(test "and stops at its next remote call" #t (wait-until 10 spins-settle?))
+(test "and stops at its next remote call" #t
+  (wait-until 10 (lambda () (settles? (lambda () (lab-proc 'spins))))))
 
 ;; Ctrl-C at the REPL interrupts the thread that poses: its components
 ;; are given up at once, not after (task-timeout).
 (define (on-robot uid proc) (remote-apply (uid->aspace uid) proc))
 (define (robots-where what) (filter (lambda (uid) (on-robot uid what)) '(near far)))
+(define (holding-mobile) (robots-where (lambda () (not (null? (topic-status 'mobile))))))
 (test "an interrupted pose-task raises the interrupt" 'interrupted
   (let ((poser (make-thread
                 (lambda ()
@@ -174,9 +175,8 @@
     (thread-join! poser)))
 (test "and its component stops, freeing the robot" '()
   (begin
-    (wait-until 10 (lambda ()
-                     (null? (robots-where (lambda () (not (null? (topic-status 'mobile))))))))
-    (robots-where (lambda () (not (null? (topic-status 'mobile)))))))
+    (wait-until 10 (lambda () (null? (holding-mobile))))
+    (holding-mobile)))
 
 (test "a metric that is neither a procedure nor #f is a clear error"
     "pose-task: a metric is a procedure or #f"
