@@ -11,7 +11,7 @@
           remote-error? remote-error-uid remote-error-message
           remote-apply-all remote-run-all! live-uids delivery-mode
           encap var-ref var-set! display-remote
-          ;; publish/subscribe (lib/pubsub.scm)
+          ;; publish/subscribe (lib/murdoch/pubsub.scm)
           subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote
           publish request request-exclusive request-non-exclusive
@@ -20,13 +20,13 @@
           receive-request-non-exclusive
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
-          ;; pose-task and dynamic teams (lib/pose-task.scm)
+          ;; pose-task and dynamic teams (lib/murdoch/pose-task.scm)
           pose-task negotiate pose-task-progress task-timeout
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
-          ;; the robot (lib/trip-client.scm)
+          ;; the robot (lib/murdoch/trip-client.scm)
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read

@@ -21,7 +21,7 @@ NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 
-lib/murdoch/%.so: lib/%.c $(NATIVE_CHIBI_HEADERS)
+lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
 	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $<
 
 bench/c-pingpong: bench/c-pingpong.c

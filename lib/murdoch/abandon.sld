@@ -5,4 +5,4 @@
           abandoned-error? despite-abandonment)
   (import (scheme base) (only (srfi 1) delete) (srfi 18)
           (only (chibi) make-exception exception? exception-kind))
-  (include "../abandon.scm"))
+  (include "abandon.scm"))

@@ -12,4 +12,4 @@
           (only (meta) mutable-environment)
           (murdoch lab) (murdoch remote) (murdoch pubsub)
           (murdoch trip-client))
-  (include "../environment.scm" "../command.scm"))
+  (include "environment.scm" "command.scm"))

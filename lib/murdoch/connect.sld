@@ -1,7 +1,7 @@
 ;;> A TCP connect that gives up at a timeout: \scheme{open-connection},
 ;;> the non-blocking replacement of (chibi net)'s \scheme{open-net-io}.
-;;> The C is lib/connect.c, built into lib/murdoch/connect.so by
-;;> \scheme{make native}; the waiting is lib/connect.scm.
+;;> The C is lib/murdoch/connect.c, built into lib/murdoch/connect.so by
+;;> \scheme{make native}; the waiting is lib/murdoch/connect.scm.
 
 (define-library (murdoch connect)
   (export open-connection)
@@ -13,4 +13,4 @@
                 set-file-descriptor-status! open/non-block)
           (only (murdoch scheduler) monotonic-seconds))
   (include-shared "connect")
-  (include "../connect.scm"))
+  (include "connect.scm"))

@@ -13,7 +13,7 @@
 ;;> bytevector \var{bytes}, as a string, when its MAC is that of the
 ;;> \var{part}s followed by the text; #f when it is not.
 ;;>
-;;> The body is lib/hmac.c, built into lib/murdoch/hmac.so by
+;;> The body is lib/murdoch/hmac.c, built into lib/murdoch/hmac.so by
 ;;> \scheme{make native}: over Chibi's SHA-256 in Scheme a frame's MAC
 ;;> cost 40 us.
 

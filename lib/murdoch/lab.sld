@@ -9,4 +9,4 @@
                 open-output-file-descriptor link-file)
           (only (chibi process) current-process-id)
           (chibi io))
-  (include "../lab.scm"))
+  (include "lab.scm"))

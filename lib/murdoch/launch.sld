@@ -8,4 +8,4 @@
           (srfi 1)
           (only (chibi process) execute current-process-id)
           (murdoch lab) (murdoch command))
-  (include "../launch.scm"))
+  (include "launch.scm"))

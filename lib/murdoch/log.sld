@@ -1,4 +1,4 @@
 (define-library (murdoch log)
   (export set-log-name! log-note log-warn)
   (import (scheme base) (scheme write))
-  (include "../log.scm"))
+  (include "log.scm"))

@@ -4,4 +4,4 @@
           netstring-error? netstring-error-message)
   (import (scheme base) (only (chibi) string-size))
   (include-shared "netstring")
-  (include "../netstring.scm"))
+  (include "netstring.scm"))

@@ -10,4 +10,4 @@
           (only (chibi) call-with-output-string)
           (murdoch log) (murdoch abandon) (murdoch sendable) (murdoch remote) (murdoch pubsub)
           (murdoch trip-client))
-  (include "../pose-task.scm"))
+  (include "pose-task.scm"))

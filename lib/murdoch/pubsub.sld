@@ -12,4 +12,4 @@
   (import (scheme base) (scheme read) (scheme file) (only (murdoch scheduler) monotonic-seconds)
           (srfi 1) (srfi 18)
           (murdoch log) (murdoch lab) (murdoch remote) (murdoch trip-client))
-  (include "../pubsub.scm"))
+  (include "pubsub.scm"))

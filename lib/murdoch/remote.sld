@@ -19,4 +19,4 @@
                 open-output-file-descriptor)
           (chibi net)
           (murdoch scheduler) (murdoch abandon) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
-  (include "../remote.scm" "../multicast.scm"))
+  (include "remote.scm" "multicast.scm"))

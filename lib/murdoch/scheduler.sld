@@ -5,7 +5,7 @@
 ;;> \scheme{ppoll} on the descriptors the threads wait on, until the
 ;;> nearest thread's deadline, instead of napping 10 ms at a time.
 ;;> Threads, mutexes and condition variables of (srfi 18) behave as
-;;> before.  The library's body is lib/scheduler.c, built into
+;;> before.  The library's body is lib/murdoch/scheduler.c, built into
 ;;> lib/murdoch/scheduler.so by \scheme{make native}.
 ;;>
 ;;> \procedure{(poll-scheduler-installed?)}

@@ -11,4 +11,4 @@
                 make-exception exception? exception-kind)
           (chibi ast)
           (srfi 1) (srfi 18) (srfi 69))
-  (include "../sendable.scm"))
+  (include "sendable.scm"))

@@ -15,4 +15,4 @@
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
           (murdoch abandon) (murdoch connect))
-  (include "../trip-client.scm"))
+  (include "trip-client.scm"))

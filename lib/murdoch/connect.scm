@@ -1,7 +1,7 @@
 ;;;; A TCP connect that gives up at a timeout without holding the process.
 ;;
 ;; The socket is made and closed here, as (chibi net) makes and closes
-;; its own; lib/connect.c starts its connect, non-blocking, and says when
+;; its own; lib/murdoch/connect.c starts its connect, non-blocking, and says when
 ;; the connect is done.  This side looks every millisecond and sleeps its
 ;; own green thread in between, so the process's other threads run on.
 
