@@ -4,7 +4,8 @@
         (srfi 18) (chibi test) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor)
         (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
-        (murdoch netstring) (murdoch hmac) (murdoch connect) (murdoch testing))
+        (murdoch netstring) (murdoch hmac) (murdoch connect) (murdoch testing)
+        (murdoch raw))
 
 (define shared-code "
 (define *counter* 0)
@@ -201,64 +202,20 @@
                     (remote-apply (troy) (lambda () (eval '(exit 1) #f))))))))
 
 ;;; Raw connections, for what a well-behaved peer never sends
-
-(define (raw-connect)
-  (let ((io (open-net-io "127.0.0.1" (aspace-port (uid->aspace 'troy)))))
-    (cons (cadr io) (car (cddr io)))))
-
-(define (raw-send! conn bytes)
-  (write-bytevector bytes (cdr conn))
-  (flush-output-port (cdr conn)))
-
-;; True when the server closes the connection (reads end of file).
-(define (closed? conn)
-  (eof-object? (guard (e (#t (eof-object))) (read-u8 (car conn)))))
-
-(define (framed mac text)
-  (let ((out (open-output-bytevector)))
-    (write-netstring (string->utf8 (string-append mac text)) out)
-    (get-output-bytevector out)))
-
-(define (hello-text nonce)
-  (let ((out (open-output-string)))
-    (write `(hello intruder "127.0.0.1" 1 ,nonce) out)
-    (get-output-string out)))
+;;; (tests/murdoch/raw.scm)
 
 (define key (lab-key (read-lab (test-lab-file lab))))
-(define (mac nonce count text)
-  (hmac-sha256 key (string->utf8 (string-append nonce ":"
-                                               (number->string count) ":"
-                                               text))))
-
-(define (text-of datum)
-  (let ((out (open-output-string)))
-    (write datum out)
-    (get-output-string out)))
-
-;; The count-th frame of a raw connection, MAC'd for the callee's nonce.
-(define (counted nonce count datum)
-  (framed (mac nonce count (text-of datum)) (text-of datum)))
-
-;; A raw connection that has said hello as nonce-name and been welcomed:
-;; (connection . the callee's nonce).
-(define (welcomed-raw-connect nonce-name)
-  (let ((conn (raw-connect)))
-    (raw-send! conn (framed (mac "hello" 0 (hello-text nonce-name))
-                            (hello-text nonce-name)))
-    (let* ((text (utf8->string (read-netstring (car conn) 100000)))
-           (welcome (read (open-input-string
-                           (substring text 64 (string-length text))))))
-      (cons conn (list-ref welcome 2)))))
+(define (troy-raw-connect) (raw-connect (aspace-port (troy))))
+(define (welcomed-troy nonce) (welcomed-raw-connect key (aspace-port (troy)) nonce))
 
 (test-group "bad frames close only their own connection"
-  (let ((bystander (raw-connect)))
-    (raw-send! bystander (framed (mac "hello" 0 (hello-text "n1"))
-                                 (hello-text "n1")))
+  (let ((bystander (troy-raw-connect)))
+    (raw-send! bystander (hello-frame key "n1"))
     (for-each
      (lambda (name bytes)
-       (let ((conn (raw-connect)))
+       (let ((conn (troy-raw-connect)))
          (raw-send! conn bytes)
-         (test name #t (closed? conn))))
+         (test name #t (raw-closed? conn))))
      '("garbage" "over-long length" "a frame that stalls half-way"
        "no comma" "no key: a wrong MAC")
      (list (string->utf8 "GET / HTTP/1.0\r\n\r\n")
@@ -266,10 +223,10 @@
            (string->utf8 "100:abc")
            (string->utf8 "3:abc;")
            (framed (make-string 64 #\0) (hello-text "n2"))))
-    (let ((conn (raw-connect)))
+    (let ((conn (troy-raw-connect)))
       (raw-send! conn (string->utf8 "100:abc"))
       (close-output-port (cdr conn))  ; the peer goes away mid-frame
-      (test "a frame cut short" #t (closed? conn)))
+      (test "a frame cut short" #t (raw-closed? conn)))
     (test "the bystander connection is still open, and answers" #t
       (let ((w (read-netstring (car bystander) 100000)))
         (bytevector? w)))
@@ -279,8 +236,8 @@
 (test-group "a frame that arrives in pieces"
   ;; The reader takes a frame at once when its port's buffer holds all of
   ;; it; this one arrives in three writes, cut in its length and payload.
-  (let* ((conn (raw-connect))
-         (bytes (framed (mac "hello" 0 (hello-text "n4")) (hello-text "n4")))
+  (let* ((conn (troy-raw-connect))
+         (bytes (hello-frame key "n4"))
          (n (bytevector-length bytes)))
     (raw-send! conn (bytevector-copy bytes 0 1))
     (thread-sleep! 0.05)
@@ -288,30 +245,27 @@
     (thread-sleep! 0.05)
     (raw-send! conn (bytevector-copy bytes (- n 10) n))
     (test "is read whole, and answered with a welcome" 'welcome
-      (let ((w (utf8->string (read-netstring (car conn) 100000))))
-        (car (read (open-input-string (substring w 64 (string-length w)))))))))
+      (car (raw-answer conn)))))
 
 (test-group "nothing is evaluated without the key"
   (let ((before (var-ref 'troy *counter*))
-        (conn (raw-connect))
-        (call-text (let ((out (open-output-string)))
-                     (write '(run 1 #(murdoch:global bump!) ()) out)
-                     (get-output-string out))))
-    (raw-send! conn (framed (mac "hello" 0 (hello-text "n3")) (hello-text "n3")))
+        (conn (troy-raw-connect))
+        (call-text (text-of '(run 1 #(murdoch:global bump!) ()))))
+    (raw-send! conn (hello-frame key "n3"))
     (let ((welcome (utf8->string (read-netstring (car conn) 100000))))
       ;; A call MAC'd with a made-up key is refused and closes the connection.
       (raw-send! conn (framed (hmac-sha256 (string->utf8 "not the key")
                                            (string->utf8 call-text))
                               call-text))
-      (test "the connection is closed" #t (closed? conn))
+      (test "the connection is closed" #t (raw-closed? conn))
       (test "and bump! never ran" before (var-ref 'troy *counter*)))))
 
 (test-group "a recorded frame cannot be replayed"
   (let ((before (var-ref 'troy *counter*)))
     ;; First a genuine exchange, recorded.
-    (let* ((welcomed (welcomed-raw-connect "n4"))
+    (let* ((welcomed (welcomed-troy "n4"))
            (conn (car welcomed))
-           (call (counted (cdr welcomed) 1 '(run 1 #(murdoch:global bump!) ()))))
+           (call (counted key (cdr welcomed) 1 '(run 1 #(murdoch:global bump!) ()))))
       (raw-send! conn call)
       (test "the genuine call runs" (+ before 1)
         (wait-until 5 (lambda () (let ((n (var-ref 'troy *counter*)))
@@ -319,25 +273,25 @@
       (test "replayed on the same connection, it is refused" #t
         (begin (read-netstring (car conn) 100000)   ; the ack
                (raw-send! conn call)
-               (closed? conn)))
-      (let ((again (car (welcomed-raw-connect "n4"))))
+               (raw-closed? conn)))
+      (let ((again (car (welcomed-troy "n4"))))
         (raw-send! again call)
-        (test "replayed on a new connection, it is refused" #t (closed? again)))
+        (test "replayed on a new connection, it is refused" #t (raw-closed? again)))
       (test "bump! ran once only" (+ before 1) (var-ref 'troy *counter*)))))
 
 (test-group "a caller that gives up says so"
-  (let* ((welcomed (welcomed-raw-connect "n5"))
+  (let* ((welcomed (welcomed-troy "n5"))
          (conn (car welcomed))
          (before (var-ref 'troy *counter*)))
-    (raw-send! conn (counted (cdr welcomed) 1 '(abandon 999)))
-    (raw-send! conn (counted (cdr welcomed) 2 '(run 1 #(murdoch:global bump!) ())))
+    (raw-send! conn (counted key (cdr welcomed) 1 '(abandon 999)))
+    (raw-send! conn (counted key (cdr welcomed) 2 '(run 1 #(murdoch:global bump!) ())))
     (test "an abandon for no running call is let be, and calls go on"
         (+ before 1)
       (wait-until 5 (lambda () (let ((n (var-ref 'troy *counter*)))
                                  (and (= n (+ before 1)) n)))))
     (read-netstring (car conn) 100000)         ; the ack
-    (raw-send! conn (counted (cdr welcomed) 3 '(abandon "1")))
-    (test "a malformed abandon closes the connection" #t (closed? conn)))
+    (raw-send! conn (counted key (cdr welcomed) 3 '(abandon "1")))
+    (test "a malformed abandon closes the connection" #t (raw-closed? conn)))
   (test "an apply that takes too long is stopped at its next remote call"
       "remote-apply: stopped, its caller gave up"
     (begin
