@@ -167,20 +167,62 @@
 ;; writing a closure's source costs more than sending it.
 (define (what-string what) (if (procedure? what) (what) what))
 
+;;; Limits
+;;
+;; A value from another address space is input: nested deep enough, its
+;; walk here would outgrow the stack, which ends the whole process in
+;; Chibi, not the call, and Chibi's writer silently cuts what nests deeper
+;; than 10,000 (so the lab's max-depth leaves room below that for a
+;; message's envelope); long enough, a list walked by recursion down its
+;; cdrs does the same, and a circular one never ends.  So every walk below
+;; goes down cdrs by iteration and counts its depth in cars and vectors,
+;; and encoding counts the pairs it meets: more than a frame could hold is
+;; an error, which a circular value reaches too.
+
+(define *max-depth* 4000)               ; the lab's max-depth
+(define *max-pairs* 524288)             ; a frame of max-frame bytes holds fewer
+
+;;> Sets the deepest nesting a value may have, and the most pairs one may
+;;> hold (half the largest frame: a pair is written in two bytes or more).
+(define (set-value-limits! depth pairs)
+  (set! *max-depth* depth)
+  (set! *max-pairs* pairs))
+
+(define (check-depth depth what)
+  (if (> depth *max-depth*)
+      (send-fail (what-string what) " nests deeper than the lab's max-depth, "
+                 (number->string *max-depth*))))
+
+;; (map f ls) for a list that may be improper, by iteration: f takes each
+;; element, and the tail that is not a pair.
+(define (map-elements f ls)
+  (let loop ((x ls) (acc '()))
+    (if (pair? x)
+        (loop (cdr x) (cons (f (car x)) acc))
+        (append-reverse! acc (if (null? x) '() (f x))))))
+
+(define (append-reverse! rev tail)
+  (if (null? rev)
+      tail
+      (let ((next (cdr rev)))
+        (set-cdr! rev tail)
+        (append-reverse! next rev))))
+
 ;; True of data that stands for itself on the wire, pairs of it included:
 ;; encode and decode give it back as it is instead of copying it, which
 ;; on a receiver's path was most of their cost.  The look stops after a
-;; budget of pairs, so that a circular list goes the general way, as it
-;; did before, instead of round and round here.
-(define (plain? x) (and (plain-pairs x 100000) #t))
+;; budget of pairs, or at the depth limit, so that a long, deep or
+;; circular value goes the general way, which says what is wrong with it.
+(define (plain? x) (and (plain-pairs x 100000 0) #t))
 
 ;; The budget left after looking through x, or #f when x is not plain or
-;; the budget runs out.
-(define (plain-pairs x budget)
+;; the budget or the depth runs out.  Down cdrs the call is a tail call.
+(define (plain-pairs x budget depth)
   (cond ((not budget) #f)
         ((pair? x)
-         (and (positive? budget)
-              (plain-pairs (cdr x) (plain-pairs (car x) (- budget 1)))))
+         (and (positive? budget) (< depth *max-depth*)
+              (plain-pairs (cdr x) (plain-pairs (car x) (- budget 1) (+ depth 1))
+                           depth)))
         ((plain-atom? x) budget)
         (else #f)))
 
@@ -195,28 +237,43 @@
   (if (plain? x) x (encode-compound x env what)))
 
 (define (encode-compound x env what)
-  (define (enc x what)
+  (define pairs-left *max-pairs*)
+  (define (spend! n what)
+    (set! pairs-left (- pairs-left n))
+    (if (negative? pairs-left)
+        (send-fail "cannot send " (what-string what)
+                   ": it is larger than a frame holds, or circular")))
+  (define (enc x what depth)
     (cond
      ((plain-atom? x) x)
-     ((pair? x) (cons (enc (car x) what) (enc (cdr x) what)))
+     ((pair? x) (check-depth (+ depth 1) what)
+                (map-elements (lambda (e) (spend! 1 what) (enc e what (+ depth 1)))
+                              x))
      ((vector? x)
+      (check-depth (+ depth 1) what)
+      (spend! (vector-length x) what)
       (list->vector
-       (cons 'murdoch:vector (map (lambda (e) (enc e what)) (vector->list x)))))
+       (cons 'murdoch:vector
+             (map-elements (lambda (e) (enc e what (+ depth 1)))
+                           (vector->list x)))))
      ((eof-object? x) (vector 'murdoch:eof))
      ((eq? x void-value) (vector 'murdoch:void))
-     ((procedure? x) (enc-procedure x what))
+     ((procedure? x) (enc-procedure x what depth))
      (else (send-fail "cannot send " (what-string what) ": it is "
                       (describe x)))))
-  (define (enc-procedure p what)
+  (define (enc-procedure p what depth)
     (cond
      ((proxy-procedure-ref p)
       => (lambda (ref) (vector 'murdoch:proxy (proxy-ref-uid ref)
                                (proxy-ref-id ref))))
      ((global-name p env) => (lambda (name) (vector 'murdoch:global name)))
-     ((and (not (opcode? p)) (closure-info p)) => enc-closure)
+     ((and (not (opcode? p)) (closure-info p))
+      => (lambda (info) (enc-closure info depth)))
      (else (send-fail "cannot send " (what-string what) ": it is "
                       (describe p)))))
-  (define (enc-closure info)
+  ;; A captured value is written inside the closure's vector, its list of
+  ;; bindings and its binding: three levels down.
+  (define (enc-closure info depth)
     (let* ((source+names (sendable-info-source+names info))
            (source (car source+names)))
       (vector 'murdoch:closure source
@@ -225,10 +282,11 @@
                            (enc value (lambda ()
                                         (string-append
                                          "variable " (symbol->string name)
-                                         " of " (abridged source 60))))))
+                                         " of " (abridged source 60)))
+                                (+ depth 3))))
                    (cdr source+names)
                    ((sendable-info-values info))))))
-  (enc x what))
+  (enc x what 0))
 
 ;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters,
 ;;> ending in "...", when it is longer: for messages and progress lines.
@@ -258,20 +316,23 @@
 ;;> are made by \var{proxy}, a procedure of a uid and an id.
 (define (make-decoder env proxy)
   (let ((compile (make-closure-compiler env)))
-    (define (dec x)
+    (define (dec x depth)
       (cond
-       ((pair? x) (cons (dec (car x)) (dec (cdr x))))
+       ((pair? x) (check-depth (+ depth 1) "a received value")
+                  (map-elements (lambda (e) (dec e (+ depth 1))) x))
        ((not (vector? x)) x)
-       (else (dec-tagged x))))
-    (define (dec-tagged v)
+       (else (dec-tagged x depth))))
+    (define (dec-tagged v depth)
+      (check-depth (+ depth 1) "a received value")
       (case (vector-ref v 0)
         ((murdoch:vector)
-         (list->vector (map dec (cdr (vector->list v)))))
+         (list->vector (map-elements (lambda (e) (dec e (+ depth 1)))
+                                     (cdr (vector->list v)))))
         ((murdoch:global) (global-ref (vector-ref v 1)))
         ((murdoch:closure)
          (let ((bindings (vector-ref v 2)))
            (apply (compile (vector-ref v 1) (map car bindings))
-                  (map (lambda (b) (dec (cdr b))) bindings))))
+                  (map (lambda (b) (dec (cdr b) (+ depth 1))) bindings))))
         ((murdoch:proxy) (proxy (vector-ref v 1) (vector-ref v 2)))
         ((murdoch:void) void-value)
         ((murdoch:eof) (eof-object))
@@ -281,4 +342,4 @@
         (if (and cell (procedure? (cdr cell)))
             (cdr cell)
             (error "no procedure of this name here" name))))
-    (lambda (x) (if (plain? x) x (dec x)))))
+    (lambda (x) (if (plain? x) x (dec x 0)))))

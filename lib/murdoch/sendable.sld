@@ -1,6 +1,6 @@
 (define-library (murdoch sendable)
   (export sendable-lambda sendable-define sendable-procedure?
-          encode make-decoder send-error? abridged
+          encode make-decoder send-error? abridged set-value-limits!
           make-proxy-ref proxy-ref? proxy-ref-uid proxy-ref-id
           make-proxy-procedure proxy-procedure-ref)
   (import (scheme base) (scheme eval) (scheme write)
