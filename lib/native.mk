@@ -17,7 +17,8 @@ NATIVE_CHIBI_HEADERS = $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)
 NATIVE_CFLAGS ?= -O2 -g -Wall
 
 NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
-                  lib/murdoch/hmac.so lib/murdoch/netstring.so lib/murdoch/connect.so
+                  lib/murdoch/hmac.so lib/murdoch/netstring.so lib/murdoch/connect.so \
+                  lib/murdoch/guard.so
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 

@@ -11,6 +11,7 @@
 
 #include <chibi/eval.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* How many bytes the input port's buffer holds, read from the descriptor
@@ -116,6 +117,124 @@ static sexp fixnum_to_decimal (sexp ctx, sexp self, sexp_sint_t n, sexp x) {
                                 (long)sexp_unbox_fixnum(x)));
 }
 
+/* Nesting.  Chibi's reader, in C, recurses for each level of nesting of
+ * what it reads, without bound, and reads datum labels, which make
+ * circular data.  A message is input from the network, so before it is
+ * read its text is scanned here: how deep it nests, counting each list or
+ * vector and each quote prefix (which the reader also reads by
+ * recursion), and whether it holds a label (#N= or #N#), which our writer
+ * never writes.  Strings, |symbols|, characters and comments are stepped
+ * over as the reader steps over them.
+ *
+ * A quote prefix nests the datum after it, however far that datum then
+ * nests inside: so a level opened after quotes costs one more for each,
+ * and gives it all back when it closes; quotes before an atom give theirs
+ * back with the atom.  Levels with quotes are few and remembered in
+ * `costly', allocated only if one comes. */
+struct nesting {
+  long depth, limit, quotes, levels;  /* levels: open lists and vectors */
+  long *costly, costly_count;         /* (level, quotes) of levels opened after quotes */
+};
+
+static int open_level (struct nesting *s) {
+  s->levels++;
+  s->depth += 1 + s->quotes;
+  if (s->quotes > 0) {
+    if (!s->costly && !(s->costly = malloc(2 * sizeof(long) * (s->limit + 1))))
+      return 0;
+    s->costly[2 * s->costly_count] = s->levels;
+    s->costly[2 * s->costly_count + 1] = s->quotes;
+    s->costly_count++;
+  }
+  s->quotes = 0;
+  return s->depth <= s->limit;
+}
+
+static void close_level (struct nesting *s) {
+  s->depth--;
+  if (s->costly_count > 0 && s->costly[2 * (s->costly_count - 1)] == s->levels) {
+    s->costly_count--;
+    s->depth -= s->costly[2 * s->costly_count + 1];
+  }
+  s->levels--;
+  s->quotes = 0;
+}
+
+static int delimiter (unsigned char c) {
+  return c <= ' ' || strchr("()[]\";'`,|", c) != NULL;
+}
+
+/* The end of the string or |symbol| that starts at p (its quote), or of
+ * the text when it is not closed. */
+static const unsigned char *skip_quoted (const unsigned char *p,
+                                         const unsigned char *end) {
+  unsigned char q = *p++;
+  for ( ; p < end && *p != q; p++)
+    if (*p == '\\') p++;
+  return p < end ? p + 1 : end;
+}
+
+static const unsigned char *skip_block_comment (const unsigned char *p,
+                                                const unsigned char *end) {
+  long open = 0;
+  for ( ; p + 1 < end; p++) {
+    if (p[0] == '#' && p[1] == '|') open++, p++;
+    else if (p[0] == '|' && p[1] == '#' && --open == 0) return p + 2;
+  }
+  return end;
+}
+
+/* What follows a #: a character, a block comment, a datum comment (whose
+ * datum is scanned as any other: the reader reads it), a label (sets
+ * *label), or anything else, stepped over as an atom's start. */
+static const unsigned char *after_hash (const unsigned char *p,
+                                        const unsigned char *end, int *label) {
+  const unsigned char *q = p + 1;
+  if (q < end && *q == '\\') return q + 2 <= end ? q + 2 : end;
+  if (q < end && *q == '|') return skip_block_comment(p, end);
+  if (q < end && *q == ';') return q + 1;
+  while (q < end && *q >= '0' && *q <= '9') q++;
+  if (q > p + 1 && q < end && (*q == '=' || *q == '#')) *label = 1;
+  return p + 1;
+}
+
+/* 1 when the text nests at most limit deep and has no label, else 0. */
+static int nests_within (const unsigned char *p, const unsigned char *end,
+                         long limit) {
+  struct nesting s = {0, limit, 0, 0, NULL, 0};
+  int ok = 1, label = 0;
+  while (ok && !label && p < end) {
+    unsigned char c = *p;
+    if (c == '(' || c == '[') ok = open_level(&s), p++;
+    else if (c == ')' || c == ']') close_level(&s), p++;
+    else if (c == '"' || c == '|') p = skip_quoted(p, end), s.quotes = 0;
+    else if (c == ';') { while (p < end && *p != '\n') p++; }
+    else if (c == '\'' || c == '`' || c == ',') {
+      ok = ++s.quotes + s.depth <= limit;
+      p += (c == ',' && p + 1 < end && p[1] == '@') ? 2 : 1;
+    }
+    else if (c == '#') p = after_hash(p, end, &label);
+    else if (c <= ' ') p++;
+    else { while (p < end && !delimiter(*p)) p++; s.quotes = 0; }
+  }
+  free(s.costly);
+  return ok && !label;
+}
+
+/* (nests-within? string limit): whether the text of string, read as a
+ * datum, nests at most limit deep and has no datum label (see Nesting). */
+static sexp nests_within_p (sexp ctx, sexp self, sexp_sint_t n,
+                            sexp str, sexp limit) {
+  const unsigned char *p;
+  if (!sexp_stringp(str))
+    return sexp_type_exception(ctx, self, SEXP_STRING, str);
+  if (!sexp_fixnump(limit))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, limit);
+  p = (const unsigned char *)sexp_string_data(str);
+  return sexp_make_boolean(nests_within(p, p + sexp_string_size(str),
+                                        sexp_unbox_fixnum(limit)));
+}
+
 sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
                         const char *version, const sexp_abi_identifier_t abi) {
   if (!(sexp_version_compatible(ctx, version, sexp_version)
@@ -127,5 +246,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "take-buffered-netstring", 2,
                       take_buffered_netstring);
   sexp_define_foreign(ctx, env, "reset-output-string!", 1, reset_output_string);
+  sexp_define_foreign(ctx, env, "nests-within?", 2, nests_within_p);
   return SEXP_VOID;
 }

@@ -1,6 +1,6 @@
 (define-library (murdoch netstring)
   (export read-netstring write-netstring buffered-byte-count
-          reset-output-string!
+          reset-output-string! nests-within?
           netstring-error? netstring-error-message)
   (import (scheme base) (only (chibi) string-size))
   (include-shared "netstring")

@@ -11,8 +11,9 @@
  *  The wrapper changes four things besides: it takes out of the run queue
  *  any second copy of a thread (see unqueue_twins), it gives the thread it
  *  hands over a longer time slice (QUANTUM), it resumes a context inside a
- *  call from C only in that call's own run of the VM (see Homes), and it
- *  wakes a blocked thread that is interrupted (see Interrupts).
+ *  call from C only in that call's own run of the VM (see Homes), it
+ *  wakes a blocked thread that is interrupted (see Interrupts), and it
+ *  stops a thread whose stack nears Chibi's limit (see The stack guard).
  *  Everything it reads or writes -- the paused list, the run queue, each
  *  thread's wait flag, deadline, event, fuel and interrupt mark -- is
  *  public in sexp.h.
@@ -469,6 +470,52 @@ static sexp next_here (sexp ctx, sexp self, sexp_sint_t n, sexp root,
   return next;
 }
 
+/* The stack guard.  A thread whose stack outgrows SEXP_MAX_STACK_SIZE
+ * does not raise an error that a handler could catch: the VM leaves its
+ * run with "out of stack space", which ends the whole process.  Received
+ * code can recurse without end, so at the end of each time slice a thread
+ * whose stack holds more than half that limit is interrupted, as
+ * thread-interrupt! does, and noted: it raises in its next instruction,
+ * inside the call that recursed, whose handler can then answer the call.
+ * A slice of QUANTUM instructions grows a stack by far less than the other
+ * half.  (stack-guard-tripped? thread) tells the handler why it was
+ * interrupted. */
+#define STACK_GUARD (SEXP_MAX_STACK_SIZE / 2)
+#define MAX_TRIPPED 64
+
+static sexp tripped[MAX_TRIPPED];     /* preserved from the collector */
+static int tripped_count;
+
+static int is_tripped (sexp thread) {
+  int i;
+  for (i = 0; i < tripped_count; i++)
+    if (tripped[i] == thread) return 1;
+  return 0;
+}
+
+/* A thread tripped once is not tripped again before its handler has
+ * asked why: it may still be deep while the raise unwinds. */
+static void guard_stack (sexp ctx) {
+  if (sexp_context_top(ctx) <= STACK_GUARD || sexp_context_interruptp(ctx)
+      || tripped_count == MAX_TRIPPED || is_tripped(ctx))
+    return;
+  sexp_preserve_object(ctx, ctx);
+  tripped[tripped_count++] = ctx;
+  sexp_context_interruptp(ctx) = 1;
+}
+
+static sexp stack_guard_trippedp (sexp ctx, sexp self, sexp_sint_t n,
+                                  sexp thread) {
+  int i;
+  for (i = 0; i < tripped_count; i++)
+    if (tripped[i] == thread) {
+      tripped[i] = tripped[--tripped_count];
+      sexp_release_object(ctx, thread);
+      return SEXP_TRUE;
+    }
+  return SEXP_FALSE;
+}
+
 /* The scheduler the VM calls at the end of every time slice.  Only a
  * current thread in a timed wait can be swept into the queue, so the queue
  * is walked for twins only then; with nothing homed, a runnable thread
@@ -477,6 +524,7 @@ static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   sexp next;
   int may_twin;
   interrupt_raised(ctx);
+  guard_stack(ctx);
   may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
   if (parked_count > 0)
     unpark_home(ctx, self, root);
@@ -544,5 +592,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "poll-scheduler-installed?", 0,
                       poll_scheduler_installedp);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
+  sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);
   return install(ctx);
 }

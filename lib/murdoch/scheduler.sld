@@ -12,13 +12,17 @@
 ;;> Returns \scheme{#t} once the wrapper is in place, which importing
 ;;> the library does.
 ;;>
+;;> \procedure{(stack-guard-tripped? thread)}
+;;> Whether \var{thread} was interrupted because its stack neared
+;;> Chibi's limit (which would end the process); answers so once.
+;;>
 ;;> \procedure{(monotonic-seconds)}
 ;;> Seconds since a fixed moment, as a flonum, from a clock that only goes
 ;;> forward: for deadlines.  (scheme time)'s \scheme{current-second} costs
 ;;> some microseconds a call and jumps when the wall clock is set.
 
 (define-library (murdoch scheduler)
-  (export poll-scheduler-installed? monotonic-seconds)
+  (export poll-scheduler-installed? monotonic-seconds stack-guard-tripped?)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
   (import (srfi 18))
   (include-shared "scheduler"))

@@ -1,0 +1,84 @@
+/*  guard.c -- the C of (murdoch guard): the heap's ceiling
+ *
+ *  Received code can ask for any amount of memory, and Chibi's own
+ *  ceiling (-h SIZE/MAX) does not hold it: the heap grows whenever it is
+ *  under MAX, by as much as one allocation asks, so (make-vector 100000000)
+ *  takes 800 MB at once; and once live data fills the ceiling, each
+ *  allocation that fails answers an exception object instead of raising,
+ *  after a full collection, so a loop that conses runs on for ever in
+ *  collections.  Neither can be answered with an error.  So an address
+ *  space ends itself when its heap passes the lab's heap-max, with a line
+ *  that says so, and the lab starts it again (bin/murdoch-lab).
+ *
+ *  The look is made by an OS thread of its own, twice a second, so that it
+ *  comes even while the VM is inside one long allocation or collection.
+ *  It reads only the heaps' sizes, which the VM writes as it grows them;
+ *  a size read mid-write is at worst one look late.
+ */
+
+#include <chibi/eval.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+static sexp_heap watched;
+static size_t ceiling;
+static char message[256];
+
+static size_t heap_bytes (void) {
+  size_t total = 0;
+  sexp_heap h;
+  for (h = watched; h; h = h->next)
+    total += h->size;
+  return total;
+}
+
+static void *watch (void *unused) {
+  for (;;) {
+    usleep(500000);
+    if (heap_bytes() > ceiling) {
+      ssize_t ignored = write(2, message, strlen(message));
+      (void)ignored;
+      _exit(3);
+    }
+  }
+  return NULL;
+}
+
+/* (start-heap-guard! bytes line): ends the process, writing line to
+ * standard error, once its heap passes bytes.  Once per process. */
+static sexp start_heap_guard (sexp ctx, sexp self, sexp_sint_t n,
+                              sexp bytes, sexp line) {
+  pthread_t thread;
+  pthread_attr_t attr;
+  int started;
+  if (!sexp_fixnump(bytes) || sexp_unbox_fixnum(bytes) <= 0)
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, bytes);
+  if (!sexp_stringp(line))
+    return sexp_type_exception(ctx, self, SEXP_STRING, line);
+  if (watched)
+    return sexp_user_exception(ctx, self, "the heap guard is already on", bytes);
+  ceiling = sexp_unbox_fixnum(bytes);
+  snprintf(message, sizeof message, "%s\n", sexp_string_data(line));
+  watched = sexp_context_heap(ctx);
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, 64 * 1024);
+  started = pthread_create(&thread, &attr, watch, NULL) == 0;
+  pthread_attr_destroy(&attr);
+  if (!started) {
+    watched = NULL;
+    return sexp_user_exception(ctx, self, "cannot start the heap guard", bytes);
+  }
+  pthread_detach(thread);
+  return SEXP_VOID;
+}
+
+sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
+                        const char *version, const sexp_abi_identifier_t abi) {
+  if (!(sexp_version_compatible(ctx, version, sexp_version)
+        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
+    return SEXP_ABI_ERROR;
+  sexp_define_foreign(ctx, env, "start-heap-guard!", 2, start_heap_guard);
+  return SEXP_VOID;
+}
