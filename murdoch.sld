@@ -20,6 +20,7 @@
           receive-request-non-exclusive
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
+          set-battery-charging! set-battery-low! set-load-threshold!
           ;; pose-task and dynamic teams (lib/murdoch/pose-task.scm)
           pose-task negotiate pose-task-progress task-timeout
           location-metric-maker load-metric-maker load-metric reverse-metric

@@ -1,7 +1,7 @@
 (define-library (murdoch command)
   (export join-lab run-aspace run-repl tell-who-is-away make-lab-environment
           make-repl-environment)
-  (import (scheme base) (scheme read) (scheme eval) (scheme file)
+  (import (scheme base) (scheme read) (scheme eval) (scheme file) (scheme char)
           (scheme process-context)
           (srfi 1) (srfi 18)
           (only (chibi process) current-process-id)
@@ -9,7 +9,6 @@
                 open-input-file-descriptor)
           (only (srfi 151) bitwise-ior)
           (murdoch log)
-          (only (meta) mutable-environment)
-          (murdoch lab) (murdoch remote) (murdoch pubsub)
+          (murdoch sandbox) (murdoch guard) (murdoch lab) (murdoch remote) (murdoch pubsub)
           (murdoch trip-client))
-  (include "environment.scm" "command.scm"))
+  (include "command.scm"))

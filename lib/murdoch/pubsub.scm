@@ -417,6 +417,20 @@
 ;; machines.
 (define *load-threshold* ".75")
 
+;; Received code reads these and cannot assign them (sandbox.scm): a
+;; setting meant to change changes through its procedure.
+
+;;> Sets *battery-charging*, the voltage in tenths above which a robot is
+;;> taken to be on its charging tether.
+(define (set-battery-charging! tenths) (set! *battery-charging* tenths))
+
+;;> Sets *battery-low*, in tenths of a volt.
+(define (set-battery-low! tenths) (set! *battery-low* tenths))
+
+;;> Sets *load-threshold*, a string such as ".75": below it the load
+;;> monitor subscribes to idle.
+(define (set-load-threshold! load) (set! *load-threshold* load))
+
 (define *monitor-period* 60)
 (define *load-source* #f)               ; a thunk answering a number
 

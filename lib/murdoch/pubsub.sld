@@ -8,6 +8,7 @@
           receive-request-non-exclusive set-lease!
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
+          set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)
   (import (scheme base) (scheme read) (scheme file) (only (murdoch scheduler) monotonic-seconds)
           (srfi 1) (srfi 18)
