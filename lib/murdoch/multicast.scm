@@ -11,9 +11,14 @@
 ;;
 ;; A datagram is 64 hex digits of HMAC-SHA256 under the lab's key over
 ;; "mcast:" and the text, then the text: (SENDER SEQUENCE BODY).  SEQUENCE
-;; grows with every datagram of a sender (it starts from the clock, so a
-;; restarted sender does not go back), and a receiver drops a datagram
-;; whose sequence it has passed: a recorded datagram cannot be replayed.
+;; is the sender's clock when it sent, in microseconds since 1970, and
+;; grows with every datagram of a sender, so a restarted sender does not go
+;; back.  A recorded datagram cannot be replayed, to any receiver: one
+;; drops a datagram
+;;   - whose sequence it has passed (it heard that one, or a later one);
+;;   - sent before it started (it joined late, or restarted, since);
+;;   - sent more than frame-timeout ago (the window a datagram may take,
+;;     and the most that the hosts' clocks may differ).
 ;; BODY is one of
 ;;   (beacon UID HOST PORT)         every beacon period: here I am
 ;;   (call ID KIND PROC ARGS)       KIND run or apply, as on a connection
@@ -27,7 +32,9 @@
 ;; space of a lab of N would receive N a second, and the lab N squared.
 
 (define *multicast* #f)                 ; (socket . group address), or #f
-(define *sequence* 0)
+(define *sequence* 0)                   ; of the last datagram sent
+(define *sequence-lock* (make-mutex 'sequence))
+(define *started* 0)                    ; microseconds, at start-multicast!
 (define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
 (define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
 (define max-datagram 60000)
@@ -47,7 +54,7 @@
         (set! *multicast*
               (cons (open-multicast-socket group port (aspace-host *local*))
                     (get-address-info group port)))
-        (set! *sequence* (exact (round (* 1000000 (current-second)))))
+        (set! *started* (clock-microseconds))
         (spawn listen-to-group 'multicast)
         (spawn send-beacons 'beacon)))))
 
@@ -57,11 +64,22 @@
 
 ;;; Sending
 
+;; The wall clock, which other hosts can compare, in microseconds.
+(define (clock-microseconds) (exact (round (* 1000000 (current-second)))))
+
+;; The sequence of the next datagram: two threads sending at once take
+;; two, else the receivers would drop the second as a replay.
+(define (next-sequence!)
+  (with-lock *sequence-lock*
+    (lambda ()
+      (set! *sequence* (max (+ *sequence* 1) (clock-microseconds)))
+      *sequence*)))
+
 ;; Sends body to the group; #f when it is too large for a datagram.
 (define (send-datagram! body)
-  (set! *sequence* (+ *sequence* 1))
-  (let* ((text (call-with-output-string
-                 (lambda (o) (write-simple (list (aspace-uid *local*) *sequence* body) o))))
+  (let* ((sequence (next-sequence!))
+         (text (call-with-output-string
+                 (lambda (o) (write-simple (list (aspace-uid *local*) sequence body) o))))
          (bytes (string->utf8 (hmac-sha256-sign *key* text "mcast:"))))
     (and (<= (bytevector-length bytes) max-datagram)
          (begin (send (car *multicast*) bytes 0 (cdr *multicast*)) #t))))
@@ -138,7 +156,7 @@
 ;; new listener when an apply runs long.
 
 (define (listen-to-group)
-  (let ((s (new-serving! "the multicast group" #f #f)))
+  (let ((s (new-serving! "the multicast group" #f #f #f)))
     ;; Datagrams are received into one buffer: a new 64 KB bytevector for
     ;; each, dozens a second, cost more than serving them.
     (serving-read-on-set! s (lambda ()
@@ -169,10 +187,17 @@
     (if (not (and (list? d) (= (length d) 3) (symbol? (car d))
                   (exact-integer? (cadr d))))
         (frame-fail "not a datagram"))
-    (if (<= (cadr d) (hash-table-ref/default *last-sequence* (car d) 0))
-        (frame-fail "replayed or out of order"))
+    (check-fresh (car d) (cadr d))
     (hash-table-set! *last-sequence* (car d) (cadr d))
     d))
+
+(define (check-fresh sender sequence)
+  (cond ((<= sequence (hash-table-ref/default *last-sequence* sender 0))
+         (frame-fail "replayed or out of order"))
+        ((< sequence *started*)
+         (frame-fail "sent before this address space started"))
+        ((< sequence (- (clock-microseconds) (* 1000000 *frame-timeout*)))
+         (frame-fail "older than frame-timeout"))))
 
 (define (serve-datagram s call d)
   (let ((sender (car d)) (body (car (cddr d))))

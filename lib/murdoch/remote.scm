@@ -140,6 +140,7 @@
 
 ;;> A per-call override: (parameterize ((remote-timeout 1)) ...).
 (define remote-timeout (make-parameter #f))
+(sandbox-parameter! remote-timeout)
 
 (define (current-timeout) (or (remote-timeout) *default-timeout*))
 
@@ -162,6 +163,8 @@
 
 (define (error-message e)
   (cond
+   ((stack-guard-tripped? (current-thread))
+    "recursed too deep: its stack neared Chibi's limit, which ends a process")
    ((error-object? e)
     (call-with-output-string
       (lambda (out)
@@ -194,19 +197,28 @@
 
 (define *key* #f)                       ; the lab's, for HMAC
 (define *max-frame* 1048576)
+(define *max-depth* 4000)
 
 ;; Each connection writes its frames' text to a string port of its own,
 ;; emptied before each frame, so that a write that failed half-way leaves
 ;; nothing behind (its writer holds the connection's lock): a new string
 ;; port per frame costs Chibi a 4 KB allocation.
-(define (write-frame! out text-port nonce count message)
+(define (frame-text text-port message)
   (reset-output-string! text-port)
   (write-simple message text-port)
   (let ((text (get-output-string text-port)))
-    (write-netstring (hmac-sha256-sign *key* text nonce ":" count ":") out)))
+    ;; The receiver would refuse it and close the connection, failing the
+    ;; calls on it that had nothing to do with this one.
+    (if (> (+ 64 (string-size text)) *max-frame*)
+        (error (string-append "the message is larger than the lab's max-frame, "
+                              (number->string *max-frame*) " bytes")))
+    text))
+
+(define (write-frame! out text nonce count)
+  (write-netstring (hmac-sha256-sign *key* text nonce ":" count ":") out))
 
 (define (send-frame! out text-port nonce count message)
-  (write-frame! out text-port nonce count message)
+  (write-frame! out (frame-text text-port message) nonce count)
   (flush-output-port out))
 
 ;;> Raised for a frame that breaks the protocol; the connection closes.
@@ -236,11 +248,17 @@
   (or (apply hmac-sha256-open *key* bytes end parts)
       (frame-fail "bad MAC")))
 
-;; Chibi's own reader, in C: (scheme read) is SRFI 38's, with datum
-;; labels, written in Scheme and a hundred times slower.  Messages have no
-;; labels: encode sends no cycles.  Text that is no datum raises a read
+;; Chibi's own reader, in C: (scheme read) is SRFI 38's, written in
+;; Scheme and a hundred times slower.  The C reader recurses without
+;; bound and reads datum labels, which make cycles, so the text is first
+;; scanned for both (nests-within?): a message may nest twice max-depth,
+;; room for its envelope and for a value one level too deep, which
+;; decoding then refuses with an error answer; deeper, or with a label,
+;; it is a protocol violation.  Text that is no datum raises a read
 ;; error; our writer puts nothing after the datum.
 (define (parse-message text)
+  (if (not (nests-within? text (* 2 *max-depth*)))
+      (frame-fail "nests deeper than twice max-depth, or has a datum label"))
   (let* ((in (open-input-string text))
          (message (read-datum in)))
     (cond ((eof-object? message) (frame-fail "empty message"))
@@ -452,13 +470,14 @@
 (define (send-counted! c message)
   (if (not (connection-open? c))
       (remote-error (connection-uid c) 'send "connection lost"))
-  (let ((count (+ 1 (connection-sent c))))
+  (let ((text (frame-text (connection-text c) message))
+        (count (+ 1 (connection-sent c))))
     (connection-sent-set! c count)
     (undo-on-raise
      (lambda () (connection-open?-set! c #f))
      (lambda ()
-       (send-frame! (connection-out c) (connection-text c)
-                    (connection-nonce c) count message)))))
+       (write-frame! (connection-out c) text (connection-nonce c) count)
+       (flush-output-port (connection-out c))))))
 
 ;; Sends the answer to call id of a multicast datagram that a, its sender,
 ;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
@@ -672,7 +691,7 @@
       (call a 'apply proc args)))
 
 (define (spawn thunk name)
-  (thread-start! (make-thread (lambda () (run-logged thunk name)) name)))
+  (thread-start! (make-guarded-thread (lambda () (run-logged thunk name)) name)))
 
 (define (run-logged thunk name)
   (guard (e (#t (log-warn name ": " (error-message e))))
@@ -746,9 +765,10 @@
 ;; read: a peer that stalls mid-frame would otherwise hold a thread and a
 ;; socket for ever, so the janitor ends it when the deadline passes.
 (define-record-type serving
-  (make-serving peer thread in out)
+  (make-serving peer host thread in out)
   serving?
   (peer serving-peer)
+  (host serving-host)
   (thread serving-thread serving-thread-set!)  ; the reader
   (in serving-in)
   (out serving-out)
@@ -760,12 +780,19 @@
 (define *serving* '())
 (define *serving-lock* (make-mutex 'serving))
 (define *frame-timeout* 5)
+(define *max-connections* 256)
+(define *max-connections-per-host* 64)
 (define janitor-seconds 0.1)
 (define takeover-seconds 0.1)
 
-(define (serve-connection fd peer)
-  (let ((s (new-serving! peer (open-input-file-descriptor fd #t)
+(define (serve-connection fd peer host)
+  (let ((s (new-serving! peer host (open-input-file-descriptor fd #t)
                          (open-output-file-descriptor fd #t))))
+    ;; The hello, which proves the key, is due within frame-timeout of the
+    ;; connect: anyone can connect, and an idle connection holds a
+    ;; descriptor.
+    (serving-deadline-set! s (+ (monotonic-seconds) *frame-timeout*))
+    (janitor-wanted!)
     (read-as-reader s (lambda ()
                         (let ((hello (read-served-frame s "hello" 0)))
                           ;; A peer that connects and leaves at once is
@@ -773,10 +800,10 @@
                           (if (not (eof-object? hello))
                               (serve-calls s hello)))))))
 
-;; A connection (or the multicast group: no ports) that this thread reads,
-;; among those the janitor watches.
-(define (new-serving! peer in out)
-  (let ((s (make-serving peer (current-thread) in out)))
+;; A connection (or the multicast group: no ports, no host) that this
+;; thread reads, among those the janitor watches.
+(define (new-serving! peer host in out)
+  (let ((s (make-serving peer host (current-thread) in out)))
     (serving-deadline-set! s #f)
     (serving-busy-since-set! s #f)
     (serving-applying-set! s '())
@@ -799,12 +826,14 @@
   (guard (e (#t #f)) (close-output-port (serving-out s))))
 
 ;; Waits as long as need be for a frame to begin, then gives it
-;; *frame-timeout* seconds to arrive whole.
+;; *frame-timeout* seconds to arrive whole: less when a deadline is
+;; already set (the hello's).
 (define (read-served-frame s nonce count)
   (if (eof-object? (peek-u8 (serving-in s)))
       (eof-object)
       (begin
-        (serving-deadline-set! s (+ (monotonic-seconds) *frame-timeout*))
+        (serving-deadline-set! s (or (serving-deadline s)
+                                     (+ (monotonic-seconds) *frame-timeout*)))
         (janitor-wanted!)
         (let ((message (read-frame (serving-in s) nonce count)))
           (serving-deadline-set! s #f)
@@ -856,15 +885,16 @@
 
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
-            " closed: stalled in the middle of a frame")
+            " closed: no whole frame within frame-timeout")
   (thread-terminate! (serving-thread s))
   (end-serving! s))
 
 (define (take-over! s)
   (mutex-lock! *serving-lock*)
   (when (serving-busy-since s)          ; its apply may just have ended
-    (let ((t (make-thread (lambda () (read-as-reader s (serving-read-on s)))
-                          'connection)))
+    (let ((t (make-guarded-thread
+              (lambda () (read-as-reader s (serving-read-on s)))
+              'connection)))
       (serving-busy-since-set! s #f)
       (serving-thread-set! s t)
       (thread-start! t)))
@@ -919,8 +949,8 @@
         (read-on call)))))
 
 ;; Runs a call that s's reader has read; (reply KIND VALUE) answers it.
-;; Until then the car of call is marker, for read-calls to answer an error
-;; with.  A run is acknowledged once its procedure is decoded, so that one
+;; Until the answer is made the car of call is marker, for read-calls to
+;; answer an error with.  A run is acknowledged once its procedure is decoded, so that one
 ;; that cannot be is reported to its caller, and runs in a worker; an apply
 ;; runs here, until the janitor gives s a new reader, and its value goes
 ;; back.
@@ -933,10 +963,11 @@
         (run-in-worker thunk))
       (begin
         (inline-apply-begins! s marker)
-        (let ((value (encoded-result proc-code args-code)))
-          (set-car! call #f)
-          (inline-apply-ends! s)
-          (reply 'value value)))))
+        ;; Answered while the call is marked: a value that cannot go back
+        ;; (too large, say) is answered with the error instead.
+        (reply 'value (encoded-result proc-code args-code))
+        (set-car! call #f)
+        (inline-apply-ends! s))))
 
 (define (serve-calls s hello)
   (let* ((caller-nonce (greet! hello))
@@ -952,9 +983,10 @@
     (define (answer! message)
       (with-lock write-lock
         (lambda ()
-          (set! sent (+ sent 1))
-          ;; A caller that left makes this raise, and the connection end.
-          (write-frame! out text caller-nonce sent message)
+          (let ((frame (frame-text text message)))
+            (set! sent (+ sent 1))
+            ;; A caller that left makes this raise, and the connection end.
+            (write-frame! out frame caller-nonce sent))
           (if (not (reader? s)) (flush-output-port out)))))
     (define (flush-if-idle!)
       (if (zero? (buffered-byte-count (serving-in s)))
@@ -1008,13 +1040,13 @@
                 (lambda (kind value)
                   (answer! (if (eq? kind 'ack) `(ack ,id) `(value ,id ,value)))))))
 
-;; The application a call asks for, as a thunk.
+;; The application a call asks for, as a thunk that runs it in the sandbox.
 (define (decode-call proc-code args-code)
   (let ((proc (*decode* proc-code))
         (args (*decode* args-code)))
     (if (not (procedure? proc))
         (error "not a procedure" proc))
-    (lambda () (apply proc args))))
+    (lambda () (call-in-sandbox (lambda () (apply proc args))))))
 
 ;; What the application a call asks for answers, encoded to go back.
 (define (encoded-result proc-code args-code)
@@ -1033,9 +1065,33 @@
     (let ((fd (accept listener (address-info-address addr)
                       (address-info-address-length addr))))
       (if fd
-          (let ((peer (peer-name (address-info-address addr))))
-            (spawn (lambda () (serve-connection fd peer)) 'connection)))
+          (let ((peer (peer-name (address-info-address addr)))
+                (host (sockaddr-name (address-info-address addr))))
+            (if (room-for? host)
+                (spawn (lambda () (serve-connection fd peer host)) 'connection)
+                (refuse-connection! fd peer))))
       (loop)))))
+
+;; Whether a connection from host stays under the lab's caps, in all and
+;; from one host: past them, connections that never say hello could take
+;; every descriptor the process has.
+(define (room-for? host)
+  (with-lock *serving-lock*
+    (lambda ()
+      (let ((from-host (count (lambda (s) (equal? (serving-host s) host))
+                              *serving*)))
+        (and (< (length *serving*) *max-connections*)
+             (< from-host *max-connections-per-host*))))))
+
+(define *last-refusal* -inf.0)
+
+;; Closes a connection over the caps; the log tells of one a second.
+(define (refuse-connection! fd peer)
+  (close-port (open-input-file-descriptor fd #t))
+  (when (> (monotonic-seconds) (+ *last-refusal* 1))
+    (set! *last-refusal* (monotonic-seconds))
+    (log-warn "connection from " peer " refused: over max-connections"
+              " or max-connections-per-host")))
 
 ;;; Proxies
 
@@ -1112,8 +1168,13 @@
     (set! *decode* (make-decoder environment decode-proxy))
     (set! *key* (lab-key lab))
     (set! *max-frame* (lab-setting lab 'max-frame 1048576))
+    (set! *max-depth* (lab-setting lab 'max-depth 4000))
+    (set-value-limits! *max-depth* (quotient *max-frame* 2))
     (set! *default-timeout* (lab-setting lab 'timeout 5))
     (set! *frame-timeout* (lab-setting lab 'frame-timeout 5))
+    (set! *max-connections* (lab-setting lab 'max-connections 256))
+    (set! *max-connections-per-host* (lab-setting lab 'max-connections-per-host 64))
+    (set-sandbox-ports! (current-output-port) (current-error-port))
     (for-each (lambda (a)
                 (learn-aspace! (make-aspace (lab-aspace-uid a)
                                             (lab-aspace-host a)

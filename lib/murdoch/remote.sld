@@ -12,11 +12,11 @@
           (scheme time)
           (srfi 1) (srfi 18) (srfi 69)
           (rename (only (chibi) read) (read read-datum))
-          (only (chibi) call-with-output-string make-exception exception?
+          (only (chibi) call-with-output-string make-exception exception? string-size
                 exception-kind exception-irritants
                 strip-syntactic-closures)
           (only (chibi filesystem) open-input-file-descriptor
                 open-output-file-descriptor)
           (chibi net)
-          (murdoch scheduler) (murdoch abandon) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch lab))
+          (murdoch scheduler) (murdoch abandon) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch sandbox) (murdoch lab))
   (include "remote.scm" "multicast.scm"))
