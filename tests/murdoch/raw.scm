@@ -33,7 +33,7 @@
 
 (define (text-of datum)
   (let ((out (open-output-string)))
-    (write datum out)
+    (write-simple datum out)
     (get-output-string out)))
 
 ;;> A hello from an address space called intruder, offering \var{nonce}.
