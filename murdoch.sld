@@ -9,6 +9,8 @@
           aspace? aspace-uid local-aspace local-aspace-uid uid->aspace
           known-uids remote-run! remote-apply remote-timeout
           remote-error? remote-error-uid remote-error-message
+          remote-timeout-error? remote-unreachable-error? remote-raised-error?
+          remote-protocol-error?
           remote-apply-all remote-run-all! live-uids delivery-mode
           encap var-ref var-set! display-remote
           ;; publish/subscribe (lib/murdoch/pubsub.scm)

@@ -2,7 +2,8 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme file)
         (scheme eval) (scheme read)
         (srfi 18) (chibi test) (chibi net)
-        (only (chibi filesystem) open-input-file-descriptor)
+        (only (chibi filesystem) open-input-file-descriptor
+              open-output-file-descriptor)
         (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
         (murdoch netstring) (murdoch hmac) (murdoch connect) (murdoch testing)
         (murdoch raw))
@@ -84,6 +85,39 @@
       (error-text (lambda () (remote-apply (troy) slow 3)))))
   (test "the connection still works after a timeout" 3
     (remote-apply (troy) (lambda () 3))))
+
+(test-group "each way a call fails has a predicate of its own"
+  (define (failure thunk) (guard (e (#t e)) (thunk)))
+  (test "no answer in time" '(#t #t)
+    (let ((e (failure (lambda () (parameterize ((remote-timeout 1/2))
+                                   (remote-apply (troy) slow 3))))))
+      (list (remote-error? e) (remote-timeout-error? e))))
+  (test "raised there" '(#t #t)
+    (let ((e (failure (lambda () (remote-apply (troy) (lambda () (car '())))))))
+      (list (remote-error? e) (remote-raised-error? e))))
+  (test "nobody listening" '(#t #t)
+    (let ((e (failure (lambda () (remote-apply (uid->aspace 'ghost) (lambda () 1))))))
+      (list (remote-error? e) (remote-unreachable-error? e))))
+  (test "a listener that answers the hello with something else" '(#t #t)
+    (let* ((listener (listen-on-free-port))
+           (answerer (make-thread
+                      (lambda ()
+                        (let* ((addr (get-address-info "127.0.0.1" (cdr listener)))
+                               (fd (accept (car listener) (address-info-address addr)
+                                           (address-info-address-length addr)))
+                               (out (open-output-file-descriptor fd)))
+                          (write-string "5:hello," out)
+                          (flush-output-port out)
+                          (thread-sleep! 1)
+                          (close-port out))))))
+      (thread-start! answerer)
+      (let ((e (failure (lambda ()
+                          (parameterize ((remote-timeout 2))
+                            (remote-apply (make-aspace 'liar "127.0.0.1" (cdr listener))
+                                          (lambda () 1)))))))
+        (thread-join! answerer)
+        (close-port (open-input-file-descriptor (car listener)))
+        (list (remote-error? e) (remote-protocol-error? e))))))
 
 (test-group "a long apply does not hold up the calls behind it"
   ;; The connection's reader runs an apply itself; one that runs long has

@@ -146,17 +146,41 @@
 
 ;;; Errors
 
-;;> Raised by remote-apply for an error in the target, a lost connection
-;;> or a timeout.  Its irritants are the target's uid, the procedure and
-;;> the original message.
-(define (remote-error uid what message)
-  (raise (make-exception 'remote-error
+;; The family of errors a remote call raises, one kind for each way it
+;; fails; its irritants are the target's uid, the procedure and the
+;; message:
+;;   timed-out     no answer within the timeout (connecting included)
+;;   unreachable   no connection, or it was lost or refused
+;;   raised        the procedure raised an error at the callee
+;;   protocol      the callee broke the wire protocol (its welcome)
+(define remote-error-kinds '(timed-out unreachable raised protocol))
+
+(define (remote-error kind uid what message)
+  (raise (make-exception kind
                          (string-append "remote-apply on "
                                         (symbol->string uid) " failed")
                          (list uid what message) #f #f)))
 
+;;> Raised by remote-apply and remote-run! for an error in the target, a
+;;> lost connection or a timeout: one of the four kinds below.
 (define (remote-error? e)
-  (and (exception? e) (eq? (exception-kind e) 'remote-error)))
+  (and (exception? e) (memq (exception-kind e) remote-error-kinds) #t))
+
+(define (remote-error-of-kind? kind e)
+  (and (exception? e) (eq? (exception-kind e) kind)))
+
+;;> A remote-error for a call that had no answer within its timeout.
+(define (remote-timeout-error? e) (remote-error-of-kind? 'timed-out e))
+
+;;> A remote-error for a target that could not be reached, or whose
+;;> connection was lost or refused.
+(define (remote-unreachable-error? e) (remote-error-of-kind? 'unreachable e))
+
+;;> A remote-error for a procedure that raised an error in the target.
+(define (remote-raised-error? e) (remote-error-of-kind? 'raised e))
+
+;;> A remote-error for a target that broke the wire protocol.
+(define (remote-protocol-error? e) (remote-error-of-kind? 'protocol e))
 
 (define (remote-error-uid e) (car (exception-irritants e)))
 (define (remote-error-message e) (car (cddr (exception-irritants e))))
@@ -265,6 +289,10 @@
           ((not (eof-object? (peek-char in))) (frame-fail "trailing data"))
           (else message))))
 
+;; Whether e says that the other side broke the protocol.
+(define (protocol-fault? e)
+  (or (frame-error? e) (netstring-error? e) (read-error? e)))
+
 ;; What was wrong with a frame or datagram that raised e, for the log.
 (define (fault-message e)
   (cond ((frame-error? e) (frame-error-message e))
@@ -342,7 +370,7 @@
     (or (live-connection-to uid)
         (with-lock-by (connecting-lock uid) deadline
           (lambda ()
-            (remote-error uid 'connect "another call's connect did not end in time"))
+            (remote-error 'timed-out uid 'connect "another call's connect did not end in time"))
           (lambda ()
             (or (live-connection-to uid)
                 (let ((c (connect! a deadline)))
@@ -368,7 +396,10 @@
   (let ((io (open-connection (aspace-host a) (aspace-port a)
                              (seconds-until deadline))))
     (if (string? io)
-        (remote-error (aspace-uid a) 'connect
+        (remote-error (if (string-prefix? "no connection within" io)
+                          'timed-out
+                          'unreachable)
+                      (aspace-uid a) 'connect
                       (string-append "cannot connect to " (aspace-host a) ":"
                                      (number->string (aspace-port a)) ": " io)))
     (let ((c (make-connection (aspace-uid a) (car io) (cadr io)
@@ -389,9 +420,11 @@
                       welcome deadline
                       (lambda ()
                         (close-connection! c)
-                        (remote-error (aspace-uid a) 'connect "no welcome")))))
-        (if (string? greeted)
-            (remote-error (aspace-uid a) 'connect greeted)))
+                        (remote-error 'timed-out (aspace-uid a) 'connect
+                                      "no welcome")))))
+        (if (not (eq? greeted #t))
+            (remote-error (if (protocol-fault? greeted) 'protocol 'unreachable)
+                          (aspace-uid a) 'connect (fault-message greeted))))
       c)))
 
 ;; The reader of one outgoing connection: the welcome, then answers, each
@@ -400,7 +433,7 @@
 ;; reports: only faults after the welcome are logged, so that the prober,
 ;; trying a gone peer every second, does not fill the log.
 (define (read-answers c nonce welcome)
-  (guard (e (#t (mailbox-put! welcome (fault-message e))
+  (guard (e (#t (mailbox-put! welcome e)
                 (if (connection-nonce c) (log-fault (connection-uid c) e))))
     (let ((w (read-frame (connection-in c) nonce 0)))
       (check-welcome w (connection-uid c))
@@ -416,11 +449,13 @@
 ;; came after uid left, on the port it had, would answer in its name, and
 ;; uid would never drop out of the lab.
 (define (check-welcome w uid)
+  (if (eof-object? w)
+      (error "the connection closed before its welcome"))
   (if (not (and (list? w) (= (length w) 3) (eq? (car w) 'welcome)
                 (symbol? (cadr w)) (string? (car (cddr w)))))
       (frame-fail "expected a welcome"))
   (if (not (eq? (cadr w) uid))
-      (frame-fail "found " (symbol->string (cadr w)) " at its address")))
+      (error (string-append "found " (symbol->string (cadr w)) " at its address"))))
 
 (define (deliver-answer! c answer)
   (if (not (and (pair? answer) (memq (car answer) '(ack value error))
@@ -469,7 +504,7 @@
 ;; write lock.  A frame that fails to go out leaves the connection closed.
 (define (send-counted! c message)
   (if (not (connection-open? c))
-      (remote-error (connection-uid c) 'send "connection lost"))
+      (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
   (let ((text (frame-text (connection-text c) message))
         (count (+ 1 (connection-sent c))))
     (connection-sent-set! c count)
@@ -547,14 +582,16 @@
     (case (car answer)
       ((ack) #t)
       ((value) (*decode* (car (cddr answer))))
-      ((error) (remote-error uid (describe-procedure proc) (car (cddr answer))))
+      ((error) (remote-error 'raised uid (describe-procedure proc)
+                             (car (cddr answer))))
       (else (note-unreachable! uid)
-            (remote-error uid (describe-procedure proc) "connection lost")))))
+            (remote-error 'unreachable uid (describe-procedure proc)
+                          "connection lost")))))
 
 ;; The call of proc to uid has had no answer within seconds.
 (define (timed-out uid proc seconds)
   (note-unreachable! uid)
-  (remote-error uid (describe-procedure proc)
+  (remote-error 'timed-out uid (describe-procedure proc)
                 (string-append "no answer within " (number->string seconds) " s")))
 
 ;;> Applies \var{proc} to \var{args} in each address space of
@@ -667,7 +704,8 @@
 
 (define (apply-here uid proc args)
   (guard (e ((remote-error? e) (raise e))
-            (#t (remote-error uid (describe-procedure proc) (error-message e))))
+            (#t (remote-error 'raised uid (describe-procedure proc)
+                              (error-message e))))
     (apply proc args)))
 
 ;;> Applies \var{proc} to \var{args} in a new thread of address space

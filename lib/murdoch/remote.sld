@@ -6,6 +6,8 @@
           remote-apply-all remote-run-all! broadcast-apply broadcast-run!
           delivery-mode
           remote-error? remote-error-uid remote-error-message
+          remote-timeout-error? remote-unreachable-error? remote-raised-error?
+          remote-protocol-error?
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote undo-on-raise)
   (import (scheme base) (scheme write) (scheme char)
@@ -17,6 +19,6 @@
                 strip-syntactic-closures)
           (only (chibi filesystem) open-input-file-descriptor
                 open-output-file-descriptor)
-          (chibi net)
+          (chibi net) (only (chibi string) string-prefix?)
           (murdoch scheduler) (murdoch abandon) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch sandbox) (murdoch lab))
   (include "remote.scm" "multicast.scm"))
