@@ -1,9 +1,10 @@
 ;;; bin/murdoch lab and pose, as real processes: a lab comes up and goes
-;;; down whole, a child that dies takes the lab down with it, and pose
-;;; poses the task a file names.
+;;; down whole, an address space that dies is started again, one that
+;;; cannot start stops the lab, and pose poses the task a file names.
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
         (only (chibi process) system? kill signal/kill)
-        (chibi io)
+        (chibi io) (chibi net)
+        (only (chibi filesystem) open-input-file-descriptor)
         (murdoch testing))
 
 ;; Workstations only, so that no simulator is needed: the launcher starts
@@ -78,13 +79,34 @@
         (text-contains? (car output) "no address space of the lab answers; away: (troy praline)"))
       (test "and nobody takes the task" "not-enough-takers" (last output)))))
 
-(test-group "a child that dies takes the lab down"
-  (let ((pid (start-lab! (in-dir "lab2.out"))))
-    (kill (car (children-of pid)) signal/kill)
+(test-group "an address space that dies is started again"
+  (let* ((pid (start-lab! (in-dir "lab2.out")))
+         (troy (car (children-of pid))))
+    (kill troy signal/kill)
+    (test "the lab names it" #t
+      (wait-until 10 (lambda () (text-contains? (file-text (in-dir "lab2.out"))
+                                                "troy died"))))
+    (test "and starts it again" #t
+      (wait-until 30 (lambda () (and (text-contains? (file-text (in-dir "lab2.out"))
+                                                     "starting troy again")
+                                     (listening? base)))))
+    (test "the others carry on" #t (listening? (+ base 1)))
+    (test "the lab runs on, and stops whole" 0 (stop-process! pid))))
+
+(test-group "a child that cannot start stops the lab, with its ERROR line"
+  ;; troy's port is taken before the lab starts.
+  (let* ((squatter (make-listener-socket (get-address-info "127.0.0.1" base) 5))
+         (out (in-dir "lab4.out"))
+         (pid (start-process! (list (tool-path "bin/murdoch") "lab" (test-lab-file lab)
+                                    "--logs" (in-dir "logs4"))
+                              out)))
     (test "the lab exits non-zero" #t (not (zero? (reap! pid))))
-    (test "naming the one that died" #t
-      (text-contains? (file-text (in-dir "lab2.out")) "troy died"))
-    (test "and stops the others" #f (listening? (+ base 1)))))
+    (test "naming the child and what went wrong" '(#t #t)
+      (let ((text (file-text out)))
+        (list (text-contains? text "troy died")
+              (text-contains? text "is another process there?"))))
+    (test "and stops the others" #f (listening? (+ base 1)))
+    (close-port (open-input-file-descriptor squatter))))
 
 (test-group "a REPL waiting for a line still serves the lab"
   ;; praline is a REPL whose input never comes: a peer all the same.
