@@ -118,9 +118,9 @@
                            (current-error-port (open-output-string))
                            (current-output-port (open-output-string))
                            'rebound)))
-  (test "a parameter set by one call is not set for the next" #f
-    (begin (remote-apply (troy) (lambda () (remote-timeout 0.001) #t))
-           (remote-apply (troy) (lambda () (remote-timeout)))))
+  (test "a parameter set by one call is not set for the next" '(#f 600)
+    (begin (remote-apply (troy) (lambda () (remote-timeout 0.001) (task-timeout 0) #t))
+           (remote-apply (troy) (lambda () (list (remote-timeout) (task-timeout))))))
   (test "the next call writes to the process's output" #t
     (begin (remote-apply (troy) (lambda () (display "written after the attack")
                                   (newline)))

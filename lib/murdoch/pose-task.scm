@@ -15,6 +15,9 @@
 ;;> A port on which pose-task tells what it is doing, or #f for silence.
 (define pose-task-progress (make-parameter #f))
 
+;; Received code that sets these sets them for its own call only.
+(sandbox-parameter! pose-task-progress)
+
 (define (progress . parts)
   (let ((out (pose-task-progress)))
     (when out
@@ -265,6 +268,7 @@
 
 ;;> The robots of the team being run.
 (define current-team (make-parameter '()))
+(sandbox-parameter! current-team)
 
 ;;> Runs \var{body} with \var{uids} as the current team.
 (define-syntax with-team
@@ -314,6 +318,7 @@
 ;;> its next robot command or remote call (abandon.scm); until then an
 ;;> exclusive one holds its subjects.
 (define task-timeout (make-parameter 600))
+(sandbox-parameter! task-timeout)
 
 (define (select-robots options)
   (cond

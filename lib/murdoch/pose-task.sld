@@ -8,6 +8,7 @@
           (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) procedure-code procedure-vars opcode? thread-interrupt!)
           (only (chibi) call-with-output-string)
-          (murdoch log) (murdoch abandon) (murdoch sendable) (murdoch remote) (murdoch pubsub)
+          (murdoch log) (murdoch abandon) (murdoch sendable) (murdoch sandbox)
+          (murdoch remote) (murdoch pubsub)
           (murdoch trip-client))
   (include "pose-task.scm"))
