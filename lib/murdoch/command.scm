@@ -41,23 +41,12 @@
 (define (run-aspace lab-file uid)
   (join-lab lab-file uid)
   (start-heap-guard!
-   (size-bytes (lab-setting (current-lab) 'heap-max "512M"))
+   (lab-setting (current-lab) 'heap-max)
    (string-append "murdoch " (symbol->string uid) ": ERROR: the heap passed"
                   " the lab's heap-max; exiting, for the lab to start it again"))
   (log-note "listening on " (aspace-host (local-aspace)) ":"
             (aspace-port (local-aspace)))
   (let wait () (thread-sleep! 3600) (wait)))
-
-;; A size as the lab file writes it: bytes, or a string with K, M or G.
-(define (size-bytes size)
-  (if (number? size)
-      size
-      (let* ((n (string-length size))
-             (unit (assv (char-upcase (string-ref size (- n 1)))
-                         '((#\K . 1024) (#\M . 1048576) (#\G . 1073741824)))))
-        (if unit
-            (* (cdr unit) (string->number (substring size 0 (- n 1))))
-            (string->number size)))))
 
 ;;> Warns of the lab's address spaces that do not answer: a guest that
 ;;> joins before the lab is up, or on another port base, would otherwise

@@ -28,22 +28,134 @@
 (define (clause-value key clauses default)
   (cond ((clause key clauses) => cadr) (else default)))
 
-;;> The value of setting \var{key} of the lab, or \var{default}.
-(define (lab-setting lab key default)
-  (clause-value key (lab-settings lab) default))
+;;; Settings
+;;
+;; Every setting a lab file may give, in one table: its name, its
+;; default, and its reader, which answers the value to use for what the
+;; file wrote, or #f when that will not do, and what will.  Most take one
+;; value; code and delivery take the rest of their clause.  read-lab reads
+;; each once, and every place that needs one asks lab-setting.
+
+(define (number-over zero what)
+  (cons (lambda (x) (and (real? x) (> x zero) x)) what))
+
+(define (whole-from low high what)
+  (cons (lambda (x) (and (exact-integer? x) (<= low x high) x)) what))
+
+(define (text what) (cons (lambda (x) (and (string? x) x)) what))
+
+(define seconds (number-over 0 "a positive number of seconds"))
+(define positive-count (whole-from 1 1000000000 "a positive whole number"))
+
+;; A size: bytes, or a string of a number and K, M or G.
+(define (size-bytes size)
+  (cond ((and (exact-integer? size) (positive? size)) size)
+        ((and (string? size) (> (string-length size) 1))
+         (let* ((n (string-length size))
+                (unit (assv (string-ref size (- n 1))
+                            '((#\K . 1024) (#\M . 1048576) (#\G . 1073741824))))
+                (number (string->number (substring size 0 (- n 1)))))
+           (and unit number (positive? number) (exact (round (* number (cdr unit)))))))
+        (else #f)))
+
+(define (delivery-clause args)
+  (cond ((equal? args '(broadcast)) args)
+        ((and (pair? args) (eq? (car args) 'multicast) (pair? (cdr args))
+              (string? (cadr args))
+              (or (null? (cddr args))
+                  (and (exact-integer? (car (cddr args))) (null? (cdr (cddr args))))))
+         args)
+        (else #f)))
+
+(define settings-table
+  `((port-base 7100 ,(whole-from 1 65535 "a port number"))
+    (interface "127.0.0.1" ,(text "an IPv4 address, in quotes"))
+    (key-file "murdoch.key" ,(text "a file name, in quotes"))
+    (max-frame 1048576 ,positive-count)
+    ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
+    (max-depth 4000 ,(whole-from 1 9000 "a whole number from 1 to 9000"))
+    (timeout 5 ,seconds)
+    (frame-timeout 5 ,seconds)
+    (lease 30 ,seconds)
+    (monitor-period 60 ,seconds)
+    (max-connections 256 ,positive-count)
+    (max-connections-per-host 64 ,positive-count)
+    (heap-max "512M" (,size-bytes . "bytes, or a size in quotes such as \"512M\""))
+    (code () (,(lambda (x) (and (every string? x) x)) . "file names, in quotes"))
+    (delivery (broadcast) (,delivery-clause . "broadcast, or multicast \"GROUP\" [PORT]"))))
+
+;; The clauses the simulator reads (docs/trip-protocol.md), and address
+;; spaces.
+(define other-clauses '(world simulator b14 aspace))
+
+(define multi-valued '(code delivery))
+
+;;> The value of setting \var{key} of the lab: what its file says, or the
+;;> default (docs/lab-file.md).
+(define (lab-setting lab key)
+  (cond ((assq key (lab-settings lab)) => cdr)
+        (else (error "lab-setting: no such setting" key))))
+
+;; The settings of the clauses, every one of the table's, checked: an
+;; error names the file, the clause and what is wrong.
+(define (read-settings path clauses)
+  (for-each (lambda (c) (check-clause path c)) clauses)
+  (map (lambda (entry)
+         (let ((c (clause (car entry) clauses)))
+           (cons (car entry)
+                 (if c
+                     (setting-value path c entry)
+                     ((car (car (cddr entry))) (cadr entry))))))
+       settings-table))
+
+(define (check-clause path c)
+  (if (not (and (pair? c) (symbol? (car c)) (list? c)))
+      (lab-file-error path c "a clause is (NAME VALUE ...)"))
+  (if (not (or (assq (car c) settings-table) (memq (car c) other-clauses)))
+      (lab-file-error path c (string-append "no such setting" (did-you-mean (car c))))))
+
+(define (setting-value path c entry)
+  (let* ((reader (car (cddr entry)))
+         (multi? (memq (car entry) multi-valued))
+         (value (cond (multi? ((car reader) (cdr c)))
+                      ((and (pair? (cdr c)) (null? (cddr c))) ((car reader) (cadr c)))
+                      (else #f))))
+    (or value
+        (lab-file-error path c (string-append (symbol->string (car c)) " takes "
+                                              (cdr reader))))))
+
+(define (did-you-mean name)
+  (let ((near (find-nearest-edits (symbol->string name)
+                                  (map (lambda (n) (symbol->string n))
+                                       (append (map car settings-table) other-clauses)))))
+    (if (and (pair? near) (<= (edit-distance (symbol->string name) (car near)) 3))
+        (string-append "; did you mean " (car near) "?")
+        "")))
+
+(define (lab-file-error path c why)
+  (error (string-append path ": " (clause-text c) ": " why)))
+
+(define (clause-text c)
+  (let ((out (open-output-string)))
+    (write c out)
+    (get-output-string out)))
 
 ;;> The clause \scheme{(key ...)} of an address space, or #f.
 (define (lab-aspace-clause a key)
   (clause key (lab-aspace-clauses a)))
 
-(define (lab-port-base settings)
+;;> The lab's port base: MURDOCH_PORT_BASE, else its port-base.
+(define (lab-port-base lab)
+  (settings-port-base (lab-settings lab)))
+
+(define (settings-port-base settings)
   (cond ((get-environment-variable "MURDOCH_PORT_BASE") => string->number)
-        (else (clause-value 'port-base settings 7100))))
+        (else (cdr (assq 'port-base settings)))))
 
 ;;> A port for a guest, an address space the file does not name (a REPL
 ;;> that joins the lab): one of port-base + 150 to + 199, by process id.
 (define (lab-guest-port lab)
-  (+ (lab-port-base (lab-settings lab)) 150 (modulo (current-process-id) 50)))
+  (+ (lab-port-base lab) 150 (modulo (current-process-id) 50)))
 
 ;;> Reads the lab file at \var{path}.  Errors name the file and the fault.
 (define (read-lab path)
@@ -54,10 +166,9 @@
                   (symbol? (cadr form)) (list? (cddr form))))
         (error "a lab file holds one (lab NAME CLAUSE ...) form" path))
     (let* ((clauses (cddr form))
-           (settings (remove (lambda (c) (and (pair? c) (eq? (car c) 'aspace)))
-                             clauses))
-           (base (lab-port-base settings))
-           (interface (clause-value 'interface settings "127.0.0.1")))
+           (settings (read-settings path clauses))
+           (base (settings-port-base settings))
+           (interface (cdr (assq 'interface settings))))
       (make-lab (cadr form) (path-directory path) settings
                 (let loop ((cs clauses) (i 0) (acc '()))
                   (cond
@@ -104,7 +215,7 @@
     (cond ((and robot (find (lambda (c) (and (pair? c) (eq? (car c) 'trip-port)))
                             (cdr robot)))
            => cadr)
-          (else (+ (lab-port-base (lab-settings lab)) 100 (lab-aspace-index a))))))
+          (else (+ (lab-port-base lab) 100 (lab-aspace-index a))))))
 
 ;;> The uids of the lab's robots, in file order.
 (define (lab-robots lab)
@@ -120,7 +231,7 @@
 ;;> 0600 and linked into place, so that peers starting at once all end up
 ;;> with the one key that won, and none reads a half-written file.
 (define (lab-key lab)
-  (let ((file (lab-path lab (lab-setting lab 'key-file "murdoch.key"))))
+  (let ((file (lab-path lab (lab-setting lab 'key-file))))
     (if (not (file-exists? file))
         (make-key-file file))
     (let ((hex (call-with-input-file file read-line)))

@@ -512,8 +512,8 @@
 ;;> capabilities; idle through load-monitor; untethered through
 ;;> battery-monitor on robots.
 (define (initialize-subscriptions! lab entry)
-  (set! *monitor-period* (lab-setting lab 'monitor-period 60))
-  (set! *lease* (lab-setting lab 'lease 30))
+  (set! *monitor-period* (lab-setting lab 'monitor-period))
+  (set! *lease* (lab-setting lab 'lease))
   (set! *load-source* (load-source (and entry (lab-aspace-clause entry 'load))))
   (for-each subscribe (list 'all (local-aspace-uid)))
   (for-each subscribe

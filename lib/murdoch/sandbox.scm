@@ -176,7 +176,7 @@
 
 ;;> The lab's code files, as its (code ...) clause names them.
 (define (lab-code-files lab)
-  (cond ((assq 'code (lab-settings lab)) => cdr) (else '())))
+  (lab-setting lab 'code))
 
 ;;> An environment for a person at a REPL: everything Chibi has, Murdoch,
 ;;> and the very procedures the lab's code defined in \var{lab-env}, so
