@@ -145,22 +145,24 @@
 ;;> Applies \var{thunk} as a received call runs: with ports of its own,
 ;;> whose output reaches the process's when flushed and when the call
 ;;> ends, and with its own bindings of the sandbox's parameters.
+;; What parameterize does, for a list of parameters known only when the
+;; process runs, in one dynamic-wind: a binding is a pair in the thread's
+;; list of them, which setting the parameter changes.
 (define (call-in-sandbox thunk)
-  (let ((p (thread-call-ports)))
-    (parameterize ((current-input-port (call-ports-in p))
-                   (current-output-port (call-ports-out p))
-                   (current-error-port (call-ports-err p)))
-      (dynamic-wind (lambda () #f)
-                    (lambda () (rebinding *parameters* thunk))
-                    (lambda ()
-                      (flush-if-open (call-ports-out p))
-                      (flush-if-open (call-ports-err p)))))))
-
-(define (rebinding parameters thunk)
-  (if (null? parameters)
-      (thunk)
-      (parameterize (((car parameters) ((car parameters))))
-        (rebinding (cdr parameters) thunk))))
+  (let* ((p (thread-call-ports))
+         (outer (thread-parameters))
+         (inner (fold (lambda (param bindings) (cons (cons param (param)) bindings))
+                      (cons* (cons current-input-port (call-ports-in p))
+                             (cons current-output-port (call-ports-out p))
+                             (cons current-error-port (call-ports-err p))
+                             outer)
+                      *parameters*)))
+    (dynamic-wind (lambda () (thread-parameters-set! inner))
+                  thunk
+                  (lambda ()
+                    (thread-parameters-set! outer)
+                    (flush-if-open (call-ports-out p))
+                    (flush-if-open (call-ports-err p))))))
 
 ;;; Making the environments
 

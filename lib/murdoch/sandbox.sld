@@ -7,6 +7,7 @@
   (import (scheme base) (scheme read) (scheme eval) (scheme file)
           (srfi 1) (srfi 18) (srfi 69)
           (only (chibi) env-parent identifier? identifier->symbol port-open?
+                thread-parameters thread-parameters-set!
                 make-syntactic-closure)
           (only (chibi ast) env-cell)
           (only (chibi io) make-custom-output-port make-null-input-port)
