@@ -1,64 +1,185 @@
-;;; The murdoch command: see `bin/murdoch help`.
-(import (scheme base) (scheme process-context) (srfi 1) (chibi app) (chibi config)
+;;; The murdoch command: see `bin/murdoch --help`.
+;;
+;; One table of commands; (chibi app) parses each command's options, as its
+;; conventions have them, and this side says, in one line and the usage,
+;; what is wrong with a command line, exiting 2: a user's mistake is no
+;; occasion for a stack trace.
+(import (scheme base) (scheme write) (scheme process-context) (srfi 1)
+        (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
-        (murdoch command) (murdoch launch))
+        (murdoch lab) (murdoch command) (murdoch launch))
 
-(define (aspace cfg spec lab-file name)
-  (run-aspace lab-file (string->symbol name)))
-
-(define (repl* cfg spec lab-file . name)
-  (run-repl lab-file (and (pair? name) (string->symbol (car name)))))
+(define version "0.3")
 
 ;; The sh scripts that supervise processes live beside this file.
 (define bin (path-directory (car (command-line))))
-
-(define (lab cfg spec lab-file)
-  (let ((option (lambda (name) (conf-get cfg (list 'command 'lab name)))))
-    (run-lab bin lab-file (except (option 'except)) (option 'logs) (option 'trace)
-             (let ((speed (option 'speed)))
-               (and speed (number->string speed))))))
 
 ;; (chibi app) reads "--except a" as a and "--except a,b" as (a b).
 (define (except names)
   (cond ((not names) '()) ((list? names) names) (else (list names))))
 
-(define (pose cfg spec lab-file task-file)
-  (run-pose lab-file task-file))
+(define (run-lab* cfg lab-file)
+  (let ((option (lambda (name) (conf-get cfg (list 'command 'lab name)))))
+    (run-lab bin lab-file (except (option 'except)) (option 'logs) (option 'trace)
+             (let ((speed (option 'speed)))
+               (and speed (number->string speed))))))
 
-(define (demo cfg spec lab-file)
-  (run-demo bin lab-file))
+(define (check lab-file)
+  (read-lab lab-file)
+  (display (string-append lab-file ": no mistakes found\n")))
+
+;; name, arguments (those in parentheses may be left out), what it does, its
+;; options as (chibi app) writes them, and what runs it: a procedure of
+;; the config and the arguments.
+(define commands
+  `((aspace (LAB NAME) "start address space NAME of the lab, until killed" ()
+            ,(lambda (cfg lab name) (run-aspace lab (string->symbol name))))
+    (repl (LAB (NAME)) "join the lab with a REPL, as NAME or as a guest" ()
+          ,(lambda (cfg lab . name)
+             (run-repl lab (and (pair? name) (string->symbol (car name))))))
+    (lab (LAB) "start the simulator and every address space of the lab, until stopped (Ctrl-C); an address space that dies is started again, at most three times a minute"
+         ((trace string "write the simulator's animated SVG trace here")
+          (speed real "simulated seconds per wall second")
+          (logs string "the children's logs go in this folder (default: a fresh one, named when the lab starts)")
+          (except (list symbol) "start all but these address spaces (a,b,...), to join by hand"))
+         ,(lambda (cfg lab) (run-lab* cfg lab)))
+    (pose (LAB FILE) "pose the task FILE evaluates to, as a guest of the running lab" ()
+          ,(lambda (cfg lab file) (run-pose lab file)))
+    (demo (LAB) "start the lab, pose the dual-sonar task, show where the trace is" ()
+          ,(lambda (cfg lab) (run-demo bin lab)))
+    (check (LAB) "check the lab file for mistakes, and start nothing" ()
+           ,(lambda (cfg lab) (check lab)))
+    (help ((COMMAND)) "show this help, or a command's" ()
+          ,(lambda (cfg . name) (show-help name)))))
+
+(define (command-named name) (assq (string->symbol name) commands))
+(define (command-args c) (cadr c))
+(define (command-doc c) (car (cddr c)))
+(define (command-options c) (cadr (cddr c)))
+(define (command-proc c) (car (cddr (cddr c))))
+
+(define (optional? arg) (pair? arg))
+(define (arg-name arg) (symbol->string (if (pair? arg) (car arg) arg)))
+
+(define (usage-line c)
+  (string-append
+   "murdoch " (symbol->string (car c))
+   (if (null? (command-options c)) "" " [OPTION ...]")
+   (apply string-append
+          (map (lambda (a)
+                 (if (optional? a)
+                     (string-append " [" (arg-name a) "]")
+                     (string-append " " (arg-name a))))
+               (command-args c)))))
+
+(define (show-usage out)
+  (write-string "Murdoch: task allocation for teams of robots.\n\nUsage:\n" out)
+  (for-each (lambda (c)
+              (write-string (string-append "  " (usage-line c) "\n      "
+                                           (command-doc c) "\n")
+                            out))
+            commands)
+  (write-string "\n  murdoch --help, murdoch help COMMAND, murdoch COMMAND --help, murdoch --version\n" out))
+
+(define (show-command-usage c out)
+  (write-string (string-append "Usage: " (usage-line c) "\n  " (command-doc c) "\n") out)
+  (for-each (lambda (o)
+              (write-string (string-append "  --" (symbol->string (car o)) " "
+                                           (string-upcase-name (cadr o))
+                                           "\n      " (car (cddr o)) "\n")
+                            out))
+            (command-options c)))
+
+(define (string-upcase-name type)
+  (if (pair? type) "A,B,..." (if (eq? type 'real) "X" "TEXT")))
+
+(define (show-help name)
+  (cond ((null? name) (show-usage (current-output-port)))
+        ((command-named (car name))
+         => (lambda (c) (show-command-usage c (current-output-port))))
+        (else (mistake #f (string-append "no command " (car name)
+                                         (nearest (car name)))))))
+
+(define (nearest name)
+  (let ((near (find-nearest-edits name (map (lambda (c) (symbol->string (car c)))
+                                            commands))))
+    (if (and (pair? near) (<= (edit-distance name (car near)) 2))
+        (string-append "; did you mean " (car near) "?")
+        "")))
+
+;; One line saying what is wrong, the usage, and exit 2.
+(define (mistake c what)
+  (let ((err (current-error-port)))
+    (write-string (string-append "murdoch" (if c (string-append " " (symbol->string (car c))) "")
+                                 ": " what "\n\n")
+                  err)
+    (if c (show-command-usage c err) (show-usage err))
+    (exit 2)))
+
+;; Whether the positional arguments suit the command c.
+(define (check-arity c args)
+  (let ((required (count (lambda (a) (not (optional? a))) (command-args c)))
+        (most (length (command-args c))))
+    (cond ((< (length args) required)
+           (mistake c (string-append "missing " (arg-name (list-ref (command-args c)
+                                                                     (length args))))))
+          ((> (length args) most)
+           (mistake c (string-append "too many arguments: " (last args)))))))
+
+(define (help-flag? arg) (member arg '("--help" "-h")))
 
 ;; (chibi app) wants a command's options before its arguments; people
 ;; write `murdoch lab LAB --trace FILE` too.  Every option takes a value.
 (define (options-first args)
-  (if (< (length args) 2)
-      args
-      (let loop ((rest (cddr args)) (options '()) (positional '()))
-        (cond
-         ((null? rest)
-          (cons* (car args) (cadr args)
-                 (append (reverse options) (reverse positional))))
-         ((and (> (string-length (car rest)) 2)
-               (string=? "--" (substring (car rest) 0 2))
-               (pair? (cdr rest)))
-          (loop (cddr rest) (cons* (cadr rest) (car rest) options) positional))
-         (else (loop (cdr rest) options (cons (car rest) positional)))))))
+  (let loop ((rest args) (options '()) (positional '()))
+    (cond
+     ((null? rest) (append (reverse options) (reverse positional)))
+     ((and (> (string-length (car rest)) 2)
+           (string=? "--" (substring (car rest) 0 2)))
+      (if (null? (cdr rest))
+          (loop (cdr rest) (cons (car rest) options) positional)
+          (loop (cddr rest) (cons* (cadr rest) (car rest) options) positional)))
+     (else (loop (cdr rest) options (cons (car rest) positional))))))
 
-(run-application
- `(murdoch
-   "Murdoch: task allocation for teams of robots"
-   (or
-    (aspace "start address space NAME of the lab" (@) (,aspace lab name))
-    (repl "join the lab with a REPL, as NAME or as a guest" (@) (,repl* lab))
-    (lab "start the simulator and every address space of the lab, until stopped"
-         (@ (trace string "write the simulator's animated SVG trace here")
-            (speed real "simulated seconds per wall second")
-            (logs string "the children's logs go here (default: a fresh folder)")
-            (except (list symbol) "start all but these address spaces (a,b,...)"))
-         (,lab lab))
-    (pose "pose the task FILE evaluates to, as a guest of the running lab"
-          (@) (,pose lab file))
-    (demo "start the lab, pose the dual-sonar task, show where the trace is"
-          (@) (,demo lab))
-    (help "show this help" (,app-help-command))))
- (options-first (command-line)))
+(define (positional args)
+  (let loop ((rest args) (acc '()))
+    (cond ((null? rest) (reverse acc))
+          ((and (> (string-length (car rest)) 2) (string=? "--" (substring (car rest) 0 2)))
+           (loop (if (pair? (cdr rest)) (cddr rest) '()) acc))
+          (else (loop (cdr rest) (cons (car rest) acc))))))
+
+(define (app-spec c)
+  `(murdoch "Murdoch"
+    (,(car c) ,(command-doc c) (@ ,@(command-options c))
+     (,(lambda (cfg spec . args) (apply (command-proc c) cfg args))))))
+
+;; Runs command c; an option (chibi app) does not know, or an error a
+;; user's input caused (a lab file's mistake), is said in one line.
+(define (run c args)
+  (check-arity c (positional args))
+  (guard (e ((error-object? e)
+             (mistake c (error-text e))))
+    (run-application (app-spec c)
+                     (cons* "murdoch" (symbol->string (car c)) (options-first args)))))
+
+(define (error-text e)
+  (let ((out (open-output-string)))
+    (write-string (error-object-message e) out)
+    (for-each (lambda (x) (write-char #\space out) (display x out))
+              (error-object-irritants e))
+    (get-output-string out)))
+
+(define (main args)
+  (cond
+   ((null? args) (mistake #f "no command given"))
+   ((help-flag? (car args)) (show-usage (current-output-port)))
+   ((equal? (car args) "--version")
+    (write-string (string-append "murdoch " version "\n")))
+   ((command-named (car args))
+    => (lambda (c)
+         (if (find help-flag? (cdr args))
+             (show-command-usage c (current-output-port))
+             (run c (cdr args)))))
+   (else (mistake #f (string-append "no command " (car args) (nearest (car args)))))))
+
+(main (cdr (command-line)))

@@ -1,0 +1,68 @@
+;;; bin/murdoch's command line: help, version, and a mistake said in one
+;;; line with the usage, exit 2, and no stack trace.
+(import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
+        (only (chibi process) system)
+        (only (chibi filesystem) delete-file-hierarchy)
+        (murdoch testing))
+
+(define dir (temporary-directory))
+(define out (string-append dir "/out"))
+
+;; (exit-status first-line whole-output) of bin/murdoch with args.
+(define (murdoch . args)
+  (let ((status (apply system "sh" "-c"
+                       "cd \"$1\" && shift && exec bin/murdoch \"$@\" >\"$0\" 2>&1"
+                       out (tool-path ".") args)))
+    (let ((text (file-text out)))
+      (list (quotient (if (pair? status) (cadr status) status) 256)
+            (let ((lines (text-lines text))) (if (pair? lines) (car lines) ""))
+            text))))
+
+(define (status r) (car r))
+(define (first-line r) (cadr r))
+(define (no-trace? r) (not (text-contains? (car (cddr r)) "called from")))
+
+(test-begin "cli")
+
+(test-group "help and version"
+  (let ((r (murdoch "--help")))
+    (test "--help: exit 0" 0 (status r))
+    (test "lists every command" #t
+      (every (lambda (c) (text-contains? (car (cddr r)) (string-append "murdoch " c)))
+              '("aspace" "repl" "lab" "pose" "demo" "check" "help"))))
+  (test "help lab lists its options" '(0 #t)
+    (let ((r (murdoch "help" "lab")))
+      (list (status r) (text-contains? (car (cddr r)) "--logs"))))
+  (test "lab --help too" '(0 #t)
+    (let ((r (murdoch "lab" "--help")))
+      (list (status r) (text-contains? (car (cddr r)) "--except"))))
+  (test "--version" '(0 "murdoch 0.3")
+    (let ((r (murdoch "--version"))) (list (status r) (first-line r)))))
+
+(test-group "mistakes: one line, the usage, exit 2"
+  (define (mistake args line)
+    (let ((r (apply murdoch args)))
+      (test (string-append "murdoch " (if (pair? args) (car args) "")) (list 2 line #t)
+        (list (status r) (first-line r) (no-trace? r)))))
+  (mistake '() "murdoch: no command given")
+  (mistake '("bogus") "murdoch: no command bogus")
+  (mistake '("labb" "x") "murdoch: no command labb; did you mean lab?")
+  (mistake '("aspace" "x.scm") "murdoch aspace: missing NAME")
+  (mistake '("pose" "a" "b" "c") "murdoch pose: too many arguments: c")
+  (mistake '("lab" "examples/tulane-lab.scm" "--bogus" "1") "murdoch lab: unknown option --bogus")
+  (mistake '("check" "/no/such/lab.scm")
+           "murdoch check: cannot read the lab file /no/such/lab.scm couldn't open input file"))
+
+(test-group "check"
+  (test "a good lab file" '(0 "examples/tulane-lab.scm: no mistakes found")
+    (let ((r (murdoch "check" "examples/tulane-lab.scm")))
+      (list (status r) (first-line r))))
+  (call-with-output-file (string-append dir "/lab.scm")
+    (lambda (o) (write-string "(lab x (timout 3))\n" o)))
+  (test "a misspelt setting" #t
+    (let ((r (murdoch "check" (string-append dir "/lab.scm"))))
+      (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?")))))
+
+(test-end)
+(delete-file-hierarchy dir)
+(test-exit)
