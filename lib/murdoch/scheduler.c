@@ -304,39 +304,55 @@ static void unqueue_twins (sexp previous, sexp next) {
  * is parked on the paused list, waiting on the scheduler itself, where
  * nothing of Chibi's wakes it, until its run is innermost again.  Threads
  * not inside a call from C hold no C state and run in any run of the VM. */
-static sexp *homes;
-static size_t homes_count, homes_size;
-static size_t parked_count;
+/* A set of contexts: an array, looked through in turn, since it holds
+ * few. */
+struct contexts {
+  sexp *items;
+  size_t count, size;
+};
 
-static int homed (sexp c) {
+static int member (const struct contexts *set, sexp c) {
   size_t i;
-  for (i = 0; i < homes_count; i++)
-    if (homes[i] == c) return 1;
+  for (i = 0; i < set->count; i++)
+    if (set->items[i] == c) return 1;
   return 0;
 }
 
-/* A context that cannot be homed, for want of memory, runs anywhere, as
- * under Chibi's own scheduler. */
-static void home (sexp c) {
+/* Answers 0 when c is not added for want of memory. */
+static int add (struct contexts *set, sexp c) {
   sexp *grown;
-  if (homed(c)) return;
-  if (homes_count == homes_size) {
-    grown = realloc(homes, (homes_size ? 2 * homes_size : 8) * sizeof(*grown));
-    if (!grown) return;
-    homes = grown;
-    homes_size = homes_size ? 2 * homes_size : 8;
+  if (member(set, c)) return 1;
+  if (set->count == set->size) {
+    grown = realloc(set->items, (set->size ? 2 * set->size : 8) * sizeof(*grown));
+    if (!grown) return 0;
+    set->items = grown;
+    set->size = set->size ? 2 * set->size : 8;
   }
-  homes[homes_count++] = c;
+  set->items[set->count++] = c;
+  return 1;
 }
 
-static void unhome (sexp c) {
+/* Answers whether c was there. */
+static int take (struct contexts *set, sexp c) {
   size_t i;
-  for (i = 0; i < homes_count; i++)
-    if (homes[i] == c) {
-      homes[i] = homes[--homes_count];
-      return;
+  for (i = 0; i < set->count; i++)
+    if (set->items[i] == c) {
+      set->items[i] = set->items[--set->count];
+      return 1;
     }
+  return 0;
 }
+
+static struct contexts homes;
+static size_t parked_count;
+
+static int homed (sexp c) { return member(&homes, c); }
+
+/* A context that cannot be homed, for want of memory, runs anywhere, as
+ * under Chibi's own scheduler. */
+static void home (sexp c) { add(&homes, c); }
+
+static void unhome (sexp c) { take(&homes, c); }
 
 /* Whether c may run in the run of the VM whose root is root.  An ended
  * context only ends, which it can do anywhere. */
@@ -481,39 +497,25 @@ static sexp next_here (sexp ctx, sexp self, sexp_sint_t n, sexp root,
  * half.  (stack-guard-tripped? thread) tells the handler why it was
  * interrupted. */
 #define STACK_GUARD (SEXP_MAX_STACK_SIZE / 2)
-#define MAX_TRIPPED 64
 
-static sexp tripped[MAX_TRIPPED];     /* preserved from the collector */
-static int tripped_count;
-
-static int is_tripped (sexp thread) {
-  int i;
-  for (i = 0; i < tripped_count; i++)
-    if (tripped[i] == thread) return 1;
-  return 0;
-}
+static struct contexts tripped;         /* preserved from the collector */
 
 /* A thread tripped once is not tripped again before its handler has
  * asked why: it may still be deep while the raise unwinds. */
 static void guard_stack (sexp ctx) {
   if (sexp_context_top(ctx) <= STACK_GUARD || sexp_context_interruptp(ctx)
-      || tripped_count == MAX_TRIPPED || is_tripped(ctx))
+      || member(&tripped, ctx) || !add(&tripped, ctx))
     return;
   sexp_preserve_object(ctx, ctx);
-  tripped[tripped_count++] = ctx;
   sexp_context_interruptp(ctx) = 1;
 }
 
 static sexp stack_guard_trippedp (sexp ctx, sexp self, sexp_sint_t n,
                                   sexp thread) {
-  int i;
-  for (i = 0; i < tripped_count; i++)
-    if (tripped[i] == thread) {
-      tripped[i] = tripped[--tripped_count];
-      sexp_release_object(ctx, thread);
-      return SEXP_TRUE;
-    }
-  return SEXP_FALSE;
+  if (!take(&tripped, thread))
+    return SEXP_FALSE;
+  sexp_release_object(ctx, thread);
+  return SEXP_TRUE;
 }
 
 /* The scheduler the VM calls at the end of every time slice.  Only a
@@ -528,11 +530,11 @@ static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
   if (parked_count > 0)
     unpark_home(ctx, self, root);
-  if (homes_count > 0)
+  if (homes.count > 0)
     park_strangers(ctx, self, root);
   if (nothing_runnable(ctx))
     wait_for_wakeup(ctx);
-  next = homes_count > 0
+  next = homes.count > 0
     ? next_here(ctx, self, n, root, may_twin)
     : chibi_next(ctx, sexp_opcode_data(self), n, root, may_twin);
   if (sexp_context_refuel(ctx) <= 0)
