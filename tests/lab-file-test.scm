@@ -30,6 +30,11 @@
   (test '() (setting "(lab x)" 'code))
   (test (* 512 1024 1024) (setting "(lab x)" 'heap-max)))
 
+(for-each (lambda (name)
+            (call-with-output-file (string-append dir "/" name)
+              (lambda (out) (write-string "(define x 1)\n" out))))
+          '("a.scm" "b.scm"))
+
 (test-group "what the file says is read"
   (test 2.5 (setting "(lab x (timeout 2.5))" 'timeout))
   (test (* 160 1024 1024) (setting "(lab x (heap-max \"160M\"))" 'heap-max))
@@ -52,7 +57,17 @@
     (says? "(lab x (heap-max \"12Q\"))" "heap-max takes bytes"))
   (test "a delivery that is neither" #t
     (says? "(lab x (delivery carrier-pigeon))" "delivery takes broadcast, or multicast"))
-  (test "the file is named" #t (says? "(lab x (timout 3))" file)))
+  (test "the file is named" #t (says? "(lab x (timout 3))" file))
+  (test "two address spaces of one name" #t
+    (says? "(lab x (aspace a) (aspace b) (aspace a))" "(aspace a): two address spaces of this name"))
+  (test "two things on one port" #t
+    (says? "(lab x (port-base 7000) (aspace a) (aspace b (port 7000)))"
+           "(port 7000): two things on this port"))
+  (test "a robot's trip server on an address space's port" #t
+    (says? "(lab x (port-base 7000) (aspace a (robot (trip-port 7001))) (aspace b))"
+           "(port 7001): two things on this port"))
+  (test "a code file that is not there" #t
+    (says? "(lab x (code \"nowhere.scm\"))" "(code \"nowhere.scm\"): no such file")))
 
 (test-end)
 (delete-file-hierarchy dir)

@@ -168,16 +168,46 @@
     (let* ((clauses (cddr form))
            (settings (read-settings path clauses))
            (base (settings-port-base settings))
-           (interface (cdr (assq 'interface settings))))
-      (make-lab (cadr form) (path-directory path) settings
-                (let loop ((cs clauses) (i 0) (acc '()))
-                  (cond
-                   ((null? cs) (reverse acc))
-                   ((and (pair? (car cs)) (eq? (caar cs) 'aspace))
-                    (loop (cdr cs) (+ i 1)
-                          (cons (parse-aspace path (car cs) i base interface)
-                                acc)))
-                   (else (loop (cdr cs) i acc))))))))
+           (interface (cdr (assq 'interface settings)))
+           (lab (make-lab (cadr form) (path-directory path) settings
+                          (let loop ((cs clauses) (i 0) (acc '()))
+                            (cond
+                             ((null? cs) (reverse acc))
+                             ((and (pair? (car cs)) (eq? (caar cs) 'aspace))
+                              (loop (cdr cs) (+ i 1)
+                                    (cons (parse-aspace path (car cs) i base interface)
+                                          acc)))
+                             (else (loop (cdr cs) i acc)))))))
+      (check-lab path lab)
+      lab)))
+
+;; What no one clause shows: two address spaces of one name, two things
+;; on one port, a code file that is not there.
+(define (check-lab path lab)
+  (let ((uids (map lab-aspace-uid (lab-aspaces lab))))
+    (cond ((find-duplicate uids)
+           => (lambda (uid)
+                (lab-file-error path (list 'aspace uid) "two address spaces of this name")))))
+  (cond ((find-duplicate (lab-ports lab))
+         => (lambda (port)
+              (lab-file-error path (list 'port port)
+                              "two things on this port (address spaces at port-base + i, robots' trip servers at port-base + 100 + i)"))))
+  (for-each (lambda (file)
+              (if (not (file-exists? (lab-path lab file)))
+                  (lab-file-error path (list 'code file) "no such file")))
+            (lab-setting lab 'code)))
+
+(define (find-duplicate ls)
+  (let loop ((ls ls))
+    (cond ((null? ls) #f)
+          ((member (car ls) (cdr ls)) (car ls))
+          (else (loop (cdr ls))))))
+
+;; Every port the lab's address spaces and robots listen on.
+(define (lab-ports lab)
+  (append (map lab-aspace-port (lab-aspaces lab))
+          (filter-map (lambda (a) (and (lab-aspace-clause a 'robot) (lab-trip-port lab a)))
+                      (lab-aspaces lab))))
 
 (define (condition-message e)
   (if (error-object? e) (error-object-message e) e))
