@@ -20,17 +20,20 @@
            (let ((assignment (hungarian (finite-costs costs) n m)))
              (and (allowed? costs assignment) assignment))))))
 
-;; The costs with each +inf.0 made a finite cost so large that an
-;; assignment with fewer of them always costs less: more than the gap
-;; between any two assignments of finite pairs.  The method's arithmetic
-;; then stays finite.
+;; The costs with each +inf.0 made the dominant cost, so that the
+;; method's arithmetic stays finite and an assignment with fewer of them
+;; always costs less.
 (define (finite-costs costs)
-  (let* ((finite (filter-finite (apply append (map vector->list (vector->list costs)))))
-         (spread (apply max 0 (map abs finite)))
-         (forbidden (+ 1 (* 2 (vector-length costs) spread))))
+  (let ((forbidden (dominant-cost costs)))
     (vector-map (lambda (row)
                   (vector-map (lambda (c) (if (finite? c) c forbidden)) row))
                 costs)))
+
+;;> A cost greater than the gap between the totals of any two
+;;> assignments that use only the finite costs of \var{costs}.
+(define (dominant-cost costs)
+  (let ((finite (filter-finite (apply append (map vector->list (vector->list costs))))))
+    (+ 1 (* 2 (vector-length costs) (apply max 0 (map abs finite))))))
 
 (define (filter-finite ls)
   (let loop ((ls ls) (acc '()))
