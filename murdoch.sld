@@ -25,8 +25,11 @@
           set-battery-charging! set-battery-low! set-load-threshold!
           ;; pose-task and dynamic teams (lib/murdoch/pose-task.scm)
           pose-task negotiate pose-task-progress task-timeout
+          pose-task-assignment pose-task-priority pose-task-retries
+          pose-task-backoff receive-rival pose-negotiations
           location-metric-maker load-metric-maker load-metric reverse-metric
-          metric-by metric-by-asking reckon-distance-between resolve-conflicts
+          metric-by metric-by-asking metric-within compose-metrics
+          reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
           ;; the robot (lib/murdoch/trip-client.scm)

@@ -78,6 +78,76 @@
              (list (reverse-metric (location-metric-maker '(0 0 0 0))))
              (list who-am-i)))
 
+;; Greedy gives the first component near, a little closer to it, and the
+;; second is left far, very far from its target: 1980 + 4243 mm.  The
+;; least total swaps them: 2121 + 141 mm.
+(define (two-targets-task)
+  (list 'swap 2 (list '((mobile) ()) '((mobile) ()))
+        (list (location-metric-maker '(1500 1500 0 0))
+              (location-metric-maker '(0 0 0 0)))
+        (list who-am-i who-am-i)))
+(test "greedy, the default: the first component takes its closest" '(near far)
+  (apply pose-task (two-targets-task)))
+(test "optimal: the least total distance" '(far near)
+  (parameterize ((pose-task-assignment 'optimal))
+    (apply pose-task (two-targets-task))))
+(test "explicit priorities: the second component chooses first" '(far near)
+  (apply pose-task (append (two-targets-task) (list '(1 2)))))
+(test "equal priorities keep the components' order" '(near far)
+  (apply pose-task (append (two-targets-task) (list '(3 3)))))
+(test "optimal takes more candidates than components" '(far)
+  (parameterize ((pose-task-assignment 'optimal))
+    (pose-task 'one-of-two 1 (list '((mobile) ()))
+               (list (location-metric-maker '(3000 3000 0 0))) (list who-am-i))))
+
+;; The progress output of thunk, a pose-task.
+(define (progress-of thunk)
+  (let ((out (open-output-string)))
+    (parameterize ((pose-task-progress out)) (thunk))
+    (get-output-string out)))
+(test "under optimal, a component without one measure keeps the greedy rule, and says so"
+    '(#t #t)
+  (let ((text (progress-of
+               (lambda ()
+                 (parameterize ((pose-task-assignment 'optimal))
+                   (pose-task 'mixed 2 (list '((mobile) ()) '((mobile) ()))
+                              (list #f (location-metric-maker '(0 0 0 0)))
+                              (list who-am-i who-am-i)))))))
+    (list (text-contains? text "component 1 is not by one measure: greedy")
+          (text-contains? text "optimal assignment: total"))))
+(test "and every subject is free" #t (all-free?))
+
+;; near measures 100 and far 105 by the first metric, 2 and 1 by the
+;; second; each measure counts the candidates it is asked about.
+(define asked '())
+(define (counted key value)
+  (metric-by (lambda (uid)
+               (set! asked (cons key asked))
+               (value uid))))
+(define (by-first) (counted 'first (lambda (uid) (if (eq? uid 'near) 100 105))))
+(define (by-second) (counted 'second (lambda (uid) (if (eq? uid 'near) 2 1))))
+(define (pose-by metric)
+  (set! asked '())
+  (pose-task 'composed 1 (list '((mobile) ())) (list metric) (list who-am-i)))
+(test "composed: the first metric decides when it does not tie" '(near)
+  (pose-by (compose-metrics (by-first) (by-second))))
+(test "composed: within its tolerance the first ties, and the second decides"
+    '(far)
+  (pose-by (compose-metrics (metric-within 10 (by-first)) (by-second))))
+(test "each candidate was measured once by each measure" '(2 2)
+  (list (count (lambda (k) (eq? k 'first)) asked)
+        (count (lambda (k) (eq? k 'second)) asked)))
+(test "the tolerance is a tie, not a preference: out of it, the first decides"
+    '(near)
+  (pose-by (compose-metrics (metric-within 4 (by-first)) (by-second))))
+(test "reversed, a composed metric reverses each of its metrics" '(near)
+  (pose-by (reverse-metric (compose-metrics (metric-within 10 (by-first))
+                                            (by-second)))))
+(test "composed with a comparator, which ties when it prefers neither" '(far)
+  (pose-by (compose-metrics (lambda (a b) #f) (by-second))))
+(test "a tolerance takes a metric by one measure" "metric-within: a tolerance >= 0 and a metric by one measure"
+  (error-text (lambda () (metric-within 1 (lambda (a b) #t)))))
+
 (test "a candidate that cannot be measured comes last" '(far)
   (pose-task 'unmeasured 1 (list '((mobile) ()))
              (list (metric-by (lambda (uid)

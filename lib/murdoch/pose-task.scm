@@ -36,23 +36,74 @@
 ;;; Metrics
 
 ;; A metric compares two candidates, (uid promise-or-result) entries, and
-;; answers #t when the first is better, as in the thesis.  Those made by
-;; metric-by also carry their measure, so that pose-task can ask each
-;; candidate once, not once per comparison: the same choice, fewer messages.
-;; A measure is a procedure of a uid, or an asking: what a candidate
-;; answers to one procedure, scored here, which pose-task sends to every
-;; candidate at once.
+;; answers #t when the first is better, as in the thesis.  Those made here
+;; also carry their keys, what they compare by, in order: a measure with
+;; the tolerance within which two candidates tie, or a comparator.  So
+;; pose-task can ask each candidate once per measure, not once per
+;; comparison: the same choice, fewer messages; and optimal assignment
+;; has the numbers it adds up.  A measure is a procedure of a uid, or an
+;; asking: what a candidate answers to one procedure, scored here, which
+;; pose-task sends to every candidate at once.
 (define-record-type asking
   (make-asking proc score)
   asking?
   (proc asking-proc)
   (score asking-score))
 
+(define-record-type measure-key
+  (make-measure-key measure tolerance)
+  measure-key?
+  (measure measure-key-measure)
+  (tolerance measure-key-tolerance))
+
+;; A metric of keys that compares as the thesis's metrics do.
+(define (keyed-metric keys)
+  (lambda (entry1 entry2)
+    (keys-better? keys (key-values keys entry1) (key-values keys entry2))))
+
+(define keyed-metric-code (procedure-code (keyed-metric '())))
+
+;; The keys of metric: its own when made here; any other procedure is its
+;; one comparator; #f, no metric, has none.
+(define (metric-keys metric)
+  (cond ((not (procedure? metric)) '())
+        ((and (not (opcode? metric))
+              (eq? (procedure-code metric) keyed-metric-code))
+         (vector-ref (procedure-vars metric) 0))
+        (else (list metric))))
+
+;; The measure of a metric by one measure, else #f.
+(define (metric-measure metric)
+  (let ((keys (metric-keys metric)))
+    (and (= (length keys) 1) (measure-key? (car keys))
+         (measure-key-measure (car keys)))))
+
+;; What a key compares of one candidate: its measure, or the entry itself.
+(define (key-values keys entry)
+  (map (lambda (key)
+         (if (measure-key? key)
+             (measure-one (measure-key-measure key) (car entry))
+             entry))
+       keys))
+
+;; Whether values as are better than bs by the first key that does not
+;; tie them.  Ties within a tolerance are judged pair by pair, so three
+;; candidates may tie two by two and still not all three.
+(define (keys-better? keys as bs)
+  (and (pair? keys)
+       (cond ((key-better? (car keys) (car as) (car bs)) #t)
+             ((or (null? (cdr keys)) (key-better? (car keys) (car bs) (car as))) #f)
+             (else (keys-better? (cdr keys) (cdr as) (cdr bs))))))
+
+(define (key-better? key a b)
+  (if (measure-key? key)
+      (< a (- b (measure-key-tolerance key)))
+      (key a b)))
+
 ;;> A metric that prefers the candidate with the smaller
 ;;> \scheme{(measure uid)}: a number for a candidate's uid.
 (define (metric-by measure)
-  (lambda (entry1 entry2)
-    (< (measure-one measure (car entry1)) (measure-one measure (car entry2)))))
+  (keyed-metric (list (make-measure-key measure 0))))
 
 ;;> A metric that prefers the candidate whose answer to \var{proc},
 ;;> applied there, has the smaller \scheme{(score answer)}.  pose-task
@@ -60,17 +111,31 @@
 (define (metric-by-asking proc score)
   (metric-by (make-asking proc score)))
 
+;;> \var{metric}, a metric by one measure (metric-by, metric-by-asking,
+;;> the makers below), counting two candidates whose measures differ by
+;;> at most \var{tolerance} as tied, for compose-metrics to decide.
+(define (metric-within tolerance metric)
+  (let ((measure (metric-measure metric)))
+    (if (not (and measure (real? tolerance) (>= tolerance 0)))
+        (error "metric-within: a tolerance >= 0 and a metric by one measure"
+               tolerance metric))
+    (keyed-metric (list (make-measure-key measure tolerance)))))
+
+;;> A metric that compares by the first of \var{metrics}; where it ties
+;;> two candidates, by the next; and so on.  pose-task measures each
+;;> candidate once per measure of them all; a comparator among them (a
+;;> metric that is a plain procedure) ties only when it prefers neither.
+(define (compose-metrics . metrics)
+  (for-each (lambda (m)
+              (if (not (procedure? m))
+                  (error "compose-metrics: a metric is a procedure" m)))
+            metrics)
+  (keyed-metric (append-map metric-keys metrics)))
+
 (define (measure-one measure uid)
   (if (asking? measure)
       ((asking-score measure) (ask uid (asking-proc measure)))
       (measure uid)))
-
-(define metric-by-code (procedure-code (metric-by #f)))
-
-(define (metric-measure metric)
-  (and (procedure? metric) (not (opcode? metric))
-       (eq? (procedure-code metric) metric-by-code)
-       (vector-ref (procedure-vars metric) 0)))
 
 ;;> The distance in mm between two reckon positions, (x y theta 0).
 (define (reckon-distance-between p q)
@@ -94,27 +159,50 @@
 ;;> The load metric of Figure 4.6.
 (define load-metric (load-metric-maker))
 
-;;> The opposite preference: the worst candidate by \var{metric} first.
+;;> The opposite preference: the worst candidate by \var{metric} first,
+;;> ties as they were.
 (define (reverse-metric metric)
-  (let ((measure (metric-measure metric)))
-    (cond ((asking? measure)
-           (let ((score (asking-score measure)))
-             (metric-by-asking (asking-proc measure) (lambda (a) (- (score a))))))
-          (measure (metric-by (lambda (uid) (- (measure uid)))))
-          (else (lambda (a b) (metric b a))))))
+  (keyed-metric (map reverse-key (metric-keys metric))))
 
-;; Sorts a component's candidates by its metric; no metric: at random.
+(define (reverse-key key)
+  (if (measure-key? key)
+      (make-measure-key (negated (measure-key-measure key))
+                        (measure-key-tolerance key))
+      (lambda (a b) (key b a))))
+
+(define (negated measure)
+  (if (asking? measure)
+      (let ((score (asking-score measure)))
+        (make-asking (asking-proc measure) (lambda (a) (- (score a)))))
+      (lambda (uid) (- (measure uid)))))
+
+;;> Sorts a component's candidates by its metric, best first; no metric:
+;;> at random.
 (define (sort-response response metric)
-  (cond
-   ((not (procedure? metric)) (shuffle response))
-   ((metric-measure metric)
-    => (lambda (measure)
-         (let ((measured (map cons (measure-all measure (map car response))
-                              response)))
-           (progress "  measured " (map (lambda (m) (list (cadr m) (car m)))
-                                        measured))
-           (map cdr (list-sort (lambda (a b) (< (car a) (car b))) measured)))))
-   (else (list-sort metric response))))
+  (let ((keys (metric-keys metric)))
+    (map cdr (sort-measured (measured-response response keys) keys))))
+
+;; Each candidate as (values . entry), its values by keys: each measure
+;; asked of every candidate at once, once.
+(define (measured-response response keys)
+  (apply map
+         (lambda (entry . values) (cons values entry))
+         response
+         (map (lambda (key)
+                (if (measure-key? key)
+                    (measured-told (measure-key-measure key) (map car response))
+                    response))
+              keys)))
+
+(define (measured-told measure uids)
+  (let ((measures (measure-all measure uids)))
+    (progress "  measured " (map list uids measures))
+    measures))
+
+(define (sort-measured measured keys)
+  (if (null? keys)
+      (shuffle measured)
+      (list-sort (lambda (a b) (keys-better? keys (car a) (car b))) measured)))
 
 ;; Measures every candidate at once: the answers' round trips overlap.  A
 ;; candidate that cannot be measured (it died, did not answer in time, or
@@ -139,29 +227,82 @@
 
 ;;; pose-task
 
+;;> How pose-task gives components their robots: \scheme{greedy}, the
+;;> thesis's rule (resolve-conflicts: each component in priority order
+;;> takes its best robot not yet taken), or \scheme{optimal}, the least
+;;> total of the components' measures (the Hungarian method, (murdoch
+;;> assign)).  Under optimal, a component whose metric is not one measure
+;;> (a comparator, a composition, none) keeps the greedy rule and picks
+;;> first, and the progress output says so.
+(define pose-task-assignment (make-parameter 'greedy))
+
+;;> The priority of the tasks posed here, a real: when tasks posed at
+;;> once want the same robots, the higher wins (see negotiate).
+(define pose-task-priority (make-parameter 0))
+
+;;> How many times a task whose robots another task holds tries again
+;;> before it answers \scheme{not-enough-takers}.
+(define pose-task-retries (make-parameter 5))
+
+;;> Seconds of the first wait before trying again; each wait is drawn at
+;;> random below this, doubled for each try before it.
+(define pose-task-backoff (make-parameter 0.1))
+
+(for-each sandbox-parameter!
+          (list pose-task-assignment pose-task-priority pose-task-retries
+                pose-task-backoff))
+
 ;; Whether a component needs resources to itself, from its layout.
 (define (component-type layout)
   (if (null? (car layout)) 'non-exclusive 'exclusive))
 
+;; The poses made here, counted, and those negotiating, each as
+;; (name rank rival-rank ...): the ranks of the other tasks that said
+;; they want robots it holds.  Threads and received calls pose at once.
 (define *poses* 0)
+(define *negotiating* '())
+(define *poses-lock* (make-mutex 'poses))
+
+(define (with-poses thunk)
+  (dynamic-wind (lambda () (mutex-lock! *poses-lock*))
+                thunk
+                (lambda () (mutex-unlock! *poses-lock*))))
 
 ;; Reservations are made under a name of this pose's own, so that the same
 ;; task posed twice at once, from here or elsewhere, never shares a robot.
+;; The name says where it was posed: NAME@UID#N.
 (define (reservation-name task-name)
-  (set! *poses* (+ *poses* 1))
-  (string->symbol (string-append (symbol->string task-name) "@"
-                                 (symbol->string (local-aspace-uid)) "#"
-                                 (number->string *poses*))))
+  (let ((n (with-poses (lambda () (set! *poses* (+ *poses* 1)) *poses*))))
+    (string->symbol (string-append (symbol->string task-name) "@"
+                                   (symbol->string (local-aspace-uid)) "#"
+                                   (number->string n)))))
+
+;; The uid of the address space that made reservation name, or #f for a
+;; task-name not made by reservation-name.
+(define (reservation-aspace-uid name)
+  (let* ((s (symbol->string name))
+         (hash (last-index s #\# (string-length s)))
+         (at (and hash (last-index s #\@ hash))))
+    (and at (string->symbol (substring s (+ at 1) hash)))))
+
+(define (last-index s char end)
+  (let loop ((i (- end 1)))
+    (cond ((< i 0) #f)
+          ((char=? (string-ref s i) char) i)
+          (else (loop (- i 1))))))
 
 (define (t) #t)
 
 ;;> Poses a task (thesis §4.2): \var{capability-list}, \var{metrics} and
-;;> \var{procs} have one entry per component, most important first.
-;;> Answers the list of the components' results, in component order, or
-;;> \scheme{not-enough-takers} when some component finds no distinct
-;;> capable robot; then every reservation made for it is freed.
-(define (pose-task task-name num-robots capability-list metrics procs)
-  (let ((team (negotiate task-name num-robots capability-list metrics procs)))
+;;> \var{procs} have one entry per component, most important first, or
+;;> as \var{priorities} says: a real for each component, the higher
+;;> choosing first.  Answers the list of the components' results, in
+;;> component order, or \scheme{not-enough-takers} when some component
+;;> finds no distinct capable robot; then every reservation made for it
+;;> is freed.
+(define (pose-task task-name num-robots capability-list metrics procs . priorities)
+  (let ((team (apply negotiate task-name num-robots capability-list metrics
+                     procs priorities)))
     (if (symbol? team)
         team
         (let ((uids (map car (car team))))
@@ -182,34 +323,78 @@
 ;;> type-list), where winners are the chosen (uid promise-or-#t) entries,
 ;;> or \scheme{not-enough-takers}.  Every promise not among the winners is
 ;;> freed.
-(define (negotiate task-name num-robots capability-list metrics procs)
-  (check-task task-name num-robots capability-list metrics procs)
-  (let* ((layouts (map capability-layout capability-list))
-         (type-list (map component-type layouts))
-         (name (reservation-name task-name))
+;;>
+;;> Tasks posed at once may want the same robots.  One that fails while
+;;> robots it could use are reserved by other poses frees everything it
+;;> holds, tells those poses its rank, waits a random while and tries
+;;> again, at most (pose-task-retries) times.  A rank is the task's
+;;> (pose-task-priority), ties broken by reservation name.  A pose told of
+;;> a higher rank before it starts its components gives way: it frees
+;;> everything and does not try again until that pose is done
+;;> negotiating.  A pose whose components have started is never stopped.
+(define (negotiate task-name num-robots capability-list metrics procs . priorities)
+  (let ((priorities (if (pair? priorities)
+                        (car priorities)
+                        (iota num-robots num-robots -1))))
+    (check-task task-name num-robots capability-list metrics procs priorities)
+    (let* ((layouts (map capability-layout capability-list))
+           (type-list (map component-type layouts))
+           (name (reservation-name task-name))
+           (task (make-pose name layouts type-list (map metric-keys metrics)
+                            procs priorities)))
+      (progress task-name ": " (length procs) " components")
+      (while-negotiating name (lambda () (negotiate-by-tries task 1))))))
+
+;; A task being negotiated, as negotiate has checked it.
+(define-record-type pose
+  (make-pose name layouts type-list keys-list procs priorities)
+  pose?
+  (name pose-name)
+  (layouts pose-layouts)
+  (type-list pose-type-list)
+  (keys-list pose-keys-list)
+  (procs pose-procs)
+  (priorities pose-priorities))
+
+;; The task's tries, from try number n on.
+(define (negotiate-by-tries task n)
+  (let ((outcome (if (outranking-rivals-negotiating? (pose-name task))
+                     'waiting
+                     (try task))))
+    (cond ((pair? outcome) outcome)
+          ((and (<= n (pose-task-retries))
+                (or (memq outcome '(waiting outranked)) (contended! task)))
+           (back-off! n outcome)
+           (negotiate-by-tries task (+ n 1)))
+          (else 'not-enough-takers))))
+
+;; One round of negotiation: (winners type-list), or not-enough-takers, or
+;; outranked when a rival outranks this pose; on failure everything is
+;; freed.
+(define (try task)
+  (let* ((type-list (pose-type-list task))
          (responses (map (lambda (layout type proc)
                            (if (eq? type 'exclusive)
-                               (request-exclusive layout name proc)
+                               (request-exclusive layout (pose-name task) proc)
                                (request (cadr layout) t)))
-                         layouts type-list procs)))
-    (progress task-name ": " (length procs) " components")
+                         (pose-layouts task) type-list (pose-procs task))))
     (for-each (lambda (i layout response)
                 (progress "  component " i " needs " layout ": candidates "
                           (map car response)))
-              (iota (length procs) 1) layouts responses)
-    (if (any null? responses)
-        (give-up responses type-list '())
-        (let* ((sorted-lists (map sort-response responses metrics))
-               (winners (resolve-conflicts sorted-lists)))
-          (cond
-           ((not winners) (give-up responses type-list '()))
-           (else
-            (release-runners-up responses type-list winners)
-            (for-each (lambda (i w) (progress "  component " i " goes to " (car w)))
-                      (iota (length winners) 1) winners)
-            (list winners type-list)))))))
+              (iota (length responses) 1) (pose-layouts task) responses)
+    (let ((winners (and (not (any null? responses))
+                        (choose (map measured-response responses (pose-keys-list task))
+                                (pose-keys-list task) (pose-priorities task)))))
+      (cond
+       ((not winners) (give-up responses type-list 'not-enough-takers))
+       ((not (commit! (pose-name task))) (give-up responses type-list 'outranked))
+       (else
+        (release-runners-up responses type-list winners)
+        (for-each (lambda (i w) (progress "  component " i " goes to " (car w)))
+                  (iota (length winners) 1) winners)
+        (list winners type-list))))))
 
-(define (check-task task-name num-robots capability-list metrics procs)
+(define (check-task task-name num-robots capability-list metrics procs priorities)
   (if (not (symbol? task-name))
       (error "pose-task: the task name is not a symbol" task-name))
   (if (not (and (list? capability-list) (list? metrics) (list? procs)))
@@ -219,6 +404,9 @@
       (error "pose-task: num-robots, capabilities, metrics and procedures do not agree"
              num-robots (length capability-list) (length metrics)
              (length procs)))
+  (if (not (and (list? priorities) (= num-robots (length priorities))
+                (every real? priorities)))
+      (error "pose-task: priorities are a real for each component" priorities))
   ;; Checked before anything is reserved, so that a bad component late in
   ;; the list leaves no reservation behind for the ones before it.
   (for-each (lambda (c)
@@ -231,13 +419,16 @@
   (for-each (lambda (p)
               (if (not (procedure? p))
                   (error "pose-task: a component's procedure is not a procedure" p)))
-            procs))
+            procs)
+  (if (not (memq (pose-task-assignment) '(greedy optimal)))
+      (error "pose-task: (pose-task-assignment) is greedy or optimal"
+             (pose-task-assignment))))
 
-;; Frees every promise but the winners' and answers not-enough-takers.
-(define (give-up responses type-list winners)
-  (release-runners-up responses type-list winners)
-  (progress "  not enough takers; every reservation freed")
-  'not-enough-takers)
+;; Frees every promise but the winners' and answers outcome.
+(define (give-up responses type-list outcome)
+  (release-runners-up responses type-list '())
+  (progress "  " outcome "; every reservation freed")
+  outcome)
 
 ;; Applies to #f each promise that did not win its component: the exact
 ;; entry, not its robot, since a robot may have promised two components.
@@ -253,16 +444,224 @@
                             response)))
             responses type-list))
 
-;;> Takes lists of (uid ...) entries, each sorted best first, in priority
-;;> order, and picks for each the first entry whose robot no earlier list
-;;> has taken; answers the picks in order, or #f if a list runs out.
-(define (resolve-conflicts sorted-lists)
-  (let loop ((lists sorted-lists) (chosen '()))
-    (if (null? lists)
-        (reverse chosen)
-        (let ((pick (find (lambda (entry) (not (assq (car entry) chosen)))
-                          (car lists))))
-          (and pick (loop (cdr lists) (cons pick chosen)))))))
+;;; Choosing the winners
+
+;; The components' winners, in component order, from their measured
+;; candidates, by (pose-task-assignment); #f when some component is left
+;; without a robot.
+(define (choose measured keys-list priorities)
+  (if (eq? (pose-task-assignment) 'optimal)
+      (choose-optimally measured keys-list priorities)
+      (resolve-conflicts (map sorted-entries measured keys-list) priorities)))
+
+(define (sorted-entries measured keys)
+  (map cdr (sort-measured measured keys)))
+
+;; Components with a metric by one measure share their robots at least
+;; total cost; the others pick first, by the greedy rule, among
+;; themselves.
+(define (choose-optimally measured keys-list priorities)
+  (let* ((all (iota (length measured)))
+         (optimal (filter (lambda (i) (one-measure? (list-ref keys-list i))) all))
+         (greedy (remove (lambda (i) (memv i optimal)) all))
+         (picks (make-vector (length measured) #f)))
+    (for-each (lambda (i) (progress "  component " (+ i 1) " is not by one measure: greedy"))
+              greedy)
+    (and (fill! picks greedy
+                (resolve-conflicts (map sorted-entries (pick-out measured greedy)
+                                        (pick-out keys-list greedy))
+                                   (pick-out priorities greedy)))
+         (fill! picks optimal
+                (assign-measured (map (lambda (m) (untaken m picks))
+                                      (pick-out measured optimal))))
+         (vector->list picks))))
+
+(define (one-measure? keys) (and (= (length keys) 1) (measure-key? (car keys))))
+
+(define (pick-out ls indices) (map (lambda (i) (list-ref ls i)) indices))
+
+;; Puts chosen, a list of picks or #f, at indices of picks; true if any.
+(define (fill! picks indices chosen)
+  (and chosen
+       (begin (for-each (lambda (i pick) (vector-set! picks i pick)) indices chosen)
+              #t)))
+
+;; The measured candidates whose robot no pick has.
+(define (untaken measured picks)
+  (remove (lambda (m) (find (lambda (p) (and p (eq? (car p) (cadr m))))
+                            (vector->list picks)))
+          measured))
+
+;; The entries, one per list of measured candidates ((measure) uid ...),
+;; of least total measure on distinct robots; #f if there is none.  A
+;; candidate that could not be measured (+inf.0) costs more than any
+;; assignment of measured ones, so it is chosen only when it must be.
+(define (assign-measured lists)
+  (let* ((uids (delete-duplicates (append-map (lambda (l) (map cadr l)) lists)))
+         (costs (cost-matrix lists uids
+                             (dominant-cost (cost-matrix lists uids +inf.0))))
+         (assignment (assign-optimal costs)))
+    (and assignment
+         (let ((picks (map (lambda (l j) (assq (list-ref uids j) (map cdr l)))
+                           lists (vector->list assignment))))
+           (progress "  optimal assignment: total "
+                     (assignment-cost costs assignment))
+           picks))))
+
+;; The components' measures of uids: +inf.0 where a uid is no candidate,
+;; unmeasured where it could not be measured.
+(define (cost-matrix lists uids unmeasured)
+  (list->vector
+   (map (lambda (measured)
+          (vector-map (lambda (uid)
+                        (let ((m (find (lambda (m) (eq? (cadr m) uid)) measured)))
+                          (cond ((not m) +inf.0)
+                                ((finite? (caar m)) (caar m))
+                                (else unmeasured))))
+                      (list->vector uids)))
+        lists)))
+
+;;> Takes lists of (uid ...) entries, each sorted best first, and picks
+;;> for each, in order of \var{priorities} (a real for each list, the
+;;> higher first; by default the lists' order, as in the thesis), the
+;;> first entry whose robot no list before it has taken; answers the
+;;> picks in the lists' order, or #f if a list runs out.
+(define (resolve-conflicts sorted-lists . priorities)
+  (let ((picks (make-vector (length sorted-lists) #f)))
+    (let loop ((order (priority-order
+                       (if (pair? priorities)
+                           (car priorities)
+                           (iota (length sorted-lists) (length sorted-lists) -1))))
+               (chosen '()))
+      (if (null? order)
+          (vector->list picks)
+          (let ((pick (find (lambda (entry) (not (assq (car entry) chosen)))
+                            (list-ref sorted-lists (car order)))))
+            (and pick
+                 (begin (vector-set! picks (car order) pick)
+                        (loop (cdr order) (cons pick chosen)))))))))
+
+;; The indices of priorities, highest first; equals keep their order.
+(define (priority-order priorities)
+  (map cdr (list-sort (lambda (a b) (> (car a) (car b)))
+                      (map cons priorities (iota (length priorities))))))
+
+;;; Tasks posed at once
+
+;; A rank is (priority name); the higher priority outranks, then the
+;; smaller name, so that no two ranks tie.
+(define (outranks? rank1 rank2)
+  (or (> (car rank1) (car rank2))
+      (and (= (car rank1) (car rank2))
+           (string<? (symbol->string (cadr rank1)) (symbol->string (cadr rank2))))))
+
+(define (own-rank name) (list (pose-task-priority) name))
+
+;; Runs thunk with name negotiating here, and then no longer.
+(define (while-negotiating name thunk)
+  (dynamic-wind
+   (lambda ()
+     (with-poses
+      (lambda () (set! *negotiating* (cons (list name (own-rank name)) *negotiating*)))))
+   thunk
+   (lambda () (with-poses (lambda () (set! *negotiating* (del-ass name *negotiating*)))))))
+
+(define (del-ass key alist) (remove (lambda (entry) (eq? (car entry) key)) alist))
+
+;;> What a pose that wants robots held by pose \var{name} calls where
+;;> \var{name} was posed, with its \var{rank} (priority name): answers #t
+;;> when \var{name} is still negotiating here, and will hear of it.
+(define (receive-rival name rank)
+  (with-poses
+   (lambda ()
+     (let ((entry (assq name *negotiating*)))
+       (and entry
+            (begin (set-cdr! (cdr entry) (cons rank (cddr entry))) #t))))))
+
+;;> The poses negotiating here, each as (name rank rival-rank ...): its
+;;> (priority name) and those of the poses that want robots it holds.
+(define (pose-negotiations)
+  (with-poses (lambda () (map list-copy *negotiating*))))
+
+;; The ranks of the rivals that outrank pose name.
+(define (outranking-rivals name)
+  (let ((entry (assq name (pose-negotiations))))
+    (filter (lambda (rank) (outranks? rank (cadr entry))) (cddr entry))))
+
+;; Commits pose name to the winners it has: #f if a rival outranks it.
+;; Rivals heard of later find it no longer negotiating.
+(define (commit! name)
+  (with-poses
+   (lambda ()
+     (let ((entry (assq name *negotiating*)))
+       (and (not (any (lambda (rank) (outranks? rank (cadr entry))) (cddr entry)))
+            (begin (set! *negotiating* (del-ass name *negotiating*)) #t))))))
+
+;; Whether a rival that outranks pose name is still negotiating where it
+;; was posed.  Rivals that are done are forgotten, so that they no longer
+;; make it give way.
+(define (outranking-rivals-negotiating? name)
+  (let ((done (remove rival-negotiating? (outranking-rivals name))))
+    (with-poses
+     (lambda ()
+       (let ((entry (assq name *negotiating*)))
+         (set-cdr! (cdr entry) (remove (lambda (rank) (member rank done)) (cddr entry))))))
+    (pair? (outranking-rivals name))))
+
+(define (rival-negotiating? rank)
+  (guard (e (#t #f))
+    (and (assq (cadr rank)
+               (remote-apply (uid->aspace (reservation-aspace-uid (cadr rank)))
+                             pose-negotiations))
+         #t)))
+
+;; After a try that found too few robots: whether other poses hold robots
+;; it could use, and if so tells those poses of this one's rank.
+(define (contended! task)
+  (let ((holders (rival-holders (pose-name task) (pose-layouts task)
+                                (pose-type-list task))))
+    (for-each (lambda (holder) (tell-rival! holder (own-rank (pose-name task))))
+              holders)
+    (pair? holders)))
+
+;; The names under which other tasks hold the exclusive subjects of
+;; robots capable of the exclusive components.
+(define (rival-holders name layouts type-list)
+  (delete-duplicates
+   (filter (lambda (status)
+             (and (symbol? status) (not (memq status (list name 'shared)))))
+           (append-map
+            (lambda (layout type)
+              (if (eq? type 'exclusive)
+                  (let ((subjects (car layout)))
+                    (append-map cadr (request (apply append layout)
+                                              (sendable-lambda ()
+                                                (map topic-status subjects)))))
+                  '()))
+            layouts type-list))))
+
+(define (tell-rival! holder rank)
+  (let ((uid (reservation-aspace-uid holder)))
+    (if uid
+        (guard (e (#t (log-warn "telling " holder " of " rank ": "
+                                (if (error-object? e) (error-object-message e) e))))
+          (remote-apply (uid->aspace uid) receive-rival holder rank)))))
+
+;; Waits a random while, below (pose-task-backoff) doubled for each try
+;; before try n.  Each process draws from its own seed: Chibi starts every
+;; process's default source alike, and posers that drew alike would
+;; collide again.
+(define (back-off! n outcome)
+  (let ((seconds (* (backoff-random) (pose-task-backoff) (expt 2 (- n 1)))))
+    (progress "  try " n ": " outcome "; trying again in "
+              (/ (round (* 1000 seconds)) 1000) " s")
+    (thread-sleep! seconds)))
+
+(define backoff-random
+  (let ((source (make-random-source)))
+    (random-source-pseudo-randomize! source (current-process-id)
+                                     (exact (floor (current-second))))
+    (random-source-make-reals source)))
 
 ;;; Dynamic teams
 
