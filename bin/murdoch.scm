@@ -148,19 +148,28 @@
            (loop (if (pair? (cdr rest)) (cddr rest) '()) acc))
           (else (loop (cdr rest) (cons (car rest) acc))))))
 
-(define (app-spec c)
+(define (app-spec c started!)
   `(murdoch "Murdoch"
     (,(car c) ,(command-doc c) (@ ,@(command-options c))
-     (,(lambda (cfg spec . args) (apply (command-proc c) cfg args))))))
+     (,(lambda (cfg spec . args)
+         (started!)
+         (apply (command-proc c) cfg args))))))
 
-;; Runs command c; an option (chibi app) does not know, or an error a
-;; user's input caused (a lab file's mistake), is said in one line.
+;; Runs command c.  An option (chibi app) does not know is a mistake on
+;; the command line; an error once the command runs (a lab file's
+;; mistake, a port in use) is one ERROR line, which bin/murdoch-lab shows
+;; of a child that dies; either exits 2.
 (define (run c args)
   (check-arity c (positional args))
-  (guard (e ((error-object? e)
-             (mistake c (error-text e))))
-    (run-application (app-spec c)
-                     (cons* "murdoch" (symbol->string (car c)) (options-first args)))))
+  (let ((started? #f))
+    (guard (e ((and (error-object? e) started?)
+               (write-string (string-append "murdoch " (symbol->string (car c))
+                                            ": ERROR: " (error-text e) "\n")
+                             (current-error-port))
+               (exit 2))
+              ((error-object? e) (mistake c (error-text e))))
+      (run-application (app-spec c (lambda () (set! started? #t)))
+                       (cons* "murdoch" (symbol->string (car c)) (options-first args))))))
 
 (define (error-text e)
   (let ((out (open-output-string)))

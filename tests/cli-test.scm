@@ -50,8 +50,11 @@
   (mistake '("aspace" "x.scm") "murdoch aspace: missing NAME")
   (mistake '("pose" "a" "b" "c") "murdoch pose: too many arguments: c")
   (mistake '("lab" "examples/tulane-lab.scm" "--bogus" "1") "murdoch lab: unknown option --bogus")
-  (mistake '("check" "/no/such/lab.scm")
-           "murdoch check: cannot read the lab file /no/such/lab.scm couldn't open input file"))
+  (test "a mistake in what a command reads is one ERROR line" '(2 #t)
+    (let ((r (murdoch "check" "/no/such/lab.scm")))
+      (list (status r)
+            (string=? (car (cddr r))
+                      "murdoch check: ERROR: cannot read the lab file /no/such/lab.scm couldn't open input file\n")))))
 
 (test-group "check"
   (test "a good lab file" '(0 "examples/tulane-lab.scm: no mistakes found")
