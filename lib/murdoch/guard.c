@@ -18,6 +18,7 @@
 
 #include <chibi/eval.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -52,6 +53,7 @@ static sexp start_heap_guard (sexp ctx, sexp self, sexp_sint_t n,
                               sexp bytes, sexp line) {
   pthread_t thread;
   pthread_attr_t attr;
+  sigset_t all, old;
   int started;
   if (!sexp_fixnump(bytes) || sexp_unbox_fixnum(bytes) <= 0)
     return sexp_type_exception(ctx, self, SEXP_FIXNUM, bytes);
@@ -64,7 +66,12 @@ static sexp start_heap_guard (sexp ctx, sexp self, sexp_sint_t n,
   watched = sexp_context_heap(ctx);
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, 64 * 1024);
+  /* The watcher is made with every signal blocked, which it keeps: a
+   * signal for the process is the VM's to handle, on its own thread. */
+  sigfillset(&all);
+  pthread_sigmask(SIG_BLOCK, &all, &old);
   started = pthread_create(&thread, &attr, watch, NULL) == 0;
+  pthread_sigmask(SIG_SETMASK, &old, NULL);
   pthread_attr_destroy(&attr);
   if (!started) {
     watched = NULL;
