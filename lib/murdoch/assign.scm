@@ -20,26 +20,38 @@
            (let ((assignment (hungarian (finite-costs costs) n m)))
              (and (allowed? costs assignment) assignment))))))
 
-;; The costs with each +inf.0 made the dominant cost, so that the
-;; method's arithmetic stays finite and an assignment with fewer of them
-;; always costs less.
+;; The costs, inexact, with each +inf.0 made the dominant cost, so that
+;; the method's arithmetic stays finite and an assignment with fewer of
+;; them always costs less.  Chibi compares two flonums as an opcode, an
+;; exact number with a flonum by a slow path that took longer than the
+;; method.
 (define (finite-costs costs)
-  (let ((forbidden (dominant-cost costs)))
+  (let ((forbidden (inexact (dominant-cost costs))))
     (vector-map (lambda (row)
-                  (vector-map (lambda (c) (if (finite? c) c forbidden)) row))
+                  (vector-map (lambda (c)
+                                (let ((x (inexact c))) (if (< x +inf.0) x forbidden)))
+                              row))
                 costs)))
 
 ;;> A cost greater than the gap between the totals of any two
 ;;> assignments that use only the finite costs of \var{costs}.
 (define (dominant-cost costs)
-  (let ((finite (filter-finite (apply append (map vector->list (vector->list costs))))))
-    (+ 1 (* 2 (vector-length costs) (apply max 0 (map abs finite))))))
+  (+ 1 (* 2 (vector-length costs) (largest-finite-magnitude costs))))
 
-(define (filter-finite ls)
-  (let loop ((ls ls) (acc '()))
-    (cond ((null? ls) acc)
-          ((finite? (car ls)) (loop (cdr ls) (cons (car ls) acc)))
-          (else (loop (cdr ls) acc)))))
+(define (largest-finite-magnitude costs)
+  (let rows ((i 0) (largest 0.))
+    (if (= i (vector-length costs))
+        largest
+        (let ((row (vector-ref costs i)))
+          (let columns ((j 0) (largest largest))
+            (if (= j (vector-length row))
+                (rows (+ i 1) largest)
+                (let* ((x (inexact (vector-ref row j)))
+                       (magnitude (if (< x 0.) (- 0. x) x)))
+                  (columns (+ j 1)
+                           (if (and (< largest magnitude) (< magnitude +inf.0))
+                               magnitude
+                               largest)))))))))
 
 (define (allowed? costs assignment)
   (let loop ((i 0))
@@ -51,8 +63,8 @@
 ;; added; u and v are the dual potentials, p(j) the row column j has
 ;; (0: none), way(j) the column before j on the augmenting path.
 (define (hungarian a n m)
-  (let ((u (make-vector (+ n 1) 0))
-        (v (make-vector (+ m 1) 0))
+  (let ((u (make-vector (+ n 1) 0.))
+        (v (make-vector (+ m 1) 0.))
         (p (make-vector (+ m 1) 0))
         (way (make-vector (+ m 1) 0)))
     (do ((i 1 (+ i 1))) ((> i n))
@@ -78,7 +90,7 @@
            ((<= j m)
             (if (vector-ref used j)
                 (scan (+ j 1) delta j1)
-                (let ((cur (- (vector-ref row (- j 1)) ui0 (vector-ref v j))))
+                (let ((cur (- (- (vector-ref row (- j 1)) ui0) (vector-ref v j))))
                   (when (< cur (vector-ref minv j))
                     (vector-set! minv j cur)
                     (vector-set! way j j0))
