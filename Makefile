@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-sim demo clean
+.PHONY: all deps native sim test bench bench-sim bench-alloc demo clean
 
 all: deps
 	$(MAKE) native
@@ -22,6 +22,10 @@ bench: all
 
 bench-sim: all
 	$(MAKE) -C sim bench
+
+# Allocation: optimal assignment's speed, greedy's price, concurrent posers.
+bench-alloc: all
+	tools/chibi bench/alloc.scm
 
 demo: all
 	bin/murdoch demo examples/tulane-lab.scm
