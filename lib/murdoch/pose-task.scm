@@ -420,6 +420,8 @@
               (if (not (procedure? p))
                   (error "pose-task: a component's procedure is not a procedure" p)))
             procs)
+  (if (not (real? (pose-task-priority)))
+      (error "pose-task: (pose-task-priority) is a real number" (pose-task-priority)))
   (if (not (memq (pose-task-assignment) '(greedy optimal)))
       (error "pose-task: (pose-task-assignment) is greedy or optimal"
              (pose-task-assignment))))
@@ -572,6 +574,10 @@
 ;;> \var{name} was posed, with its \var{rank} (priority name): answers #t
 ;;> when \var{name} is still negotiating here, and will hear of it.
 (define (receive-rival name rank)
+  ;; A rank comes from another peer, and is compared under the lock.
+  (if (not (and (list? rank) (= (length rank) 2) (real? (car rank))
+                (symbol? (cadr rank))))
+      (error "receive-rival: a rank is (priority name)" rank))
   (with-poses
    (lambda ()
      (let ((entry (assq name *negotiating*)))
