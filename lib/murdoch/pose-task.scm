@@ -8,7 +8,9 @@
 ;; candidates by its metric, gives each component the best candidate not
 ;; already chosen for a more important one (the components come in
 ;; priority order), frees every promise it will not use, and runs the
-;; components as a team.
+;; components as a team.  Beyond the thesis (docs/allocation.md): explicit
+;; priorities, composed metrics, optimal assignment, and a rule by which
+;; tasks posed at once that want the same robots take turns.
 
 ;;; Progress
 
