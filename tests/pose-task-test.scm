@@ -62,6 +62,9 @@
   (resolve-conflicts '(((a 1) (b 1)) ((a 2) (b 2)) ((c 3) (a 3)))))
 (test "resolve-conflicts: #f when a list runs out" #f
   (resolve-conflicts '(((a 1)) ((a 2)))))
+(test "resolve-conflicts: the higher priority picks first, picks in list order"
+    '((b 1) (a 2) (c 3))
+  (resolve-conflicts '(((a 1) (b 1)) ((a 2) (b 2)) ((c 3) (a 3))) '(1 2 0)))
 
 (test "the closest robot gets each target, the least loaded the sums"
     '(near far quiet)

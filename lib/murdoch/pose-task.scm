@@ -337,7 +337,7 @@
 (define (negotiate task-name num-robots capability-list metrics procs . priorities)
   (let ((priorities (if (pair? priorities)
                         (car priorities)
-                        (iota num-robots num-robots -1))))
+                        (thesis-priorities num-robots))))
     (check-task task-name num-robots capability-list metrics procs priorities)
     (let* ((layouts (map capability-layout capability-list))
            (type-list (map component-type layouts))
@@ -528,14 +528,14 @@
 ;;> Takes lists of (uid ...) entries, each sorted best first, and picks
 ;;> for each, in order of \var{priorities} (a real for each list, the
 ;;> higher first; by default the lists' order, as in the thesis), the
-;;> first entry whose robot no list before it has taken; answers the
+;;> first entry whose robot no list picked before has taken; answers the
 ;;> picks in the lists' order, or #f if a list runs out.
 (define (resolve-conflicts sorted-lists . priorities)
   (let ((picks (make-vector (length sorted-lists) #f)))
     (let loop ((order (priority-order
                        (if (pair? priorities)
                            (car priorities)
-                           (iota (length sorted-lists) (length sorted-lists) -1))))
+                           (thesis-priorities (length sorted-lists)))))
                (chosen '()))
       (if (null? order)
           (vector->list picks)
@@ -544,6 +544,9 @@
             (and pick
                  (begin (vector-set! picks (car order) pick)
                         (loop (cdr order) (cons pick chosen)))))))))
+
+;; The thesis's priorities of n components: their order, first highest.
+(define (thesis-priorities n) (iota n n -1))
 
 ;; The indices of priorities, highest first; equals keep their order.
 (define (priority-order priorities)
