@@ -49,6 +49,10 @@
       (cdr (read-lines (in-dir "lab.out"))))
     (test "every address space listens" '(#t #t)
       (map listening? (list base (+ base 1))))
+    (test "its log lines say when, and who" #t
+      (let ((line (car (read-lines (in-dir "logs/troy.log")))))
+        (and (char=? (string-ref line 4) #\-) (char=? (string-ref line 10) #\T)
+             (text-contains? line "Z murdoch troy: listening on"))))
     (test-group "pose"
       (call-with-output-file (in-dir "task.scm")
         (lambda (out)

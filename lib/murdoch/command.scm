@@ -39,6 +39,7 @@
 
 ;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
 (define (run-aspace lab-file uid)
+  (stamp-log-lines!)
   (join-lab lab-file uid)
   (start-heap-guard!
    (lab-setting (current-lab) 'heap-max)

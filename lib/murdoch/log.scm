@@ -8,8 +8,49 @@
 ;;> Names this process in log lines, e.g. "murdoch troy".
 (define (set-log-name! name) (set! *log-name* name))
 
+(define *stamped?* #f)
+
+;;> Starts each log line with the time, in UTC to the millisecond: for an
+;;> address space, whose log is a file; a person at a REPL sees its lines
+;;> as they come.
+(define (stamp-log-lines!) (set! *stamped?* #t))
+
+;; Seconds since 1970 by the system's clock: (scheme time)'s
+;; current-second counts TAI seconds, 37 ahead.
+(define (now)
+  (let ((tv (car (get-time-of-day))))
+    (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.))))
+
+;; "2026-11-25T03:19:13.123Z " for seconds since 1970 (the civil date of
+;; a count of days, as in H. Hinnant's chrono algorithms).
+(define (timestamp seconds)
+  (let* ((ms (exact (floor (* 1000 seconds))))
+         (days (floor-quotient ms 86400000))
+         (in-day (floor-remainder ms 86400000))
+         (z (+ days 719468))
+         (era (floor-quotient z 146097))
+         (doe (- z (* era 146097)))
+         (yoe (quotient (- doe (quotient doe 1460) (- (quotient doe 36524)) (quotient doe 146096)) 365))
+         (doy (- doe (- (+ (* 365 yoe) (quotient yoe 4)) (quotient yoe 100))))
+         (mp (quotient (+ (* 5 doy) 2) 153))
+         (day (+ 1 (- doy (quotient (+ (* 153 mp) 2) 5))))
+         (month (if (< mp 10) (+ mp 3) (- mp 9)))
+         (year (+ yoe (* era 400) (if (<= month 2) 1 0))))
+    (string-append (digits year 4) "-" (digits month 2) "-" (digits day 2)
+                   "T" (digits (quotient in-day 3600000) 2)
+                   ":" (digits (quotient (remainder in-day 3600000) 60000) 2)
+                   ":" (digits (quotient (remainder in-day 60000) 1000) 2)
+                   "." (digits (remainder in-day 1000) 3) "Z ")))
+
+(define (digits n width)
+  (let ((s (number->string n)))
+    (if (< (string-length s) width)
+        (string-append (make-string (- width (string-length s)) #\0) s)
+        s)))
+
 (define (log-line level parts)
   (let ((err (current-error-port)))
+    (if *stamped?* (write-string (timestamp (now)) err))
     (write-string *log-name* err)
     (write-string level err)
     (for-each (lambda (p) (if (string? p) (write-string p err) (display p err)))
