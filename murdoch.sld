@@ -32,6 +32,8 @@
           reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
+          ;; what the lab is doing (lib/murdoch/status.scm)
+          aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/trip-client.scm)
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
           reckon set-reckon-position! set-reckon-heading!
@@ -39,4 +41,4 @@
           buttons-read lights say battery-voltage tethered? set-tether!
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch sendable) (murdoch remote) (murdoch pubsub)
-          (murdoch pose-task) (murdoch trip-client)))
+          (murdoch pose-task) (murdoch trip-client) (murdoch status)))

@@ -49,6 +49,8 @@
           ,(lambda (cfg lab) (run-demo bin lab)))
     (check (LAB) "check the lab file for mistakes, and start nothing" ()
            ,(lambda (cfg lab) (check lab)))
+    (status (LAB) "show each address space of the running lab: up since, pose, battery, the subjects held and by whom" ()
+            ,(lambda (cfg lab) (run-status lab)))
     (help ((COMMAND)) "show this help, or a command's" ()
           ,(lambda (cfg . name) (show-help name)))))
 

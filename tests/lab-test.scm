@@ -28,12 +28,16 @@
              (number->string pid) file)
     (map string->number (read-lines file))))
 
-;; The lines `bin/murdoch pose` prints for the task file `task`.
-(define (pose-output task)
-  (let ((out (in-dir "pose.out")))
-    (system? "sh" "-c" "timeout -s KILL 60 \"$1\" pose \"$2\" \"$3\" >\"$4\" 2>&1"
-             "pose" (tool-path "bin/murdoch") (test-lab-file lab) (in-dir task) out)
+;; The lines `bin/murdoch COMMAND LAB ARG ...` prints.
+(define (command-lines command . args)
+  (let ((out (in-dir "command.out")))
+    (apply system? "sh" "-c"
+           "out=$1; shift; timeout -s KILL 60 \"$@\" >\"$out\" 2>&1"
+           "command" out (tool-path "bin/murdoch") command (test-lab-file lab) args)
     (read-lines out)))
+
+;; The lines `bin/murdoch pose` prints for the task file `task`.
+(define (pose-output task) (command-lines "pose" (in-dir task)))
 
 (define (address port)
   (string-append "127.0.0.1:" (number->string port)))
@@ -73,6 +77,11 @@
         (text-contains? (car (pose-output "task.scm")) "pose-task: where"))
       (test "a file that defines its task as a procedure: it is called"
           "(called)" (last (pose-output "thunk.scm"))))
+    (test "status: each address space, up" '(#t #t)
+      (let ((lines (command-lines "status")))
+        (map (lambda (uid)
+               (any (lambda (l) (text-contains? l (string-append uid "  up "))) lines))
+             '("troy" "praline"))))
     (let ((status (stop-process! pid)))
       (if (not (zero? status)) (display (file-text (in-dir "lab.out"))))
       (test "SIGTERM: the lab exits 0" 0 status))

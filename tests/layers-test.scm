@@ -16,7 +16,7 @@
     (robot (murdoch trip-client))
     (remote (murdoch remote))
     (messaging (murdoch pubsub))
-    (tasks (murdoch assign) (murdoch pose-task))
+    (tasks (murdoch assign) (murdoch pose-task) (murdoch status))
     (interface (murdoch))
     (commands (murdoch command) (murdoch launch))))
 

@@ -66,6 +66,17 @@
     (newline)
     (exit 0)))
 
+;;> `murdoch status LAB`: joins the lab as a guest and shows what each of
+;;> its address spaces says of itself (see show-status); one that does not
+;;> answer within two seconds is shown away.
+(define (run-status lab-file)
+  (let ((lab (read-lab lab-file)))
+    (join-lab lab-file (string->symbol (string-append
+                                        "status-" (number->string (current-process-id))))
+              (lab-guest-port lab))
+    (parameterize ((remote-timeout 2)) (show-status))
+    (exit 0)))
+
 ;;> The task \var{file} evaluates to in \var{env}: the value of its last
 ;;> form, or, when that form defines a procedure of no arguments, what the
 ;;> procedure answers, as the thesis's \scheme{(define (dual-sonar-task) ...)}.

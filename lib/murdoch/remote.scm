@@ -47,6 +47,7 @@
   (port aspace-port))
 
 (define *local* #f)                     ; the local aspace, once started
+(define *started-at* #f)                ; (current-second) then
 (define *lab* #f)
 (define *peers* (make-hash-table eq?))  ; uid -> aspace, from lab and hellos
 (define *peers-lock* (make-mutex 'peers))
@@ -54,6 +55,9 @@
 ;;> The local address space.
 (define (local-aspace)
   (or *local* (error "this process has not joined a lab")))
+
+;;> The (current-second) at which this address space joined its lab.
+(define (aspace-started-at) *started-at*)
 
 ;;> The uid of the local address space.
 (define (local-aspace-uid) (aspace-uid (local-aspace)))
@@ -1195,6 +1199,7 @@
 (define (start-aspace! lab uid environment . port)
   (let ((entry (lab-aspace-by-uid lab uid)))
     (set! *lab* lab)
+    (set! *started-at* (current-second))
     (set! *local* (make-aspace uid
                                (if entry (lab-aspace-host entry)
                                    (lab-setting lab 'interface))

@@ -1,6 +1,6 @@
 (define-library (murdoch remote)
   (export aspace? aspace-uid aspace-host aspace-port make-aspace
-          local-aspace local-aspace-uid uid->aspace known-uids
+          local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
           learn-aspace! live-uids current-lab lab-environment
           remote-run! remote-apply remote-timeout set-remote-timeout!
           remote-apply-all remote-run-all! broadcast-apply broadcast-run!

@@ -1,0 +1,66 @@
+;;;; Status: each address space says how it is, and the lab's status is
+;;;; what they all say, asked at once.
+
+;;> What this address space says of itself: (UID UP-SINCE POSE BATTERY
+;;> HELD), UP-SINCE the wall-clock second it joined the lab, POSE what
+;;> safe-reckon answers, BATTERY safe-battery-voltage in tenths of a volt,
+;;> HELD the (subject holder) of each subject held here.
+(define (aspace-report)
+  (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
+        (safe-battery-voltage)
+        (filter (lambda (s) (not (null? (cadr s))))
+                (subscription-statuses '>))))
+
+;;> The lab's status: for each address space of \var{lab}, in file order,
+;;> its report (see aspace-report) when it answered within
+;;> (remote-timeout) seconds, else (UID away WHY).
+(define (lab-status lab)
+  (map (lambda (r)
+         (if (cadr r) (car (cddr r)) (list (car r) 'away (car (cddr r)))))
+       (remote-apply-all (map (lambda (a) (uid->aspace (lab-aspace-uid a)))
+                              (lab-aspaces lab))
+                         aspace-report)))
+
+;;> Writes the status of the lab this address space is in (see
+;;> lab-status) as a person reads it: a line per address space, then one
+;;> per subject held.
+(define (show-status . port)
+  (display-lab-status (lab-status (current-lab)) (current-second)
+                      (if (pair? port) (car port) (current-output-port))))
+
+(define (display-lab-status status now out)
+  (for-each (lambda (r) (write-report r now out)) status))
+
+(define (write-report r now out)
+  (let ((uid (symbol->string (car r))))
+    (cond
+     ((eq? (cadr r) 'away)
+      (write-line out uid "  away: " (car (cddr r))))
+     (else
+      (write-line out uid "  up " (seconds-text (- now (cadr r))) " s"
+                  (pose-text (car (cddr r)))
+                  "  battery " (tenths-text (cadr (cddr r))))
+      (for-each (lambda (held)
+                  (write-line out "    " (symbol->string (car held))
+                              " held by " (held-text (cadr held))))
+                (car (cddr (cddr r))))))))
+
+(define (write-line out . parts)
+  (for-each (lambda (p) (write-string p out)) parts)
+  (newline out))
+
+(define (seconds-text s) (number->string (exact (round s))))
+
+(define (pose-text pose)
+  (if pose
+      (string-append "  at (" (number->string (exact (round (car pose)))) " "
+                     (number->string (exact (round (cadr pose)))) ") heading "
+                     (number->string (exact (round (car (cddr pose))))))
+      ""))
+
+(define (tenths-text tenths) (string-append (number->string (/ tenths 10.)) " V"))
+
+(define (held-text holder)
+  (let ((out (open-output-string)))
+    (display holder out)
+    (get-output-string out)))

@@ -1,0 +1,7 @@
+;;> What the lab is doing, asked of every address space: the \scheme{status}
+;;> command and REPL procedure.
+(define-library (murdoch status)
+  (export aspace-report lab-status show-status)
+  (import (scheme base) (scheme write) (scheme time) (srfi 1)
+          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch trip-client))
+  (include "status.scm"))
