@@ -265,10 +265,7 @@
 (define *negotiating* '())
 (define *poses-lock* (make-mutex 'poses))
 
-(define (with-poses thunk)
-  (dynamic-wind (lambda () (mutex-lock! *poses-lock*))
-                thunk
-                (lambda () (mutex-unlock! *poses-lock*))))
+(define (with-poses thunk) (with-lock *poses-lock* thunk))
 
 ;; Reservations are made under a name of this pose's own, so that the same
 ;; task posed twice at once, from here or elsewhere, never shares a robot.

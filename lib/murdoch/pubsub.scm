@@ -28,10 +28,7 @@
 (define *subscriptions* '())
 (define *subscriptions-lock* (make-mutex 'subscriptions))
 
-(define (with-subscriptions thunk)
-  (dynamic-wind (lambda () (mutex-lock! *subscriptions-lock*))
-                thunk
-                (lambda () (mutex-unlock! *subscriptions-lock*))))
+(define (with-subscriptions thunk) (with-lock *subscriptions-lock* thunk))
 
 (define (find-subscription topic)
   (find (lambda (s) (eq? (subscription-topic s) topic)) *subscriptions*))

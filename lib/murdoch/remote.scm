@@ -111,6 +111,8 @@
               (lambda () (hash-table-keys *unreachable*))))
   (prober))
 
+;;> Applies \var{thunk} holding the mutex \var{m}, which it frees however
+;;> thunk leaves.
 (define (with-lock m thunk)
   (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
 

@@ -9,7 +9,7 @@
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
           remote-protocol-error?
           encap release-proxy! start-aspace!
-          var-ref var-set! display-remote undo-on-raise)
+          var-ref var-set! display-remote undo-on-raise with-lock)
   (import (scheme base) (scheme write) (scheme char)
           (scheme time)
           (srfi 1) (srfi 18) (srfi 69)
