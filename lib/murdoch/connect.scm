@@ -2,8 +2,9 @@
 ;;
 ;; The socket is made and closed here, as (chibi net) makes and closes
 ;; its own; lib/murdoch/connect.c starts its connect, non-blocking, and says when
-;; the connect is done.  This side looks every millisecond and sleeps its
-;; own green thread in between, so the process's other threads run on.
+;; the connect is done.  This side waits for the socket to turn writable,
+;; which is when a connect ends, pausing only its own green thread
+;; (port-wait!), so the process's other threads run on.
 
 ;;> \procedure{(open-connection host port seconds)}
 ;;> Connects to TCP \var{port} of \var{host} (an IPv4 address or a name
@@ -25,22 +26,21 @@
           (let ((started (connect-start sock host port)))
             (if (string? started)
                 (close-socket sock started)
-                (await-connect sock (+ (monotonic-seconds) seconds) seconds)))))))
+                (await-connect sock (open-output-file-descriptor sock #t)
+                               (+ (monotonic-seconds) seconds) seconds)))))))
 
-;; A millisecond is little next to the timeouts of a remote call, and the
-;; first look comes at once, soon enough for a connect on the loopback.
-(define (await-connect sock deadline seconds)
+;; out is the socket's output port, the one a writable socket wakes.
+(define (await-connect sock out deadline seconds)
   (let ((done (connect-poll sock)))
     (cond
-     ((string? done) (close-socket sock done))
-     (done (list (open-input-file-descriptor sock #t)
-                 (open-output-file-descriptor sock #t)))
-     ((> (monotonic-seconds) deadline)
-      (close-socket sock (string-append "no connection within "
-                                        (seconds-text seconds) " s")))
+     ((string? done) (close-port out) done)
+     (done (list (open-input-file-descriptor sock #t) out))
+     ((>= (monotonic-seconds) deadline)
+      (close-port out)
+      (string-append "no connection within " (seconds-text seconds) " s"))
      (else
-      (thread-sleep! 0.001)
-      (await-connect sock deadline seconds)))))
+      (port-wait! out (- deadline (monotonic-seconds)))
+      (await-connect sock out deadline seconds)))))
 
 ;; Seconds to the millisecond, as a person would write them: a caller's
 ;; remaining time of 0.99996 s is 1 s.

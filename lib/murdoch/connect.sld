@@ -11,6 +11,6 @@
           (only (chibi filesystem) open-input-file-descriptor
                 open-output-file-descriptor get-file-descriptor-status
                 set-file-descriptor-status! open/non-block)
-          (only (murdoch scheduler) monotonic-seconds))
+          (only (murdoch scheduler) monotonic-seconds port-wait!))
   (include-shared "connect")
   (include "connect.scm"))

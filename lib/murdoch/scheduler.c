@@ -586,6 +586,24 @@ static sexp monotonic_seconds (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_flonum(ctx, now.tv_sec + now.tv_nsec / 1e9);
 }
 
+/* (port-wait! PORT SECONDS): pauses the calling thread until PORT's
+ * descriptor is ready (for reading an input port, for writing an output
+ * port) or SECONDS have passed, through Chibi's own blocker, as a read
+ * that would block does; the thread pauses at its next yield, which the
+ * Scheme side makes at once.  For what has no port-level wait of its own:
+ * a non-blocking connect ends when its socket turns writable. */
+static sexp port_wait (sexp ctx, sexp self, sexp_sint_t n, sexp port,
+                       sexp seconds) {
+  sexp blocker = sexp_global(ctx, SEXP_G_THREADS_BLOCKER);
+  if (!sexp_portp(port))
+    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
+  if (!sexp_flonump(seconds))
+    return sexp_type_exception(ctx, self, SEXP_FLONUM, seconds);
+  if (sexp_applicablep(blocker))
+    sexp_apply2(ctx, blocker, port, seconds);
+  return SEXP_VOID;
+}
+
 sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
                         const char *version, const sexp_abi_identifier_t abi) {
   if (!(sexp_version_compatible(ctx, version, sexp_version)
@@ -595,5 +613,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
                       poll_scheduler_installedp);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);
+  sexp_define_foreign(ctx, env, "%port-wait!", 2, port_wait);
   return install(ctx);
 }

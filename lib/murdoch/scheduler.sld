@@ -20,9 +20,20 @@
 ;;> Seconds since a fixed moment, as a flonum, from a clock that only goes
 ;;> forward: for deadlines.  (scheme time)'s \scheme{current-second} costs
 ;;> some microseconds a call and jumps when the wall clock is set.
+;;>
+;;> \procedure{(port-wait! port seconds)}
+;;> Pauses the calling thread, and only it, until \var{port}'s descriptor
+;;> is ready (to read, for an input port; to write, for an output port)
+;;> or \var{seconds} have passed, whichever is first.  The caller then
+;;> looks again at what it waits for: readiness is a hint.
 
 (define-library (murdoch scheduler)
-  (export poll-scheduler-installed? monotonic-seconds stack-guard-tripped?)
+  (export poll-scheduler-installed? monotonic-seconds stack-guard-tripped?
+          port-wait!)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
-  (import (srfi 18))
-  (include-shared "scheduler"))
+  (import (scheme base) (srfi 18))
+  (include-shared "scheduler")
+  (begin
+    (define (port-wait! port seconds)
+      (%port-wait! port (inexact seconds))
+      (thread-yield!))))
