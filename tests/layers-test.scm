@@ -8,12 +8,17 @@
 
 ;; Bottom to top.
 (define layers
-  '((process (murdoch scheduler) (murdoch guard) (murdoch log))
-    (wire (murdoch netstring) (murdoch hmac) (murdoch multicast)
-          (murdoch connect))
+  '((process (murdoch scheduler) (murdoch guard) (murdoch log) (murdoch wait))
+    (wire (murdoch remote-error) (murdoch netstring) (murdoch hmac)
+          (murdoch multicast) (murdoch connect) (murdoch frame))
     (lab (murdoch lab))
     (values (murdoch sendable) (murdoch abandon) (murdoch sandbox))
     (robot (murdoch trip-client))
+    (aspace (murdoch aspace))
+    (call (murdoch connection) (murdoch worker) (murdoch call))
+    (serve (murdoch serve))
+    (proxy (murdoch proxy))
+    (delivery (murdoch delivery))
     (remote (murdoch remote))
     (messaging (murdoch pubsub))
     (tasks (murdoch assign) (murdoch pose-task) (murdoch status))

@@ -82,6 +82,20 @@
       (wait-until 5 (lambda () (= 1 (evaluated 'a) (evaluated 'c))))
       (map evaluated '(a b c)))))
 
+(test-group "many threads publishing at once"
+  ;; By multicast each publish is one datagram, numbered by its sender:
+  ;; two threads taking one number would have the second dropped.
+  (let* ((before (evaluated 'a))
+         (publisher (lambda ()
+                      (do ((k 0 (+ k 1))) ((= k 10))
+                        (publish 'foo (lab-proc 'note!)))))
+         (threads (map (lambda (i) (make-thread publisher)) (iota 8))))
+    (for-each thread-start! threads)
+    (for-each thread-join! threads)
+    (test "each of 80 publishes ran on a" (+ before 80)
+      (wait-until 10 (lambda () (let ((n (evaluated 'a)))
+                                  (and (= n (+ before 80)) n)))))))
+
 (test-group "Figure 4.2: request"
   (test "A and C answer with their uids" '((a a) (c c))
     (by-uid (request '(foo bar) (lambda () (local-aspace-uid)))))

@@ -5,15 +5,17 @@
 ;; only, no leading zero but for the empty payload, at most MAX bytes of
 ;; payload, and the comma.
 
-;;> Raised when a peer sends something that is not a netstring; the
-;;> message says what was wrong, for the log.
-(define-record-type netstring-error
-  (make-netstring-error message)
-  netstring-error?
-  (message netstring-error-message))
-
+;; What a peer sends that is not a netstring is a protocol error of the
+;; remote-error family, whose message says what was wrong, for the log.
 (define (netstring-fail . parts)
-  (raise (make-netstring-error (apply string-append parts))))
+  (apply protocol-fail "netstring" parts))
+
+;;> Whether \var{e} is the error for a bad netstring, or any other
+;;> protocol violation: the same family (remote-error.scm).
+(define netstring-error? remote-protocol-error?)
+
+;;> What was wrong with the netstring.
+(define netstring-error-message remote-error-message)
 
 (define (digit-byte? b) (and (>= b 48) (<= b 57)))
 
@@ -55,7 +57,7 @@
 
 ;;> Reads one netstring from the binary port \var{in} and returns its
 ;;> payload as a bytevector, or an eof object when the port ends cleanly
-;;> between frames.  Raises a \scheme{netstring-error} on anything else.
+;;> between frames.  Raises a protocol remote-error on anything else.
 (define (read-netstring in max)
   (or (take-buffered-netstring in max)  ; lib/murdoch/netstring.c: a whole frame
       (read-netstring-bytewise in max)))

@@ -2,6 +2,7 @@
   (export read-netstring write-netstring buffered-byte-count
           reset-output-string! nests-within?
           netstring-error? netstring-error-message)
-  (import (scheme base) (only (chibi) string-size))
+  (import (scheme base) (only (chibi) string-size)
+          (murdoch remote-error))
   (include-shared "netstring")
   (include "netstring.scm"))

@@ -1,3 +1,8 @@
+;;> The remote layer as one import: address spaces, remote-run! and
+;;> remote-apply (thesis §3.3.2), their errors, proxies and delivery, and
+;;> start-aspace!, which starts them.  Each part is a library of its own;
+;;> see lib/murdoch/remote.scm for their order.
+
 (define-library (murdoch remote)
   (export aspace? aspace-uid aspace-host aspace-port make-aspace
           local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
@@ -10,15 +15,9 @@
           remote-protocol-error?
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote undo-on-raise with-lock)
-  (import (scheme base) (scheme write) (scheme char)
-          (scheme time)
-          (srfi 1) (srfi 18) (srfi 69)
-          (rename (only (chibi) read) (read read-datum))
-          (only (chibi) call-with-output-string make-exception exception? string-size
-                exception-kind exception-irritants
-                strip-syntactic-closures)
-          (only (chibi filesystem) open-input-file-descriptor
-                open-output-file-descriptor)
-          (chibi net) (only (chibi string) string-prefix?)
-          (murdoch scheduler) (murdoch abandon) (murdoch connect) (murdoch multicast) (murdoch log) (murdoch netstring) (murdoch hmac) (murdoch sendable) (murdoch sandbox) (murdoch lab))
-  (include "remote.scm" "multicast.scm"))
+  (import (scheme base) (scheme write)
+          (murdoch log) (murdoch wait) (murdoch remote-error) (murdoch frame)
+          (murdoch lab) (murdoch sendable) (murdoch sandbox)
+          (murdoch aspace) (murdoch worker) (murdoch call) (murdoch serve)
+          (murdoch proxy) (murdoch delivery))
+  (include "remote.scm"))

@@ -1,11 +1,11 @@
-;;;; Multicast delivery: one datagram reaches the whole lab.
+;;;; Delivery: how publish and request reach the whole lab (thesis §4.1).
 ;;
 ;; The thesis sent each message to every machine in turn, for want of
 ;; broadcast in Kali (§4.1), and wished for IP multicast (§1.2).  With
 ;; (delivery multicast GROUP [PORT]) in the lab file, publish and the query
 ;; phase of request and request-exclusive go out as one datagram to the
 ;; lab's group; each address space answers the sender point to point over
-;; its TCP connection, with an answer frame (send-multicast-answer!), so
+;; its TCP connection, with an answer frame (send-datagram-answer!), so
 ;; the semantics are the broadcast's.  A message too large for a datagram
 ;; goes the broadcast way.
 ;;
@@ -31,12 +31,35 @@
 ;; beacons a second: with every one beaconing each second, each address
 ;; space of a lab of N would receive N a second, and the lab N squared.
 
+
+;;; Broadcast
+
+;;> remote-apply-all to every live address space (here too): by one
+;;> multicast datagram when the lab's delivery is multicast and the message
+;;> fits, else to each in turn.
+(define (broadcast-apply proc . args) (broadcast 'apply proc args))
+
+;;> remote-run-all! to every live address space, as broadcast-apply.
+(define (broadcast-run! proc . args) (broadcast 'run proc args))
+
+(define (broadcast kind proc args)
+  (check-not-abandoned (if (eq? kind 'run) "broadcast-run!" "broadcast-apply"))
+  (let ((seconds (current-timeout))
+        (proc-code (encode proc (lab-environment) "the procedure"))
+        (args-code (encode-arguments args)))
+    (or (multicast-call-all kind proc-code args-code proc args seconds)
+        (send-all (map uid->aspace (live-uids)) kind proc args
+                  proc-code args-code seconds))))
+
+;;; Multicast
+
 (define *multicast* #f)                 ; (socket . group address), or #f
 (define *sequence* 0)                   ; of the last datagram sent
 (define *sequence-lock* (make-mutex 'sequence))
 (define *started* 0)                    ; microseconds, at start-multicast!
 (define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
 (define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
+(define *last-heard-lock* (make-mutex 'last-heard))
 (define max-datagram 60000)
 (define lab-beacons-per-second 16)
 
@@ -52,7 +75,7 @@
                       (car (cddr delivery))
                       (+ (lab-port-base lab) 149))))
         (set! *multicast*
-              (cons (open-multicast-socket group port (aspace-host *local*))
+              (cons (open-multicast-socket group port (aspace-host (local-aspace)))
                     (get-address-info group port)))
         (set! *started* (clock-microseconds))
         (spawn listen-to-group 'multicast)
@@ -79,44 +102,27 @@
 (define (send-datagram! body)
   (let* ((sequence (next-sequence!))
          (text (call-with-output-string
-                 (lambda (o) (write-simple (list (aspace-uid *local*) sequence body) o))))
-         (bytes (string->utf8 (hmac-sha256-sign *key* text "mcast:"))))
+                 (lambda (o)
+                   (write-simple (list (local-aspace-uid) sequence body) o))))
+         (bytes (datagram-bytes text)))
     (and (<= (bytevector-length bytes) max-datagram)
          (begin (send (car *multicast*) bytes 0 (cdr *multicast*)) #t))))
 
 (define (send-beacons)
-  (send-datagram! `(beacon ,(aspace-uid *local*) ,(aspace-host *local*)
-                           ,(aspace-port *local*)))
+  (let ((me (local-aspace)))
+    (send-datagram! (make-message 'beacon (aspace-uid me) (aspace-host me)
+                                  (aspace-port me))))
   (let ((now (monotonic-seconds))
         (period (beacon-seconds)))
     (for-each (lambda (uid)
-                (if (< (hash-table-ref/default *last-heard* uid now)
+                (if (< (with-lock *last-heard-lock*
+                         (lambda ()
+                           (hash-table-ref/default *last-heard* uid now)))
                        (- now (* 3 period)))
                     (note-unreachable! uid)))
               (known-uids))
     (thread-sleep! period))
   (send-beacons))
-
-;;; The calls of one datagram, awaiting their answers
-
-(define *multicast-calls* (make-hash-table eqv?)) ; id -> ((uid . mailbox) ...)
-(define *next-multicast-id* 0)
-
-;; Hands an (answer ID KIND VALUE) frame from address space uid to the
-;; call that waits for it; one for a call no longer waited for is dropped.
-(define (take-multicast-answer! uid message)
-  (if (not (and (list? message) (= (length message) 4)
-                (exact-integer? (list-ref message 1))
-                (memq (list-ref message 2) '(ack value error))))
-      (frame-fail "expected an answer"))
-  (let* ((id (list-ref message 1))
-         (waiting (with-lock *peers-lock*
-                    (lambda () (hash-table-ref/default *multicast-calls* id '())))))
-    (cond ((assq uid waiting)
-           => (lambda (w)
-                (mailbox-put! (cdr w)
-                              (list (list-ref message 2) id (list-ref message 3))))))))
-
 ;; call-all over multicast, when it is on and the message fits a
 ;; datagram: answers call-all's list, or #f to send the broadcast way.
 (define (multicast-call-all kind proc-code args-code proc args seconds)
@@ -124,16 +130,9 @@
        (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                               (live-uids)))
               (waiting (map (lambda (uid) (cons uid (make-mailbox))) others))
-              (id (with-lock *peers-lock*
-                    (lambda ()
-                      (set! *next-multicast-id* (+ *next-multicast-id* 1))
-                      (hash-table-set! *multicast-calls* *next-multicast-id*
-                                       waiting)
-                      *next-multicast-id*))))
-         (define (forget!)
-           (with-lock *peers-lock*
-             (lambda () (hash-table-delete! *multicast-calls* id))))
-         (if (send-datagram! (list 'call id kind proc-code args-code))
+              (id (expect-answers! waiting)))
+         (define (forget!) (forget-answers! id))
+         (if (send-datagram! (make-message 'call id kind proc-code args-code))
              (let* ((here (capture (local-aspace-uid)
                                    (lambda () (local-call kind proc args))))
                     (deadline (+ (monotonic-seconds) seconds))
@@ -151,7 +150,7 @@
 
 ;;; Receiving
 ;;
-;; The group is read as a connection is (see Serving calls in remote.scm):
+;; The group is read as a connection is (serve.scm):
 ;; its listener applies a call itself, and the janitor gives the group a
 ;; new listener when an apply runs long.
 
@@ -176,48 +175,47 @@
               (lambda (to+id e)
                 (guard (e2 (#t (log-warn "an answer was lost: "
                                          (fault-message e2))))
-                  (send-multicast-answer! (car to+id) (cdr to+id) 'error
+                  (send-datagram-answer! (car to+id) (cdr to+id) 'error
                                           (error-message e))))
               (lambda (e) (log-warn "datagram dropped: " (fault-message e)))))
 
 ;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
 ;; bytes of buffer.
 (define (open-datagram buffer n)
-  (let ((d (parse-message (authentic-text buffer n "mcast:"))))
-    (if (not (and (list? d) (= (length d) 3) (symbol? (car d))
-                  (exact-integer? (cadr d))))
-        (frame-fail "not a datagram"))
-    (check-fresh (car d) (cadr d))
-    (hash-table-set! *last-sequence* (car d) (cadr d))
-    d))
+  (let ((d (check-datagram (open-datagram-text buffer n))))
+    (match d
+      ((sender sequence body)
+       (check-fresh sender sequence)
+       (hash-table-set! *last-sequence* sender sequence)
+       d))))
 
 (define (check-fresh sender sequence)
   (cond ((<= sequence (hash-table-ref/default *last-sequence* sender 0))
          (frame-fail "replayed or out of order"))
         ((< sequence *started*)
          (frame-fail "sent before this address space started"))
-        ((< sequence (- (clock-microseconds) (* 1000000 *frame-timeout*)))
+        ((< sequence (- (clock-microseconds) (* 1000000 (frame-timeout))))
          (frame-fail "older than frame-timeout"))))
 
 (define (serve-datagram s call d)
-  (let ((sender (car d)) (body (car (cddr d))))
-    (with-lock *peers-lock*
-      (lambda () (hash-table-set! *last-heard* sender (monotonic-seconds))))
-    (cond
-     ((eq? sender (aspace-uid *local*)) #f)   ; our own, looped back
-     ((and (pair? body) (eq? (car body) 'beacon) (= (length body) 4))
-      (learn-aspace! (make-aspace (list-ref body 1) (list-ref body 2)
-                                  (list-ref body 3)))
-      (with-lock *peers-lock*
-        (lambda () (hash-table-delete! *unreachable* sender))))
-     ((and (pair? body) (eq? (car body) 'call) (= (length body) 5))
-      (serve-multicast-call s call sender (cdr body)))
-     (else (frame-fail "not a beacon or a call")))))
+  (match d
+    ((sender sequence body)
+     (with-lock *last-heard-lock*
+       (lambda () (hash-table-set! *last-heard* sender (monotonic-seconds))))
+     (if (not (eq? sender (local-aspace-uid)))   ; else our own, looped back
+         (serve-body s call sender
+                     (check-message body '(beacon call) "a beacon or a call"))))))
 
-;; Runs a call that came by datagram (see serve-call), and answers its
-;; sender over TCP; an error is answered by receive-datagrams.
-(define (serve-multicast-call s call sender message)
-  (let ((id (car message)) (to (uid->aspace sender)))
-    (serve-call s call (cons to id) (cadr message)
-                (car (cddr message)) (cadr (cddr message))
-                (lambda (kind value) (send-multicast-answer! to id kind value)))))
+;; A beacon brings its sender (back) into the live set.  A call runs as
+;; serve-call runs one, and is answered to its sender over TCP; an error
+;; is answered by receive-datagrams.
+(define (serve-body s call sender body)
+  (match body
+    (('beacon uid host port)
+     (learn-aspace! (make-aspace uid host port))
+     (note-reachable! sender))
+    (('call id kind proc-code args-code)
+     (let ((to (uid->aspace sender)))
+       (serve-call s call (cons to id) kind proc-code args-code
+                   (lambda (kind value)
+                     (send-datagram-answer! to id kind value)))))))

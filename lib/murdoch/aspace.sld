@@ -1,0 +1,13 @@
+;;> Address spaces: the local one, the peers it knows, which of them
+;;> answer, and the settings every call reads.
+
+(define-library (murdoch aspace)
+  (export aspace? aspace-uid aspace-host aspace-port make-aspace
+          local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
+          learn-aspace! note-unreachable! note-reachable! unreachable-uids
+          live-uids current-lab join-lab!
+          remote-timeout set-remote-timeout! current-timeout
+          lab-environment decode-value describe-procedure)
+  (import (scheme base) (scheme time) (srfi 1) (srfi 18) (srfi 69)
+          (murdoch wait) (murdoch lab) (murdoch sendable) (murdoch sandbox))
+  (include "aspace.scm"))

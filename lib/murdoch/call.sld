@@ -1,0 +1,14 @@
+;;> remote-run! and remote-apply, their -all forms, and the waiting for
+;;> answers that delivery's datagram calls share.
+
+(define-library (murdoch call)
+  (export remote-run! remote-apply remote-apply-all remote-run-all!
+          encode-arguments send-all local-call capture
+          capture-each await-answer expect-answers! forget-answers!
+          take-datagram-answer! prober)
+  (import (scheme base) (srfi 1) (srfi 18) (srfi 69)
+          (chibi match)
+          (murdoch scheduler) (murdoch wait) (murdoch remote-error)
+          (murdoch abandon) (murdoch sendable) (murdoch aspace)
+          (murdoch connection) (murdoch worker))
+  (include "call.scm"))

@@ -1,0 +1,11 @@
+;;> The caller's side of the wire: one greeted connection to each address
+;;> space called, whose reader hands each answer to the call awaiting it.
+
+(define-library (murdoch connection)
+  (export connection-to send-call! give-up-call! send-datagram-answer!)
+  (import (scheme base) (srfi 18) (srfi 69)
+          (only (chibi string) string-prefix?)
+          (chibi match)
+          (murdoch scheduler) (murdoch wait) (murdoch remote-error)
+          (murdoch connect) (murdoch frame) (murdoch lab) (murdoch aspace))
+  (include "connection.scm"))

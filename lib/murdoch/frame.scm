@@ -1,0 +1,194 @@
+;;;; The wire: frames, and the one table of message kinds (thesis §3.3.2).
+;;
+;; Procedures travel between address spaces as S-expressions
+;; (sendable.scm), in frames.  Each connection is opened by the address
+;; space that calls; the callee only answers on it.  Every frame is a
+;; netstring whose payload is 64 hex digits of HMAC-SHA256 followed by an
+;; S-expression:
+;;
+;;   MAC = HMAC(key, NONCE ":" COUNT ":" S-EXPRESSION)
+;;
+;; where NONCE is the one the receiving side chose for this connection and
+;; COUNT numbers the frames sent in this direction from 1.  A recorded frame
+;; is thus worthless on another connection or at another place in this one.
+;;
+;;  1. Caller -> callee: (hello UID HOST PORT NONCE), MAC'd with nonce
+;;     "hello" and count 0.  HOST and PORT say where the caller listens.
+;;  2. Callee -> caller: (welcome UID NONCE), MAC'd with the caller's nonce
+;;     and count 0.  From here on each side uses the other's nonce.
+;;  3. Caller -> callee, any number, pipelined:
+;;       (run ID PROC ARGS)    apply in a worker thread, answer at once
+;;       (apply ID PROC ARGS)  apply, answer with the value (serve.scm says
+;;                             which thread applies it)
+;;       (answer ID KIND VALUE)  not answered: the answer to call ID of a
+;;                             multicast datagram from the callee
+;;       (abandon ID)          not answered: the caller gave up waiting for
+;;                             apply ID; the thread running it stops at its
+;;                             next remote call or robot command (abandon.scm)
+;;     PROC, ARGS and VALUE are encoded values (sendable.scm); ID is the
+;;     caller's, or for an answer the datagram sender's.
+;;  4. Callee -> caller, in any order:
+;;       (ack ID)  (value ID VALUE)  (error ID MESSAGE)
+;;
+;; A multicast datagram (delivery.scm) is 64 hex digits of HMAC-SHA256
+;; over "mcast:" and its text, then the text: (SENDER SEQUENCE BODY), BODY
+;; a beacon or a call.
+;;
+;; A frame that is not a netstring, fails its MAC, or is not one of the
+;; kinds in message-kinds closes its connection after one log line; the
+;; address space and its other connections carry on.  Nothing is evaluated
+;; before its MAC checks.
+
+;;; The message kinds
+
+(define (anything? x) #t)
+(define (answer-kind? x) (memq x '(ack value error)))
+(define (call-kind? x) (memq x '(run apply)))
+
+;; Every message: its kind, then its fields, each with its check.  The
+;; datagram has no kind word of its own; the rest begin with theirs.
+(define message-kinds
+  `((hello (uid ,symbol?) (host ,string?) (port ,exact-integer?)
+           (nonce ,string?))
+    (welcome (uid ,symbol?) (nonce ,string?))
+    (run (id ,exact-integer?) (proc ,anything?) (args ,list?))
+    (apply (id ,exact-integer?) (proc ,anything?) (args ,list?))
+    (answer (id ,exact-integer?) (kind ,answer-kind?) (value ,anything?))
+    (abandon (id ,exact-integer?))
+    (ack (id ,exact-integer?))
+    (value (id ,exact-integer?) (value ,anything?))
+    (error (id ,exact-integer?) (message ,string?))
+    (datagram (sender ,symbol?) (sequence ,exact-integer?) (body ,pair?))
+    (beacon (uid ,symbol?) (host ,string?) (port ,exact-integer?))
+    (call (id ,exact-integer?) (kind ,call-kind?) (proc ,anything?)
+          (args ,list?))))
+
+(define (message-fields kind)
+  (cond ((assq kind message-kinds) => cdr)
+        (else (error "no such message kind" kind))))
+
+;;> A message of \var{kind} with \var{fields}, which must be as many as
+;;> the table says.
+(define (make-message kind . fields)
+  (if (not (= (length fields) (length (message-fields kind))))
+      (error "wrong number of fields for a message" kind fields))
+  (cons kind fields))
+
+;;> \var{message} when it is one of \var{kinds} and each field passes its
+;;> check; else a protocol error, "expected WHAT".
+(define (check-message message kinds what)
+  (if (not (and (pair? message) (memq (car message) kinds)
+                (fields-pass? (cdr message) (message-fields (car message)))))
+      (frame-fail "expected " what))
+  message)
+
+;;> A datagram's (SENDER SEQUENCE BODY), checked as check-message does.
+(define (check-datagram d)
+  (if (not (fields-pass? d (message-fields 'datagram)))
+      (protocol-fail "datagram" "not a datagram"))
+  d)
+
+(define (fields-pass? values fields)
+  (cond ((null? fields) (null? values))
+        ((pair? values) (and ((cadr (car fields)) (car values))
+                             (fields-pass? (cdr values) (cdr fields))))
+        (else #f)))
+
+;;; Frames
+
+;; The lab's, set once when the address space starts (configure-wire!).
+(define *key* #f)
+(define *max-frame* 1048576)
+(define *max-depth* 4000)
+
+;;> Sets the lab's key and limits, once, before any frame.
+(define (configure-wire! key max-frame max-depth)
+  (set! *key* key)
+  (set! *max-frame* max-frame)
+  (set! *max-depth* max-depth))
+
+;; Each connection writes its frames' text to a string port of its own,
+;; emptied before each frame, so that a write that failed half-way leaves
+;; nothing behind (its writer holds the connection's lock): a new string
+;; port per frame costs Chibi a 4 KB allocation.
+(define (frame-text text-port message)
+  (reset-output-string! text-port)
+  (write-simple message text-port)
+  (let ((text (get-output-string text-port)))
+    ;; The receiver would refuse it and close the connection, failing the
+    ;; calls on it that had nothing to do with this one.
+    (if (> (+ 64 (string-size text)) *max-frame*)
+        (error (string-append "the message is larger than the lab's max-frame, "
+                              (number->string *max-frame*) " bytes")))
+    text))
+
+(define (write-frame! out text nonce count)
+  (write-netstring (hmac-sha256-sign *key* text nonce ":" count ":") out))
+
+(define (send-frame! out text-port nonce count message)
+  (write-frame! out (frame-text text-port message) nonce count)
+  (flush-output-port out))
+
+;; A frame that breaks the protocol raises a protocol remote-error; its
+;; connection closes.
+(define (frame-fail . parts)
+  (apply protocol-fail "frame" parts))
+
+;; The next frame's message, or an eof object when the peer closed.  A
+;; bad frame raises (see fault-message), and the connection's one handler
+;; closes it: a handler of its own for each frame would cost Chibi a
+;; continuation, 25 KB copied, on every message.
+(define (read-frame in nonce count)
+  (let ((payload (read-netstring in *max-frame*)))
+    (if (eof-object? payload)
+        payload
+        (parse-message
+         (authentic-text payload (bytevector-length payload)
+                         nonce ":" count ":")))))
+
+;; The text after the MAC in the first end bytes of bytes, once the MAC is
+;; that of the parts followed by the text.
+(define (authentic-text bytes end . parts)
+  (or (apply hmac-sha256-open *key* bytes end parts)
+      (frame-fail "bad MAC")))
+
+;; Chibi's own reader, in C: (scheme read) is SRFI 38's, written in
+;; Scheme and a hundred times slower.  The C reader recurses without
+;; bound and reads datum labels, which make cycles, so the text is first
+;; scanned for both (nests-within?): a message may nest twice max-depth,
+;; room for its envelope and for a value one level too deep, which
+;; decoding then refuses with an error answer; deeper, or with a label,
+;; it is a protocol violation.  Text that is no datum raises a read
+;; error; our writer puts nothing after the datum.
+(define (parse-message text)
+  (if (not (nests-within? text (* 2 *max-depth*)))
+      (frame-fail "nests deeper than twice max-depth, or has a datum label"))
+  (let* ((in (open-input-string text))
+         (message (read-datum in)))
+    (cond ((eof-object? message) (frame-fail "empty message"))
+          ((not (eof-object? (peek-char in))) (frame-fail "trailing data"))
+          (else message))))
+
+;; Whether e says that the other side broke the protocol.
+(define (protocol-fault? e)
+  (or (remote-protocol-error? e) (read-error? e)))
+
+;; What was wrong with a frame or datagram that raised e, for the log.
+(define (fault-message e)
+  (if (read-error? e)
+      (string-append "unreadable message: " (error-message e))
+      (error-message e)))
+
+;; The one log line of a connection closed for e.
+(define (log-fault peer e)
+  (log-warn "connection with " peer " closed: " (fault-message e)))
+
+;;; Datagrams
+
+;;> The bytes of a datagram carrying \var{text}, with its MAC.
+(define (datagram-bytes text)
+  (string->utf8 (hmac-sha256-sign *key* text "mcast:")))
+
+;;> The message of the authentic datagram in the first n bytes of buffer.
+(define (open-datagram-text buffer n)
+  (parse-message (authentic-text buffer n "mcast:")))

@@ -1,0 +1,349 @@
+;;;; Serving calls: the callee's side of the wire.
+;;
+;; Each connection has one reader thread, and the reader runs an apply
+;; itself: handing it to a worker cost a thread switch, about a seventh of
+;; a receiver's CPU a request.  So that a long apply holds up the calls
+;; behind it on its connection for takeover-seconds at most, the janitor
+;; then gives the connection a new reader; the old one answers its call
+;; and ends.
+
+;; A connection being served.  Its deadline is set while a frame is half
+;; read: a peer that stalls mid-frame would otherwise hold a thread and a
+;; socket for ever, so the janitor ends it when the deadline passes.
+(define-record-type serving
+  (make-serving peer host thread in out)
+  serving?
+  (peer serving-peer)
+  (host serving-host)
+  (thread serving-thread serving-thread-set!)  ; the reader
+  (in serving-in)
+  (out serving-out)
+  (deadline serving-deadline serving-deadline-set!)
+  (busy-since serving-busy-since serving-busy-since-set!) ; of an inline apply
+  (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
+  (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
+
+(define *serving* '())
+(define *serving-lock* (make-mutex 'serving))
+(define *frame-timeout* 5)
+(define *max-connections* 256)
+(define *max-connections-per-host* 64)
+(define janitor-seconds 0.1)
+(define takeover-seconds 0.1)
+
+(define (serve-connection fd peer host)
+  (let ((s (new-serving! peer host (open-input-file-descriptor fd #t)
+                         (open-output-file-descriptor fd #t))))
+    ;; The hello, which proves the key, is due within frame-timeout of the
+    ;; connect: anyone can connect, and an idle connection holds a
+    ;; descriptor.
+    (serving-deadline-set! s (+ (monotonic-seconds) *frame-timeout*))
+    (janitor-wanted!)
+    (read-as-reader s (lambda ()
+                        (let ((hello (read-served-frame s "hello" 0)))
+                          ;; A peer that connects and leaves at once is
+                          ;; probing the port.
+                          (if (not (eof-object? hello))
+                              (serve-calls s hello)))))))
+
+;; A connection (or the multicast group: no ports, no host) that this
+;; thread reads, among those the janitor watches.
+(define (new-serving! peer host in out)
+  (let ((s (make-serving peer host (current-thread) in out)))
+    (serving-deadline-set! s #f)
+    (serving-busy-since-set! s #f)
+    (serving-applying-set! s '())
+    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
+    s))
+
+;; Runs a reader's loop; the connection ends with it, unless the janitor
+;; has given it a new reader meanwhile.
+(define (read-as-reader s thunk)
+  (guard (e (#t (log-fault (serving-peer s) e)))
+    (thunk))
+  (if (reader? s) (end-serving! s)))
+
+(define (reader? s) (eq? (current-thread) (serving-thread s)))
+
+(define (end-serving! s)
+  (with-lock *serving-lock*
+    (lambda () (set! *serving* (remove (lambda (x) (eq? x s)) *serving*))))
+  (guard (e (#t #f)) (close-input-port (serving-in s)))
+  (guard (e (#t #f)) (close-output-port (serving-out s))))
+
+;; Waits as long as need be for a frame to begin, then gives it
+;; *frame-timeout* seconds to arrive whole: less when a deadline is
+;; already set (the hello's).
+(define (read-served-frame s nonce count)
+  (if (eof-object? (peek-u8 (serving-in s)))
+      (eof-object)
+      (begin
+        (serving-deadline-set! s (or (serving-deadline s)
+                                     (+ (monotonic-seconds) *frame-timeout*)))
+        (janitor-wanted!)
+        (let ((message (read-frame (serving-in s) nonce count)))
+          (serving-deadline-set! s #f)
+          message))))
+
+(define (janitor)
+  (thread-sleep! janitor-seconds)
+  (let ((now (monotonic-seconds)))
+    (for-each end-stalled! (serving-where serving-deadline now))
+    (for-each take-over! (serving-where serving-busy-since
+                                        (- now takeover-seconds))))
+  (rest-while-idle)
+  (janitor))
+
+;; The connections whose (moment s) is before time.
+(define (serving-where moment time)
+  (with-lock *serving-lock*
+    (lambda ()
+      (filter (lambda (s) (let ((t (moment s))) (and t (< t time))))
+              *serving*))))
+
+;; The janitor rests while no frame is half read and no apply runs in a
+;; reader: looking ten times a second cost an idle lab of 64 a twelfth of
+;; a core.  A reader that begins either wakes it (janitor-wanted!).  The
+;; janitor raises its flag before it looks and holds its mutex from the
+;; flag to the wait; a reader sets what it begins before it reads the flag.
+;; So either the look sees what the reader began, or the reader sees the
+;; flag and its wake-up finds the janitor waiting.
+(define *janitor-resting* #f)
+(define *janitor-mutex* (make-mutex 'janitor))
+(define *janitor-wake* (make-condition-variable 'janitor))
+
+(define (rest-while-idle)
+  (mutex-lock! *janitor-mutex*)
+  (set! *janitor-resting* #t)
+  (cond ((pair? (serving-where (lambda (s) (or (serving-deadline s)
+                                               (serving-busy-since s)))
+                               +inf.0))
+         (set! *janitor-resting* #f)
+         (mutex-unlock! *janitor-mutex*))
+        (else (mutex-unlock! *janitor-mutex* *janitor-wake*))))
+
+(define (janitor-wanted!)
+  (when *janitor-resting*
+    (mutex-lock! *janitor-mutex*)
+    (set! *janitor-resting* #f)
+    (condition-variable-signal! *janitor-wake*)
+    (mutex-unlock! *janitor-mutex*)))
+
+(define (end-stalled! s)
+  (log-warn "connection with " (serving-peer s)
+            " closed: no whole frame within frame-timeout")
+  (thread-terminate! (serving-thread s))
+  (end-serving! s))
+
+(define (take-over! s)
+  (mutex-lock! *serving-lock*)
+  (when (serving-busy-since s)          ; its apply may just have ended
+    (let ((t (make-guarded-thread
+              (lambda () (read-as-reader s (serving-read-on s)))
+              'connection)))
+      (serving-busy-since-set! s #f)
+      (serving-thread-set! s t)
+      (thread-start! t)))
+  (mutex-unlock! *serving-lock*))
+
+;; Marks the start and the end of the reader's inline apply of call id;
+;; ending answers whether this thread is still the reader.  Until it ends,
+;; the thread is found by id when its caller gives up.
+(define (inline-apply-begins! s id)
+  (mutex-lock! *serving-lock*)
+  (serving-applying-set! s (cons (cons id (current-thread))
+                                 (serving-applying s)))
+  (serving-busy-since-set! s (monotonic-seconds))
+  (mutex-unlock! *serving-lock*)
+  (janitor-wanted!))
+
+(define (inline-apply-ends! s)
+  (mutex-lock! *serving-lock*)
+  (let ((still (reader? s)))
+    (serving-applying-set! s (remove (lambda (a) (eq? (cdr a) (current-thread)))
+                                     (serving-applying s)))
+    (if still (serving-busy-since-set! s #f))
+    (mutex-unlock! *serving-lock*)
+    (if (abandoned?) (forget-abandoned! (current-thread)))
+    still))
+
+;; The caller of apply id gave up on it: its thread is marked, to stop
+;; where it next calls out (abandon.scm).  An apply already done is let be.
+(define (abandon-call! s id)
+  (let ((a (with-lock *serving-lock* (lambda () (assv id (serving-applying s))))))
+    (when a
+      (log-note "call " id " from " (serving-peer s) " abandoned by its caller;"
+                " it stops at its next remote call or robot command")
+      (abandon-thread! (cdr a)))))
+
+;; Runs (read-on call) while this thread is s's reader, under one handler
+;; for the thread's life: a handler per call would cost a continuation
+;; each (see undo-on-raise).  The car of call says which call the thread
+;; is running, if any; an error in it is answered by (answer-error call
+;; e), any other by (other-failure e), which may raise to end the reader.
+(define (read-calls s read-on answer-error other-failure)
+  (let ((call (list #f)))
+    (let again ()
+      (guard (e ((car call)
+                 => (lambda (c)
+                      (set-car! call #f)
+                      (let ((still (inline-apply-ends! s)))
+                        (answer-error c e)
+                        (if still (again)))))
+                (#t (other-failure e)
+                    (if (reader? s) (again))))
+        (read-on call)))))
+
+;; Runs a call that s's reader has read; (reply KIND VALUE) answers it.
+;; Until the answer is made the car of call is marker, for read-calls to
+;; answer an error with.  A run is acknowledged once its procedure is decoded, so that one
+;; that cannot be is reported to its caller, and runs in a worker; an apply
+;; runs here, until the janitor gives s a new reader, and its value goes
+;; back.
+(define (serve-call s call marker kind proc-code args-code reply)
+  (set-car! call marker)
+  (if (eq? kind 'run)
+      (let ((thunk (decode-call proc-code args-code)))
+        (set-car! call #f)
+        (reply 'ack #t)
+        (run-in-worker thunk))
+      (begin
+        (inline-apply-begins! s marker)
+        ;; Answered while the call is marked: a value that cannot go back
+        ;; (too large, say) is answered with the error instead.
+        (reply 'value (encoded-result proc-code args-code))
+        (set-car! call #f)
+        (inline-apply-ends! s))))
+
+(define (serve-calls s hello)
+  (match (check-message hello '(hello) "a hello")
+    (('hello uid host port caller-nonce)
+     ;; Where the caller listens, learned from its hello.
+     (learn-aspace! (make-aspace uid host port))
+     (serve-greeted s uid caller-nonce))))
+
+;; Welcomes the caller uid, then serves its frames.
+(define (serve-greeted s uid caller-nonce)
+  (let ((nonce (random-hex 16))
+        (out (serving-out s))
+        (text (open-output-string))
+        (write-lock (make-mutex))
+        (sent 0)
+        (count 0))
+    ;; The reader's own answers wait in the port's buffer until it has
+    ;; read every call that has arrived: a burst of calls is answered in
+    ;; one write.  Answers from former readers go at once.
+    (define (answer! message)
+      (with-lock write-lock
+        (lambda ()
+          (let ((frame (frame-text text message)))
+            (set! sent (+ sent 1))
+            ;; A caller that left makes this raise, and the connection end.
+            (write-frame! out frame caller-nonce sent))
+          (if (not (reader? s)) (flush-output-port out)))))
+    (define (flush-if-idle!)
+      (if (zero? (buffered-byte-count (serving-in s)))
+          (with-lock write-lock (lambda () (flush-output-port out)))))
+    ;; Serves frames while this thread is the reader; see read-calls.
+    (define (read-on call)
+      (let ((message (read-served-frame s nonce (+ count 1))))
+        (unless (eof-object? message)
+          (set! count (+ count 1))
+          (serve-frame s call uid answer!
+                       (check-message message '(run apply answer abandon)
+                                      "a call"))
+          (flush-if-idle!)
+          (if (reader? s) (read-on call)))))
+    (define (serve)
+      (read-calls s read-on
+                  (lambda (id e)
+                    (answer! (make-message 'error id (error-message e)))
+                    (flush-if-idle!))
+                  raise))
+    (send-frame! out text caller-nonce 0
+                 (make-message 'welcome (local-aspace-uid) nonce))
+    (serving-read-on-set! s serve)
+    (serve)))
+
+;; Serves one frame from the caller uid: a call, whose answer goes back
+;; by answer!; the answer to one of our datagram calls; or an abandon.
+(define (serve-frame s call uid answer! message)
+  (match message
+    (('answer . _) (take-datagram-answer! uid message))
+    (('abandon id) (abandon-call! s id))
+    ((kind id proc-code args-code)
+     (serve-call s call id kind proc-code args-code
+                 (lambda (kind value)
+                   (answer! (if (eq? kind 'ack)
+                                (make-message 'ack id)
+                                (make-message 'value id value))))))))
+
+;; The application a call asks for, as a thunk that runs it in the sandbox.
+(define (decode-call proc-code args-code)
+  (let ((proc (decode-value proc-code))
+        (args (decode-value args-code)))
+    (if (not (procedure? proc))
+        (error "not a procedure" proc))
+    (lambda () (call-in-sandbox (lambda () (apply proc args))))))
+
+;; What the application a call asks for answers, encoded to go back.
+(define (encoded-result proc-code args-code)
+  (encode ((decode-call proc-code args-code)) (lab-environment) "the result"))
+
+(define (peer-name sockaddr)
+  (string-append (sockaddr-name sockaddr) ":"
+                 (number->string (sockaddr-port sockaddr))))
+
+(define (accept-loop listener addr)
+  (let ((fd (accept listener (address-info-address addr)
+                    (address-info-address-length addr))))
+    (if fd
+        (let ((peer (peer-name (address-info-address addr)))
+              (host (sockaddr-name (address-info-address addr))))
+          (if (room-for? host)
+              (spawn (lambda () (serve-connection fd peer host)) 'connection)
+              (refuse-connection! fd peer))))
+    (accept-loop listener addr)))
+
+;; Whether a connection from host stays under the lab's caps, in all and
+;; from one host: past them, connections that never say hello could take
+;; every descriptor the process has.
+(define (room-for? host)
+  (with-lock *serving-lock*
+    (lambda ()
+      (let ((from-host (count (lambda (s) (equal? (serving-host s) host))
+                              *serving*)))
+        (and (< (length *serving*) *max-connections*)
+             (< from-host *max-connections-per-host*))))))
+
+(define *last-refusal* -inf.0)
+
+;; Closes a connection over the caps; the log tells of one a second.
+(define (refuse-connection! fd peer)
+  (close-port (open-input-file-descriptor fd #t))
+  (when (> (monotonic-seconds) (+ *last-refusal* 1))
+    (set! *last-refusal* (monotonic-seconds))
+    (log-warn "connection from " peer " refused: over max-connections"
+              " or max-connections-per-host")))
+
+;;> Starts serving calls to the local address space, under the limits of
+;;> \var{lab}: listens on its port, and starts the janitor.
+(define (start-serving! lab)
+  (set! *frame-timeout* (lab-setting lab 'frame-timeout))
+  (set! *max-connections* (lab-setting lab 'max-connections))
+  (set! *max-connections-per-host* (lab-setting lab 'max-connections-per-host))
+  (let* ((host (aspace-host (local-aspace)))
+         (port (aspace-port (local-aspace)))
+         (addr (get-address-info host port)))
+    (if (not addr) (error "cannot resolve the interface" host))
+    (let ((listener
+           (guard (e (#t (error (string-append "cannot listen on " host ":"
+                                               (number->string port)
+                                               " (is another process there?)"))))
+             (make-listener-socket addr))))
+      (spawn (lambda () (accept-loop listener addr)) 'accept)
+      (spawn janitor 'janitor))))
+
+;; Seconds a frame, once begun, has to arrive whole.
+(define (frame-timeout) *frame-timeout*)
+

@@ -1,0 +1,70 @@
+;;;; Waiting with a deadline: one clock, one way to wait.
+;;
+;; Every deadline in Murdoch is a moment on the monotonic clock
+;; (monotonic-seconds), and every wait for another thread is a mailbox or
+;; a mutex taken by a deadline: no loop sleeps and looks again.  (A wait
+;; for a socket is the scheduler's port-wait!.)
+
+;;> Applies \var{thunk} holding the mutex \var{m}, which it frees however
+;;> thunk leaves.
+(define (with-lock m thunk)
+  (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
+
+;; As with-lock, giving up with (too-late) when m is not free by the
+;; deadline, on the monotonic clock.
+(define (with-lock-by m deadline too-late thunk)
+  (if (mutex-lock! m (seconds-until deadline))
+      (dynamic-wind (lambda () #f) thunk (lambda () (mutex-unlock! m)))
+      (too-late)))
+
+;; Seconds from now to deadline, none if it has passed.
+(define (seconds-until deadline)
+  (max 0 (- deadline (monotonic-seconds))))
+
+;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
+;; dynamic-wind, not a guard: a guard takes a continuation, which costs
+;; Chibi a copy of the stack, 25 KB, each time, and these are on the path
+;; of every call.
+(define (undo-on-raise undo thunk)
+  (let ((done #f))
+    (dynamic-wind (lambda () #f)
+                  (lambda () (let ((value (thunk))) (set! done #t) value))
+                  (lambda () (if (not done) (undo))))))
+
+;; A one-shot mailbox: the reader thread puts an answer, the caller takes
+;; it or gives up at its deadline.
+(define-record-type mailbox
+  (%make-mailbox mutex condvar value full?)
+  mailbox?
+  (mutex mailbox-mutex)
+  (condvar mailbox-condvar)
+  (value mailbox-value mailbox-value-set!)
+  (full? mailbox-full? mailbox-full?-set!))
+
+(define (make-mailbox)
+  (%make-mailbox (make-mutex) (make-condition-variable) #f #f))
+
+(define (mailbox-put! mb value)
+  (mutex-lock! (mailbox-mutex mb))
+  (mailbox-value-set! mb value)
+  (mailbox-full?-set! mb #t)
+  (condition-variable-broadcast! (mailbox-condvar mb))
+  (mutex-unlock! (mailbox-mutex mb)))
+
+;; The mailbox's value, or (timed-out) once the deadline, on the monotonic
+;; clock, has passed.  Chibi's SRFI-18 time objects count whole seconds, so
+;; each wait is given as the seconds left.
+(define (mailbox-take mb deadline timed-out)
+  (let loop ()
+    (mutex-lock! (mailbox-mutex mb))
+    (if (mailbox-full? mb)
+        (begin (mutex-unlock! (mailbox-mutex mb))
+               (mailbox-value mb))
+        (let ((left (seconds-until deadline)))
+          (cond
+           ((and (positive? left)
+                 (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
+            (loop))
+           (else
+            (mutex-unlock! (mailbox-mutex mb))
+            (timed-out)))))))

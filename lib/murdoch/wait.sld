@@ -1,0 +1,9 @@
+;;> Waiting with a deadline: locks, one-shot mailboxes, and undoing on a
+;;> raise.  Deadlines are moments of (murdoch scheduler)'s
+;;> monotonic-seconds.
+
+(define-library (murdoch wait)
+  (export with-lock with-lock-by seconds-until undo-on-raise
+          make-mailbox mailbox-put! mailbox-take)
+  (import (scheme base) (srfi 18) (murdoch scheduler))
+  (include "wait.scm"))

@@ -1,0 +1,63 @@
+;;;; Workers: the threads that run what nobody waits for.
+
+;;> Starts thunk in a new thread named name, which received code cannot
+;;> stop (make-guarded-thread); if thunk raises, the log says so.
+(define (spawn thunk name)
+  (thread-start! (make-guarded-thread (lambda () (run-logged thunk name)) name)))
+
+(define (run-logged thunk name)
+  (guard (e (#t (log-warn name ": " (error-message e))))
+    (thunk)))
+
+;; A remote-run!'s procedure runs in a thread of its own, since its caller
+;; does not wait for it (an apply runs in the thread that read it: see
+;; serve.scm).  Making a thread costs Chibi more than the rest of a
+;; call, so a thread that is done waits a while for the next procedure to
+;; run instead of ending.
+(define *idle-workers* '())             ; mailboxes of waiting workers
+(define *workers-lock* (make-mutex 'workers))
+(define worker-idle-seconds 10)
+
+;; Runs thunk in a worker; if it raises, the log says so.
+(define (run-in-worker thunk)
+  (let ((idle (with-lock *workers-lock*
+                (lambda ()
+                  (and (pair? *idle-workers*)
+                       (let ((mb (car *idle-workers*)))
+                         (set! *idle-workers* (cdr *idle-workers*))
+                         mb))))))
+    (if idle
+        (mailbox-put! idle thunk)
+        (spawn (lambda () (work thunk)) 'worker))))
+
+;; One handler for the worker's whole life, entered again only after a job
+;; raised: a handler per job would cost a continuation each (see
+;; undo-on-raise).
+(define (work job)
+  (let serve ((job job))
+    (guard (e (#t (log-warn "worker: " (error-message e))
+                  (let ((next (next-job)))
+                    (if next (serve next)))))
+      (let loop ((job job))
+        (job)
+        (let ((next (next-job)))
+          (if next (loop next)))))))
+
+;; The next job for this worker, or #f when none came within
+;; worker-idle-seconds.
+(define (next-job)
+  (let ((mb (make-mailbox)))
+    (with-lock *workers-lock*
+      (lambda () (set! *idle-workers* (cons mb *idle-workers*))))
+    (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds)
+                      (lambda () #f))
+        ;; Timed out; but a caller may have taken this worker meanwhile, in
+        ;; which case its procedure is on the way.
+        (and (not (with-lock *workers-lock*
+                    (lambda ()
+                      (and (memq mb *idle-workers*)
+                           (begin (set! *idle-workers*
+                                        (delete mb *idle-workers* eq?))
+                                  #t)))))
+             ;; The job is on its way; an hour is only a bound.
+             (mailbox-take mb (+ (monotonic-seconds) 3600) (lambda () #f))))))
