@@ -40,5 +40,5 @@
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether!
           safe-im safe-battery-voltage safe-reckon)
-  (import (murdoch sendable) (murdoch remote) (murdoch pubsub)
+  (import (murdoch sendable) (murdoch remote) (murdoch pubsub) (murdoch monitor)
           (murdoch pose-task) (murdoch trip-client) (murdoch status)))

@@ -21,7 +21,10 @@
     (delivery (murdoch delivery))
     (remote (murdoch remote))
     (messaging (murdoch pubsub))
-    (tasks (murdoch assign) (murdoch pose-task) (murdoch status))
+    (monitors (murdoch monitor))
+    (task-parts (murdoch assign) (murdoch progress) (murdoch metric))
+    (team (murdoch team))
+    (tasks (murdoch pose-task) (murdoch status))
     (interface (murdoch))
     (commands (murdoch command) (murdoch launch))))
 

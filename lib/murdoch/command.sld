@@ -10,5 +10,6 @@
           (only (srfi 151) bitwise-ior)
           (murdoch log)
           (murdoch sandbox) (murdoch guard) (murdoch lab) (murdoch remote) (murdoch pubsub)
+          (murdoch monitor)
           (murdoch trip-client))
   (include "command.scm"))

@@ -1,3 +1,8 @@
+;;> pose-task: the negotiation that gives a task's components their
+;;> robots, and runs them as a team.  Exports the metrics and teams of
+;;> (murdoch metric) and (murdoch team) with it, as the thesis's
+;;> new-task.scm had them.
+
 (define-library (murdoch pose-task)
   (export pose-task negotiate pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
@@ -14,6 +19,6 @@
           (only (chibi) call-with-output-string)
           (only (chibi process) current-process-id)
           (murdoch log) (murdoch abandon) (murdoch sendable) (murdoch sandbox)
-          (murdoch remote) (murdoch pubsub)
-          (murdoch trip-client) (murdoch assign))
+          (murdoch remote) (murdoch pubsub) (murdoch assign)
+          (murdoch progress) (murdoch metric) (murdoch team))
   (include "pose-task.scm"))

@@ -1,5 +1,4 @@
-;;;; Publish/subscribe messaging (thesis §4.1, appendix A.8 publish.scm,
-;;;; A.2 initial.scm, A.6 monitor.scm).
+;;;; Publish/subscribe messaging (thesis §4.1, appendix A.8 publish.scm).
 ;;
 ;; Each address space keeps its own subscription list: the subjects it
 ;; answers to, each free or reserved.  A message is addressed to a subject
@@ -285,6 +284,11 @@
 ;;> Seconds an unapplied promise holds its subjects.
 (define (set-lease! seconds) (set! *lease* seconds))
 
+;;> Starts freeing the subjects of promises unapplied for \var{seconds}.
+(define (start-leases! seconds)
+  (set-lease! seconds)
+  (thread-start! (make-thread lease-keeper 'lease-keeper)))
+
 ;; A subject is free for task when it is free or already held by task: two
 ;; components of one task may both get a promise from one robot, and
 ;; conflict resolution gives that robot at most one of them.
@@ -404,119 +408,3 @@
                           (< (reservation-deadline r) (monotonic-seconds)))
                         *reservations*))))
   (lease-keeper))
-
-;;; Monitors (A.6): capabilities that come and go with the machine's state
-
-(define *battery-charging* 130)         ; tenths of a volt
-(define *battery-low* 100)
-
-;; A string, as in the thesis, where it crossed differently byte-ordered
-;; machines.
-(define *load-threshold* ".75")
-
-;; Received code reads these and cannot assign them (sandbox.scm): a
-;; setting meant to change changes through its procedure.
-
-;;> Sets *battery-charging*, the voltage in tenths above which a robot is
-;;> taken to be on its charging tether.
-(define (set-battery-charging! tenths) (set! *battery-charging* tenths))
-
-;;> Sets *battery-low*, in tenths of a volt.
-(define (set-battery-low! tenths) (set! *battery-low* tenths))
-
-;;> Sets *load-threshold*, a string such as ".75": below it the load
-;;> monitor subscribes to idle.
-(define (set-load-threshold! load) (set! *load-threshold* load))
-
-(define *monitor-period* 60)
-(define *load-source* #f)               ; a thunk answering a number
-
-;;> This machine's load as a string, e.g. "0.42": from the lab's (load ...)
-;;> clause, else the one-minute average of /proc/loadavg.
-(define (get-system-load)
-  (number->string (*load-source*)))
-
-(define (start-thread! name thunk)
-  (thread-start! (make-thread thunk name)))
-
-(define *load-monitor-thread* #f)
-(define *battery-monitor-thread* #f)
-
-;; A monitor keeps subject in the subscription list while present? holds,
-;; looking every *monitor-period* seconds.
-(define (watch subject present?)
-  (lambda ()
-    (let loop ()
-      (if (present?) (subscribe subject) (unsubscribe subject))
-      (thread-sleep! *monitor-period*)
-      (loop))))
-
-;; Starts a monitor thread, terminating the one it replaces, as A.6 does.
-(define (restart-monitor! old name thunk)
-  (if (thread? old)
-      (begin (log-warn "terminating the running " name " thread")
-             (thread-terminate! old)))
-  (start-thread! name thunk))
-
-(define load-monitor-procedure
-  (watch 'idle
-         (lambda ()
-           (< (string->number (get-system-load))
-              (string->number *load-threshold*)))))
-
-(define battery-monitor-procedure
-  (watch 'untethered
-         (lambda () (< (safe-battery-voltage) *battery-charging*))))
-
-;;> Subscribes to idle while the load is under *load-threshold*.
-(define (load-monitor)
-  (set! *load-monitor-thread*
-        (restart-monitor! *load-monitor-thread* 'load-monitor
-                          load-monitor-procedure))
-  #t)
-
-;;> Subscribes to untethered while the battery is under
-;;> *battery-charging*, as when its charging tether is off.
-(define (battery-monitor)
-  (set! *battery-monitor-thread*
-        (restart-monitor! *battery-monitor-thread* 'battery-monitor
-                          battery-monitor-procedure))
-  #t)
-
-;;; Initialization (A.2), from the lab file rather than host names
-
-;; The lab's (load L) or (load ((SECONDS L) ...)): a fixed load, or one
-;; that steps to each L at SECONDS after start; else /proc/loadavg.
-(define (load-source clause)
-  (let ((start (monotonic-seconds)))
-    (cond
-     ((not clause) read-loadavg)
-     ((number? (cadr clause)) (lambda () (cadr clause)))
-     (else
-      (let ((steps (cadr clause)))
-        (lambda ()
-          (let ((now (- (monotonic-seconds) start)))
-            (fold (lambda (step load) (if (>= now (car step)) (cadr step) load))
-                  (cadr (car steps))
-                  steps))))))))
-
-(define (read-loadavg)
-  (call-with-input-file "/proc/loadavg"
-    (lambda (in) (read in))))
-
-;;> Sets up this address space's subscriptions and monitors from its lab
-;;> clause (the thesis's make-subscription-initializer): all, its uid, its
-;;> capabilities; idle through load-monitor; untethered through
-;;> battery-monitor on robots.
-(define (initialize-subscriptions! lab entry)
-  (set! *monitor-period* (lab-setting lab 'monitor-period))
-  (set! *lease* (lab-setting lab 'lease))
-  (set! *load-source* (load-source (and entry (lab-aspace-clause entry 'load))))
-  (for-each subscribe (list 'all (local-aspace-uid)))
-  (for-each subscribe
-            (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
-                  (else '())))
-  (load-monitor)
-  (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))
-  (start-thread! 'lease-keeper lease-keeper)
-  #t)

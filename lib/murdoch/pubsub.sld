@@ -5,12 +5,8 @@
           capability-layout check-subjects
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive set-lease!
-          get-system-load load-monitor battery-monitor
-          *battery-charging* *battery-low* *load-threshold*
-          set-battery-charging! set-battery-low! set-load-threshold!
-          initialize-subscriptions!)
-  (import (scheme base) (scheme read) (scheme file) (only (murdoch scheduler) monotonic-seconds)
+          receive-request-non-exclusive set-lease! start-leases!)
+  (import (scheme base) (only (murdoch scheduler) monotonic-seconds)
           (srfi 1) (srfi 18)
-          (murdoch log) (murdoch lab) (murdoch remote) (murdoch trip-client))
+          (murdoch log) (murdoch lab) (murdoch remote))
   (include "pubsub.scm"))

@@ -1,0 +1,192 @@
+;;;; Metrics (thesis §4.2, appendix A.7): how a component ranks its
+;;;; candidates.
+
+;; A metric compares two candidates, (uid promise-or-result) entries, and
+;; answers #t when the first is better, as in the thesis.  Those made here
+;; also carry their keys, what they compare by, in order: a measure with
+;; the tolerance within which two candidates tie, or a comparator.  So
+;; pose-task can ask each candidate once per measure, not once per
+;; comparison: the same choice, fewer messages; and optimal assignment
+;; has the numbers it adds up.  A measure is a procedure of a uid, or an
+;; asking: what a candidate answers to one procedure, scored here, which
+;; pose-task sends to every candidate at once.
+(define-record-type asking
+  (make-asking proc score)
+  asking?
+  (proc asking-proc)
+  (score asking-score))
+
+(define-record-type measure-key
+  (make-measure-key measure tolerance)
+  measure-key?
+  (measure measure-key-measure)
+  (tolerance measure-key-tolerance))
+
+;; A metric of keys that compares as the thesis's metrics do.
+(define (keyed-metric keys)
+  (lambda (entry1 entry2)
+    (keys-better? keys (key-values keys entry1) (key-values keys entry2))))
+
+(define keyed-metric-code (procedure-code (keyed-metric '())))
+
+;; The keys of metric: its own when made here; any other procedure is its
+;; one comparator; #f, no metric, has none.
+(define (metric-keys metric)
+  (cond ((not (procedure? metric)) '())
+        ((and (not (opcode? metric))
+              (eq? (procedure-code metric) keyed-metric-code))
+         (vector-ref (procedure-vars metric) 0))
+        (else (list metric))))
+
+;; The measure of a metric by one measure, else #f.
+(define (metric-measure metric)
+  (let ((keys (metric-keys metric)))
+    (and (= (length keys) 1) (measure-key? (car keys))
+         (measure-key-measure (car keys)))))
+
+;; What a key compares of one candidate: its measure, or the entry itself.
+(define (key-values keys entry)
+  (map (lambda (key)
+         (if (measure-key? key)
+             (measure-one (measure-key-measure key) (car entry))
+             entry))
+       keys))
+
+;; Whether values as are better than bs by the first key that does not
+;; tie them.  Ties within a tolerance are judged pair by pair, so three
+;; candidates may tie two by two and still not all three.
+(define (keys-better? keys as bs)
+  (and (pair? keys)
+       (cond ((key-better? (car keys) (car as) (car bs)) #t)
+             ((or (null? (cdr keys)) (key-better? (car keys) (car bs) (car as))) #f)
+             (else (keys-better? (cdr keys) (cdr as) (cdr bs))))))
+
+(define (key-better? key a b)
+  (if (measure-key? key)
+      (< a (- b (measure-key-tolerance key)))
+      (key a b)))
+
+;;> A metric that prefers the candidate with the smaller
+;;> \scheme{(measure uid)}: a number for a candidate's uid.
+(define (metric-by measure)
+  (keyed-metric (list (make-measure-key measure 0))))
+
+;;> A metric that prefers the candidate whose answer to \var{proc},
+;;> applied there, has the smaller \scheme{(score answer)}.  pose-task
+;;> asks all of a component's candidates with one message each.
+(define (metric-by-asking proc score)
+  (metric-by (make-asking proc score)))
+
+;;> \var{metric}, a metric by one measure (metric-by, metric-by-asking,
+;;> the makers below), counting two candidates whose measures differ by
+;;> at most \var{tolerance} as tied, for compose-metrics to decide.
+(define (metric-within tolerance metric)
+  (let ((measure (metric-measure metric)))
+    (if (not (and measure (real? tolerance) (>= tolerance 0)))
+        (error "metric-within: a tolerance >= 0 and a metric by one measure"
+               tolerance metric))
+    (keyed-metric (list (make-measure-key measure tolerance)))))
+
+;;> A metric that compares by the first of \var{metrics}; where it ties
+;;> two candidates, by the next; and so on.  pose-task measures each
+;;> candidate once per measure of them all; a comparator among them (a
+;;> metric that is a plain procedure) ties only when it prefers neither.
+(define (compose-metrics . metrics)
+  (for-each (lambda (m)
+              (if (not (procedure? m))
+                  (error "compose-metrics: a metric is a procedure" m)))
+            metrics)
+  (keyed-metric (append-map metric-keys metrics)))
+
+(define (measure-one measure uid)
+  (if (asking? measure)
+      ((asking-score measure) (ask uid (asking-proc measure)))
+      (measure uid)))
+
+;;> The distance in mm between two reckon positions, (x y theta 0).
+(define (reckon-distance-between p q)
+  (let ((dx (- (car p) (car q))) (dy (- (cadr p) (cadr q))))
+    (sqrt (+ (* dx dx) (* dy dy)))))
+
+;; What candidate uid answers to proc, asked point to point.
+(define (ask uid proc)
+  (remote-apply (uid->aspace uid) proc))
+
+;;> Prefers the candidate closest to \var{target}, (x y theta 0) as reckon
+;;> answers, by each candidate's safe-reckon.
+(define (location-metric-maker target)
+  (metric-by-asking safe-reckon
+                    (lambda (position) (reckon-distance-between target position))))
+
+;;> Prefers the candidate with the lowest system load.
+(define (load-metric-maker)
+  (metric-by-asking get-system-load string->number))
+
+;;> The load metric of Figure 4.6.
+(define load-metric (load-metric-maker))
+
+;;> The opposite preference: the worst candidate by \var{metric} first,
+;;> ties as they were.
+(define (reverse-metric metric)
+  (keyed-metric (map reverse-key (metric-keys metric))))
+
+(define (reverse-key key)
+  (if (measure-key? key)
+      (make-measure-key (negated (measure-key-measure key))
+                        (measure-key-tolerance key))
+      (lambda (a b) (key b a))))
+
+(define (negated measure)
+  (if (asking? measure)
+      (let ((score (asking-score measure)))
+        (make-asking (asking-proc measure) (lambda (a) (- (score a)))))
+      (lambda (uid) (- (measure uid)))))
+
+;;> Sorts a component's candidates by its metric, best first; no metric:
+;;> at random.
+(define (sort-response response metric)
+  (let ((keys (metric-keys metric)))
+    (map cdr (sort-measured (measured-response response keys) keys))))
+
+;; Each candidate as (values . entry), its values by keys: each measure
+;; asked of every candidate at once, once.
+(define (measured-response response keys)
+  (apply map
+         (lambda (entry . values) (cons values entry))
+         response
+         (map (lambda (key)
+                (if (measure-key? key)
+                    (measured-told (measure-key-measure key) (map car response))
+                    response))
+              keys)))
+
+(define (measured-told measure uids)
+  (let ((measures (measure-all measure uids)))
+    (progress "  measured " (map list uids measures))
+    measures))
+
+(define (sort-measured measured keys)
+  (if (null? keys)
+      (shuffle measured)
+      (list-sort (lambda (a b) (keys-better? keys (car a) (car b))) measured)))
+
+;; Measures every candidate at once: the answers' round trips overlap.  A
+;; candidate that cannot be measured (it died, did not answer in time, or
+;; its answer does not score) measures +inf.0, and so comes last.
+(define (measure-all measure uids)
+  (if (asking? measure)
+      (map (lambda (answer)
+             (let ((score (and (cadr answer)
+                               (guard (e (#t #f))
+                                 ((asking-score measure) (car (cddr answer)))))))
+               (if (real? score) score +inf.0)))
+           (remote-apply-all (map uid->aspace uids) (asking-proc measure)))
+      (map thread-join!
+           (map (lambda (uid)
+                  (thread-start!
+                   (make-thread (lambda () (guard (e (#t +inf.0)) (measure uid))))))
+                uids))))
+
+(define (shuffle ls)
+  (map cdr (list-sort (lambda (a b) (< (car a) (car b)))
+                      (map (lambda (x) (cons (random-real) x)) ls))))
