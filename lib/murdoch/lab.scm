@@ -78,6 +78,10 @@
     (frame-timeout 5 ,seconds)
     (lease 30 ,seconds)
     (monitor-period 60 ,seconds)
+    ;; A started task's components and their poser hear from each other
+    ;; every heartbeat seconds (task.scm).
+    (heartbeat 0.5 ,seconds)
+    (max-attempts 3 ,positive-count)
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" (,size-bytes . "bytes, or a size in quotes such as \"512M\""))
