@@ -23,15 +23,19 @@
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!
-          ;; pose-task and dynamic teams (lib/murdoch/pose-task.scm)
+          ;; pose-task, metrics and dynamic teams (lib/murdoch/pose-task.scm,
+          ;; metric.scm, team.scm)
           pose-task negotiate pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
-          pose-task-backoff receive-rival pose-negotiations
+          pose-task-backoff pose-task-excluded receive-rival pose-negotiations
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
+          ;; the task life cycle (lib/murdoch/task.scm)
+          start-task task? task-id task-name task-status task-wait cancel-task
+          tasks run-component component-heartbeat! stop-component!
           ;; what the lab is doing (lib/murdoch/status.scm)
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/trip-client.scm)
@@ -41,4 +45,5 @@
           buttons-read lights say battery-voltage tethered? set-tether!
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch sendable) (murdoch remote) (murdoch pubsub) (murdoch monitor)
-          (murdoch pose-task) (murdoch trip-client) (murdoch status)))
+          (murdoch pose-task) (murdoch task) (murdoch trip-client)
+          (murdoch status)))

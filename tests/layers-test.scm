@@ -24,7 +24,8 @@
     (monitors (murdoch monitor))
     (task-parts (murdoch assign) (murdoch progress) (murdoch metric))
     (team (murdoch team))
-    (tasks (murdoch pose-task) (murdoch status))
+    (tasks (murdoch pose-task))
+    (life-cycle (murdoch task) (murdoch status))
     (interface (murdoch))
     (commands (murdoch command) (murdoch launch))))
 

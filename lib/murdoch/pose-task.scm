@@ -35,9 +35,13 @@
 ;;> random below this, doubled for each try before it.
 (define pose-task-backoff (make-parameter 0.1))
 
+;;> Robots that pose-task gives no component to: a task that lost a
+;;> robot renegotiates without it (task.scm).
+(define pose-task-excluded (make-parameter '()))
+
 (for-each sandbox-parameter!
           (list pose-task-assignment pose-task-priority pose-task-retries
-                pose-task-backoff))
+                pose-task-backoff pose-task-excluded))
 
 ;; Whether a component needs resources to itself, from its layout.
 (define (component-type layout)
@@ -156,9 +160,11 @@
 (define (try task)
   (let* ((type-list (pose-type-list task))
          (responses (map (lambda (layout type proc)
-                           (if (eq? type 'exclusive)
-                               (request-exclusive layout (pose-name task) proc)
-                               (request (cadr layout) t)))
+                           (without-excluded
+                            type
+                            (if (eq? type 'exclusive)
+                                (request-exclusive layout (pose-name task) proc)
+                                (request (cadr layout) t))))
                          (pose-layouts task) type-list (pose-procs task))))
     (for-each (lambda (i layout response)
                 (progress "  component " i " needs " layout ": candidates "
@@ -207,6 +213,16 @@
   (if (not (memq (pose-task-assignment) '(greedy optimal)))
       (error "pose-task: (pose-task-assignment) is greedy or optimal"
              (pose-task-assignment))))
+
+;; response without the robots of (pose-task-excluded), whose promises
+;; are freed.
+(define (without-excluded type response)
+  (let ((excluded (pose-task-excluded)))
+    (if (null? excluded)
+        response
+        (let ((out (filter (lambda (e) (memq (car e) excluded)) response)))
+          (release-runners-up (list out) (list type) '())
+          (remove (lambda (e) (memq e out)) response)))))
 
 ;; Frees every promise but the winners' and answers outcome.
 (define (give-up responses type-list outcome)

@@ -4,9 +4,9 @@
 ;;> new-task.scm had them.
 
 (define-library (murdoch pose-task)
-  (export pose-task negotiate pose-task-progress task-timeout
+  (export pose-task negotiate check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
-          pose-task-backoff receive-rival pose-negotiations
+          pose-task-backoff pose-task-excluded receive-rival pose-negotiations
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between sort-response resolve-conflicts

@@ -1,0 +1,391 @@
+;;;; Tasks that survive failure: the task life cycle (after MURDOCH 2002).
+;;
+;; pose-task blocks until its components are done, as in the thesis.
+;; start-task poses the same task and answers at once with a task record,
+;; which task-status, task-wait and cancel-task read and act on, and it
+;; keeps watch over each component while it runs:
+;;
+;;  1. The task is negotiated as pose-task negotiates it.
+;;  2. Each component runs on its robot inside run-component, which
+;;     registers it there.  Every (lab-setting lab 'heartbeat) seconds the
+;;     poser remote-applies component-heartbeat! on the robot: an answer
+;;     tells the poser that the robot lives, its arrival tells the robot
+;;     that its poser does.
+;;  3. A component's robot is lost when it is silent for three heartbeat
+;;     periods, when its address space is gone (the call's connection is
+;;     lost), or when the component raises a robot failure: its trip
+;;     connection closed, or its base stalled.  A restartable component
+;;     is then negotiated again, without the robots it had and those of
+;;     the task's other components, and started again, on at most
+;;     max-attempts robots in all.  Any other component is failed, as is
+;;     one that raises an ordinary error, as pose-task reports it.
+;;  4. A component whose poser is silent for three periods stops on its
+;;     robot, at its next robot command or remote call (abandon.scm), and
+;;     so frees its reservation: no orphans.  The same rule stops the
+;;     component of a robot cut off from its poser, which the poser
+;;     declares lost, before it can come back: no ghosts.
+;;  5. cancel-task stops every component on its robot so, at once, and
+;;     what is still being negotiated is freed when the negotiation ends.
+
+;;; The poser's side
+
+(define-record-type task
+  (make-task id name components done)
+  task?
+  (id task-id)
+  (name task-name)
+  (components task-components)          ; a list of components
+  (done task-done)                      ; a mailbox: the results, once done
+  (state task-state task-state-set!))   ; negotiating running done cancelled
+
+(define-record-type component
+  (make-component index capabilities metric proc restartable?)
+  component?
+  (index component-index)
+  (capabilities component-capabilities)
+  (metric component-metric)
+  (proc component-proc)
+  (restartable? component-restartable?)
+  ;; (negotiating), (running UID SINCE), (done VALUE), (failed WHY) or
+  ;; (reassigned FROM TO); SINCE is a (current-second).
+  (state component-state component-state-set!)
+  (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
+
+(define *posed* '())                    ; the tasks started here, newest first
+(define *tasks-lock* (make-mutex 'tasks))
+(define *started* 0)
+
+;;> Poses a task as pose-task does, with the same arguments, and answers
+;;> at once with its task record.  \var{options} are the components'
+;;> priorities (as pose-task's), and then a list with a boolean for each
+;;> component: #t when a component whose robot is lost may be given to
+;;> another robot (see the header of lib/murdoch/task.scm); by default
+;;> none may, and a lost robot's component fails, as in the thesis.
+(define (start-task task-name num-robots capability-list metrics procs . options)
+  (let ((priorities (if (pair? options) (car options) (iota num-robots num-robots -1)))
+        (restartable (if (and (pair? options) (pair? (cdr options)))
+                         (cadr options)
+                         (make-list num-robots #f))))
+    (check-task task-name num-robots capability-list metrics procs priorities)
+    (if (not (and (list? restartable) (= (length restartable) num-robots)
+                  (every boolean? restartable)))
+        (error "start-task: restartable is a list of a boolean for each component"
+               restartable))
+    (let ((t (new-task task-name capability-list metrics procs restartable)))
+      (thread-start!
+       (make-thread (inheriting
+                     (lambda () (run-task t priorities)))
+                    (task-id t)))
+      t)))
+
+(define (new-task task-name capability-list metrics procs restartable)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (set! *started* (+ *started* 1))
+      (let ((t (make-task
+                (string->symbol (string-append (symbol->string task-name) "@"
+                                               (symbol->string (local-aspace-uid))
+                                               "/" (number->string *started*)))
+                task-name
+                (map (lambda (k caps metric proc r)
+                       (let ((c (make-component k caps metric proc r)))
+                         (component-state-set! c '(negotiating))
+                         (component-attempts-set! c '())
+                         c))
+                     (iota (length procs) 1) capability-list metrics procs
+                     restartable)
+                (make-mailbox))))
+        (task-state-set! t 'negotiating)
+        (set! *posed* (cons t *posed*))
+        t))))
+
+;; thunk, to run in a new thread with this thread's pose-task settings:
+;; a thread does not inherit its maker's parameters.
+(define (inheriting thunk)
+  (let ((port (pose-task-progress)) (priority (pose-task-priority))
+        (assignment (pose-task-assignment)) (seconds (task-timeout)))
+    (lambda ()
+      (parameterize ((pose-task-progress port) (pose-task-priority priority)
+                     (pose-task-assignment assignment) (task-timeout seconds))
+        (thunk)))))
+
+;; Negotiates t, runs its components, each watched over by a thread of
+;; its own, and puts their results in t's mailbox.
+(define (run-task t priorities)
+  (let* ((cs (task-components t))
+         (team (negotiate (task-name t) (length cs)
+                          (map component-capabilities cs)
+                          (map component-metric cs) (map component-proc cs)
+                          priorities)))
+    (cond
+     ((symbol? team)
+      (for-each (lambda (c) (component-state-set! c (list 'failed team))) cs)
+      (finish! t team))
+     ((eq? (task-state t) 'cancelled)
+      (for-each (lambda (winner type) (free-winner! winner type)) (car team) (cadr team))
+      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
+      (finish! t (map component-result cs)))
+     (else
+      (task-state-set! t 'running)
+      (for-each thread-join!
+                (map (lambda (c winner type)
+                       (thread-start!
+                        (make-thread (inheriting
+                                      (lambda ()
+                                        (supervise t c (car winner)
+                                                   (work-for winner type c)))))))
+                     cs (car team) (cadr team)))
+      (finish! t (map component-result cs))))))
+
+(define (finish! t results)
+  (if (not (eq? (task-state t) 'cancelled)) (task-state-set! t 'done))
+  (progress (task-id t) ": " (task-state t))
+  (mailbox-put! (task-done t) results))
+
+;; What a winner runs: (proc arg ...), a promise applied to #t for an
+;; exclusive component.
+(define (work-for winner type c)
+  (if (eq? type 'exclusive)
+      (list (cadr winner) #t)
+      (list (component-proc c))))
+
+(define (free-winner! winner type)
+  (if (eq? type 'exclusive)
+      (guard (e (#t #f)) ((cadr winner) #f))))
+
+;; Runs component c on uid, and again elsewhere while its robot is lost
+;; and it may be restarted.
+(define (supervise t c uid work)
+  (component-state-set! c (list 'running uid (current-second)))
+  (progress "  component " (component-index c) " starts on " uid)
+  (let ((outcome (attempt t c uid work)))
+    (component-attempts-set! c (append (component-attempts c)
+                                       (list (cons uid outcome))))
+    (progress "  component " (component-index c) " on " uid ": " outcome)
+    (cond
+     ((eq? (task-state t) 'cancelled)
+      (component-state-set! c '(failed "cancelled")))
+     ((and (eq? (car outcome) 'lost) (restart? c))
+      (let ((next (renegotiate t c)))
+        (cond
+         (next
+          (component-state-set! c (list 'reassigned uid (car next)))
+          (progress "  component " (component-index c) " reassigned from "
+                    uid " to " (car next))
+          (supervise t c (car next) (cdr next)))
+         (else
+          (component-state-set!
+           c (list 'failed (string-append (cadr outcome)
+                                          "; no other capable robot is free")))))))
+     ((eq? (car outcome) 'done) (component-state-set! c outcome))
+     (else (component-state-set! c (list 'failed (cadr outcome)))))))
+
+(define (restart? c)
+  (and (component-restartable? c)
+       (< (length (component-attempts c))
+          (lab-setting (current-lab) 'max-attempts))))
+
+;; The next robot for c, (uid proc arg ...), or #f: c is negotiated alone,
+;; without the robots it had, nor those of the task's other components.
+(define (renegotiate t c)
+  (parameterize ((pose-task-excluded
+                  (append (map car (component-attempts c))
+                          (filter-map (lambda (other)
+                                        (and (eq? (car (component-state other)) 'running)
+                                             (cadr (component-state other))))
+                                      (task-components t)))))
+    (let ((team (negotiate (task-name t) 1 (list (component-capabilities c))
+                           (list (component-metric c)) (list (component-proc c)))))
+      (and (pair? team)
+           (cons (car (caar team)) (work-for (caar team) (caadr team) c))))))
+
+;; One run of c on uid, watched by heartbeats: (done VALUE), (failed WHY)
+;; or (lost WHY).
+(define (attempt t c uid work)
+  (let* ((a (uid->aspace uid))
+         (period (lab-setting (current-lab) 'heartbeat))
+         (answer (make-mailbox))
+         (runner (make-thread
+                  (call-there a answer (task-id t) (component-index c)
+                              (local-aspace-uid) period work))))
+    (thread-start! runner)
+    (let watch ((heard (monotonic-seconds)))
+      (let ((got (mailbox-take answer (+ (monotonic-seconds) period)
+                               (lambda () #f))))
+        (cond
+         (got (outcome-of got))
+         ((heartbeat a (task-id t) (component-index c) period)
+          (watch (monotonic-seconds)))
+         ((> (- (monotonic-seconds) heard) (* 3 period))
+          (thread-interrupt! runner)    ; its call is given up
+          (list 'lost (string-append (symbol->string uid)
+                                     " silent for three heartbeats")))
+         (else (watch heard)))))))
+
+;; A thunk that runs work on a inside run-component, and puts (value V)
+;; or (raised E) in the mailbox answer.
+(define (call-there a answer id k poser period work)
+  (let ((seconds (task-timeout)))
+    (lambda ()
+      (mailbox-put!
+       answer
+       (guard (e (#t (list 'raised e)))
+         (list 'value
+               (parameterize ((remote-timeout seconds))
+                 (remote-apply a (sendable-lambda ()
+                                   (run-component id k poser period work))))))))))
+
+;; Whether the robot a answered a heartbeat within a period.
+(define (heartbeat a id k period)
+  (guard (e (#t #f))
+    (parameterize ((remote-timeout period))
+      (remote-apply a (sendable-lambda () (component-heartbeat! id k)))
+      #t)))
+
+(define (outcome-of answer)
+  (let ((what (cadr answer)))
+    (cond
+     ((eq? (car answer) 'value)
+      (if (and (pair? what) (eq? (car what) 'robot-failure))
+          (list 'lost (cadr what))
+          (list 'done what)))
+     ((remote-unreachable-error? what) (list 'lost (remote-error-message what)))
+     ((remote-error? what) (list 'failed (remote-error-message what)))
+     (else (list 'failed (error-message what))))))
+
+;; A component's result, as pose-task gives it: its value, or (error UID
+;; WHY) with the last robot it had.
+(define (component-result c)
+  (let ((state (component-state c)))
+    (if (eq? (car state) 'done)
+        (cadr state)
+        (list 'error (let ((last (last-pair (component-attempts c))))
+                       (and (pair? last) (caar last)))
+              (cadr state)))))
+
+;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS):
+;;> STATE is (negotiating), (running UID SINCE), (done VALUE), (failed
+;;> WHY) or (reassigned FROM TO), SINCE a (current-second); ATTEMPTS has
+;;> (UID . OUTCOME) for each robot that had the component and is done
+;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
+(define (task-status task)
+  (check-task-record "task-status" task)
+  (map (lambda (c)
+         (list (component-index c) (component-state c) (component-attempts c)))
+       (task-components task)))
+
+;;> Waits for \var{task} to end, at most \var{seconds} (default: for
+;;> ever), and answers what pose-task would have: each component's result,
+;;> (error UID WHY) for a failed one, or not-enough-takers.  Raises an
+;;> error naming the task when the time runs out.
+(define (task-wait task . seconds)
+  (check-task-record "task-wait" task)
+  (let ((s (if (pair? seconds) (car seconds) +inf.0)))
+    (mailbox-take (task-done task) (+ (monotonic-seconds) s)
+                  (lambda ()
+                    (error (string-append "task-wait: " (symbol->string (task-id task))
+                                          " is not done within "
+                                          (number->string s) " s"))))))
+
+;;> Cancels \var{task}: every running component stops on its robot at its
+;;> next robot command or remote call, its robot stops, and every
+;;> reservation is freed.  Answers #t.
+(define (cancel-task task)
+  (check-task-record "cancel-task" task)
+  (task-state-set! task 'cancelled)
+  (for-each (lambda (c)
+              (let ((state (component-state c)))
+                (if (eq? (car state) 'running)
+                    (stop-there (cadr state) (task-id task) (component-index c)))))
+            (task-components task))
+  #t)
+
+(define (stop-there uid id k)
+  (guard (e (#t (log-warn "cancel: " uid " did not hear it: " (error-message e))))
+    (parameterize ((remote-timeout 1))
+      (remote-apply (uid->aspace uid) (sendable-lambda () (stop-component! id k))))))
+
+(define (check-task-record who x)
+  (if (not (task? x))
+      (error (string-append who ": not a task; start-task answers one") x)))
+
+;;> The tasks of this address space: (posed ID STATE) for each it started,
+;;> newest first, and (running ID INDEX POSER) for each component it runs.
+(define (tasks)
+  (append (map (lambda (t) (list 'posed (task-id t) (task-state t)))
+               (with-lock *tasks-lock* (lambda () *posed*)))
+          (map (lambda (r) (list 'running (running-id r) (running-index r)
+                                 (running-poser r)))
+               (with-lock *running-lock* (lambda () *running*)))))
+
+;;; The robot's side
+
+;; A component running here.
+(define-record-type running
+  (make-running id index poser thread heard)
+  running?
+  (id running-id)
+  (index running-index)
+  (poser running-poser)
+  (thread running-thread)
+  (heard running-heard running-heard-set!)    ; monotonic-seconds
+  (over? running-over? running-over?-set!))
+
+(define *running* '())
+(define *running-lock* (make-mutex 'running))
+
+;;> Runs component \var{k} of task \var{id} here, for \var{poser}, which
+;;> sends a heartbeat every \var{period} seconds: work is (PROC ARG ...).
+;;> A robot failure comes back as (robot-failure WHY).
+(define (run-component id k poser period work)
+  (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
+    (running-over?-set! r #f)
+    (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
+    (thread-start! (make-thread (lambda () (watch-poser r period)) 'watch-poser))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       (guard (e ((robot-failure? e) (list 'robot-failure (error-message e))))
+         (apply (car work) (cdr work))))
+     (lambda ()
+       (running-over?-set! r #t)
+       (with-lock *running-lock*
+         (lambda () (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+
+;; A trip connection closed or a stalled base: the robot, not the task,
+;; failed.
+(define (robot-failure? e)
+  (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
+
+;; Stops r when its poser is silent for three periods.
+(define (watch-poser r period)
+  (thread-sleep! period)
+  (cond ((running-over? r) #t)
+        ((> (- (monotonic-seconds) (running-heard r)) (* 3 period))
+         (log-warn "the poser " (running-poser r) " of " (running-id r)
+                   " is silent: component " (running-index r) " stops")
+         (stop-running! r))
+        (else (watch-poser r period))))
+
+(define (stop-running! r)
+  (abandon-thread! (running-thread r))
+  (guard (e (#t #f)) (stop-base)))      ; when this address space has a robot
+
+(define (find-running id k)
+  (with-lock *running-lock*
+    (lambda ()
+      (find (lambda (r) (and (eq? (running-id r) id) (= (running-index r) k)))
+            *running*))))
+
+;;> A heartbeat from the poser of component \var{k} of task \var{id}:
+;;> answers whether it runs here.
+(define (component-heartbeat! id k)
+  (let ((r (find-running id k)))
+    (if r (running-heard-set! r (monotonic-seconds)))
+    (and r #t)))
+
+;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
+(define (stop-component! id k)
+  (let ((r (find-running id k)))
+    (if r (stop-running! r))
+    (and r #t)))

@@ -1,0 +1,15 @@
+;;> The task life cycle: start-task answers a task record at once;
+;;> task-status, task-wait, cancel-task and tasks read and act on it; the
+;;> components are watched by heartbeats, and a lost robot's restartable
+;;> component is given to another.  See lib/murdoch/task.scm's header.
+
+(define-library (murdoch task)
+  (export start-task task? task-id task-name task-status task-wait cancel-task
+          tasks run-component component-heartbeat! stop-component!)
+  (import (scheme base) (scheme cxr) (scheme time) (srfi 1) (srfi 18)
+          (only (chibi ast) thread-interrupt!)
+          (murdoch scheduler) (murdoch log) (murdoch wait) (murdoch abandon)
+          (murdoch remote-error) (murdoch sendable) (murdoch lab)
+          (murdoch remote) (murdoch trip-client) (murdoch progress)
+          (murdoch team) (murdoch pose-task))
+  (include "task.scm"))
