@@ -23,7 +23,10 @@ NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
 native: $(NATIVE_MODULES) bench/c-pingpong
 
 lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
-	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $<
+	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< $(NATIVE_LIBS_$*)
+
+# HMAC-SHA256 and the constant-time comparison are OpenSSL's.
+NATIVE_LIBS_hmac = -lcrypto
 
 bench/c-pingpong: bench/c-pingpong.c
 	$(CC) $(NATIVE_CFLAGS) -o $@ bench/c-pingpong.c

@@ -1,7 +1,9 @@
 #!/bin/sh
 # Install what Murdoch needs on a Debian machine, idempotently.
 #
-# 1. Debian 12 packages: a C/C++ tool chain and Box2D (for the simulator).
+# 1. Debian 12 packages: a C/C++ tool chain, Box2D (for the simulator),
+#    OpenSSL's libcrypto (HMAC), iproute2 (the network-namespace test) and
+#    Chromium (the browser test of the live view).
 # 2. Chibi-Scheme >= 0.10: used as is when on PATH; otherwise Debian
 #    unstable's 0.12 binaries are unpacked into .deps/chibi together with
 #    unstable's libc (they need glibc >= 2.38), and .deps/bin/chibi-scheme
@@ -26,7 +28,8 @@ need_root() {
 
 install_debian_packages() {
     missing=""
-    for p in build-essential g++ libbox2d-dev netcat-openbsd clang; do
+    for p in build-essential g++ libbox2d-dev netcat-openbsd clang libssl-dev \
+             iproute2 chromium; do
         dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
     done
     [ -z "$missing" ] && return 0
