@@ -36,6 +36,8 @@
           ;; the task life cycle (lib/murdoch/task.scm)
           start-task task? task-id task-name task-status task-wait cancel-task
           tasks run-component component-heartbeat! stop-component!
+          task-step start-steps pose-steps with-coordinator team-barrier
+          team-send! team-receive
           ;; what the lab is doing (lib/murdoch/status.scm)
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/trip-client.scm)
@@ -45,5 +47,6 @@
           buttons-read lights say battery-voltage tethered? set-tether!
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch sendable) (murdoch remote) (murdoch pubsub) (murdoch monitor)
-          (murdoch pose-task) (murdoch task) (murdoch trip-client)
+          (murdoch pose-task) (murdoch task) (murdoch component) (murdoch trip-client)
+          (only (murdoch team) with-coordinator team-barrier team-send! team-receive)
           (murdoch status)))

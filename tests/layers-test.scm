@@ -24,7 +24,7 @@
     (monitors (murdoch monitor))
     (task-parts (murdoch assign) (murdoch progress) (murdoch metric))
     (team (murdoch team))
-    (tasks (murdoch pose-task))
+    (tasks (murdoch pose-task) (murdoch component))
     (life-cycle (murdoch task) (murdoch status))
     (interface (murdoch))
     (commands (murdoch command) (murdoch launch))))

@@ -26,6 +26,8 @@
 ;;     declares lost, before it can come back: no ghosts.
 ;;  5. cancel-task stops every component on its robot so, at once, and
 ;;     what is still being negotiated is freed when the negotiation ends.
+;;
+;; A task of steps (start-steps) is a sequence of such tasks, one a step.
 
 ;;; The poser's side
 
@@ -36,7 +38,9 @@
   (name task-name)
   (components task-components)          ; a list of components
   (done task-done)                      ; a mailbox: the results, once done
-  (state task-state task-state-set!))   ; negotiating running done cancelled
+  (state task-state task-state-set!)    ; negotiating running done failed cancelled
+  (team task-team task-team-set!)       ; its robots, in component order
+  (steps task-steps task-steps-set!))   ; of a task of steps, those started
 
 (define-record-type component
   (make-component index capabilities metric proc restartable?)
@@ -96,6 +100,8 @@
                      restartable)
                 (make-mailbox))))
         (task-state-set! t 'negotiating)
+        (task-team-set! t '())
+        (task-steps-set! t #f)
         (set! *posed* (cons t *posed*))
         t))))
 
@@ -127,6 +133,7 @@
       (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
+      (task-team-set! t (map car (car team)))
       (for-each thread-join!
                 (map (lambda (c winner type)
                        (thread-start!
@@ -138,7 +145,7 @@
       (finish! t (map component-result cs))))))
 
 (define (finish! t results)
-  (if (not (eq? (task-state t) 'cancelled)) (task-state-set! t 'done))
+  (if (memq (task-state t) '(negotiating running)) (task-state-set! t 'done))
   (progress (task-id t) ": " (task-state t))
   (mailbox-put! (task-done t) results))
 
@@ -170,6 +177,8 @@
         (cond
          (next
           (component-state-set! c (list 'reassigned uid (car next)))
+          (task-team-set! t (map (lambda (u) (if (eq? u uid) (car next) u))
+                                 (task-team t)))
           (progress "  component " (component-index c) " reassigned from "
                     uid " to " (car next))
           (supervise t c (car next) (cdr next)))
@@ -270,9 +279,13 @@
 ;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
 (define (task-status task)
   (check-task-record "task-status" task)
-  (map (lambda (c)
-         (list (component-index c) (component-state c) (component-attempts c)))
-       (task-components task)))
+  (if (task-steps task)
+      (map (lambda (i sub) (list 'step i (task-status sub)))
+           (iota (length (task-steps task)) 1) (task-steps task))
+      (map (lambda (c)
+             (list (component-index c) (component-state c)
+                   (component-attempts c)))
+           (task-components task))))
 
 ;;> Waits for \var{task} to end, at most \var{seconds} (default: for
 ;;> ever), and answers what pose-task would have: each component's result,
@@ -280,12 +293,18 @@
 ;;> error naming the task when the time runs out.
 (define (task-wait task . seconds)
   (check-task-record "task-wait" task)
-  (let ((s (if (pair? seconds) (car seconds) +inf.0)))
-    (mailbox-take (task-done task) (+ (monotonic-seconds) s)
-                  (lambda ()
-                    (error (string-append "task-wait: " (symbol->string (task-id task))
-                                          " is not done within "
-                                          (number->string s) " s"))))))
+  (if (pair? seconds)
+      (mailbox-take (task-done task) (+ (monotonic-seconds) (car seconds))
+                    (lambda ()
+                      (error (string-append "task-wait: "
+                                            (symbol->string (task-id task))
+                                            " is not done within "
+                                            (number->string (car seconds)) " s"))))
+      ;; A wait takes a finite timeout: an hour at a time.
+      (let loop ()
+        (or (mailbox-take (task-done task) (+ (monotonic-seconds) 3600)
+                          (lambda () #f))
+            (loop)))))
 
 ;;> Cancels \var{task}: every running component stops on its robot at its
 ;;> next robot command or remote call, its robot stops, and every
@@ -293,6 +312,7 @@
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
   (task-state-set! task 'cancelled)
+  (if (task-steps task) (for-each cancel-task (task-steps task)))
   (for-each (lambda (c)
               (let ((state (component-state c)))
                 (if (eq? (car state) 'running)
@@ -314,78 +334,110 @@
 (define (tasks)
   (append (map (lambda (t) (list 'posed (task-id t) (task-state t)))
                (with-lock *tasks-lock* (lambda () *posed*)))
-          (map (lambda (r) (list 'running (running-id r) (running-index r)
-                                 (running-poser r)))
-               (with-lock *running-lock* (lambda () *running*)))))
+          (map (lambda (r) (cons 'running r)) (components-running))))
 
-;;; The robot's side
+;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
+;;; synchronization)
+;;
+;; A task of steps runs its steps in order, each a task as start-task runs
+;; one: a step starts when every component of the step before is done (a
+;; barrier), and its procedures are applied to that step's results.  Its
+;; components may ask for a robot that had a component of an earlier step,
+;; so that a team keeps its members, and run as a team: team-barrier,
+;; team-send! and team-receive (team.scm) reach the other members.  A step
+;; with a failed component stops the task; everything is freed as each
+;; step's components end.
 
-;; A component running here.
-(define-record-type running
-  (make-running id index poser thread heard)
-  running?
-  (id running-id)
-  (index running-index)
-  (poser running-poser)
-  (thread running-thread)
-  (heard running-heard running-heard-set!)    ; monotonic-seconds
-  (over? running-over? running-over?-set!))
+(define-record-type step
+  (make-step capabilities metrics procs options)
+  step?
+  (capabilities step-capabilities)
+  (metrics step-metrics)
+  (procs step-procs)
+  (options step-options))
 
-(define *running* '())
-(define *running-lock* (make-mutex 'running))
+;;> A step of a task of steps: start-task's lists, one entry per component,
+;;> then optionally its priorities and its restartable list.  A capability
+;;> entry (same J K) asks for the robot that had component K of step J.
+;;> Each procedure is applied to the list of the step before's results
+;;> ('() for the first step), on its robot, as a member of the step's team.
+(define (task-step capability-list metrics procs . options)
+  (if (not (and (list? capability-list) (list? metrics) (list? procs)
+                (= (length capability-list) (length metrics) (length procs))))
+      (error "task-step: capabilities, metrics and procedures are lists of one length"))
+  (make-step capability-list metrics procs options))
 
-;;> Runs component \var{k} of task \var{id} here, for \var{poser}, which
-;;> sends a heartbeat every \var{period} seconds: work is (PROC ARG ...).
-;;> A robot failure comes back as (robot-failure WHY).
-(define (run-component id k poser period work)
-  (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
-    (running-over?-set! r #f)
-    (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
-    (thread-start! (make-thread (lambda () (watch-poser r period)) 'watch-poser))
-    (dynamic-wind
-     (lambda () #f)
-     (lambda ()
-       (guard (e ((robot-failure? e) (list 'robot-failure (error-message e))))
-         (apply (car work) (cdr work))))
-     (lambda ()
-       (running-over?-set! r #t)
-       (with-lock *running-lock*
-         (lambda () (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+;;> Starts a task of \var{steps} (made by task-step) and answers its task
+;;> record at once.  task-status gives (step I STATUS) for each step
+;;> started, task-wait the list of each step's results, and cancel-task
+;;> stops the step running and those after it.
+(define (start-steps task-name . steps)
+  (if (not (and (symbol? task-name) (pair? steps) (every step? steps)))
+      (error "start-steps: a task name, then one or more steps made by task-step"))
+  (for-each check-same steps (iota (length steps) 1))
+  (let ((t (new-task task-name '() '() '() '())))
+    (task-steps-set! t '())
+    (thread-start! (make-thread (inheriting (lambda () (run-steps t steps)))
+                                (task-id t)))
+    t))
 
-;; A trip connection closed or a stalled base: the robot, not the task,
-;; failed.
-(define (robot-failure? e)
-  (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
+;;> Runs a task of steps and answers, as task-wait, each step's results.
+(define (pose-steps task-name . steps)
+  (task-wait (apply start-steps task-name steps)))
 
-;; Stops r when its poser is silent for three periods.
-(define (watch-poser r period)
-  (thread-sleep! period)
-  (cond ((running-over? r) #t)
-        ((> (- (monotonic-seconds) (running-heard r)) (* 3 period))
-         (log-warn "the poser " (running-poser r) " of " (running-id r)
-                   " is silent: component " (running-index r) " stops")
-         (stop-running! r))
-        (else (watch-poser r period))))
+(define (same? capability)
+  (and (pair? capability) (eq? (car capability) 'same)))
 
-(define (stop-running! r)
-  (abandon-thread! (running-thread r))
-  (guard (e (#t #f)) (stop-base)))      ; when this address space has a robot
+;; A (same J K) entry of step i names a component of an earlier step.
+(define (check-same s i)
+  (for-each (lambda (c)
+              (if (and (same? c)
+                       (not (and (= (length c) 3) (exact-integer? (cadr c))
+                                 (< 0 (cadr c) i) (exact-integer? (car (cddr c))))))
+                  (error "task-step: (same J K) names component K of a step J before this one"
+                         c)))
+            (step-capabilities s)))
 
-(define (find-running id k)
-  (with-lock *running-lock*
-    (lambda ()
-      (find (lambda (r) (and (eq? (running-id r) id) (= (running-index r) k)))
-            *running*))))
+(define (run-steps t steps)
+  (let loop ((i 1) (steps steps) (previous '()) (results '()))
+    (cond
+     ((or (null? steps) (eq? (task-state t) 'cancelled))
+      (finish! t (reverse results)))
+     (else
+      (let* ((sub #f)
+             (coordinator (make-coordinator (lambda () (if sub (task-team sub) '()))))
+             (step-results
+              (begin
+                (set! sub (start-step t (car steps) i previous coordinator))
+                (task-steps-set! t (append (task-steps t) (list sub)))
+                (task-wait sub))))
+        (release-proxy! coordinator)
+        (progress (task-id t) ": step " i " done: " step-results)
+        (if (step-failed? step-results)
+            (begin (if (not (eq? (task-state t) 'cancelled)) (task-state-set! t 'failed))
+                   (finish! t (reverse (cons step-results results))))
+            (loop (+ i 1) (cdr steps) step-results (cons step-results results))))))))
 
-;;> A heartbeat from the poser of component \var{k} of task \var{id}:
-;;> answers whether it runs here.
-(define (component-heartbeat! id k)
-  (let ((r (find-running id k)))
-    (if r (running-heard-set! r (monotonic-seconds)))
-    (and r #t)))
+(define (step-failed? results)
+  (or (symbol? results)
+      (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
 
-;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
-(define (stop-component! id k)
-  (let ((r (find-running id k)))
-    (if r (stop-running! r))
-    (and r #t)))
+;; Starts step number i of t as a task of its own.
+(define (start-step t s i previous coordinator)
+  (apply start-task (task-name t) (length (step-procs s))
+         (map (lambda (c) (if (same? c) (same-robot t c) c)) (step-capabilities s))
+         (map (lambda (c m) (if (same? c) #f m))
+              (step-capabilities s) (step-metrics s))
+         (map (lambda (p)
+                (sendable-lambda ()
+                  (with-coordinator coordinator (lambda () (p previous)))))
+              (step-procs s))
+         (step-options s)))
+
+;; The capabilities of the robot that (same J K) names: its uid, to
+;; itself.
+(define (same-robot t c)
+  (let ((team (task-team (list-ref (task-steps t) (- (cadr c) 1)))))
+    (if (> (car (cddr c)) (length team))
+        (error "task-step: no such component" c))
+    (list (list (list-ref team (- (car (cddr c)) 1))) '())))

@@ -5,11 +5,11 @@
 
 (define-library (murdoch task)
   (export start-task task? task-id task-name task-status task-wait cancel-task
-          tasks run-component component-heartbeat! stop-component!)
+          tasks task-step start-steps pose-steps)
   (import (scheme base) (scheme cxr) (scheme time) (srfi 1) (srfi 18)
           (only (chibi ast) thread-interrupt!)
           (murdoch scheduler) (murdoch log) (murdoch wait) (murdoch abandon)
           (murdoch remote-error) (murdoch sendable) (murdoch lab)
-          (murdoch remote) (murdoch trip-client) (murdoch progress)
-          (murdoch team) (murdoch pose-task))
+          (murdoch remote) (murdoch progress)
+          (murdoch team) (murdoch pose-task) (murdoch component))
   (include "task.scm"))

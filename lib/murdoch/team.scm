@@ -132,6 +132,102 @@
     (log-warn "component on " uid " failed: " message)
     (list 'error uid message)))
 
+;;; Synchronization inside a team, MOVER's way
+;;
+;; The members of a team running one step of a task wait for each other at
+;; named barriers and pass values to each other by uid, through the team's
+;; coordinator: a proxy (encap) made where the task was posed, which every
+;; member calls.  The poser runs the step's procedures inside
+;; with-coordinator, so a member finds its team and coordinator where it
+;; runs, whichever robot that is.
+
+;; The coordinator of the team being run here, or #f.
+(define current-coordinator (make-parameter #f))
+(sandbox-parameter! current-coordinator)
+
+;;> Runs \var{thunk} as a member of the team whose coordinator is
+;;> \var{coordinator}: team-barrier, team-send! and team-receive reach it,
+;;> and current-team is its robots.
+(define (with-coordinator coordinator thunk)
+  (parameterize ((current-coordinator coordinator)
+                 (current-team (coordinator 'team)))
+    (thunk)))
+
+(define (team-coordinator who)
+  (or (current-coordinator)
+      (error (string-append who ": not inside a team's step"))))
+
+;;> Waits until every member of the current team has come to the barrier
+;;> \var{name}, at most \var{seconds} (default: (task-timeout)); raises an
+;;> error naming the members that did not come, when they run out.
+(define (team-barrier name . seconds)
+  (let ((s (if (pair? seconds) (car seconds) (task-timeout)))
+        (c (team-coordinator "team-barrier")))
+    (parameterize ((remote-timeout (+ s 1)))
+      (let ((missing (c 'arrive name (local-aspace-uid) s)))
+        (if (pair? missing)
+            (error (string-append "team-barrier " (symbol->string name)
+                                  ": timed out waiting for")
+                   missing))
+        #t))))
+
+;;> Sends \var{value} to the member \var{uid} of the current team.
+(define (team-send! uid value)
+  ((team-coordinator "team-send!") 'send uid (local-aspace-uid) value)
+  #t)
+
+;;> The next value a member sent to this one, as (FROM . VALUE), waiting at
+;;> most \var{seconds} (default: (task-timeout)); raises an error when none
+;;> comes in time.
+(define (team-receive . seconds)
+  (let ((s (if (pair? seconds) (car seconds) (task-timeout)))
+        (c (team-coordinator "team-receive")))
+    (parameterize ((remote-timeout (+ s 1)))
+      (or (c 'receive (local-aspace-uid) s)
+          (error "team-receive: nothing came within" s)))))
+
+;;> A coordinator for a team, as a proxy: (COORDINATOR 'team) is its
+;;> robots, which \var{team-of} answers, once they are chosen.  Release it
+;;> with release-proxy! when the team is done.
+(define (make-coordinator team-of)
+  (let ((arrived '()) (inboxes '())
+        (lock (make-mutex 'team)) (changed (make-condition-variable 'team)))
+    (define (wait-until done? seconds)
+      (let ((deadline (+ (monotonic-seconds) seconds)))
+        (let loop ()
+          (mutex-lock! lock)
+          (cond ((done?) => (lambda (x) (mutex-unlock! lock) x))
+                ((and (< (monotonic-seconds) deadline)
+                      (mutex-unlock! lock changed (seconds-until deadline)))
+                 (loop))
+                (else (mutex-unlock! lock) #f)))))
+    (define (change! thunk)
+      (with-lock lock thunk)
+      (condition-variable-broadcast! changed))
+    (define (arrive name uid seconds)
+      (let ((missing (lambda ()
+                       (remove (lambda (u) (member (cons name u) arrived))
+                               (team-of)))))
+        (change! (lambda () (set! arrived (cons (cons name uid) arrived))))
+        (if (wait-until (lambda () (null? (missing))) seconds)
+            '()
+            (with-lock lock missing))))
+    (define (send to from value)
+      (change! (lambda () (set! inboxes (append inboxes (list (list to from value)))))))
+    (define (receive uid seconds)
+      (wait-until (lambda ()
+                    (let ((m (assq uid inboxes)))
+                      (and m (begin (set! inboxes (remove (lambda (x) (eq? x m)) inboxes))
+                                    (cons (cadr m) (car (cddr m)))))))
+                  seconds))
+    (encap (lambda (op . args)
+             (case op
+               ((team) (team-of))
+               ((arrive) (apply arrive args))
+               ((send) (apply send args))
+               ((receive) (apply receive args))
+               (else (error "a coordinator does not know" op)))))))
+
 ;;; What the thesis's task procedures call
 
 ;;> The procedure that answers #t, as the thesis's tasks use it.

@@ -1,0 +1,79 @@
+;;;; The robot's side of the task life cycle (task.scm): the components
+;;;; of started tasks that run here, each watched for its poser's
+;;;; heartbeats.
+
+
+;; A component running here.
+(define-record-type running
+  (make-running id index poser thread heard)
+  running?
+  (id running-id)
+  (index running-index)
+  (poser running-poser)
+  (thread running-thread)
+  (heard running-heard running-heard-set!)    ; monotonic-seconds
+  (over? running-over? running-over?-set!))
+
+(define *running* '())
+(define *running-lock* (make-mutex 'running))
+
+;;> Runs component \var{k} of task \var{id} here, for \var{poser}, which
+;;> sends a heartbeat every \var{period} seconds: work is (PROC ARG ...).
+;;> A robot failure comes back as (robot-failure WHY).
+(define (run-component id k poser period work)
+  (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
+    (running-over?-set! r #f)
+    (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
+    (thread-start! (make-thread (lambda () (watch-poser r period)) 'watch-poser))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       (guard (e ((robot-failure? e) (list 'robot-failure (error-message e))))
+         (apply (car work) (cdr work))))
+     (lambda ()
+       (running-over?-set! r #t)
+       (with-lock *running-lock*
+         (lambda () (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+
+;; A trip connection closed or a stalled base: the robot, not the task,
+;; failed.
+(define (robot-failure? e)
+  (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
+
+;; Stops r when its poser is silent for three periods.
+(define (watch-poser r period)
+  (thread-sleep! period)
+  (cond ((running-over? r) #t)
+        ((> (- (monotonic-seconds) (running-heard r)) (* 3 period))
+         (log-warn "the poser " (running-poser r) " of " (running-id r)
+                   " is silent: component " (running-index r) " stops")
+         (stop-running! r))
+        (else (watch-poser r period))))
+
+(define (stop-running! r)
+  (abandon-thread! (running-thread r))
+  (guard (e (#t #f)) (stop-base)))      ; when this address space has a robot
+
+(define (find-running id k)
+  (with-lock *running-lock*
+    (lambda ()
+      (find (lambda (r) (and (eq? (running-id r) id) (= (running-index r) k)))
+            *running*))))
+
+;;> A heartbeat from the poser of component \var{k} of task \var{id}:
+;;> answers whether it runs here.
+(define (component-heartbeat! id k)
+  (let ((r (find-running id k)))
+    (if r (running-heard-set! r (monotonic-seconds)))
+    (and r #t)))
+
+;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
+(define (stop-component! id k)
+  (let ((r (find-running id k)))
+    (if r (stop-running! r))
+    (and r #t)))
+
+;; (ID INDEX POSER) for each component running here.
+(define (components-running)
+  (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
+       (with-lock *running-lock* (lambda () *running*))))
