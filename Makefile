@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-sim bench-alloc demo clean
+.PHONY: all deps native sim test bench bench-sim bench-alloc bench-chaos demo clean
 
 all: deps
 	$(MAKE) native
@@ -26,6 +26,11 @@ bench-sim: all
 # Allocation: optimal assignment's speed, greedy's price, concurrent posers.
 bench-alloc: all
 	tools/chibi bench/alloc.scm
+
+# Tasks that survive failure: random kills of robots under three posers
+# (docs/tasks.md); MURDOCH_CHAOS_SECONDS, default 90.
+bench-chaos: all
+	tools/chibi bench/chaos.scm
 
 demo: all
 	bin/murdoch demo examples/tulane-lab.scm

@@ -1,0 +1,198 @@
+;;; make bench-chaos: tasks that survive failure, under random kills.
+;;;
+;;; Three posers (threads of this address space, each starting one
+;;; restartable one-component task after another) and five robots
+;;; (workstations with the mobile capability), while a killer kill -9s a
+;;; random robot's address space every few seconds and starts it again a
+;;; second later.  Each component tells quiet when it starts and ends on
+;;; its robot, so that two exclusive components on one robot at once (a
+;;; double booking) are seen from inside.  It prints
+;;;   bench: recovery-p50 / -p95 S s   kill to the component running elsewhere
+;;;   bench: recovery-floor S s        the same, for a kill whose
+;;;                                    connection reset is the only news:
+;;;                                    renegotiating one component, measured
+;;;                                    here with no kill
+;;;   bench: chaos-tasks N, with how they ended
+;;;   bench: chaos-double-bookings N, chaos-leaked N, chaos-hung N
+;;; MURDOCH_CHAOS_SECONDS sets how long the kills go on (default 90).
+(import (except (scheme base) lambda define) (scheme write) (scheme eval)
+        (scheme process-context) (scheme inexact)
+        (srfi 1) (srfi 18) (srfi 27) (srfi 132)
+        (murdoch) (murdoch remote) (murdoch command) (murdoch testing)
+        (only (murdoch scheduler) monotonic-seconds))
+
+(define seconds
+  (cond ((get-environment-variable "MURDOCH_CHAOS_SECONDS") => string->number)
+        (else 90)))
+
+(define robots '(r1 r2 r3 r4 r5))
+
+(define lab-code "
+(define inside '())       ; on quiet: ((uid started-at) . n) now running
+(define double-bookings 0)
+(define (enter! who)
+  (let ((e (assoc who inside)))
+    (if (and e (> (cdr e) 0)) (set! double-bookings (+ double-bookings 1)))
+    (set! inside (cons (cons who (+ 1 (if e (cdr e) 0)))
+                       (remove (lambda (x) (equal? (car x) who)) inside)))))
+(define (leave! who)
+  (set! inside (map (lambda (x) (if (equal? (car x) who) (cons who (- (cdr x) 1)) x))
+                    inside)))
+(define (chaos-component)
+  (let ((who (list (local-aspace-uid) (aspace-started-at))))
+    (remote-apply (uid->aspace 'quiet) (lambda () (enter! who)))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       (let loop ((n 40))
+         (remote-apply (uid->aspace 'quiet) (lambda () #t))
+         (thread-sleep! 0.05)
+         (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
+     (lambda ()
+       (guard (e (#t #f))
+         (remote-apply (uid->aspace 'quiet) (lambda () (leave! who))))))))
+(define (held subjects)
+  (apply + (map (lambda (r) (length (filter (lambda (s) (pair? (cadr s))) (cadr r))))
+                (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects))))))
+")
+
+(define lab
+  (make-test-lab
+   `((code "code.scm") (lease 10)
+     (aspace tester)
+     (aspace quiet (load 0.1))
+     ,@(map (lambda (uid i) `(aspace ,uid (position ,(* 1000 i) 0 0)
+                                     (capabilities mobile) (load 0.5)))
+            robots (iota (length robots))))
+   `(("code.scm" . ,lab-code))))
+
+(define pids (map (lambda (uid) (cons uid (start-lab-aspace! lab uid)))
+                  (cons 'quiet robots)))
+(join-lab (test-lab-file lab) 'tester)
+(define (lab-proc name) (eval name (lab-environment)))
+(define (at-quiet expr) (remote-apply (uid->aspace 'quiet) (eval `(lambda () ,expr) (lab-environment))))
+
+;;; The killer
+
+(define kills '())                      ; (uid . monotonic-seconds), newest first
+(define lock (make-mutex))
+(define (locked thunk) (mutex-lock! lock) (let ((v (thunk))) (mutex-unlock! lock) v))
+
+(define (killer until)
+  (when (< (monotonic-seconds) until)
+    (thread-sleep! (+ 2 (* 2 (random-real))))
+    (let ((uid (list-ref robots (random-integer (length robots)))))
+      (locked (lambda () (set! kills (cons (cons uid (monotonic-seconds)) kills))))
+      (kill-process! (cdr (assq uid pids)))
+      (thread-sleep! 1)
+      (set! pids (cons (cons uid (start-lab-aspace! lab uid)) pids)))
+    (killer until)))
+
+;; When uid was last killed, at or after moment, or #f.
+(define (killed-after uid moment)
+  (locked (lambda ()
+            (let ((k (find (lambda (k) (and (eq? (car k) uid) (>= (cdr k) moment)))
+                           kills)))
+              (and k (cdr k))))))
+
+;;; The posers
+
+(define recoveries '())
+(define outcomes '())                   ; one symbol a task
+(define hung 0)
+
+(define (note! what) (locked (lambda () (set! outcomes (cons what outcomes)))))
+
+;; Starts a task and watches it: each move to another robot after a kill
+;; is a recovery, from the kill to the component's start there.
+(define (one-task)
+  (let ((t (start-task 'chaos 1 (list '((mobile) ())) (list #f)
+                       (list (lab-proc 'chaos-component)) '(1) '(#t)))
+        (began (monotonic-seconds)))
+    (let watch ((uid #f) (since began))
+      (let ((state (cadr (car (task-status t)))))
+        (cond
+         ((memq (car state) '(done failed))
+          (note! (outcome-of state)))
+         ((> (monotonic-seconds) (+ began 60))
+          (locked (lambda () (set! hung (+ hung 1))))
+          (cancel-task t))
+         ((and (eq? (car state) 'running) (not (eq? (cadr state) uid)))
+          (let ((killed (and uid (killed-after uid since))))
+            (if killed
+                (locked (lambda ()
+                          (set! recoveries
+                                (cons (- (monotonic-seconds) killed) recoveries))))))
+          (thread-sleep! 0.02)
+          (watch (cadr state) (monotonic-seconds)))
+         (else (thread-sleep! 0.02) (watch uid since)))))))
+
+(define (outcome-of state)
+  (cond ((eq? (car state) 'done) 'done)
+        ((equal? state '(failed not-enough-takers)) 'not-enough-takers)
+        ((and (string? (cadr state))
+              (string-search "no other capable robot" (cadr state)))
+         'lost-no-robot)
+        (else 'failed)))
+
+(define (string-search needle hay)
+  (let ((n (string-length needle)) (h (string-length hay)))
+    (let loop ((i 0))
+      (cond ((> (+ i n) h) #f)
+            ((string=? needle (substring hay i (+ i n))) i)
+            (else (loop (+ i 1)))))))
+
+(define (poser until)
+  (when (< (monotonic-seconds) until)
+    (one-task)
+    (poser until)))
+
+;;; The floor: a component moved by hand, with nothing killed -- what
+;;; renegotiating one component and starting it again costs.
+
+(define (floor-once)
+  (let* ((t0 (monotonic-seconds))
+         (r (pose-task 'floor 1 (list '((mobile) ())) (list #f)
+                       (list (lambda () #t)))))
+    (- (monotonic-seconds) t0)))
+
+(define (median xs)
+  (let ((s (list-sort < xs)) (n (length xs)))
+    (if (zero? n) +nan.0 (list-ref s (quotient n 2)))))
+(define (percentile xs p)
+  (let ((s (list-sort < xs)) (n (length xs)))
+    (if (zero? n) +nan.0 (list-ref s (min (- n 1) (exact (floor (* p n))))))))
+(define (seconds-text x) (number->string (/ (round (* 1000 x)) 1000)))
+
+(let* ((floors (map (lambda (i) (floor-once)) (iota 7)))
+       (until (+ (monotonic-seconds) seconds))
+       (threads (cons (make-thread (lambda () (killer until)))
+                      (map (lambda (i) (make-thread (lambda () (poser until))))
+                           (iota 3)))))
+  (for-each thread-start! threads)
+  (for-each thread-join! threads)
+  (wait-until 15 (lambda () (zero? ((lab-proc 'held) '(mobile)))))
+  (let ((leaked ((lab-proc 'held) '(mobile)))
+        (doubles (at-quiet 'double-bookings)))
+    (for-each
+     (lambda (line) (display line) (newline))
+     (list (string-append "bench: recovery-p50 " (seconds-text (median recoveries)) " s")
+           (string-append "bench: recovery-p95 " (seconds-text (percentile recoveries 0.95)) " s")
+           (string-append "bench: recovery-floor " (seconds-text (median floors)) " s")
+           (string-append "bench: chaos-recoveries " (number->string (length recoveries)))
+           (string-append "bench: chaos-tasks " (number->string (length outcomes)))
+           (string-append "chaos: kills " (number->string (length kills))
+                          "; tasks ended "
+                          (let ((kinds '(done lost-no-robot not-enough-takers failed)))
+                            (apply string-append
+                                   (map (lambda (k)
+                                          (string-append (symbol->string k) " "
+                                                         (number->string (count (lambda (o) (eq? o k)) outcomes))
+                                                         " "))
+                                        kinds))))
+           (string-append "bench: chaos-double-bookings " (number->string doubles))
+           (string-append "bench: chaos-leaked " (number->string leaked))
+           (string-append "bench: chaos-hung " (number->string hung))))))
+
+(stop-all-processes!)
+(remove-test-lab! lab)
