@@ -12,6 +12,13 @@
 ;;   bench: chibi-pingpong-rtt-nap VALUE us
 ;;   bench: chibi-pingpong-rtt VALUE us
 ;;
+;; Usage: tools/chibi bench/scheme-pingpong.scm pipelined
+;;
+;; The floor of a sender keeping 16 calls in flight: with (murdoch
+;; scheduler) at both ends, 16 netstrings are kept on their way to the echo
+;; server, a new one sent as each echo comes back:
+;;   bench: chibi-pipelined-throughput VALUE per-s
+;;
 ;; Usage: tools/chibi bench/scheme-pingpong.scm fanout N [poll]
 ;;
 ;; The floor of a request to a lab of N, in Chibi: N echo servers, each a
@@ -93,6 +100,20 @@
 (define (median-round-trip in out trips warm-up)
   (median-time (lambda () (round-trip in out)) trips warm-up))
 
+;; Frames a second through the echo server, depth of them on their way at
+;; any moment, after a warm-up as long.
+(define (pipelined-throughput in out frames depth)
+  (define (send!) (write-netstring payload out) (flush-output-port out))
+  (define (take!) (read-netstring in max-frame))
+  (define (run n)
+    (let ((start (microseconds)))
+      (do ((i 0 (+ i 1))) ((= i depth)) (send!))
+      (do ((i depth (+ i 1))) ((= i n)) (take!) (send!))
+      (do ((i 0 (+ i 1))) ((= i depth)) (take!))
+      (/ (* n 1000000.) (- (microseconds) start))))
+  (run frames)
+  (exact (round (run frames))))
+
 (define (measure mode)
   (let* ((listener+port (listen-on-free-port))
          (pid (begin (flush-output-port) (fork))))
@@ -107,8 +128,10 @@
       (let* ((io (guard (e (#t (kill pid signal/kill) (waitpid pid 0) (raise e)))
                    (open-net-io "127.0.0.1" (cdr listener+port))))
              (counts (trip-counts mode))
-             (rtt (median-round-trip (cadr io) (car (cddr io))
-                                     (car counts) (cdr counts))))
+             (rtt (if (eq? mode 'pipelined)
+                      (pipelined-throughput (cadr io) (car (cddr io)) 20000 16)
+                      (median-round-trip (cadr io) (car (cddr io))
+                                         (car counts) (cdr counts)))))
         ;; Closing the connection ends the server.
         (close-output-port (car (cddr io)))
         (close-input-port (cadr io))
@@ -126,6 +149,10 @@
      (environment '(murdoch scheduler))   ; loading it installs it
      (set! poll-loaded? #t)
      (report "chibi-pingpong-rtt" (measure mode)))
+    ((pipelined)
+     (environment '(murdoch scheduler))
+     (set! poll-loaded? #t)
+     (report "chibi-pipelined-throughput" (measure mode) "per-s"))
     (else (error "unknown mode; expected nap or poll" mode))))
 
 (define (serve port wait)
@@ -159,9 +186,10 @@
           (stop-all-processes!)
           median)))))
 
-(define (report name value)
+(define (report name value . unit)
   (display "bench: ") (display name) (display " ")
-  (display value) (display " us") (newline))
+  (display value) (display " ") (display (if (pair? unit) (car unit) "us"))
+  (newline))
 
 (let ((args (cdr (command-line))))
   (cond
