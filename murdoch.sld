@@ -44,7 +44,7 @@
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
-          buttons-read lights say battery-voltage tethered? set-tether!
+          buttons-read lights say battery-voltage tethered? set-tether! fiducials
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch sendable) (murdoch remote) (murdoch pubsub) (murdoch monitor)
           (murdoch pose-task) (murdoch task) (murdoch component) (murdoch trip-client)

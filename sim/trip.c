@@ -10,7 +10,8 @@
 #include "trip.h"
 
 static const char *const device_names[DEVICES] = {
-    "base", "sonar", "ir", "bumpers", "skirt", "buttons", "lights", "speech", "battery" };
+    "base", "sonar", "ir", "bumpers", "skirt", "buttons", "lights", "speech", "battery",
+    "fiducial" };
 
 enum { MAX_WORDS = 8 };
 
@@ -192,6 +193,16 @@ static int ir_read(request *q)
     return 0;
 }
 
+static int fiducial_read(request *q)
+{
+    fiducial f[FIDUCIALS];
+    int n = robot_fiducials(q->w, q->r, f, FIDUCIALS), i;
+    put(q, " %d", n);
+    for (i = 0; i < n; i++)
+        put(q, " %d %.0f %.1f %.1f", f[i].id, f[i].range, f[i].bearing, f[i].orientation);
+    return 0;
+}
+
 static int bumpers_read(request *q)
 {
     int b[BUMPERS], s[SKIRTS];
@@ -310,6 +321,7 @@ static const struct command {
     { SPEECH, "say", -2, 1, speech_say },
     { BATTERY, "read", 0, 1, battery_read },
     { BATTERY, "tether", 1, 1, battery_tether },
+    { FIDUCIAL, "read", 0, 1, fiducial_read },
 };
 
 static int numbers(request *q, int n)

@@ -5,7 +5,8 @@
 #include <stddef.h>
 #include "world.h"
 
-enum device { BASE, SONAR, IR, BUMPERS_DEV, SKIRT, BUTTONS_DEV, LIGHTS_DEV, SPEECH, BATTERY, DEVICES };
+enum device { BASE, SONAR, IR, BUMPERS_DEV, SKIRT, BUTTONS_DEV, LIGHTS_DEV, SPEECH, BATTERY,
+              FIDUCIAL, DEVICES };
 
 typedef struct {
     world *w;

@@ -476,6 +476,35 @@ void robot_contacts(const world *w, int i, int bumpers[BUMPERS], int skirt[SKIRT
     }
 }
 
+int robot_fiducials(world *w, int i, fiducial *out, int max)
+{
+    const robot *r = &w->robots[i];
+    int b, n = 0;
+    for (b = 0; b < w->lab->nboxes && n < max; b++) {
+        const lab_box *box = &w->lab->boxes[b];
+        pose at = physics_box_pose(w->phys, b);
+        double dx = at.x - r->at.x, dy = at.y - r->at.y, d = hypot(dx, dy);
+        double bearing = wrap180(atan2(dy, dx) / RAD - r->at.heading);
+        double half = hypot(box->w, box->d) / 2, first;
+        if (d > FIDUCIAL_RANGE || fabs(bearing) > FIDUCIAL_FOV / 2.0 || d < 1)
+            continue;
+        /* The line of sight: the first thing on it is this box's own edge,
+         * no nearer than the centre less its half diagonal. */
+        dx /= d;
+        dy /= d;
+        sense_fan(w->sense, &w->scratch[0], r->circle, r->at.x, r->at.y, &dx, &dy, 1,
+                  d, &first);
+        if (first < d - half - 1)
+            continue;
+        out[n].id = b;
+        out[n].range = d;
+        out[n].bearing = bearing;
+        out[n].orientation = wrap180(at.heading - r->at.heading);
+        n++;
+    }
+    return n;
+}
+
 void robot_say(world *w, int i, const char *text, size_t n)
 {
     char clean[512];

@@ -100,5 +100,15 @@ void robot_ir(world *w, int r, double out[IRS]);
 void robot_contacts(const world *w, int r, int bumpers[BUMPERS], int skirt[SKIRTS]);
 void robot_say(world *w, int r, const char *text, size_t n);
 
+/* A fiducial finder, as Stage's: each box whose centre lies within
+ * FIDUCIAL_RANGE mm and FIDUCIAL_FOV degrees across the heading, with
+ * nothing nearer on the line to it, is seen as its index, its range (mm)
+ * and bearing (degrees from the heading) and its heading relative to the
+ * robot's (degrees): what a fiducial on the box tells, not where the box
+ * is in the room.  Answers how many, at most max. */
+enum { FIDUCIAL_RANGE = 5000, FIDUCIAL_FOV = 180, FIDUCIALS = 16 };
+typedef struct { int id; double range, bearing, orientation; } fiducial;
+int robot_fiducials(world *w, int r, fiducial *out, int max);
+
 double wrap180(double a);
 #endif

@@ -113,6 +113,17 @@ LAB
   (trip-request moseley 'buttons 'press 1)
   (test "a button pressed on this robot" '(0 1 0 0) (buttons-read)))
 
+(test-group "the fiducial finder"
+  ;; After the motion tests moseley stands near (370 130), heading -45; the
+  ;; box's centre is at (1800 1800).
+  (rotate 'by 90)
+  (let ((seen (fiducials)))
+    (test "facing it, one box, the lab's first" '(0) (map car seen))
+    (test-assert "its range and bearing, as seen from here"
+      (and (near? (cadr (car seen)) 2200 150) (near? (car (cddr (car seen))) 5 15))))
+  (rotate 'by 180)
+  (test "facing away, none" '() (fiducials)))
+
 (test-group "sonar against a wall"
   (parameterize ((current-robot ernst))
     ;; ernst faces the wall at x = -3000 (face at -2975) from x = -2000

@@ -228,7 +228,7 @@
 
 ;;; Devices
 
-(define devices '(base sonar ir bumpers skirt buttons lights speech battery))
+(define devices '(base sonar ir bumpers skirt buttons lights speech battery fiducial))
 
 (define (robot)
   (or (current-robot)
@@ -347,6 +347,19 @@
 
 ;;> The battery in tenths of a volt, an integer (136 for 13.6 V): the unit
 ;;> of the thesis's thresholds (130 charging, 100 low, 140 a workstation).
+;;> The boxes the fiducial finder sees (docs/trip-protocol.md), as
+;;> (ID RANGE BEARING ORIENTATION) each: range in mm, bearing from the
+;;> heading and the box's heading from the robot's, in degrees.  Only
+;;> boxes within range and the field of view, in plain sight.
+(define (fiducials)
+  (let loop ((words (cdr (device 'fiducial "read"))) (seen '()))
+    (if (null? words)
+        (reverse seen)
+        (loop (list-tail words 4)
+              (cons (list (exact (car words)) (cadr words) (car (cddr words))
+                          (cadr (cddr words)))
+                    seen)))))
+
 (define (battery-voltage)
   (exact (round (* 10 (car (device 'battery "read"))))))
 

@@ -8,7 +8,7 @@
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
-          buttons-read lights say battery-voltage tethered? set-tether!
+          buttons-read lights say battery-voltage tethered? set-tether! fiducials
           safe-im safe-battery-voltage safe-reckon workstation-position
           split-words)
   (import (scheme base) (scheme write) (srfi 18) (srfi 151)

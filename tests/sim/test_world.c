@@ -141,6 +141,44 @@ static void test_push_box(void)
     lab_free(&l);
 }
 
+static void test_fiducials(void)
+{
+    lab l = room();
+    lab_box ahead = { 1000, 1000, 400, 400, 30, 5 };   /* 45 degrees left, 1414 mm */
+    lab_box behind = { -1500, 0, 400, 400, 0, 5 };
+    lab_box walled = { 1000, -2000, 400, 400, 0, 5 };  /* behind the wall below */
+    fiducial f[FIDUCIALS];
+    int r, n, seen_ahead = 0, seen_other = 0, k;
+    world *w;
+    lab_add_box(&l, &ahead);
+    lab_add_box(&l, &behind);
+    lab_add_box(&l, &walled);
+    lab_add_wall(&l, -3000, -1000, 3000, -1000, 50);
+    r = add(&l, "a", 0, 0, 0);
+    w = world_new(&l);
+    world_step(w);
+    n = robot_fiducials(w, r, f, FIDUCIALS);
+    for (k = 0; k < n; k++) {
+        if (f[k].id == 0)
+            seen_ahead = fabs(f[k].range - 1414) < 5 && fabs(f[k].bearing - 45) < 1
+                && fabs(f[k].orientation - 30) < 1;
+        else
+            seen_other = 1;
+    }
+    CHECK("the finder sees a box ahead, with its range, bearing and orientation", seen_ahead);
+    CHECK("not one behind the robot, nor one behind a wall", !seen_other);
+    robot_set_heading(w, r, 0);         /* odometry only: the true heading stays */
+    w->robots[r].at.heading = 180;       /* turned round, by hand */
+    n = robot_fiducials(w, r, f, FIDUCIALS);
+    CHECK("turned round, it sees the one that was behind", n == 1 && f[0].id == 1
+          && fabs(f[0].range - 1500) < 5 && fabs(f[0].bearing) < 1);
+    w->robots[r].at.x = -1500 + 6000; /* far away: out of range */
+    n = robot_fiducials(w, r, f, FIDUCIALS);
+    CHECK("nothing beyond its range", n == 0);
+    world_free(w);
+    lab_free(&l);
+}
+
 static void test_stall(void)
 {
     lab l = room();
@@ -246,6 +284,7 @@ int main(void)
     test_odometry_frame();
     test_sonar_wall();
     test_push_box();
+    test_fiducials();
     test_stall();
     test_battery();
     test_deterministic();
