@@ -69,6 +69,29 @@
   (test "a code file that is not there" #t
     (says? "(lab x (code \"nowhere.scm\"))" "(code \"nowhere.scm\"): no such file")))
 
+(test-group "the line of the clause"
+  (test "a mistake on line 4 says :4:" #t
+    (says? "; a lab\n(lab x\n  (lease 30)\n  (timout 3))\n" (string-append file ":4: (timout 3)"))))
+
+(define room
+  "(lab x (world (wall -3000 -3000 3000 -3000) (box 1500 1500 600 600 30))\n")
+
+(test-group "robots placed where they cannot stand"
+  (test "inside a wall" #t
+    (says? (string-append room "(aspace a (robot (pose 0 -2990 0))))")
+           "the robot a stands inside or against (wall -3000 -3000 3000 -3000)"))
+  (test "on a box" #t
+    (says? (string-append room "(aspace a (robot (pose 1500 1700 0))))")
+           "the robot a stands on (box 1500 1500 600 600 30)"))
+  (test "on another robot, on its own line" #t
+    (says? (string-append room "(aspace a (robot (pose 0 0 0)))\n(aspace b (robot (pose 200 100 0))))")
+           ":2: (aspace a (robot (pose 0 0 0))): the robot a stands on the robot b"))
+  (test "apart, they are fine" #t
+    (lab? (read-text (string-append room "(aspace a (robot (pose 0 0 0))) (aspace b (robot (pose 1000 0 0))))"))))
+  (test "a larger radius from the b14 clause counts" #t
+    (says? (string-append room "(b14 (radius 600)) (aspace a (robot (pose 0 0 0))) (aspace b (robot (pose 1000 0 0))))")
+           "stands on the robot b")))
+
 (test-end)
 (delete-file-hierarchy dir)
 (test-exit)

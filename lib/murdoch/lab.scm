@@ -136,8 +136,14 @@
         (string-append "; did you mean " (car near) "?")
         "")))
 
+;; Where each clause of the lab file being read starts: ((CLAUSE . LINE) ...),
+;; by eq?, for its errors.
+(define clause-lines (make-parameter '()))
+
 (define (lab-file-error path c why)
-  (error (string-append path ": " (clause-text c) ": " why)))
+  (let ((line (assq c (clause-lines))))
+    (error (string-append path (if line (string-append ":" (number->string (cdr line))) "")
+                          ": " (clause-text c) ": " why))))
 
 (define (clause-text c)
   (let ((out (open-output-string)))
@@ -163,27 +169,58 @@
 
 ;;> Reads the lab file at \var{path}.  Errors name the file and the fault.
 (define (read-lab path)
-  (let ((form (guard (e (#t (error "cannot read the lab file" path
+  (let* ((read (guard (e (#t (error "cannot read the lab file" path
                                    (condition-message e))))
-                (call-with-input-file path read))))
+                 (call-with-input-file path read-lab-form)))
+         (form (car read)))
     (if (not (and (pair? form) (eq? (car form) 'lab) (pair? (cdr form))
                   (symbol? (cadr form)) (list? (cddr form))))
         (error "a lab file holds one (lab NAME CLAUSE ...) form" path))
-    (let* ((clauses (cddr form))
-           (settings (read-settings path clauses))
-           (base (settings-port-base settings))
-           (interface (cdr (assq 'interface settings)))
-           (lab (make-lab (cadr form) (path-directory path) settings
-                          (let loop ((cs clauses) (i 0) (acc '()))
-                            (cond
-                             ((null? cs) (reverse acc))
-                             ((and (pair? (car cs)) (eq? (caar cs) 'aspace))
-                              (loop (cdr cs) (+ i 1)
-                                    (cons (parse-aspace path (car cs) i base interface)
-                                          acc)))
-                             (else (loop (cdr cs) i acc)))))))
-      (check-lab path lab)
-      lab)))
+    (parameterize ((clause-lines (cdr read)))
+      (parse-lab path form))))
+
+;; The file's (lab NAME CLAUSE ...) form, and the line each clause starts
+;; on: (FORM (CLAUSE . LINE) ...).  Anything else is read whole, for
+;; read-lab to refuse.
+(define (read-lab-form in)
+  (skip-blanks in)
+  (if (not (eqv? (peek-char in) #\())
+      (list (read in))
+      (begin
+        (read-char in)
+        (let loop ((items '()) (lines '()))
+          (skip-blanks in)
+          (cond ((eof-object? (peek-char in)) (list (reverse items)))
+                ((eqv? (peek-char in) #\)) (read-char in) (cons (reverse items) lines))
+                (else (let* ((line (port-line in))
+                             (item (read in)))
+                        (loop (cons item items) (cons (cons item line) lines)))))))))
+
+;; Skips white space and ; comments.
+(define (skip-blanks in)
+  (let ((c (peek-char in)))
+    (cond ((eof-object? c) c)
+          ((char-whitespace? c) (read-char in) (skip-blanks in))
+          ((char=? c #\;) (read-line in) (skip-blanks in))
+          (else c))))
+
+(define (parse-lab path form)
+  (let* ((clauses (cddr form))
+         (settings (read-settings path clauses))
+         (base (settings-port-base settings))
+         (interface (cdr (assq 'interface settings)))
+         (lab (make-lab (cadr form) (path-directory path) settings
+                        (let loop ((cs clauses) (i 0) (acc '()))
+                          (cond
+                           ((null? cs) (reverse acc))
+                           ((and (pair? (car cs)) (eq? (caar cs) 'aspace))
+                            (loop (cdr cs) (+ i 1)
+                                  (cons (parse-aspace path (car cs) i base interface)
+                                        acc)))
+                           (else (loop (cdr cs) i acc)))))))
+    (check-lab path lab)
+    (check-room path clauses)
+    lab))
 
 ;; What no one clause shows: two address spaces of one name, two things
 ;; on one port, a code file that is not there.

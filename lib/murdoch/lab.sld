@@ -3,10 +3,12 @@
           lab-setting lab-port-base lab-guest-port lab-trip-port lab-path lab-aspace-by-uid lab-robots lab-key
           lab-aspace? lab-aspace-uid lab-aspace-index lab-aspace-host
           lab-aspace-port lab-aspace-clause lab-aspace-clauses random-hex)
-  (import (scheme base) (scheme read) (scheme write) (scheme file) (scheme process-context)
+  (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file) (scheme process-context)
+          (scheme inexact)
           (srfi 1) (srfi 151)
           (only (chibi filesystem) open open/write open/create open/exclusive
                 open-output-file-descriptor link-file)
           (only (chibi process) current-process-id)
+          (only (chibi ast) port-line)
           (chibi io) (chibi edit-distance))
-  (include "lab.scm"))
+  (include "lab.scm" "room.scm"))
