@@ -18,7 +18,7 @@ NATIVE_CFLAGS ?= -O2 -g -Wall
 
 NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
                   lib/murdoch/hmac.so lib/murdoch/netstring.so lib/murdoch/connect.so \
-                  lib/murdoch/guard.so
+                  lib/murdoch/guard.so lib/murdoch/process-name.so
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 

@@ -57,6 +57,12 @@
       (let ((line (car (read-lines (in-dir "logs/troy.log")))))
         (and (char=? (string-ref line 4) #\-) (char=? (string-ref line 10) #\T)
              (text-contains? line "Z murdoch troy: listening on"))))
+    (test "ps names each address space murdoch-UID" '(#t #t)
+      (map (lambda (uid)
+             (not (equal? "0" (command-output
+                               (list "sh" "-c" (string-append "ps -eo comm | grep -c '^murdoch-"
+                                                              uid "$'"))))))
+           '("troy" "praline")))
     (test-group "pose"
       (call-with-output-file (in-dir "task.scm")
         (lambda (out)

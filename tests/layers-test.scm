@@ -8,7 +8,8 @@
 
 ;; Bottom to top.
 (define layers
-  '((process (murdoch scheduler) (murdoch guard) (murdoch log) (murdoch wait))
+  '((process (murdoch scheduler) (murdoch guard) (murdoch process-name) (murdoch log)
+             (murdoch wait))
     (wire (murdoch remote-error) (murdoch netstring) (murdoch hmac)
           (murdoch multicast) (murdoch connect) (murdoch frame))
     (lab (murdoch lab))

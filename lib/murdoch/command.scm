@@ -40,6 +40,7 @@
 ;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
 (define (run-aspace lab-file uid)
   (stamp-log-lines!)
+  (set-process-name! (string-append "murdoch-" (symbol->string uid)))
   (join-lab lab-file uid)
   (start-heap-guard!
    (lab-setting (current-lab) 'heap-max)

@@ -4,7 +4,8 @@
           start-lab-aspace! start-murdoch-lab! median-seconds
           wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
-          text-contains? listen-on-free-port read-lines text-lines error-text)
+          text-contains? listen-on-free-port read-lines text-lines error-text
+          command-output)
   (import (scheme base) (scheme time) (scheme write) (scheme file)
           (scheme read) (scheme process-context)
           (srfi 18) (srfi 132)
