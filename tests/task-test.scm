@@ -26,6 +26,15 @@
        (thread-sleep! 0.05)
        (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
    (lambda () (set! stopped #t))))
+;; A component that counts how many components run here at once.
+(define inside 0)
+(define most-inside 0)
+(define (crowd)
+  (set! inside (+ inside 1))
+  (set! most-inside (max most-inside inside))
+  (dynamic-wind (lambda () #f)
+                (lambda () (spin-for 6))
+                (lambda () (set! inside (- inside 1)))))
 (define (spin) (spin-for 50))
 (define (spin-long) (spin-for 1000))
 (define (free-everywhere? subjects)
@@ -108,6 +117,13 @@
   (let ((t (start-task 'cancelled 1 (list '((mobile) ())) (list near-first)
                        (list (lab-proc 'spin-long)))))
     (test-assert "it runs on near" (running-on? t 1 'near))
+    (test "the lab's status shows it, where it was posed and where it runs"
+        (list (list 'posed (task-id t) 'running) (list 'running (task-id t) 1 'tester))
+      (let ((status (lab-status (current-lab))))
+        (list (find (lambda (x) (eq? (cadr x) (task-id t)))
+                    (list-ref (assq 'tester status) 5))
+              (find (lambda (x) (eq? (cadr x) (task-id t)))
+                    (list-ref (assq 'near status) 5)))))
     (test "cancel-task answers #t" #t (cancel-task t))
     (test "the component stops on its robot within a second" #t
       (wait-until 1 (lambda () (stopped-at? 'near))))
@@ -171,6 +187,23 @@
       (test "and runs it no more" before (spins-at 'near)))
     (cancel-task t)
     (task-wait t 10)
+    (test "every subject is free" #t (wait-until 5 all-free?))))
+
+(test-group "no robot runs two exclusive components at once"
+  ;; Six one-component tasks at once, from two threads, for three robots;
+  ;; each component counts, on its robot, how many run there together.
+  (let* ((start (lambda ()
+                  (start-task 'crowd 1 (list '((mobile) ())) (list #f)
+                              (list (lab-proc 'crowd)) '(1) '(#t))))
+         (ts (append-map (lambda (batch)
+                           (map (lambda (i) (start)) (iota 3)))
+                         '(1 2))))
+    (for-each (lambda (t) (task-wait t 60)) ts)
+    (test "at most one at a time on each robot, seen from inside" '(1 1 1)
+      (map (lambda (uid)
+             (remote-apply (uid->aspace uid)
+                           (eval '(lambda () (max most-inside 1)) (lab-environment))))
+           '(near far spare)))
     (test "every subject is free" #t (wait-until 5 all-free?))))
 
 (test-group "wrong arguments"

@@ -2,14 +2,19 @@
 ;;;; what they all say, asked at once.
 
 ;;> What this address space says of itself: (UID UP-SINCE POSE BATTERY
-;;> HELD), UP-SINCE the wall-clock second it joined the lab, POSE what
-;;> safe-reckon answers, BATTERY safe-battery-voltage in tenths of a volt,
-;;> HELD the (subject holder) of each subject held here.
+;;> HELD TASKS), UP-SINCE the wall-clock second it joined the lab, POSE
+;;> what safe-reckon answers, BATTERY safe-battery-voltage in tenths of a
+;;> volt, HELD the (subject holder) of each subject held here, and TASKS
+;;> what (tasks) answers: the tasks it started that are not over, and the
+;;> components it runs.
 (define (aspace-report)
   (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
         (safe-battery-voltage)
         (filter (lambda (s) (not (null? (cadr s))))
-                (subscription-statuses '>))))
+                (subscription-statuses '>))
+        (remove (lambda (t) (and (eq? (car t) 'posed)
+                                 (memq (car (cddr t)) '(done failed cancelled))))
+                (tasks))))
 
 ;;> The lab's status: for each address space of \var{lab}, in file order,
 ;;> its report (see aspace-report) when it answered within
@@ -43,7 +48,16 @@
       (for-each (lambda (held)
                   (write-line out "    " (symbol->string (car held))
                               " held by " (held-text (cadr held))))
-                (car (cddr (cddr r))))))))
+                (list-ref r 4))
+      (for-each (lambda (t) (write-line out "    " (task-text t)))
+                (list-ref r 5))))))
+
+;; (posed ID STATE) or (running ID INDEX POSER), as a line.
+(define (task-text t)
+  (if (eq? (car t) 'posed)
+      (string-append "task " (held-text (cadr t)) " " (held-text (car (cddr t))))
+      (string-append "runs component " (held-text (car (cddr t))) " of "
+                     (held-text (cadr t)) " for " (held-text (cadr (cddr t))))))
 
 (define (write-line out . parts)
   (for-each (lambda (p) (write-string p out)) parts)

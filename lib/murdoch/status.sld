@@ -3,5 +3,6 @@
 (define-library (murdoch status)
   (export aspace-report lab-status show-status)
   (import (scheme base) (scheme write) (scheme time) (srfi 1)
-          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch trip-client))
+          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch trip-client)
+          (murdoch task))
   (include "status.scm"))
