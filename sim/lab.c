@@ -112,6 +112,9 @@ static int read_robot(lab *l, const sx *aspace, int index, const sx *robot,
             r.battery = v[0];
         } else if (sx_is(c->head, "trip-port") && numbers(c, v, 1) == 1) {
             r.trip_port = (int)v[0];
+        } else if (sx_is(c->head, "trip-host") && arg && arg->kind == SX_STRING) {
+            /* where the robot's address space finds this server: the
+             * server itself listens on the lab's interface */
         } else {
             return bad(err, errlen, "robot", r.name);
         }

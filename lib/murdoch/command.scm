@@ -20,13 +20,14 @@
 (define (take-body! lab entry)
   (cond
    ((lab-aspace-clause entry 'robot)
-    (let ((port (lab-trip-port lab entry)))
+    (let ((host (lab-trip-host lab entry))
+          (port (lab-trip-port lab entry)))
       (set-current-robot!
        (or (wait-for (lambda ()
                        (guard (e (#t #f))
-                         (trip-connect (lab-aspace-host entry) port))))
+                         (trip-connect host port))))
            (error "cannot reach the robot's trip server"
-                  (lab-aspace-uid entry) (lab-aspace-host entry) port)))
+                  (lab-aspace-uid entry) host port)))
       (im)))
    ((lab-aspace-clause entry 'position)
     => (lambda (clause) (workstation-position (cdr clause))))))

@@ -282,11 +282,20 @@
 ;;> The port of the trip server of robot \var{a}: its (robot (trip-port N))
 ;;> or port-base + 100 + its index.
 (define (lab-trip-port lab a)
+  (robot-setting a 'trip-port (+ (lab-port-base lab) 100 (lab-aspace-index a))))
+
+;;> The host of the trip server of robot \var{a}: its (robot (trip-host
+;;> "ADDR")), for a robot whose address space runs on another host than
+;;> the simulator, or else its address space's host.
+(define (lab-trip-host lab a)
+  (robot-setting a 'trip-host (lab-aspace-host a)))
+
+(define (robot-setting a key default)
   (let ((robot (lab-aspace-clause a 'robot)))
-    (cond ((and robot (find (lambda (c) (and (pair? c) (eq? (car c) 'trip-port)))
+    (cond ((and robot (find (lambda (c) (and (pair? c) (eq? (car c) key) (pair? (cdr c))))
                             (cdr robot)))
            => cadr)
-          (else (+ (lab-port-base lab) 100 (lab-aspace-index a))))))
+          (else default))))
 
 ;;> The uids of the lab's robots, in file order.
 (define (lab-robots lab)
