@@ -28,6 +28,7 @@
 #include "frame.h"
 #include "trace.h"
 #include "trip.h"
+#include "alloc.h"
 
 enum {
     MAX_CLIENTS = 256,
@@ -166,10 +167,10 @@ static void accept_client(server *sv, int robot)
         return;
     }
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    c = calloc(1, sizeof *c);
+    c = xcalloc(1, sizeof *c);
     c->fd = fd;
-    c->payload = malloc(sv->lab.b14.max_frame);
-    c->out = malloc(MAX_BACKLOG);
+    c->payload = xmalloc(sv->lab.b14.max_frame);
+    c->out = xmalloc(MAX_BACKLOG);
     frame_init(&c->parser, c->payload, sv->lab.b14.max_frame);
     trip_begin(&c->session, sv->w, robot, sv->lockdir);
     sv->clients[k] = c;
@@ -270,7 +271,7 @@ static char *default_lockdir(int port_base)
 {
     const char *tmp = getenv("TMPDIR");
     size_t n = 4096;
-    char *dir = malloc(n);
+    char *dir = xmalloc(n);
     snprintf(dir, n, "%s/b14-locks-%d", tmp && *tmp ? tmp : "/tmp", port_base);
     return dir;
 }
@@ -343,6 +344,7 @@ int main(int argc, char **argv)
     struct sigaction sa;
     options o;
     char err[256];
+    struct trace *trace = NULL;         /* the run as an SVG, when asked for */
     const char *env = getenv("MURDOCH_PORT_BASE");
     int i, made_lockdir;
 
@@ -371,11 +373,13 @@ int main(int argc, char **argv)
     signal(SIGPIPE, SIG_IGN);
 
     sv.w = world_new(&sv.lab);
-    if (o.trace)
-        sv.w->trace = trace_open(o.trace);
-    sv.listeners = malloc((sv.lab.nrobots + 1) * sizeof(int));
-    sv.fds = malloc((sv.lab.nrobots + MAX_CLIENTS) * sizeof *sv.fds);
-    sv.who = malloc((sv.lab.nrobots + MAX_CLIENTS) * sizeof *sv.who);
+    if (o.trace) {
+        trace = trace_open(o.trace);
+        sv.w->observer = trace_observer(trace);
+    }
+    sv.listeners = xmalloc((sv.lab.nrobots + 1) * sizeof(int));
+    sv.fds = xmalloc((sv.lab.nrobots + MAX_CLIENTS) * sizeof *sv.fds);
+    sv.who = xmalloc((sv.lab.nrobots + MAX_CLIENTS) * sizeof *sv.who);
     for (i = 0; i < sv.lab.nrobots; i++) {
         int port = lab_trip_port(&sv.lab, &sv.lab.robots[i]);
         sv.listeners[i] = listen_on(sv.lab.interface, port);
@@ -394,7 +398,7 @@ int main(int argc, char **argv)
         close(sv.listeners[i]);
     if (made_lockdir)
         remove_locks(&sv);
-    if (sv.w->trace && trace_close(sv.w->trace, sv.w) < 0)
+    if (trace && trace_close(trace, sv.w) < 0)
         return 1;
     return 0;
 }

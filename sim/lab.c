@@ -4,6 +4,7 @@
 #include <string.h>
 #include "lab.h"
 #include "sexp.h"
+#include "alloc.h"
 
 void lab_defaults(lab *l)
 {
@@ -30,7 +31,7 @@ static void *grow(void *v, int n, size_t size)
 {
     /* arrays grow by doubling; n is the count before adding one */
     if ((n & (n - 1)) == 0) {
-        v = realloc(v, (n ? 2 * n : 1) * size);
+        v = xrealloc(v, (n ? 2 * n : 1) * size);
         if (!v) {
             perror("b14");
             exit(1);

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "sense.h"
+#include "alloc.h"
 
 typedef struct { double x1, y1, x2, y2; } segment;
 typedef struct { double x, y, r; int moved; } circle;
@@ -30,19 +31,9 @@ struct sense {
     int *count;                 /* scratch for filing */
 };
 
-static void *xrealloc(void *p, size_t n)
-{
-    p = realloc(p, n ? n : 1);
-    if (!p) {
-        perror("b14");
-        exit(1);
-    }
-    return p;
-}
-
 sense *sense_new(double x0, double y0, double x1, double y1, double cell)
 {
-    sense *s = calloc(1, sizeof *s);
+    sense *s = xcalloc(1, sizeof *s);
     int cells;
     s->x0 = x0;
     s->y0 = y0;
@@ -50,9 +41,9 @@ sense *sense_new(double x0, double y0, double x1, double y1, double cell)
     s->nx = (int)ceil((x1 - x0) / cell) + 1;
     s->ny = (int)ceil((y1 - y0) / cell) + 1;
     cells = s->nx * s->ny;
-    s->cells.start = calloc(cells + 1, sizeof(int));
-    s->changed = calloc(cells, sizeof(int));
-    s->count = calloc(cells + 1, sizeof(int));
+    s->cells.start = xcalloc(cells + 1, sizeof(int));
+    s->changed = xcalloc(cells, sizeof(int));
+    s->count = xcalloc(cells + 1, sizeof(int));
     memset(s->changed, 0xff, cells * sizeof(int));   /* -1: never */
     return s;
 }
@@ -79,7 +70,7 @@ sense *sense_snapshot(sense *into, const sense *from)
     sense kept;
     int cells = from->nx * from->ny;
     if (!into)
-        into = calloc(1, sizeof *into);
+        into = xcalloc(1, sizeof *into);
     kept = *into;
     *into = *from;
     into->segs = copy(kept.segs, from->segs, from->nsegs * sizeof *from->segs);
@@ -300,7 +291,7 @@ static void start_cast(const sense *s, sense_scratch *sc)
     if (shapes > sc->cap || ++sc->cast == 0) {
         sc->cap = shapes > sc->cap ? shapes : sc->cap;
         free(sc->met);
-        sc->met = calloc(sc->cap, sizeof *sc->met);
+        sc->met = xcalloc(sc->cap, sizeof *sc->met);
         sc->cast = 1;
     }
 }

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "sexp.h"
+#include "alloc.h"
 
 typedef struct {
     const char *s;
@@ -38,7 +39,7 @@ static void skip_space(reader *r)
 
 static sx *make(enum sexp_kind kind)
 {
-    sx *x = calloc(1, sizeof *x);
+    sx *x = xcalloc(1, sizeof *x);
     if (!x) {
         perror("b14");
         exit(1);
@@ -82,7 +83,7 @@ static sx *read_string(reader *r)
     if (*r->s != '"')
         return fail(r, "unclosed string");
     x = make(SX_STRING);
-    x->text = out = malloc(r->s - start + 1);
+    x->text = out = xmalloc(r->s - start + 1);
     for (; start < r->s; start++)
         *out++ = *start == '\\' ? *++start : *start;
     *out = 0;
@@ -151,7 +152,7 @@ sx *sx_read_file(const char *path, char *err, int errlen)
     fseek(f, 0, SEEK_END);
     n = ftell(f);
     rewind(f);
-    text = malloc(n + 1);
+    text = xmalloc(n + 1);
     n = (long)fread(text, 1, n, f);
     text[n] = 0;
     fclose(f);

@@ -4,6 +4,7 @@
 #include <string.h>
 #include "trace.h"
 #include "world.h"
+#include "alloc.h"
 
 enum { SAMPLE_HZ = 10, SONAR_HZ = 5, MAX_SONARS = 5000, MAX_SAYS = 1000 };
 
@@ -23,10 +24,10 @@ struct trace {
 
 struct trace *trace_open(const char *path)
 {
-    struct trace *t = calloc(1, sizeof *t);
-    t->path = strdup(path);
-    t->sonars = malloc(MAX_SONARS * sizeof *t->sonars);
-    t->says = malloc(MAX_SAYS * sizeof *t->says);
+    struct trace *t = xcalloc(1, sizeof *t);
+    t->path = xstrdup(path);
+    t->sonars = xmalloc(MAX_SONARS * sizeof *t->sonars);
+    t->says = xmalloc(MAX_SAYS * sizeof *t->says);
     return t;
 }
 
@@ -39,7 +40,7 @@ void trace_step(struct trace *t, const world *w)
     t->width = w->nrobots + w->lab->nboxes;
     if (t->nsamples == t->capsamples) {
         t->capsamples = t->capsamples ? 2 * t->capsamples : 256;
-        t->samples = realloc(t->samples, (size_t)t->capsamples * t->width * sizeof(pose));
+        t->samples = xrealloc(t->samples, (size_t)t->capsamples * t->width * sizeof(pose));
     }
     row = &t->samples[(size_t)t->nsamples++ * t->width];
     for (i = 0; i < w->nrobots; i++)
@@ -54,7 +55,7 @@ void trace_sonar(struct trace *t, const world *w, int r)
     sonar_event *e;
     if (!t->last_sonar) {
         int i;
-        t->last_sonar = malloc((w->nrobots + 1) * sizeof(double));
+        t->last_sonar = xmalloc((w->nrobots + 1) * sizeof(double));
         for (i = 0; i < w->nrobots; i++)
             t->last_sonar[i] = -1;
     }
@@ -72,7 +73,7 @@ void trace_say(struct trace *t, const world *w, int r, const char *text)
 {
     if (t->nsays == MAX_SAYS)
         return;
-    t->says[t->nsays++] = (say_event){ world_time(w), w->robots[r].at, strdup(text), r };
+    t->says[t->nsays++] = (say_event){ world_time(w), w->robots[r].at, xstrdup(text), r };
 }
 
 static const char *colour(int i)
@@ -193,10 +194,22 @@ static void bounds(const world *w, double *x0, double *y0, double *x1, double *y
     }
 }
 
+static void observe_step(void *t, const world *w) { trace_step(t, w); }
+static void observe_sonar(void *t, const world *w, int r) { trace_sonar(t, w, r); }
+static void observe_say(void *t, const world *w, int r, const char *text)
+{
+    trace_say(t, w, r, text);
+}
+
+world_observer trace_observer(struct trace *t)
+{
+    return (world_observer){ t, observe_step, observe_sonar, observe_say };
+}
+
 int trace_close(struct trace *t, const world *w)
 {
     size_t n = strlen(t->path) + 8;
-    char *tmp = malloc(n);
+    char *tmp = xmalloc(n);
     double x0, y0, x1, y1, dur = fmax(t->nsamples, 2) / (double)SAMPLE_HZ;
     FILE *f;
     int e, rc = -1;

@@ -8,6 +8,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 #include "trip.h"
+#include "alloc.h"
 
 static const char *const device_names[DEVICES] = {
     "base", "sonar", "ir", "bumpers", "skirt", "buttons", "lights", "speech", "battery",
@@ -164,12 +165,12 @@ static int base_status(request *q)
     return 0;
 }
 
-static int sonar_start(request *q) { q->w->robots[q->r].sonar_on = 1; return 0; }
-static int sonar_stop(request *q) { q->w->robots[q->r].sonar_on = 0; return 0; }
+static int sonar_start(request *q) { robot_sonar_on(q->w, q->r, 1); return 0; }
+static int sonar_stop(request *q) { robot_sonar_on(q->w, q->r, 0); return 0; }
 
 static int sonar_read(request *q)
 {
-    robot *r = &q->w->robots[q->r];
+    const robot *r = &q->w->robots[q->r];
     if (!r->sonar_fired)
         robot_sonar_fire(q->w, q->r);
     put_ranges(q, r->sonar, SONARS);
@@ -229,9 +230,9 @@ static int button_index(request *q)
 
 static int buttons_read(request *q)
 {
-    int *b = q->w->robots[q->r].buttons;
+    int b[BUTTONS];
+    robot_take_buttons(q->w, q->r, b);
     put_flags(q, b, BUTTONS);
-    memset(b, 0, BUTTONS * sizeof *b);
     return 0;
 }
 
@@ -239,7 +240,7 @@ static int buttons_press(request *q)
 {
     int i = button_index(q);
     if (i >= 0)
-        q->w->robots[q->r].buttons[i] = 1;
+        robot_button(q->w, q->r, i, 1);
     return i < 0 ? -1 : 0;
 }
 
@@ -247,7 +248,7 @@ static int buttons_release(request *q)
 {
     int i = button_index(q);
     if (i >= 0)
-        q->w->robots[q->r].buttons[i] = 0;
+        robot_button(q->w, q->r, i, 0);
     return i < 0 ? -1 : 0;
 }
 
@@ -258,7 +259,7 @@ static int lights_set(request *q)
         if (q->arg[i] != 0 && q->arg[i] != 1)
             return fail(q, "args", "lights take four 0 or 1");
     for (i = 0; i < LIGHTS; i++)
-        q->w->robots[q->r].lights[i] = (int)q->arg[i];
+        robot_light(q->w, q->r, i, (int)q->arg[i]);
     return 0;
 }
 
@@ -285,7 +286,7 @@ static int battery_tether(request *q)
 {
     if (q->arg[0] != 0 && q->arg[0] != 1)
         return fail(q, "args", "battery tether takes 0 or 1");
-    q->w->robots[q->r].tethered = (int)q->arg[0];
+    robot_tether(q->w, q->r, (int)q->arg[0]);
     return 0;
 }
 
@@ -410,7 +411,7 @@ static int valid_tag(const char *t)
 size_t trip_handle(trip_session *s, const char *req, size_t n, char *out, size_t cap)
 {
     request q;
-    char *text = malloc(n + 1), *say;
+    char *text = xmalloc(n + 1), *say;
     memset(&q, 0, sizeof q);
     q.s = s;
     q.w = s->w;

@@ -4,8 +4,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "trace.h"
 #include "world.h"
+#include "alloc.h"
 
 static const double RAD = M_PI / 180;
 
@@ -111,8 +111,8 @@ static void make_fan(world *w)
     const b14_params *p = &w->lab->b14;
     int n = p->sonar_rays, i, j, k = 0, rays = SONARS * n;
     ray r[MAX_RAYS];
-    w->fan = malloc(2 * (rays + IRS) * sizeof *w->fan);
-    w->fan_sonar = malloc(rays * sizeof *w->fan_sonar);
+    w->fan = xmalloc(2 * (rays + IRS) * sizeof *w->fan);
+    w->fan_sonar = xmalloc(rays * sizeof *w->fan_sonar);
     for (i = 0; i < SONARS; i++)
         for (j = 0; j < n; j++, k++) {
             double off = 22.5 * i + (n == 1 ? 0 : p->sonar_cone * ((double)j / (n - 1) - 0.5));
@@ -130,7 +130,7 @@ static void make_fan(world *w)
 
 world *world_new(lab *l)
 {
-    world *w = calloc(1, sizeof *w);
+    world *w = xcalloc(1, sizeof *w);
     int i;
     w->lab = l;
     w->dt = 1.0 / l->step_hz;
@@ -149,7 +149,7 @@ world *world_new(lab *l)
         physics_add_box(w->phys, at, b->w, b->d, b->mass, l->friction);
         sense_place_box(w->sense, sense_add_box(w->sense, b->w, b->d), at);
     }
-    w->robots = calloc(l->nrobots ? l->nrobots : 1, sizeof *w->robots);
+    w->robots = xcalloc(l->nrobots ? l->nrobots : 1, sizeof *w->robots);
     w->nrobots = l->nrobots;
     for (i = 0; i < l->nrobots; i++) {
         const lab_robot *c = &l->robots[i];
@@ -165,8 +165,8 @@ world *world_new(lab *l)
         r->ss.step = -1;
     }
     sense_refile(w->sense, 0);
-    w->round = calloc(1, sizeof *w->round);
-    w->round->shots = malloc((w->nrobots + 1) * sizeof *w->round->shots);
+    w->round = xcalloc(1, sizeof *w->round);
+    w->round->shots = xmalloc((w->nrobots + 1) * sizeof *w->round->shots);
     return w;
 }
 
@@ -439,8 +439,8 @@ static void publish(world *w, const shot *h)
     memcpy(r->sonar, h->reading, sizeof r->sonar);
     r->sonar_seq++;
     r->sonar_fired = 1;
-    if (w->trace)
-        trace_sonar(w->trace, w, h->robot);
+    if (w->observer.sonar)
+        w->observer.sonar(w->observer.data, w, h->robot);
 }
 
 void robot_sonar_fire(world *w, int i)
@@ -474,6 +474,17 @@ void robot_contacts(const world *w, int i, int bumpers[BUMPERS], int skirt[SKIRT
         if (fabs(rel) < 90)
             bumpers[(int)fmin(floor((rel + 90) / 15), BUMPERS - 1)] = 1;
     }
+}
+
+void robot_sonar_on(world *w, int i, int on) { w->robots[i].sonar_on = on; }
+void robot_button(world *w, int i, int button, int pressed) { w->robots[i].buttons[button] = pressed; }
+void robot_light(world *w, int i, int light, int on) { w->robots[i].lights[light] = on; }
+void robot_tether(world *w, int i, int on) { w->robots[i].tethered = on; }
+
+void robot_take_buttons(world *w, int i, int out[BUTTONS])
+{
+    memcpy(out, w->robots[i].buttons, sizeof w->robots[i].buttons);
+    memset(w->robots[i].buttons, 0, sizeof w->robots[i].buttons);
 }
 
 int robot_fiducials(world *w, int i, fiducial *out, int max)
@@ -513,8 +524,8 @@ void robot_say(world *w, int i, const char *text, size_t n)
         clean[k] = text[k] >= 0x20 && text[k] < 0x7f ? text[k] : '?';
     clean[k] = 0;
     fprintf(stderr, "b14: %.3f %s says: %s\n", world_time(w), w->robots[i].name, clean);
-    if (w->trace)
-        trace_say(w->trace, w, i, clean);
+    if (w->observer.say)
+        w->observer.say(w->observer.data, w, i, clean);
 }
 
 /* ---- the step -------------------------------------------------------- */
@@ -614,6 +625,6 @@ void world_step(world *w)
         sense_place_box(w->sense, i, physics_box_pose(w->phys, i));
     sense_refile(w->sense, w->step);
     fire_due_sonars(w);
-    if (w->trace)
-        trace_step(w->trace, w);
+    if (w->observer.step)
+        w->observer.step(w->observer.data, w);
 }

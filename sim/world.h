@@ -54,8 +54,18 @@ typedef struct {
     int buttons[BUTTONS], lights[LIGHTS];
 } robot;
 
-struct trace;
 struct round;
+struct world;
+
+/* Whoever watches the world run (the trace, sim/trace.c): handed to the
+ * world by whoever made both, so that the world knows no watcher's
+ * insides.  Each procedure may be NULL. */
+typedef struct {
+    void *data;
+    void (*step)(void *data, const struct world *w);            /* a step ended */
+    void (*sonar)(void *data, const struct world *w, int robot); /* a reading */
+    void (*say)(void *data, const struct world *w, int robot, const char *text);
+} world_observer;
 
 typedef struct world {
     lab *lab;
@@ -68,7 +78,7 @@ typedef struct world {
     int threads;                /* sonar workers, counting the caller */
     int plain;                  /* sense through Box2D's ray cast, one thread,
                                    no reuse: the bench's reference */
-    struct trace *trace;        /* NULL: no trace */
+    world_observer observer;    /* all NULL: nobody watches */
     double *fan;                /* sonar rays then ir rays: cos, sin of the
                                    offset from the heading, in pairs */
     int *fan_sonar;             /* the sonar each sonar ray belongs to */
@@ -93,12 +103,19 @@ void robot_set_position(world *w, int r, double x, double y);
 void robot_set_heading(world *w, int r, double h);
 
 /* Sensors */
+void robot_sonar_on(world *w, int r, int on);   /* fire at the sonar rate, or stop */
 void robot_sonar_fire(world *w, int r);
 /* Finish and publish the round of readings under way, if any. */
 void world_sync(world *w);
 void robot_ir(world *w, int r, double out[IRS]);
 void robot_contacts(const world *w, int r, int bumpers[BUMPERS], int skirt[SKIRTS]);
 void robot_say(world *w, int r, const char *text, size_t n);
+
+/* What a finger on the robot, or its owner, does */
+void robot_button(world *w, int r, int button, int pressed);
+void robot_take_buttons(world *w, int r, int out[BUTTONS]);  /* read, then clear */
+void robot_light(world *w, int r, int light, int on);
+void robot_tether(world *w, int r, int on);
 
 /* A fiducial finder, as Stage's: each box whose centre lies within
  * FIDUCIAL_RANGE mm and FIDUCIAL_FOV degrees across the heading, with
