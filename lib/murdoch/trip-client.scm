@@ -72,13 +72,14 @@
     (write-u8 etx out)
     (flush-output-port out)))
 
-;; The next byte, an eof object, or #f once the deadline has passed;
-;; waits only by napping, never in a read.
+;; The next byte, an eof object, or #f once the deadline has passed (on
+;; the monotonic clock); waits for the socket (port-wait!), never in a
+;; read, so that a deadline holds.
 (define (next-byte in deadline)
   (let loop ()
     (cond ((u8-ready? in) (read-u8 in))
-          ((> (time->seconds (current-time)) deadline) #f)
-          (else (thread-sleep! 0.001) (loop)))))
+          ((>= (monotonic-seconds) deadline) #f)
+          (else (port-wait! in (- deadline (monotonic-seconds))) (loop)))))
 
 ;; The next whole frame's payload as a string, an eof object, or #f at the
 ;; deadline.  Bytes between frames and broken frames are skipped: the server
@@ -188,7 +189,7 @@
 (define (request c . words)
   (let ((command (join (map ->word words)))
         (lock (trip-connection-lock c))
-        (deadline (+ (time->seconds (current-time)) (trip-timeout))))
+        (deadline (+ (monotonic-seconds) (trip-timeout))))
     (define (fail code text)
       (mutex-unlock! lock)
       (trip-error (robot-name c) command code text))
@@ -258,7 +259,7 @@
 ;; Wait until the base's motion is over; the final odometry pose.  In a
 ;; call whose caller gave up, the robot is stopped where it is.
 (define (await-motion what)
-  (let ((deadline (+ (time->seconds (current-time)) (trip-motion-timeout))))
+  (let ((deadline (+ (monotonic-seconds) (trip-motion-timeout))))
     (let loop ()
       (if (abandoned?)
           (begin (despite-abandonment (lambda () (device 'base "stop")))
@@ -269,7 +270,7 @@
           (if (= 1 (list-ref status 6))
               (trip-error (robot-name (robot)) what "stalled" "the base is blocked"))
           (list (car status) (cadr status) (car (cddr status)) 0))
-         ((> (time->seconds (current-time)) deadline)
+         ((> (monotonic-seconds) deadline)
           (device 'base "stop")
           (trip-error (robot-name (robot)) what "timeout" "motion took too long"))
          (else (sleep-a-little) (loop)))))))

@@ -14,5 +14,6 @@
   (import (scheme base) (scheme write) (srfi 18) (srfi 151)
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
-          (murdoch abandon) (murdoch connect))
+          (murdoch abandon) (murdoch connect)
+          (only (murdoch scheduler) monotonic-seconds port-wait!))
   (include "trip-client.scm"))
