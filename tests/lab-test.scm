@@ -147,6 +147,12 @@
                                                 "praline> "))))
     (test "and takes a task posed from elsewhere" "(praline)"
       (last (pose-output "asks-praline.scm")))
+    (call-with-output-file (in-dir "fifo")
+      (lambda (out)
+        (write-string "(remote-apply (uid->aspace 'troy) (lambda () (thread-sleep! 6) 'slept))\n"
+                      out)))
+    (test "a call from the REPL outlasts the lab's 5 s timeout (repl-timeout)" #t
+      (wait-until 30 (lambda () (text-contains? (file-text (in-dir "repl.out")) "slept"))))
     (stop-process! repl)
     (stop-process! pid)))
 

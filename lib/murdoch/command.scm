@@ -76,6 +76,7 @@
          (lab-env (join-read-lab lab uid
                                  (if guest? (list (lab-guest-port lab)) '()))))
     (tell-who-is-away lab)
+    (set-remote-timeout! (lab-setting lab 'repl-timeout))
     ;; (chibi repl) is loaded here, not imported: it costs seconds, and
     ;; only a person at a REPL needs it.
     ((eval 'repl (environment '(chibi repl)))

@@ -75,6 +75,9 @@
     ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
     (max-depth 4000 ,(whole-from 1 9000 "a whole number from 1 to 9000"))
     (timeout 5 ,seconds)
+    ;; At a REPL a person waits, and Ctrl-C gives a call up: a robot's
+    ;; motion there runs to its end (command.scm).
+    (repl-timeout 600 ,seconds)
     (frame-timeout 5 ,seconds)
     (lease 30 ,seconds)
     (monitor-period 60 ,seconds)
