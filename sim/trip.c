@@ -75,6 +75,10 @@ static void release(trip_session *s, int d)
     if (s->lock[d] >= 0) {
         close(s->lock[d]);      /* closing the file drops the flock */
         s->lock[d] = -1;
+        /* A base let go, or whose client died, stops, as a B14's own
+         * watchdog stops it when its controller falls silent. */
+        if (d == BASE)
+            robot_stop(s->w, s->robot);
     }
     if (d == SONAR)
         s->stream = 0;

@@ -245,6 +245,32 @@ static void test_exclusion(void)
     }
 }
 
+/* A client that drives its base and goes away leaves it stopped. */
+static void test_dropped_base_stops(void)
+{
+    conn c, d;
+    int moving = 1, k;
+    double v = 1;
+    dial(&c, 1);
+    ask(&c, "1 open base");
+    ask(&c, "2 base vel 300 0");
+    close(c.fd);
+    dial(&d, 1);
+    for (k = 0; k < 100 && moving; k++) {
+        const char *r;
+        if (strcmp(ask(&d, "1 open base"), "1 ok") != 0) {
+            usleep(20000);
+            continue;
+        }
+        r = ask(&d, "2 base status");
+        if (sscanf(r, "2 ok %*f %*f %*f %lf %*f %d", &v, &moving) != 2)
+            moving = 1;
+    }
+    CHECK("a base whose client went away stops", !moving && v == 0);
+    ask(&d, "3 close base");
+    close(d.fd);
+}
+
 static void test_killed_client(void)
 {
     int ready[2], k, held = 0, ok = 0;
@@ -408,6 +434,7 @@ int main(int argc, char **argv)
         test_stall();
         test_exclusion();
         test_killed_client();
+        test_dropped_base_stops();
         test_stream();
         test_motion();
         test_heading_range();
