@@ -3,7 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "trace.h"
-#include "world.h"
 #include "alloc.h"
 
 enum { SAMPLE_HZ = 10, SONAR_HZ = 5, MAX_SONARS = 5000, MAX_SAYS = 1000 };
@@ -69,11 +68,18 @@ void trace_sonar(struct trace *t, const world *w, int r)
     memcpy(e->ranges, w->robots[r].sonar, sizeof e->ranges);
 }
 
+/* The trace reads the world it is shown but calls nothing of world.c:
+ * the world calls the trace (through its observer), never the reverse. */
+static double seconds(const world *w)
+{
+    return w->step * w->dt;
+}
+
 void trace_say(struct trace *t, const world *w, int r, const char *text)
 {
     if (t->nsays == MAX_SAYS)
         return;
-    t->says[t->nsays++] = (say_event){ world_time(w), w->robots[r].at, xstrdup(text), r };
+    t->says[t->nsays++] = (say_event){ seconds(w), w->robots[r].at, xstrdup(text), r };
 }
 
 static const char *colour(int i)
@@ -219,7 +225,7 @@ int trace_close(struct trace *t, const world *w)
         fprintf(f, "<?xml version=\"1.0\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"%.0f %.0f %.0f %.0f\" width=\"800\" height=\"%.0f\">\n",
                 x0 - 500, -y1 - 500, x1 - x0 + 1000, y1 - y0 + 1000, 800 * (y1 - y0 + 1000) / (x1 - x0 + 1000));
         fprintf(f, "<title>b14 trace, %.1f s simulated</title>\n<rect x=\"%.0f\" y=\"%.0f\" width=\"100%%\" height=\"100%%\" fill=\"#f4f1ea\"/>\n",
-                world_time(w), x0 - 500, -y1 - 500);
+                seconds(w), x0 - 500, -y1 - 500);
         fputs("<g transform=\"scale(1,-1)\">\n", f);
         write_walls(f, w->lab);
         if (t->nsamples > 0) {
