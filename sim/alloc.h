@@ -24,4 +24,5 @@ static inline void *xcalloc(size_t n, size_t size)
 }
 static inline void *xrealloc(void *p, size_t n) { return alloc_checked(realloc(p, n ? n : 1)); }
 static inline char *xstrdup(const char *s) { return alloc_checked(strdup(s)); }
+static inline char *xstrndup(const char *s, size_t n) { return alloc_checked(strndup(s, n)); }
 #endif

@@ -30,13 +30,8 @@ void lab_defaults(lab *l)
 static void *grow(void *v, int n, size_t size)
 {
     /* arrays grow by doubling; n is the count before adding one */
-    if ((n & (n - 1)) == 0) {
+    if ((n & (n - 1)) == 0)
         v = xrealloc(v, (n ? 2 * n : 1) * size);
-        if (!v) {
-            perror("b14");
-            exit(1);
-        }
-    }
     return v;
 }
 

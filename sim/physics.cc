@@ -1,6 +1,9 @@
 // Box2D behind the C interface of physics.h.
 #include <box2d/box2d.h>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
 #include <vector>
 #include "physics.h"
 
@@ -20,9 +23,30 @@ static pose pose_of(const b2Body *b)
     return pose{at.x / MM, at.y / MM, b->GetAngle() / DEG};
 }
 
+// Our own allocations are checked as sim/alloc.h checks C's: no C++
+// exception may unwind through the C callers.  (Box2D's own allocations,
+// inside the library, are Box2D's.)
+[[noreturn]] static void out_of_memory()
+{
+    std::fputs("b14: ERROR: out of memory\n", stderr);
+    std::exit(1);
+}
+
+static int keep(std::vector<b2Body *> &v, b2Body *b)
+{
+    try {
+        v.push_back(b);
+    } catch (const std::bad_alloc &) {
+        out_of_memory();
+    }
+    return (int)v.size() - 1;
+}
+
 physics *physics_new(void)
 {
-    physics *p = new physics;
+    physics *p = new (std::nothrow) physics;
+    if (!p)
+        out_of_memory();
     b2BodyDef def;
     p->ground = p->world.CreateBody(&def);
     return p;
@@ -66,8 +90,7 @@ int physics_add_box(physics *p, pose at, double w, double d, double mass, double
     // a rough lever arm for top-down friction of a rectangle
     joint.maxTorque = mu * mass * G * hypot(w, d) * MM / 3;
     p->world.CreateJoint(&joint);
-    p->boxes.push_back(box);
-    return (int)p->boxes.size() - 1;
+    return keep(p->boxes, box);
 }
 
 int physics_add_robot(physics *p, pose at, double radius, double mass)
@@ -85,8 +108,7 @@ int physics_add_robot(physics *p, pose at, double radius, double mass)
     fix.density = mass / (M_PI * shape.m_radius * shape.m_radius);
     fix.friction = 0.3f;
     robot->CreateFixture(&fix);
-    p->robots.push_back(robot);
-    return (int)p->robots.size() - 1;
+    return keep(p->robots, robot);
 }
 
 void physics_drive(physics *p, int robot, double v, double turn)

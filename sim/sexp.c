@@ -115,7 +115,7 @@ static sx *read_atom(reader *r)
     if (end == r->s && n > 0 && !isalpha((unsigned char)start[n - 1]))
         return x;
     x->kind = SX_SYMBOL;
-    x->text = strndup(start, n);
+    x->text = xstrndup(start, n);
     return x;
 }
 
@@ -139,23 +139,32 @@ sx *sx_read(const char *text, char *err, int errlen)
     return read_datum(&r);
 }
 
+/* Read in pieces, so that a pipe or a /proc file, whose size is not known
+ * beforehand, reads as well as a plain file, and a directory is refused. */
 sx *sx_read_file(const char *path, char *err, int errlen)
 {
     FILE *f = fopen(path, "r");
-    char *text;
-    long n;
+    char *text = NULL;
+    size_t n = 0, cap = 0;
+    int failed;
     sx *x;
     if (!f) {
         snprintf(err, errlen, "%s: cannot open", path);
         return NULL;
     }
-    fseek(f, 0, SEEK_END);
-    n = ftell(f);
-    rewind(f);
-    text = xmalloc(n + 1);
-    n = (long)fread(text, 1, n, f);
-    text[n] = 0;
+    do {
+        if (cap - n < 4096)
+            text = xrealloc(text, cap = 2 * cap + 4096);
+        n += fread(text + n, 1, cap - n - 1, f);
+    } while (!feof(f) && !ferror(f));
+    failed = ferror(f);
     fclose(f);
+    if (failed) {
+        snprintf(err, errlen, "%s: cannot read", path);
+        free(text);
+        return NULL;
+    }
+    text[n] = 0;
     x = sx_read(text, err, errlen);
     free(text);
     return x;
