@@ -390,6 +390,14 @@ int main(int argc, char **argv)
 
     run(&sv, sv.lab.speed);
     world_sync(sv.w);           /* the last round's readings, for the trace */
+    /* Where the boxes ended, for a demo to judge its task by: the room's
+     * truth, which no robot is told. */
+    for (i = 0; i < sv.lab.nboxes; i++) {
+        pose at = physics_box_pose(sv.w->phys, i);
+        printf("b14: box %d ends at %.0f %.0f %.1f after %.1f s\n", i, at.x, at.y,
+               wrap180(at.heading), world_time(sv.w));
+    }
+    fflush(stdout);
 
     for (i = 0; i < MAX_CLIENTS; i++)
         if (sv.clients[i])

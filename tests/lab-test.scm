@@ -82,7 +82,15 @@
       (test "pose-task's progress comes first" #t
         (text-contains? (car (pose-output "task.scm")) "pose-task: where"))
       (test "a file that defines its task as a procedure: it is called"
-          "(called)" (last (pose-output "thunk.scm"))))
+          "(called)" (last (pose-output "thunk.scm")))
+      (call-with-output-file (in-dir "started.scm")
+        (lambda (out)
+          (write-string "(start-task 'where 1 (list (list '() (list 'camera)))
+                                    (list load-metric)
+                                    (list (lambda () 'started)))\n"
+                        out)))
+      (test "a file whose task is already started: it is waited for"
+          "(started)" (last (pose-output "started.scm"))))
     (test "status: each address space, up" '(#t #t)
       (let ((lines (command-lines "status")))
         (map (lambda (uid)

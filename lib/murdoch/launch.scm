@@ -62,7 +62,12 @@
                                                    (lab-guest-port lab)))))
     (tell-who-is-away lab)
     (eval `(pose-task-progress (current-output-port)) env)
-    (write (apply (eval 'pose-task env) (task-of task-file env)))
+    ;; A task file answers pose-task's arguments, or a task already
+    ;; started (start-task, start-steps), which is waited for.
+    (let ((task (task-of task-file env)))
+      (write (if ((eval 'task? env) task)
+                 ((eval 'task-wait env) task)
+                 (apply (eval 'pose-task env) task))))
     (newline)
     (exit 0)))
 
