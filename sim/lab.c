@@ -14,6 +14,7 @@ void lab_defaults(lab *l)
         .sonar_min = 150, .sonar_max = 6500, .sonar_cone = 25,
         .sonar_noise = 10, .sonar_hz = 10, .sonar_rays = 3,
         .ir_range = 600,
+        .fiducial_range = 5000, .fiducial_fov = 180,
         .drain = 0.002, .idle = 0.0002, .charge = 0.01,
         .v_low = 10.0, .v_high = 14.0, .max_frame = 1024 };
     memset(l, 0, sizeof *l);
@@ -171,6 +172,7 @@ static int read_b14(lab *l, const sx *b14, char *err, int errlen)
         P("max-turn", max_turn), P("speed", speed), P("turn-speed", turn),
         P("sonar-cone", sonar_cone), P("sonar-noise", sonar_noise),
         P("sonar-hz", sonar_hz), P("ir-range", ir_range),
+        P("fiducial-range", fiducial_range),
         P("battery-drain", drain), P("battery-idle", idle),
         P("battery-charge", charge),
 #undef P
@@ -190,6 +192,8 @@ static int read_b14(lab *l, const sx *b14, char *err, int errlen)
             p->sonar_min = v[0]; p->sonar_max = v[1];
         } else if (sx_is(c->head, "battery-range") && n == 2 && v[0] < v[1]) {
             p->v_low = v[0]; p->v_high = v[1];
+        } else if (sx_is(c->head, "fiducial-fov") && n == 1 && v[0] > 0 && v[0] <= 360) {
+            p->fiducial_fov = v[0];
         } else if (sx_is(c->head, "sonar-rays") && n == 1 && v[0] >= 1 && v[0] <= 16)
             p->sonar_rays = (int)v[0];
         else if (sx_is(c->head, "max-frame") && n == 1 && v[0] >= 64 && v[0] <= 65536)

@@ -20,6 +20,7 @@ typedef struct {
     double sonar_min, sonar_max, sonar_cone, sonar_noise, sonar_hz;
     int sonar_rays;
     double ir_range;
+    double fiducial_range, fiducial_fov;    /* mm; degrees, centred on the heading */
     double drain, idle, charge, v_low, v_high;
     int max_frame;
 } b14_params;

@@ -143,14 +143,25 @@ static int base_stop(request *q) { robot_stop(q->w, q->r); return 0; }
 static int base_set_position(request *q) { robot_set_position(q->w, q->r, q->arg[0], q->arg[1]); return 0; }
 static int base_set_heading(request *q) { robot_set_heading(q->w, q->r, q->arg[0]); return 0; }
 
-/* A heading in (-180, 180], to two decimals.  The range must hold for the
- * text, not only for the number: wrap180 keeps -179.999 as it is, and
- * that prints as -180.00, which is 180. */
-static void put_heading(request *q, double h)
+/* An angle in (-180, 180] with `digits` decimals.  The range must hold for
+ * the text, not only for the number: wrap180 keeps -179.999 as it is, and
+ * that prints as -180.00, which is 180; and a hair below 0 prints as -0.0,
+ * which is 0. */
+static void put_angle(request *q, double a, int digits)
 {
     char text[32];
-    snprintf(text, sizeof text, "%.2f", h);
-    put(q, " %s", strcmp(text, "-180.00") == 0 ? "180.00" : text);
+    snprintf(text, sizeof text, "%.*f", digits, a);
+    if (strspn(text, "-0.") == strlen(text) && text[0] == '-')
+        put(q, " %s", text + 1);
+    else if (strncmp(text, "-180.", 5) == 0 && strspn(text + 5, "0") == strlen(text + 5))
+        put(q, " %s", text + 1);
+    else
+        put(q, " %s", text);
+}
+
+static void put_heading(request *q, double h)
+{
+    put_angle(q, h, 2);
 }
 
 static int base_reckon(request *q)
@@ -203,8 +214,11 @@ static int fiducial_read(request *q)
     fiducial f[FIDUCIALS];
     int n = robot_fiducials(q->w, q->r, f, FIDUCIALS), i;
     put(q, " %d", n);
-    for (i = 0; i < n; i++)
-        put(q, " %d %.0f %.1f %.1f", f[i].id, f[i].range, f[i].bearing, f[i].orientation);
+    for (i = 0; i < n; i++) {
+        put(q, " %d %.0f", f[i].id, f[i].range);
+        put_angle(q, f[i].bearing, 1);
+        put_angle(q, f[i].orientation, 1);
+    }
     return 0;
 }
 

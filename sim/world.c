@@ -487,31 +487,77 @@ void robot_take_buttons(world *w, int i, int out[BUTTONS])
     memset(w->robots[i].buttons, 0, sizeof w->robots[i].buttons);
 }
 
+/* How far along the ray from (x, y) along the unit (dx, dy) it enters the
+ * box at `at`, w by d: 0 from inside, -1 when it misses (slabs, in the
+ * box's own frame). */
+static double box_entry(pose at, double w, double d, double x, double y, double dx, double dy)
+{
+    double c = cos(at.heading * RAD), s = sin(at.heading * RAD);
+    double o[2] = { (x - at.x) * c + (y - at.y) * s, -(x - at.x) * s + (y - at.y) * c };
+    double u[2] = { dx * c + dy * s, -dx * s + dy * c }, half[2] = { w / 2, d / 2 };
+    double in = 0, out = INFINITY, t1, t2;
+    int k;
+    for (k = 0; k < 2; k++) {
+        if (fabs(u[k]) < 1e-12) {
+            if (fabs(o[k]) > half[k])
+                return -1;
+            continue;
+        }
+        t1 = (-half[k] - o[k]) / u[k];
+        t2 = (half[k] - o[k]) / u[k];
+        in = greater(in, lesser(t1, t2));
+        out = lesser(out, greater(t1, t2));
+    }
+    return in <= out ? in : -1;
+}
+
+/* Whether robot r sees box b at `at` along the line to (tx, ty): the
+ * first thing the line meets is this box's edge. */
+static int in_sight(world *w, const robot *r, const lab_box *b, pose at, double tx, double ty)
+{
+    double dx = tx - r->at.x, dy = ty - r->at.y, d = hypot(dx, dy), entry, first;
+    if (d < 1)
+        return 1;
+    dx /= d;
+    dy /= d;
+    entry = box_entry(at, b->w, b->d, r->at.x, r->at.y, dx, dy);
+    if (entry < 0)
+        return 0;
+    sense_fan(w->sense, &w->scratch[0], r->circle, r->at.x, r->at.y, &dx, &dy, 1, d, &first);
+    return first >= entry - 1;
+}
+
 int robot_fiducials(world *w, int i, fiducial *out, int max)
 {
     const robot *r = &w->robots[i];
-    int b, n = 0;
-    for (b = 0; b < w->lab->nboxes && n < max; b++) {
+    const b14_params *p = &w->lab->b14;
+    int b, n = 0, k;
+    for (b = 0; b < w->lab->nboxes; b++) {
         const lab_box *box = &w->lab->boxes[b];
         pose at = physics_box_pose(w->phys, b);
-        double dx = at.x - r->at.x, dy = at.y - r->at.y, d = hypot(dx, dy);
-        double bearing = wrap180(atan2(dy, dx) / RAD - r->at.heading);
-        double half = hypot(box->w, box->d) / 2, first;
-        if (d > FIDUCIAL_RANGE || fabs(bearing) > FIDUCIAL_FOV / 2.0 || d < 1)
+        double d = hypot(at.x - r->at.x, at.y - r->at.y);
+        double bearing = wrap180(atan2(at.y - r->at.y, at.x - r->at.x) / RAD - r->at.heading);
+        double c = cos(at.heading * RAD), s = sin(at.heading * RAD), inset = 0.9;
+        int seen = 0, corner;
+        fiducial f;
+        if (d > p->fiducial_range || fabs(bearing) > p->fiducial_fov / 2)
             continue;
-        /* The line of sight: the first thing on it is this box's own edge,
-         * no nearer than the centre less its half diagonal. */
-        dx /= d;
-        dy /= d;
-        sense_fan(w->sense, &w->scratch[0], r->circle, r->at.x, r->at.y, &dx, &dy, 1,
-                  d, &first);
-        if (first < d - half - 1)
+        seen = in_sight(w, r, box, at, at.x, at.y);
+        /* a box whose centre is hidden may still show a corner */
+        for (corner = 0; corner < 4 && !seen; corner++) {
+            double u = (corner & 1 ? 0.5 : -0.5) * box->w * inset;
+            double v = (corner & 2 ? 0.5 : -0.5) * box->d * inset;
+            seen = in_sight(w, r, box, at, at.x + u * c - v * s, at.y + u * s + v * c);
+        }
+        if (!seen)
             continue;
-        out[n].id = b;
-        out[n].range = d;
-        out[n].bearing = bearing;
-        out[n].orientation = wrap180(at.heading - r->at.heading);
-        n++;
+        f = (fiducial){ b, d, bearing, wrap180(at.heading - r->at.heading) };
+        /* keep the nearest max, nearest first */
+        for (k = n < max ? n++ : max; k > 0 && out[k - 1].range > d; k--)
+            if (k < max)
+                out[k] = out[k - 1];
+        if (k < max)
+            out[k] = f;
     }
     return n;
 }

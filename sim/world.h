@@ -117,13 +117,18 @@ void robot_take_buttons(world *w, int r, int out[BUTTONS]);  /* read, then clear
 void robot_light(world *w, int r, int light, int on);
 void robot_tether(world *w, int r, int on);
 
-/* A fiducial finder, as Stage's: each box whose centre lies within
- * FIDUCIAL_RANGE mm and FIDUCIAL_FOV degrees across the heading, with
- * nothing nearer on the line to it, is seen as its index, its range (mm)
- * and bearing (degrees from the heading) and its heading relative to the
- * robot's (degrees): what a fiducial on the box tells, not where the box
- * is in the room.  Answers how many, at most max. */
-enum { FIDUCIAL_RANGE = 5000, FIDUCIAL_FOV = 180, FIDUCIALS = 16 };
+/* A fiducial finder, as Stage's: a marker on every box.  A box is seen
+ * when its centre lies within the b14's fiducial-range (mm) and within
+ * its fiducial-fov (degrees, centred on the heading), and the line from
+ * the robot's centre to the box's centre, or to one of its corners, meets
+ * this box before anything else (a wall, a robot, another box).  It is
+ * told as its index among the lab's boxes, its range (mm, centre to
+ * centre), its bearing (degrees from the heading, counter-clockwise) and
+ * its heading less the robot's (degrees): what a fiducial on the box
+ * tells, not where the box is in the room.  Fills out with the nearest
+ * max boxes seen, nearest first; answers how many.  FIDUCIALS is as many
+ * as a trip reply holds. */
+enum { FIDUCIALS = 32 };
 typedef struct { int id; double range, bearing, orientation; } fiducial;
 int robot_fiducials(world *w, int r, fiducial *out, int max);
 

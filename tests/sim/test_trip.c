@@ -6,6 +6,7 @@
  *
  * Nothing here depends on timing except bounded waits for the server. */
 #include <errno.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <arpa/inet.h>
 #include <poll.h>
@@ -122,6 +123,46 @@ static void test_basics(void)
     CHECK("lights read", strcmp(ask(&c, "15 lights read"), "15 ok 1 0 1 1") == 0);
     ask(&c, "16 open battery");
     CHECK("battery read", starts(ask(&c, "17 battery read"), "17 ok 13."));
+    close(c.fd);
+}
+
+/* Poll base status (the base open on c) until the motion is over, at most
+ * 10 s; the heading it ends at. */
+static double await_still(conn *c)
+{
+    double x, y, h = 999, rv;
+    int tv, moving = 1, stalled, k;
+    for (k = 0; k < 500 && moving; k++) {
+        if (sscanf(ask(c, "99 base status"), "99 ok %lf %lf %lf %d %lf %d %d",
+                   &x, &y, &h, &tv, &rv, &moving, &stalled) != 7)
+            break;
+        if (moving)
+            usleep(20000);
+    }
+    return h;
+}
+
+/* moseley, at the origin facing +x, has the lab's one box 1500 mm ahead. */
+static void test_fiducial(void)
+{
+    conn c;
+    int n = -1, id = -1;
+    double range = 0, bearing = 99, orientation = 99;
+    dial(&c, 0);
+    CHECK("fiducial read needs the device open",
+          starts(ask(&c, "1 fiducial read"), "1 err not-open open fiducial first"));
+    CHECK("open fiducial", strcmp(ask(&c, "2 open fiducial"), "2 ok") == 0);
+    CHECK("fiducial read takes no arguments", starts(ask(&c, "3 fiducial read 1"), "3 err args"));
+    sscanf(ask(&c, "4 fiducial read"), "4 ok %d %d %lf %lf %lf", &n, &id, &range, &bearing, &orientation);
+    CHECK("fiducial read: the box ahead, its range, bearing and orientation",
+          n == 1 && id == 0 && range == 1500 && bearing == 0 && orientation == 0);
+    CHECK("no angle is answered as -0.0", strstr((char *)c.buf, "-0.0") == NULL);
+    ask(&c, "5 open base");
+    ask(&c, "6 base rotate 180");
+    CHECK("fiducial test: the robot turns round", fabs(fabs(await_still(&c)) - 180) < 1);
+    CHECK("turned away it sees nothing", strcmp(ask(&c, "8 fiducial read"), "8 ok 0") == 0);
+    ask(&c, "9 base rotate -180");
+    CHECK("fiducial test: and back", fabs(await_still(&c)) < 1);
     close(c.fd);
 }
 
@@ -428,6 +469,7 @@ int main(int argc, char **argv)
         while (fgets(line, sizeof line, out) && strcmp(line, "b14: ready\n") != 0)
             ;
         test_basics();
+        test_fiducial();
         test_errors();
         test_too_many_errors();
         test_flood();

@@ -137,46 +137,145 @@ static void test_push_box(void)
     CHECK("the front skirt segment is pressed", skirt[0] && !skirt[3]);
     robot_ir(w, r, ir);
     CHECK("ir sees the box at the front", ir[0] < 20 && ir[8] == l.b14.ir_range);
+    {
+        fiducial f[FIDUCIALS];
+        int n = robot_fiducials(w, r, f, FIDUCIALS);
+        CHECK("the fiducial finder sees the box it pushes, against its skin",
+              n == 1 && fabs(f[0].range - 480) < 30 && fabs(f[0].bearing) < 10);
+    }
     world_free(w);
     lab_free(&l);
 }
 
+/* ---- the fiducial finder ----------------------------------------------
+ * Each case is a room of its own, 16 m across so that its walls are out of
+ * the way, with a robot at the origin facing `heading` and the boxes given. */
+
+static lab open_room(void)
+{
+    lab l;
+    lab_defaults(&l);
+    lab_add_wall(&l, -8000, -8000, 8000, -8000, 50);
+    lab_add_wall(&l, 8000, -8000, 8000, 8000, 50);
+    lab_add_wall(&l, 8000, 8000, -8000, 8000, 50);
+    lab_add_wall(&l, -8000, 8000, -8000, -8000, 50);
+    return l;
+}
+
+static void put_box(lab *l, double x, double y, double w, double d, double heading)
+{
+    lab_box b = { x, y, w, d, heading, 5 };
+    lab_add_box(l, &b);
+}
+
+/* What the robot at the origin, facing `heading`, sees of l (freed). */
+static int look(lab *l, double heading, fiducial *f, int max)
+{
+    int r = add(l, "a", 0, 0, heading), n;
+    world *w = world_new(l);
+    world_step(w);
+    n = robot_fiducials(w, r, f, max);
+    world_free(w);
+    lab_free(l);
+    return n;
+}
+
+static int find(const fiducial *f, int n, int id)
+{
+    int k;
+    for (k = 0; k < n; k++)
+        if (f[k].id == id)
+            return k;
+    return -1;
+}
+
 static void test_fiducials(void)
 {
-    lab l = room();
-    lab_box ahead = { 1000, 1000, 400, 400, 30, 5 };   /* 45 degrees left, 1414 mm */
-    lab_box behind = { -1500, 0, 400, 400, 0, 5 };
-    lab_box walled = { 1000, -2000, 400, 400, 0, 5 };  /* behind the wall below */
     fiducial f[FIDUCIALS];
-    int r, n, seen_ahead = 0, seen_other = 0, k;
-    world *w;
-    lab_add_box(&l, &ahead);
-    lab_add_box(&l, &behind);
-    lab_add_box(&l, &walled);
-    lab_add_wall(&l, -3000, -1000, 3000, -1000, 50);
-    r = add(&l, "a", 0, 0, 0);
-    w = world_new(&l);
-    world_step(w);
-    n = robot_fiducials(w, r, f, FIDUCIALS);
-    for (k = 0; k < n; k++) {
-        if (f[k].id == 0)
-            seen_ahead = fabs(f[k].range - 1414) < 5 && fabs(f[k].bearing - 45) < 1
-                && fabs(f[k].orientation - 30) < 1;
-        else
-            seen_other = 1;
-    }
-    CHECK("the finder sees a box ahead, with its range, bearing and orientation", seen_ahead);
-    CHECK("not one behind the robot, nor one behind a wall", !seen_other);
-    robot_set_heading(w, r, 0);         /* odometry only: the true heading stays */
-    w->robots[r].at.heading = 180;       /* turned round, by hand */
-    n = robot_fiducials(w, r, f, FIDUCIALS);
-    CHECK("turned round, it sees the one that was behind", n == 1 && f[0].id == 1
-          && fabs(f[0].range - 1500) < 5 && fabs(f[0].bearing) < 1);
-    w->robots[r].at.x = -1500 + 6000; /* far away: out of range */
-    n = robot_fiducials(w, r, f, FIDUCIALS);
-    CHECK("nothing beyond its range", n == 0);
-    world_free(w);
-    lab_free(&l);
+    lab l;
+    int n, k;
+
+    l = open_room();
+    put_box(&l, 1000, 1000, 400, 400, 30);      /* 1414 mm at 45 degrees left */
+    n = look(&l, 20, f, FIDUCIALS);
+    CHECK("a box in view is seen, by its index", n == 1 && f[0].id == 0);
+    CHECK("its range, centre to centre, in mm", n == 1 && fabs(f[0].range - 1414.2) < 2);
+    CHECK("its bearing from the robot's heading", n == 1 && fabs(f[0].bearing - 25) < 0.5);
+    CHECK("its heading relative to the robot's", n == 1 && fabs(f[0].orientation - 10) < 0.5);
+
+    l = open_room();
+    put_box(&l, -1500, 0, 400, 400, 0);
+    CHECK("a box behind the robot is not seen", look(&l, 0, f, FIDUCIALS) == 0);
+    l = open_room();
+    put_box(&l, -1500, 0, 400, 400, 0);
+    n = look(&l, 180, f, FIDUCIALS);
+    CHECK("turned round, the robot sees it dead ahead", n == 1 && fabs(f[0].range - 1500) < 2
+          && fabs(f[0].bearing) < 0.5 && fabs(fabs(f[0].orientation) - 180) < 0.5);
+
+    l = open_room();
+    put_box(&l, -347.3, 1969.6, 400, 400, 0);   /* 2000 mm, 100 degrees left */
+    put_box(&l, 347.3, -1969.6, 400, 400, 0);   /* 2000 mm, 80 degrees right */
+    n = look(&l, 0, f, FIDUCIALS);
+    CHECK("the field of view is 180 degrees: 80 degrees off is in it, 100 is not",
+          n == 1 && f[0].id == 1 && fabs(f[0].bearing + 80) < 0.5);
+    l = open_room();
+    put_box(&l, -347.3, 1969.6, 400, 400, 0);
+    l.b14.fiducial_fov = 240;
+    CHECK("a wider field of view (b14 fiducial-fov) takes it in", look(&l, 0, f, FIDUCIALS) == 1);
+
+    l = open_room();
+    put_box(&l, 4900, 0, 400, 400, 0);
+    put_box(&l, 0, 5100, 400, 400, 0);
+    n = look(&l, 45, f, FIDUCIALS);
+    CHECK("the range is 5 m: a box at 4.9 m in plain sight is seen, one at 5.1 m is not",
+          n == 1 && f[0].id == 0 && fabs(f[0].range - 4900) < 2);
+    l = open_room();
+    put_box(&l, 4900, 0, 400, 400, 0);
+    l.b14.fiducial_range = 4000;
+    CHECK("a shorter range (b14 fiducial-range) leaves it out", look(&l, 0, f, FIDUCIALS) == 0);
+
+    l = open_room();
+    put_box(&l, 3000, 0, 600, 600, 0);
+    lab_add_wall(&l, 2000, -1500, 2000, 1500, 50);
+    CHECK("a box behind a wall is not seen", look(&l, 0, f, FIDUCIALS) == 0);
+    l = open_room();
+    put_box(&l, 3000, 0, 600, 600, 0);
+    lab_add_wall(&l, 2000, -100, 2000, 100, 50);    /* a post on the line of sight */
+    n = look(&l, 0, f, FIDUCIALS);
+    CHECK("a box whose centre a post hides is seen by its corners",
+          n == 1 && fabs(f[0].range - 3000) < 2 && fabs(f[0].bearing) < 0.5);
+
+    l = open_room();
+    put_box(&l, 1500, 0, 400, 400, 0);
+    put_box(&l, 3000, 0, 400, 400, 0);              /* wholly behind the first */
+    n = look(&l, 0, f, FIDUCIALS);
+    CHECK("a box hidden by another box is not seen; the nearer one is",
+          n == 1 && f[0].id == 0);
+    l = open_room();
+    put_box(&l, 3000, 0, 400, 400, 0);
+    add(&l, "b", 1500, 0, 0);                       /* another robot in the way */
+    n = look(&l, 0, f, FIDUCIALS);
+    CHECK("nor one hidden by another robot", n == 0);
+
+    l = open_room();
+    put_box(&l, 3000, 1500, 400, 400, 0);
+    put_box(&l, 1000, -500, 400, 400, 0);
+    put_box(&l, 2000, 0, 400, 400, 0);
+    n = look(&l, 0, f, FIDUCIALS);
+    CHECK("several boxes are told nearest first",
+          n == 3 && f[0].id == 1 && f[1].id == 2 && f[2].id == 0);
+    l = open_room();
+    put_box(&l, 3000, 1500, 400, 400, 0);
+    put_box(&l, 1000, -500, 400, 400, 0);
+    put_box(&l, 2000, 0, 400, 400, 0);
+    n = look(&l, 0, f, 2);
+    CHECK("at most max of them, the nearest", n == 2 && f[0].id == 1 && f[1].id == 2);
+
+    l = open_room();
+    for (k = 0; k < 40; k++)                        /* a row of 40 small boxes */
+        put_box(&l, 1000 + 90 * (k % 10), -1500 + 1000 * (k / 10), 50, 50, 0);
+    n = look(&l, 0, f, FIDUCIALS);
+    CHECK("a crowd is cut at FIDUCIALS", n == FIDUCIALS && find(f, n, 0) >= 0);
 }
 
 static void test_stall(void)
