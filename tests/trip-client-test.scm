@@ -27,7 +27,8 @@
   (aspace ernst (robot (pose -2000 0 180) (battery 13.4)))
   (world (wall -3000 -3000 3000 -3000) (wall 3000 -3000 3000 3000)
          (wall 3000 3000 -3000 3000) (wall -3000 3000 -3000 -3000)
-         (box 1800 1800 600 600 0))
+         (box 1800 1800 600 600 0)
+         (box 2500 -500 600 600 0) (wall 1500 -1200 1500 600))
   (simulator (speed 10)))
 LAB
             \"$b14\" lab.scm --port-base $base --lock-dir locks >out 2>err &
@@ -114,13 +115,22 @@ LAB
   (test "a button pressed on this robot" '(0 1 0 0) (buttons-read)))
 
 (test-group "the fiducial finder"
-  ;; After the motion tests moseley stands near (370 130), heading -45; the
-  ;; box's centre is at (1800 1800).
+  ;; After the motion tests moseley stands near (371 129), heading -45.
+  ;; Turned to 45, box 0 (centre (1800 1800), heading 0) is 2199 mm away,
+  ;; 4.5 degrees to the left, turned -45 from the robot; box 1 is in the
+  ;; field of view too (62 degrees right) but behind the wall at x = 1500.
   (rotate 'by 90)
   (let ((seen (fiducials)))
-    (test "facing it, one box, the lab's first" '(0) (map car seen))
-    (test-assert "its range and bearing, as seen from here"
-      (and (near? (cadr (car seen)) 2200 150) (near? (car (cddr (car seen))) 5 15))))
+    (test "facing them, one box seen, the lab's first: the other is behind a wall"
+          '(0) (map car seen))
+    (test-assert "each as (ID RANGE BEARING ORIENTATION), id and range integers"
+      (and (= 4 (length (car seen))) (exact-integer? (car (car seen)))
+           (exact-integer? (cadr (car seen)))))
+    (test-assert "its range, from here, in mm" (near? (cadr (car seen)) 2199 60))
+    (test-assert "its bearing, from the heading, in degrees"
+      (near? (car (cddr (car seen))) 4.5 5))
+    (test-assert "its orientation relative to the robot's"
+      (near? (cadr (cddr (car seen))) -45 3)))
   (rotate 'by 180)
   (test "facing away, none" '() (fiducials)))
 

@@ -346,21 +346,23 @@
                      things)))
   #t)
 
-;;> The battery in tenths of a volt, an integer (136 for 13.6 V): the unit
-;;> of the thesis's thresholds (130 charging, 100 low, 140 a workstation).
-;;> The boxes the fiducial finder sees (docs/trip-protocol.md), as
-;;> (ID RANGE BEARING ORIENTATION) each: range in mm, bearing from the
-;;> heading and the box's heading from the robot's, in degrees.  Only
-;;> boxes within range and the field of view, in plain sight.
+;;> The boxes the fiducial finder sees (docs/trip-protocol.md, Stage's
+;;> fiducial finder), nearest first, as (ID RANGE BEARING ORIENTATION)
+;;> each: ID the box's index among the lab's boxes, RANGE in mm to its
+;;> centre, BEARING in degrees from the heading (counter-clockwise), and
+;;> ORIENTATION the box's heading less the robot's, in degrees.  Only boxes
+;;> within range and the field of view, and in sight; () when none.
 (define (fiducials)
   (let loop ((words (cdr (device 'fiducial "read"))) (seen '()))
     (if (null? words)
         (reverse seen)
         (loop (list-tail words 4)
-              (cons (list (exact (car words)) (cadr words) (car (cddr words))
+              (cons (list (exact (car words)) (exact (cadr words)) (car (cddr words))
                           (cadr (cddr words)))
                     seen)))))
 
+;;> The battery in tenths of a volt, an integer (136 for 13.6 V): the unit
+;;> of the thesis's thresholds (130 charging, 100 low, 140 a workstation).
 (define (battery-voltage)
   (exact (round (* 10 (car (device 'battery "read"))))))
 
