@@ -4,9 +4,10 @@
 ;; conventions have them, and this side says, in one line and the usage,
 ;; what is wrong with a command line, exiting 2: a user's mistake is no
 ;; occasion for a stack trace.
-(import (scheme base) (scheme write) (scheme process-context) (srfi 1)
+(import (scheme base) (scheme write) (scheme process-context) (scheme eval) (srfi 1)
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
+        (only (chibi ast) setenv)
         (murdoch lab) (murdoch command) (murdoch launch))
 
 (define version "0.3")
@@ -18,8 +19,27 @@
 (define (except names)
   (cond ((not names) '()) ((list? names) names) (else (list names))))
 
+;; The page of the live view, its script and style.
+(define web (string-append bin "/../web"))
+
+;; The view is loaded only by the commands that serve it: its HTTP server
+;; costs a second to load.
+(define (view-procedure name)
+  (eval name (environment '(murdoch view))))
+
+;; A port number given as an argument.
+(define (port-argument c text)
+  (let ((n (string->number text)))
+    (if (and (exact-integer? n) (< 0 n 65536))
+        n
+        (mistake c (string-append "not a port number: " text)))))
+
 (define (run-lab* cfg lab-file)
   (let ((option (lambda (name) (conf-get cfg (list 'command 'lab name)))))
+    ;; bin/murdoch-lab starts the view, on this port (0: the lab's
+    ;; port-base + 148), when MURDOCH_VIEW is set.
+    (if (option 'view)
+        (setenv "MURDOCH_VIEW" (number->string (option 'view))))
     (run-lab bin lab-file (except (option 'except)) (option 'logs) (option 'trace)
              (let ((speed (option 'speed)))
                (and speed (number->string speed))))))
@@ -41,12 +61,23 @@
          ((trace string "write the simulator's animated SVG trace here")
           (speed real "simulated seconds per wall second")
           (logs string "the children's logs go in this folder (default: a fresh one, named when the lab starts)")
-          (except (list symbol) "start all but these address spaces (a,b,...), to join by hand"))
+          (except (list symbol) "start all but these address spaces (a,b,...), to join by hand")
+          (view integer "also serve the live view in the browser, at http://127.0.0.1:PORT/ (PORT may be left out: the lab's port-base + 148)"))
          ,(lambda (cfg lab) (run-lab* cfg lab)))
     (pose (LAB FILE) "pose the task FILE evaluates to, as a guest of the running lab" ()
           ,(lambda (cfg lab file) (run-pose lab file)))
     (demo (LAB) "start the lab, pose the dual-sonar task, show where the trace is" ()
           ,(lambda (cfg lab) (run-demo bin lab)))
+    (view (LAB (PORT)) "show the running lab in the browser: serve its live view at http://127.0.0.1:PORT/ (default: the lab's port-base + 148), writing its trace as it goes"
+          ((trace string "write the view's trace here (default: runs/LAB-SECONDS.jsonl)"))
+          ,(lambda (cfg lab . port)
+             ((view-procedure 'run-view)
+              web lab (and (pair? port) (port-argument (command-named "view") (car port)))
+              (conf-get cfg '(command view trace)))))
+    (replay (TRACE (PORT)) "serve the view of a finished run from its trace, to play in the browser (default port 7248)" ()
+            ,(lambda (cfg trace . port)
+               ((view-procedure 'run-replay)
+                web trace (and (pair? port) (port-argument (command-named "replay") (car port))))))
     (check (LAB) "check the lab file for mistakes, and start nothing" ()
            ,(lambda (cfg lab) (check lab)))
     (status (LAB) "show each address space of the running lab: up since, pose, battery, the subjects held and by whom" ()
@@ -93,7 +124,8 @@
             (command-options c)))
 
 (define (string-upcase-name type)
-  (if (pair? type) "A,B,..." (if (eq? type 'real) "X" "TEXT")))
+  (cond ((pair? type) "A,B,...") ((eq? type 'real) "X") ((eq? type 'integer) "PORT")
+        (else "TEXT")))
 
 (define (show-help name)
   (cond ((null? name) (show-usage (current-output-port)))
@@ -131,11 +163,15 @@
 (define (help-flag? arg) (member arg '("--help" "-h")))
 
 ;; (chibi app) wants a command's options before its arguments; people
-;; write `murdoch lab LAB --trace FILE` too.  Every option takes a value.
+;; write `murdoch lab LAB --trace FILE` too.  Every option takes a value
+;; but --view, whose port may be left out: it is then 0.
 (define (options-first args)
   (let loop ((rest args) (options '()) (positional '()))
     (cond
      ((null? rest) (append (reverse options) (reverse positional)))
+     ((and (equal? (car rest) "--view")
+           (or (null? (cdr rest)) (not (string->number (cadr rest)))))
+      (loop (cdr rest) (cons* "0" "--view" options) positional))
      ((and (> (string-length (car rest)) 2)
            (string=? "--" (substring (car rest) 0 2)))
       (if (null? (cdr rest))
@@ -146,6 +182,9 @@
 (define (positional args)
   (let loop ((rest args) (acc '()))
     (cond ((null? rest) (reverse acc))
+          ((and (equal? (car rest) "--view")
+                (or (null? (cdr rest)) (not (string->number (cadr rest)))))
+           (loop (cdr rest) acc))
           ((and (> (string-length (car rest)) 2) (string=? "--" (substring (car rest) 0 2)))
            (loop (if (pair? (cdr rest)) (cddr rest) '()) acc))
           (else (loop (cdr rest) (cons (car rest) acc))))))

@@ -4,12 +4,23 @@
 ;; names an address space, and the file says where it listens.
 
 (define-record-type lab
-  (make-lab name directory settings aspaces)
+  (make-lab name directory settings aspaces clauses)
   lab?
   (name lab-name)
   (directory lab-directory)
   (settings lab-settings)
-  (aspaces lab-aspaces))
+  (aspaces lab-aspaces)
+  (clauses lab-clauses))
+
+;;> The radius of the lab's robots in millimetres: its b14 clause's, or
+;;> the simulator's B14's (room.scm).
+(define (lab-robot-radius lab)
+  (robot-radius (lab-clauses lab)))
+
+;;> The lab file's top-level clause \scheme{(key ...)}, such as its
+;;> \scheme{world}, or #f.
+(define (lab-clause lab key)
+  (clause key (lab-clauses lab)))
 
 ;;> One address space of the lab file.  \var{clauses} keeps the clauses that
 ;;> later layers read (robot, position, capabilities, load).
@@ -220,7 +231,8 @@
                             (loop (cdr cs) (+ i 1)
                                   (cons (parse-aspace path (car cs) i base interface)
                                         acc)))
-                           (else (loop (cdr cs) i acc)))))))
+                           (else (loop (cdr cs) i acc))))
+                        clauses)))
     (check-lab path lab)
     (check-room path clauses)
     lab))

@@ -1,0 +1,552 @@
+;;;; The live view.
+;;
+;; One process, a guest of the lab, asks every address space at once,
+;; twice a second, how it is -- status.scm's aspace-report and, on a
+;; robot, its latest sonar ring and the boxes its fiducial finder sees --
+;; and makes of the answers a snapshot: one JSON object with the time,
+;; every address space, where the boxes are, and the tasks.  Snapshots
+;; are appended to the run's trace, one line each, after a line that
+;; describes the room.  The page (web/view.html, web/view.js) reads the
+;; trace so far from /trace and then each new snapshot from /events, as
+;; server-sent events; a replay serves a finished trace and no events, and
+;; the same page plays it.  The server is (chibi net http-server), on
+;; 127.0.0.1 only.
+;;
+;; The room is the lab file's world; a box is drawn where the lab file
+;; puts it until a robot's fiducial finder sees it, then where that robot
+;; saw it last.  A robot's pose is its odometry (safe-reckon), which the
+;; simulator starts at the lab file's pose.
+
+(define poll-seconds 0.5)
+
+;; Snapshots kept in memory for the pages that are following along; one
+;; that falls further behind reads the trace again.
+(define kept-snapshots 200)
+
+;;; JSON
+
+;;> \var{x} written as JSON, to a string: objects are alists of symbols,
+;;> arrays vectors (chibi json).
+(define (json-text x)
+  (let ((out (open-output-string)))
+    (json-write x out)
+    (get-output-string out)))
+
+;; A number as JSON takes it: exact integers as they are, anything else
+;; to a tenth.
+(define (num x)
+  (cond ((exact-integer? x) x)
+        ((and (real? x) (finite? x)) (/ (round (* 10. x)) 10.))
+        (else 'null)))
+
+(define (text x)
+  (cond ((string? x) x)
+        ((symbol? x) (symbol->string x))
+        ((error-object? x)
+         (let ((out (open-output-string)))
+           (display (error-object-message x) out)
+           (for-each (lambda (i) (write-char #\space out) (display i out))
+                     (error-object-irritants x))
+           (get-output-string out)))
+        (else (let ((out (open-output-string))) (display x out) (get-output-string out)))))
+
+(define (numbers ls) (list->vector (map num ls)))
+
+;;; The room: the first line of a trace
+
+(define (world-items lab kind n)
+  (filter-map (lambda (item)
+                (and (pair? item) (eq? (car item) kind) (list? item)
+                     (>= (length (cdr item)) n) (every real? (cdr item))
+                     (cdr item)))
+              (cond ((lab-clause lab 'world) => cdr) (else '()))))
+
+;;> The first line of a trace, as JSON: the lab's name, the robots'
+;;> radius, its walls as (x1 y1 x2 y2 thickness), its boxes as (x y
+;;> width depth heading), and its address spaces, robots or not.
+(define (lab-header lab)
+  `((kind . "lab")
+    (lab . ,(symbol->string (lab-name lab)))
+    (radius . ,(num (lab-robot-radius lab)))
+    (walls . ,(list->vector
+               (map (lambda (w)
+                      (numbers (append (take w 4)
+                                       (if (> (length w) 4) (list (list-ref w 4)) '(50)))))
+                    (world-items lab 'wall 4))))
+    (boxes . ,(list->vector (map (lambda (b) (numbers (take b 5)))
+                                 (world-items lab 'box 5))))
+    (aspaces . ,(list->vector
+                 (map (lambda (a)
+                        `((name . ,(symbol->string (lab-aspace-uid a)))
+                          (robot . ,(if (lab-aspace-clause a 'robot) #t #f))))
+                      (lab-aspaces lab))))
+    (started . ,(num (current-second)))))
+
+(define (degrees->radians d) (* d (/ (acos -1) 180)))
+
+;;> Where box \var{id} is, as (x y heading), from a robot at \var{pose}
+;;> (x y heading ...) that sees it at \var{range} mm and \var{bearing}
+;;> degrees, the box's heading being \var{orientation} degrees from the
+;;> robot's.
+(define (box-seen pose range bearing orientation)
+  (let ((a (degrees->radians (+ (list-ref pose 2) bearing))))
+    (list (+ (car pose) (* range (cos a)))
+          (+ (cadr pose) (* range (sin a)))
+          (+ (list-ref pose 2) orientation))))
+
+;;; The tasks: what the address spaces say they hold and run
+;;
+;; A robot tells the subjects it holds and for whom -- a reservation
+;; name, NAME@POSER#N (pose-task.scm) -- and the components of started
+;; tasks that it runs, (running ID INDEX POSER) with ID NAME@POSER/N
+;; (task.scm).  The table remembers each component from when it is first
+;; seen on a robot to when that robot no longer shows it; a component of
+;; a started task seen on another robot than before was reassigned.  A
+;; task's own state is what its poser says, when the poser is an address
+;; space of the lab; else running while a component is seen, then done.
+
+(define-record-type task-entry
+  (make-task-entry key name poser state components)
+  task-entry?
+  (key task-entry-key)
+  (name task-entry-name)
+  (poser task-entry-poser)
+  (state task-entry-state task-entry-state-set!)
+  (components task-entry-components task-entry-components-set!))
+
+(define-record-type component-entry
+  (make-component-entry index robot subjects since until end from)
+  component-entry?
+  (index component-entry-index)
+  (robot component-entry-robot)
+  (subjects component-entry-subjects component-entry-subjects-set!)
+  (since component-entry-since)
+  (until component-entry-until component-entry-until-set!)
+  (end component-entry-end component-entry-end-set!)
+  (from component-entry-from))
+
+;;> A table of the tasks seen so far, empty.
+(define (make-task-table) (list 'tasks))
+
+(define (table-tasks table) (cdr table))
+
+;;> The task name and poser that reservation name or task id \var{key}
+;;> (a string, NAME@POSER#N or NAME@POSER/N) holds, as a list, or the key
+;;> and #f when it is neither.
+(define (reservation-task key)
+  (let* ((n (string-length key))
+         (mark (last-index key (lambda (c) (memv c '(#\# #\/))) n))
+         (at (and mark (last-index key (lambda (c) (char=? c #\@)) mark))))
+    (if at
+        (list (substring key 0 at) (substring key (+ at 1) mark))
+        (list key #f))))
+
+(define (last-index s pred end)
+  (let loop ((i (- end 1)))
+    (cond ((< i 0) #f)
+          ((pred (string-ref s i)) i)
+          (else (loop (- i 1))))))
+
+;; NAME@POSER of a key: what a started task's id and its reservations share.
+(define (key-base key)
+  (let ((nt (reservation-task key)))
+    (if (cadr nt) (string-append (car nt) "@" (cadr nt)) key)))
+
+;; What one address space's report shows running there: (KEY INDEX
+;; SUBJECTS) for each component, INDEX #f when only held subjects show it.
+(define (report-components report)
+  (let* ((held (map (lambda (h) (cons (text (car h)) (text (cadr h))))
+                    (list-ref report 4)))
+         (running (filter-map (lambda (t)
+                                (and (pair? t) (eq? (car t) 'running)
+                                     (>= (length t) 3)
+                                     (list (text (cadr t)) (list-ref t 2))))
+                              (list-ref report 5)))
+         (subjects-of (lambda (pred)
+                        (map car (filter (lambda (h) (pred (cdr h))) held))))
+         (covered? (lambda (holder)
+                     (any (lambda (r) (equal? (key-base (car r)) (key-base holder)))
+                          running))))
+    (append
+     (map (lambda (r)
+            (list (car r) (cadr r)
+                  (subjects-of (lambda (holder)
+                                 (equal? (key-base holder) (key-base (car r)))))))
+          running)
+     (map (lambda (holder)
+            (list holder #f (subjects-of (lambda (h) (equal? h holder)))))
+          (delete-duplicates (remove covered? (map cdr held)))))))
+
+;; (KEY STATE) for each task the report says this address space posed.
+(define (report-posed report)
+  (filter-map (lambda (t)
+                (and (pair? t) (eq? (car t) 'posed) (= (length t) 3)
+                     (list (text (cadr t)) (text (car (cddr t))))))
+              (list-ref report 5)))
+
+(define (task-named table key)
+  (or (find (lambda (t) (equal? (task-entry-key t) key)) (table-tasks table))
+      (let* ((nt (reservation-task key))
+             (t (make-task-entry key (car nt) (cadr nt) #f '())))
+        (set-cdr! table (append (table-tasks table) (list t)))
+        t)))
+
+(define (open? c) (not (component-entry-until c)))
+
+;;> Brings \var{table} up to the time \var{t} (seconds) with
+;;> \var{reports}: (UID REPORT) for each address space that answered,
+;;> REPORT as aspace-report makes it.  Components that an address space
+;;> that answered no longer shows have ended.
+(define (task-table-update! table t reports)
+  (let ((seen '()))                     ; the component entries seen now
+    (for-each
+     (lambda (uid+report)
+       (let ((robot (text (car uid+report)))
+             (report (cadr uid+report)))
+         (for-each (lambda (posed)
+                     (task-entry-state-set! (task-named table (car posed))
+                                            (cadr posed)))
+                   (report-posed report))
+         (for-each
+          (lambda (obs)
+            (set! seen (cons (observe! (task-named table (car obs)) t robot
+                                       (cadr obs) (car (cddr obs)))
+                             seen)))
+          (report-components report))))
+     reports)
+    (let ((answered (map (lambda (r) (text (car r))) reports)))
+      (for-each
+       (lambda (task)
+         (for-each (lambda (c)
+                     (when (and (open? c) (not (memq c seen))
+                                (member (component-entry-robot c) answered))
+                       (component-entry-until-set! c t)
+                       (component-entry-end-set! c "done")))
+                   (task-entry-components task)))
+       (table-tasks table)))))
+
+;; The component entry of task that robot shows at t, made if new.
+(define (observe! task t robot index subjects)
+  (let* ((cs (task-entry-components task))
+         (same (find (lambda (c)
+                       (and (open? c)
+                            (if index
+                                (eqv? (component-entry-index c) index)
+                                (and (not (component-entry-index c))
+                                     (equal? (component-entry-robot c) robot)))))
+                     cs)))
+    (cond
+     ((and same (equal? (component-entry-robot same) robot))
+      (component-entry-subjects-set!
+       same (lset-union equal? (component-entry-subjects same) subjects))
+      same)
+     (else
+      (when same                        ; its index moved to another robot
+        (component-entry-until-set! same t)
+        (component-entry-end-set! same (string-append "moved to " robot)))
+      (let* ((before (and index
+                          (find (lambda (c)
+                                  (and (eqv? (component-entry-index c) index)
+                                       (not (equal? (component-entry-robot c) robot))))
+                                (reverse cs))))
+             (c (make-component-entry index robot subjects t #f #f
+                                      (and before (component-entry-robot before)))))
+        (task-entry-components-set! task (append cs (list c)))
+        c)))))
+
+;;> The table as JSON: the newest \var{most} tasks, each with its name,
+;;> poser, state and components (index, robot, subjects, since, until,
+;;> how it ended, and the robot it was reassigned from).
+(define (task-table->json table most)
+  (list->vector
+   (map (lambda (task)
+          (let ((cs (task-entry-components task)))
+            `((id . ,(task-entry-key task))
+              (name . ,(task-entry-name task))
+              (poser . ,(or (task-entry-poser task) 'null))
+              (state . ,(or (task-entry-state task)
+                            (if (any open? cs) "running" "done")))
+              (components
+               . ,(list->vector
+                   (map (lambda (c)
+                          `((index . ,(or (component-entry-index c) 'null))
+                            (robot . ,(component-entry-robot c))
+                            (subjects . ,(list->vector (component-entry-subjects c)))
+                            (since . ,(num (component-entry-since c)))
+                            (until . ,(if (open? c) 'null (num (component-entry-until c))))
+                            (end . ,(or (component-entry-end c) 'null))
+                            (from . ,(or (component-entry-from c) 'null))))
+                        cs))))))
+        (let ((all (table-tasks table)))
+          (reverse (if (> (length all) most) (take-right all most) all))))))
+
+;;; Snapshots
+
+;; What each address space is asked: its report, and on a robot its
+;; sonar ring and fiducials (#f on a workstation, where they raise).
+(define report-source
+  '(lambda ()
+     (list (aspace-report)
+           (guard (e (#t #f)) (sonar-read))
+           (guard (e (#t #f)) (fiducials)))))
+
+;;> The snapshot at \var{t} seconds of the lab: \var{answers} are
+;;> remote-apply-all's, for the lab's address spaces, of report-source;
+;;> \var{boxes} the vector of boxes (x y w d heading), which the robots'
+;;> fiducials move; \var{table} the task table, brought up to date.
+(define (view-snapshot lab t answers boxes table)
+  (let ((reports (filter-map (lambda (a) (and (cadr a) (list (car a) (car (car (cddr a))))))
+                             answers)))
+    (task-table-update! table t reports)
+    (for-each (lambda (a) (if (cadr a) (move-boxes! boxes (car (cddr a))))) answers)
+    `((kind . "state")
+      (t . ,(num t))
+      (clock . ,(num (current-second)))
+      (aspaces . ,(list->vector (map aspace-json answers)))
+      (boxes . ,(vector-map (lambda (b) b) boxes))
+      (tasks . ,(task-table->json table 12)))))
+
+(define (move-boxes! boxes answer)
+  (let ((pose (list-ref (car answer) 2))
+        (seen (car (cddr answer))))
+    (if (and pose (list? seen))
+        (for-each
+         (lambda (f)
+           (let ((id (car f)))
+             (if (and (exact-integer? id) (< -1 id (vector-length boxes)))
+                 (let ((b (vector-ref boxes id))
+                       (at (box-seen pose (cadr f) (list-ref f 2) (list-ref f 3))))
+                   (vector-set! boxes id
+                                (vector (num (car at)) (num (cadr at))
+                                        (vector-ref b 2) (vector-ref b 3)
+                                        (num (car (cddr at)))))))))
+         seen))))
+
+(define (aspace-json answer)
+  (let ((name (text (car answer))))
+    (if (not (cadr answer))
+        `((name . ,name) (away . #t) (why . ,(text (car (cddr answer)))))
+        (let* ((value (car (cddr answer)))
+               (report (car value))
+               (pose (list-ref report 2))
+               (battery (list-ref report 3)))
+          `((name . ,name)
+            (away . #f)
+            (since . ,(num (list-ref report 1)))
+            (pose . ,(if (and (list? pose) (>= (length pose) 3)) (numbers (take pose 3)) 'null))
+            (battery . ,(if (real? battery) (num (/ battery 10)) 'null))
+            (held . ,(list->vector (map (lambda (h) (vector (text (car h)) (text (cadr h))))
+                                        (list-ref report 4))))
+            (sonar . ,(if (and (list? (cadr value)) (every real? (cadr value)))
+                          (numbers (cadr value))
+                          'null))
+            ;; A report that tells where the robot's goto-xy is going, as
+            ;; a seventh element (x y), has it drawn.
+            (goal . ,(let ((goal (and (> (length report) 6) (list-ref report 6))))
+                       (if (and (list? goal) (>= (length goal) 2) (every real? (take goal 2)))
+                           (numbers (take goal 2))
+                           'null))))))))
+
+;;; The feed: snapshots for the trace file and the pages that follow
+
+;; The trace is written as the run goes, a line at a time, so that a
+;; lab stopped any way leaves a trace to replay.
+(define-record-type feed
+  (make-feed trace out count recent)
+  feed?
+  (trace feed-trace)                    ; the trace file's path
+  (out feed-out)                        ; and its port
+  (count feed-count feed-count-set!)    ; snapshots so far
+  (recent feed-recent feed-recent-set!)) ; ((INDEX . JSON) ...), newest first
+
+(define (feed-add! feed line)
+  (write-string line (feed-out feed))
+  (newline (feed-out feed))
+  (flush-output-port (feed-out feed))
+  (let ((k (feed-count feed)))
+    (feed-recent-set! feed (let ((r (cons (cons k line) (feed-recent feed))))
+                             (if (> (length r) kept-snapshots) (take r kept-snapshots) r)))
+    (feed-count-set! feed (+ k 1))))
+
+;;; Serving
+
+(define content-types
+  '(("html" . "text/html; charset=UTF-8")
+    ("js" . "text/javascript; charset=UTF-8")
+    ("css" . "text/css; charset=UTF-8")))
+
+(define (file-string path)
+  (call-with-input-file path
+    (lambda (in)
+      (let loop ((parts '()))
+        (let ((s (read-string 65536 in)))
+          (if (eof-object? s)
+              (apply string-append (reverse parts))
+              (loop (cons s parts))))))))
+
+(define (respond request status type body)
+  (servlet-respond request status (if (= status 200) "OK" "Not Found")
+                   `((Content-Type . ,type)
+                     (Content-Length . ,(bytevector-length (string->utf8 body)))
+                     (Cache-Control . "no-cache")
+                     (Connection . "close")))
+  (write-string body (request-out request)))
+
+;; The servlet: the page and its files from web, /info, /trace, /state
+;; and /events.  feed is #f in a replay.
+(define (view-servlet web trace feed info)
+  (lambda (cfg request next restart)
+    (let ((path (request-path request)))
+      (cond
+       ((member path '("/" "/index.html"))
+        (respond request 200 (cdr (assoc "html" content-types))
+                 (file-string (string-append web "/view.html"))))
+       ((member path '("/view.js" "/view.css"))
+        (respond request 200
+                 (cdr (assoc (if (equal? path "/view.js") "js" "css") content-types))
+                 (file-string (string-append web path))))
+       ((equal? path "/info")
+        (respond request 200 "application/json" (json-text (info))))
+       ((equal? path "/trace")
+        (respond request 200 "text/plain; charset=UTF-8"
+                 (if (file-exists? trace) (file-string trace) "")))
+       ((and feed (equal? path "/state"))
+        (respond request 200 "application/json"
+                 (let ((r (feed-recent feed))) (if (pair? r) (cdar r) "null"))))
+       ((and feed (equal? path "/events"))
+        (send-events request feed))
+       (else (respond request 404 "text/plain" "not found\n"))))))
+
+;; Server-sent events: each snapshot from the one the page asks for
+;; (?from=N, or the one after its Last-Event-ID when it reconnects), as
+;; "id: N" and "data: JSON", until the page goes.  A comment every 10 s
+;; finds out a page that went quietly.  With ?once=1, only those there
+;; are now, and the stream ends: a page that polls.
+(define (send-events request feed)
+  (let ((out (request-out request))
+        (from (or (let ((id (assq 'last-event-id (request-headers request))))
+                    (and id (string? (cdr id))
+                         (let ((n (string->number (cdr id)))) (and n (+ n 1)))))
+                  (let ((p (request-param request "from")))
+                    (and p (string->number p)))
+                  (feed-count feed)))
+        (once? (request-param request "once")))
+    (servlet-respond request 200 "OK"
+                     '((Content-Type . "text/event-stream")
+                       (Cache-Control . "no-cache")))
+    (guard (e (#t #f))                  ; the page went away
+      (let loop ((next from) (quiet 0))
+        (let ((new (reverse (filter (lambda (r) (>= (car r) next)) (feed-recent feed)))))
+          (for-each (lambda (r)
+                      (write-string (string-append "id: " (number->string (car r))
+                                                   "\ndata: " (cdr r) "\n\n")
+                                    out))
+                    new)
+          (cond ((pair? new) (flush-output-port out))
+                ((> quiet 50) (write-string ":\n\n" out) (flush-output-port out)))
+          (unless once?
+            (thread-sleep! 0.2)
+            (loop (if (pair? new) (+ 1 (car (last new))) next)
+                  (if (or (pair? new) (> quiet 50)) 0 (+ quiet 1)))))))))
+
+;; A listening socket on 127.0.0.1:port, or an error that says so.
+(define (listen-on port)
+  (let ((addr (get-address-info "127.0.0.1" port)))
+    (guard (e (#t (error (string-append "the view cannot listen on 127.0.0.1:"
+                                        (number->string port)
+                                        " (is another process there?)"))))
+      (make-listener-socket addr))))
+
+(define (serve! listener servlet)
+  (run-http-server listener servlet (make-conf '((quiet? . #t)) #f #f #f)))
+
+(define (say . parts)
+  (for-each display parts)
+  (newline)
+  (flush-output-port (current-output-port)))
+
+;;> `murdoch view LAB [PORT]`: joins the running lab at \var{lab-file} as
+;;> a guest, polls it twice a second, appends each snapshot to
+;;> \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl), and serves the
+;;> page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
+;;> lab's port-base + 148), until killed.
+(define (run-view web lab-file port trace)
+  (set-process-name! "murdoch-view")
+  (let* ((lab (read-lab lab-file))
+         (port (or port (+ (lab-port-base lab) 148)))
+         (listener (listen-on port))
+         (trace (or trace (default-trace lab)))
+         (uid (string->symbol (string-append "view-" (number->string (current-process-id)))))
+         (env (join-lab lab-file uid (lab-guest-port lab)))
+         (proc (eval report-source (make-repl-environment lab env)))
+         (aspaces (map (lambda (a) (uid->aspace (lab-aspace-uid a))) (lab-aspaces lab)))
+         (header (or (trace-header trace) (lab-header lab)))
+         (boxes (list->vector (vector->list (cdr (assq 'boxes header)))))
+         (table (make-task-table))
+         (out (open-trace trace header))
+         (feed (make-feed trace out (max 0 (- (trace-line-count trace) 1)) '()))
+         (start (cdr (assq 'started header))))
+    (tell-who-is-away lab)
+    (thread-start!
+     (make-thread
+      (lambda ()
+        (let loop ()
+          (let ((t0 (current-second)))
+            (feed-add! feed (json-text
+                             (view-snapshot lab (- t0 start)
+                                            (parameterize ((remote-timeout 1))
+                                              (remote-apply-all aspaces proc))
+                                            boxes table)))
+            (thread-sleep! (max 0.05 (- (+ t0 poll-seconds) (current-second))))
+            (loop))))
+      'view-poll))
+    (say "view: http://127.0.0.1:" port "/ (trace " trace ")")
+    (serve! listener
+            (view-servlet web trace feed
+                          (lambda () `((live . #t) (lab . ,(symbol->string (lab-name lab)))
+                                       (trace . ,trace)))))))
+
+;; The header of the trace already at path, or #f: the view started
+;; again by the lab carries on with the trace it was writing.
+(define (trace-header path)
+  (and (file-exists? path)
+       (let ((line (call-with-input-file path read-line)))
+         (and (string? line)
+              (guard (e (#t #f)) (string->json line))))))
+
+(define (trace-line-count path)
+  (if (file-exists? path)
+      (call-with-input-file path
+        (lambda (in)
+          (let loop ((n 0))
+            (if (eof-object? (read-line in)) n (loop (+ n 1))))))
+      0))
+
+;; The trace's port: a new file that starts with the header, or the end
+;; of the trace there is.
+(define (open-trace path header)
+  (if (trace-header path)
+      (open-output-file-descriptor
+       (open path (bitwise-ior open/write open/append)))
+      (let ((out (open-output-file path)))
+        (write-string (json-text header) out)
+        (newline out)
+        (flush-output-port out)
+        out)))
+
+(define (default-trace lab)
+  (let ((dir "runs"))
+    (if (not (file-exists? dir)) (create-directory* dir))
+    (string-append dir "/" (symbol->string (lab-name lab)) "-"
+                   (number->string (exact (floor (current-second)))) ".jsonl")))
+
+;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
+;;> (default 7248) to play the run that \var{trace} holds.
+(define (run-replay web trace port)
+  (if (not (file-exists? trace)) (error "no such trace" trace))
+  (let* ((port (or port 7248))
+         (listener (listen-on port)))
+    (say "view: http://127.0.0.1:" port "/ (replaying " trace ")")
+    (serve! listener
+            (view-servlet web trace #f
+                          (lambda () `((live . #f) (trace . ,trace)))))))

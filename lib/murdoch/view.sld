@@ -1,0 +1,21 @@
+;;> The live view: a page on localhost that draws the lab as it runs --
+;;> the room, the robots, their paths and sonar, the tasks -- and replays
+;;> a finished run from the trace it wrote.  \scheme{murdoch lab LAB
+;;> --view}, \scheme{murdoch view} and \scheme{murdoch replay}.
+(define-library (murdoch view)
+  (export run-view run-replay
+          ;; the parts, for tests
+          lab-header view-snapshot make-task-table task-table-update!
+          task-table->json reservation-task json-text box-seen)
+  (import (scheme base) (scheme write) (scheme file) (scheme eval)
+          (scheme time) (scheme inexact) (scheme char)
+          (srfi 1) (srfi 18)
+          (chibi net) (chibi net http-server) (chibi net servlet)
+          (only (chibi config) make-conf)
+          (only (chibi process) current-process-id)
+          (only (chibi filesystem) create-directory* open open/write open/append
+                open-output-file-descriptor)
+          (only (srfi 151) bitwise-ior)
+          (chibi json)
+          (murdoch process-name) (murdoch lab) (murdoch command) (murdoch remote))
+  (include "view.scm"))

@@ -1,0 +1,272 @@
+;;; The live view: its parts (the room, the task table, a box seen by a
+;;; fiducial finder), then a real lab with --view, read over HTTP and as
+;;; server-sent events, and shown in a real browser, headless chromium:
+;;; the page names each robot and the task panel names the task and the
+;;; robot that won it.  A replay of the run's trace shows the same.
+(import (scheme base) (scheme write) (scheme file) (scheme char) (scheme process-context)
+        (srfi 1) (srfi 18) (chibi test)
+        (only (chibi process) system?)
+        (only (chibi filesystem) delete-file-hierarchy file-size)
+        (chibi json)
+        (murdoch lab) (murdoch view) (murdoch connect) (murdoch testing))
+
+(define (assq-ref key alist) (cdr (assq key alist)))
+
+(test-begin "view")
+
+;;; The parts
+
+(define lab
+  (make-test-lab
+   '((aspace moseley (robot (pose -1000 0 0)) (capabilities mobile))
+     (aspace ernst (robot (pose 1000 -1500 90)) (capabilities mobile))
+     (aspace troy (position 0 2500 0))
+     (world (wall -3000 -3000 3000 -3000) (wall 3000 -3000 3000 3000)
+            (wall 3000 3000 -3000 3000 80) (wall -3000 3000 -3000 -3000)
+            (box 1500 1500 400 400 30)))))
+(define dir (test-lab-directory lab))
+(define (in-dir name) (string-append dir "/" name))
+
+(test-group "the room: the trace's first line"
+  (let ((header (string->json (json-text (lab-header (read-lab (test-lab-file lab)))))))
+    (test "the lab's name" "test" (assq-ref 'lab header))
+    (test "walls, 50 mm thick unless said" '(#(-3000 -3000 3000 -3000 50) #(3000 3000 -3000 3000 80))
+      (let ((walls (vector->list (assq-ref 'walls header))))
+        (list (first walls) (third walls))))
+    (test "boxes" '#(#(1500 1500 400 400 30)) (assq-ref 'boxes header))
+    (test "the robots' radius" 180 (assq-ref 'radius header))
+    (test "which address spaces are robots" '(("moseley" . #t) ("ernst" . #t) ("troy" . #f))
+      (map (lambda (a) (cons (assq-ref 'name a) (assq-ref 'robot a)))
+           (vector->list (assq-ref 'aspaces header))))))
+
+(test-group "a box where a robot's fiducial finder sees it"
+  (define (mm ls) (map (lambda (x) (exact (round x))) ls))
+  (test "to the right of a robot facing +y, turned" '(2500 0 120)
+    (mm (box-seen '(1000 0 90 0) 1500 -90 30)))
+  (test "to the left of a robot facing +x" '(0 2000 0)
+    (mm (box-seen '(0 0 0 0) 2000 90 0))))
+
+(test-group "reservation names and task ids"
+  (test '("dual-sonar-task" "pose-12") (reservation-task "dual-sonar-task@pose-12#3"))
+  (test '("box@move" "tester") (reservation-task "box@move@tester/2"))
+  (test '("plain" #f) (reservation-task "plain")))
+
+;; A report as aspace-report makes it: (UID UP-SINCE POSE BATTERY HELD TASKS).
+(define (report uid held tasks) (list uid 0 '(0 0 0 0) 136 held tasks))
+
+(define (components table)
+  (map (lambda (t)
+         (cons (assq-ref 'name t)
+               (map (lambda (c)
+                      (list (assq-ref 'index c) (assq-ref 'robot c)
+                            (vector->list (assq-ref 'subjects c))
+                            (assq-ref 'until c) (assq-ref 'end c) (assq-ref 'from c)))
+                    (vector->list (assq-ref 'components t)))))
+       (vector->list (string->json (json-text (task-table->json table 10))))))
+
+(test-group "the task table"
+  (let ((table (make-task-table)))
+    ;; pose-task: the winners hold their exclusive subjects.
+    (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |t@pose-1#1|) (sonar |t@pose-1#1|)) '()))
+                                      (list 'ernst (report 'ernst '((mobile |t@pose-1#1|)) '()))))
+    (test "a subject held is a component on that robot"
+        '(("t" (null "moseley" ("mobile" "sonar") null null null)
+               (null "ernst" ("mobile") null null null)))
+      (components table))
+    (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))))
+    (test "a robot that no longer holds it is done; one that did not answer is not"
+        '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
+               (null "ernst" ("mobile") null null null)))
+      (components table))
+    ;; start-task: components by index, and a reassignment.
+    (let ((table (make-task-table)))
+      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |s@tester#4|))
+                                                               '((running |s@tester/1| 1 tester))))
+                                        (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
+      (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))
+                                        (list 'ernst (report 'ernst '() '((running |s@tester/1| 1 tester))))
+                                        (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
+      (test "a component that moves to another robot was reassigned from the first"
+          '(("s" (1 "moseley" ("mobile") 2 "moved to ernst" null)
+                 (1 "ernst" () null null "moseley")))
+        (components table))
+      (test "the task's state is what its poser says" "running"
+        (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0))))))
+
+;;; A real lab
+
+;; The body of an HTTP GET of path on port, or #f.
+(define (http-get port path)
+  (let ((io (open-connection "127.0.0.1" port 5)))
+    (and (pair? io)
+         (let ((in (car io)) (out (cadr io)))
+           (write-string (string-append "GET " path " HTTP/1.0\r\nHost: localhost\r\n\r\n") out)
+           (flush-output-port out)
+           (let loop ((acc '()))
+             (let ((s (read-string 65536 in)))
+               (if (eof-object? s)
+                   (begin (close-port in) (close-port out)
+                          (let* ((all (apply string-append (reverse acc)))
+                                 (end (string-search "\r\n\r\n" all)))
+                            (and end (substring all (+ end 4) (string-length all)))))
+                   (loop (cons s acc)))))))))
+
+(define (string-search word text)
+  (let ((n (string-length word)))
+    (let loop ((i 0))
+      (cond ((> (+ i n) (string-length text)) #f)
+            ((string=? word (substring text i (+ i n))) i)
+            (else (loop (+ i 1)))))))
+
+;; The first n events of /events?from=0, as (ID . DATA), or timeout.
+(define (first-events port n)
+  (let ((t (make-thread
+            (lambda ()
+              (let* ((io (open-connection "127.0.0.1" port 5))
+                     (in (car io)) (out (cadr io)))
+                (write-string "GET /events?from=0 HTTP/1.1\r\nHost: localhost\r\n\r\n" out)
+                (flush-output-port out)
+                (let loop ((events '()) (id #f))
+                  (if (= (length events) n)
+                      (begin (close-port in) (close-port out) (reverse events))
+                      (let ((line (read-line in)))
+                        (cond ((eof-object? line) (reverse events))
+                              ((string-prefix? "id: " line)
+                               (loop events (string->number (substring line 4 (string-length line)))))
+                              ((string-prefix? "data: " line)
+                               (loop (cons (cons id (substring line 6 (string-length line))) events) #f))
+                              (else (loop events id)))))))))))
+    (thread-start! t)
+    (thread-join! t 20 'timeout)))
+
+(define (string-prefix? p s)
+  (and (>= (string-length s) (string-length p))
+       (string=? p (substring s 0 (string-length p)))))
+
+(define chromium
+  (find (lambda (c) (system? "sh" "-c" (string-append "command -v " c " >/dev/null")))
+        '("chromium" "chromium-browser" "google-chrome")))
+
+;; The page's DOM once its scripts ran, as headless chromium dumps it.
+(define (browser-dom url file)
+  (system? "sh" "-c"
+           "timeout 120 \"$0\" --headless --no-sandbox --disable-gpu --user-data-dir=\"$1\" --virtual-time-budget=4000 --dump-dom \"$2\" >\"$3\" 2>/dev/null"
+           chromium (in-dir "chromium") url file)
+  (file-text file))
+
+(define (screenshot url file)
+  (system? "sh" "-c"
+           "timeout 120 \"$0\" --headless --no-sandbox --disable-gpu --user-data-dir=\"$1\" --hide-scrollbars --window-size=1400,900 --virtual-time-budget=4000 --screenshot=\"$3\" \"$2\" >/dev/null 2>&1"
+           chromium (in-dir "chromium") url file))
+
+;; The points of the path of robot name the page drew.
+(define (path-points dom name)
+  (let* ((tag (string-append "<polyline data-name=\"" name "\" points=\""))
+         (at (string-search tag dom)))
+    (if at
+        (let* ((start (+ at (string-length tag)))
+               (end (+ start (string-search "\"" (substring dom start (string-length dom))))))
+          (delete-duplicates (text-words (substring dom start end))))
+        '())))
+
+(define (text-words s)
+  (let loop ((chars (string->list s)) (word '()) (acc '()))
+    (cond ((null? chars)
+           (reverse (if (null? word) acc (cons (list->string (reverse word)) acc))))
+          ((char=? (car chars) #\space)
+           (loop (cdr chars) '() (if (null? word) acc (cons (list->string (reverse word)) acc))))
+          (else (loop (cdr chars) (cons (car chars) word) acc)))))
+
+(define view-port (+ (test-lab-port-base lab) 148))
+
+(if (not (file-exists? (tool-path "sim/b14")))
+    (begin (display "no simulator (make -C sim): the lab part is left out\n"))
+    (let ((pid (start-murdoch-lab! (list (test-lab-file lab) "--logs" (in-dir "logs") "--view")
+                                   (in-dir "lab.out"))))
+      (test "the lab says where the view is" #t
+        (text-contains? (file-text (in-dir "lab.out"))
+                        (string-append "lab: view at http://127.0.0.1:" (number->string view-port) "/")))
+      (test "ps names it murdoch-view" #t
+        (not (equal? "0" (command-output
+                          (list "sh" "-c" "ps -eo comm | grep -c '^murdoch-view$'")))))
+      (test "the page" #t (text-contains? (or (http-get view-port "/") "") "view.js"))
+      (test "the trace starts with the room" "test"
+        (assq-ref 'lab (string->json (car (text-lines (http-get view-port "/trace"))))))
+      (let ((events (first-events view-port 3)))
+        (test "server-sent events: snapshots 0, 1, 2" '(0 1 2)
+          (if (list? events) (map car events) events))
+        (test "each a snapshot of every address space" '("moseley" "ernst" "troy")
+          (if (list? events)
+              (map (lambda (a) (assq-ref 'name a))
+                   (vector->list (assq-ref 'aspaces (string->json (cdr (car events))))))
+              events)))
+      ;; A task that drives one robot for a while.
+      (call-with-output-file (in-dir "task.scm")
+        (lambda (out)
+          (write-string "(start-task 'drive-a-while 1 (list (list (list 'mobile) '())) (list #f)
+                          (list (lambda () (translate 600) (thread-sleep! 1) (local-aspace-uid))))\n"
+                        out)))
+      (system? "sh" "-c" "timeout 60 \"$0\" pose \"$1\" \"$2\" >\"$3\" 2>&1"
+               (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "task.scm") (in-dir "pose.out"))
+      (let ((winner (let ((lines (read-lines (in-dir "pose.out"))))
+                      (if (pair? lines) (last lines) "")))
+            (state (lambda () (string->json (http-get view-port "/state")))))
+        (test "the task ran on a robot" #t (and (member winner '("(moseley)" "(ernst)")) #t))
+        (let ((winner (if (> (string-length winner) 2)
+                          (substring winner 1 (- (string-length winner) 1))
+                          winner)))
+          (test "the view's state has the task, and who won it" (list "drive-a-while" winner)
+            (let ((tasks (vector->list (assq-ref 'tasks (state)))))
+              (if (null? tasks)
+                  tasks
+                  (list (assq-ref 'name (car tasks))
+                        (assq-ref 'robot (vector-ref (assq-ref 'components (car tasks)) 0))))))
+          (if (not chromium)
+              (display "skipped: no chromium on this machine, so the page is not tried in a browser\n")
+              (let ((dom (browser-dom (string-append "http://127.0.0.1:" (number->string view-port)
+                                                     "/?poll=300")
+                                      (in-dir "live.html"))))
+                (test "in the browser: the lab's name" #t (text-contains? dom "lab test"))
+                (test "each name drawn in the room, robots' and the workstation's" '(#t #t #t)
+                  (map (lambda (n) (text-contains? dom (string-append ">" n "</text>")))
+                       '("moseley" "ernst" "troy")))
+                (test "each name in the table of address spaces" '(#t #t #t)
+                  (map (lambda (n) (text-contains? dom (string-append "<tr data-name=\"" n "\"")))
+                       '("moseley" "ernst" "troy")))
+                (test "the task panel names the task" #t
+                  (text-contains? dom "<span class=\"task-name\">drive-a-while</span>"))
+                (test "and the robot that won it" #t
+                  (text-contains? dom (string-append ">" winner "</td>")))
+                (test "the winner's path: more than one point" #t
+                  (> (length (path-points dom winner)) 1))
+                (test "a clock" #t (text-contains? dom "t = "))
+                (let ((shot (string-append (or (get-environment-variable "TMPDIR") "/tmp")
+                                           "/murdoch-view-test.png")))
+                  (screenshot (string-append "http://127.0.0.1:" (number->string view-port)
+                                             "/?poll=300")
+                              shot)
+                  (test "a screenshot" #t (and (file-exists? shot) (> (file-size shot) 1000)))
+                  (display (string-append "screenshot: " shot "\n")))))
+          (test "SIGTERM: the lab and its view stop" 0 (stop-process! pid))
+          (let* ((trace (in-dir "logs/view.jsonl"))
+                 (replay-port (+ (test-lab-port-base lab) 147))
+                 (replay (start-process! (list (tool-path "bin/murdoch") "replay" trace
+                                               (number->string replay-port))
+                                         (in-dir "replay.out"))))
+            (test "the replay serves the page" #t (wait-for-port replay-port 30))
+            (test "its trace is the run's" #t
+              (string=? (file-text trace) (or (http-get replay-port "/trace") "")))
+            (if chromium
+                (let ((dom (browser-dom (string-append "http://127.0.0.1:"
+                                                       (number->string replay-port) "/")
+                                        (in-dir "replay.html"))))
+                  (test "in the browser: a replay" #t (text-contains? dom "replay of"))
+                  (test "with each robot and the task" '(#t #t #t)
+                    (map (lambda (w) (text-contains? dom w))
+                         (list "<tr data-name=\"moseley\"" "<tr data-name=\"ernst\""
+                               "drive-a-while")))))
+            (stop-process! replay))))))
+
+(test-end)
+(remove-test-lab! lab)
+(test-exit)
