@@ -12,21 +12,6 @@
 (system? "sh" "-c" "cd \"$0\" && tools/chibi tools/gen-reference.scm >\"$1\""
          (tool-path ".") generated)
 
-;; The names whose row says they have no comment.
-(define (undocumented text)
-  (filter-map (lambda (line)
-                (and (text-contains? line "(no `;;>` comment yet)")
-                     (let* ((start (+ 1 (string-index-of line #\`)))
-                            (end (+ start (string-index-of (substring line start (string-length line)) #\`))))
-                       (string->symbol (substring line start end)))))
-              (text-lines text)))
-
-(define (string-index-of s c)
-  (let loop ((i 0))
-    (cond ((= i (string-length s)) #f)
-          ((char=? (string-ref s i) c) i)
-          (else (loop (+ i 1))))))
-
 ;; The name each row of the tables is about: its first cell, `NAME` or
 ;; `(NAME ARG ...)`.
 (define (row-names text)
@@ -38,6 +23,13 @@
                                    (if (memv (string-ref cell i) '(#\space #\) #\`)) i (loop (+ i 1))))))
                        (string->symbol (substring cell 0 end)))))
               (text-lines text)))
+
+;; The names whose row says they have no comment.
+(define (undocumented text)
+  (row-names (apply string-append
+                    (map (lambda (line) (string-append line "\n"))
+                         (filter (lambda (line) (text-contains? line "(no `;;>` comment yet)"))
+                                 (text-lines text))))))
 
 ;; Exports that had no ;;> comment when this test was written, in
 ;; libraries this test's author could not change.  Document one and take
