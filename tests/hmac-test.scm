@@ -33,6 +33,58 @@
     "9b09ffa71b942fcb27635fbcd5b0e944bfdc63644f0713938a7f51535c3a35e2"
   (hmac-sha256 (repeat #xaa 131)
                (text "This is a test using a larger than block-size key and a larger than block-size data. The key needs to be hashed before being used by the HMAC algorithm.")))
+;; Beyond RFC 4231: the edges of the key, worked out by the RFC 2104
+;; formula over a separate SHA-256.
+(test "an empty key and an empty message"
+    "b613679a0814d9ec772f95d778c35fc5ff1697c493715653c6c712144292c5ad"
+  (hmac-sha256 (bytevector)))
+(test "an empty key as a string"
+    "b613679a0814d9ec772f95d778c35fc5ff1697c493715653c6c712144292c5ad"
+  (hmac-sha256 "" ""))
+(test "a key of exactly a block is used as it is"
+    "ce3c639dcb9d8baae5d44c3b8b5e233faab4d1860e07489af5c84f213998bd79"
+  (hmac-sha256 (repeat #xaa 64) "x"))
+(test "a key one byte over a block is hashed first"
+    "c2b9a0a013df029c7d812c5ac18388feef0194ee64fcc5f321d149c06137caa3"
+  (hmac-sha256 (repeat #xaa 65) "x"))
+
+;; The C keeps the last key's pads for the next call under the same key:
+;; every change of key must be seen, whatever its length or object.
+(define jefe-mac "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843")
+(define jefe-text "what do ya want for nothing?")
+(test "the same key twice" (list jefe-mac jefe-mac)
+  (list (hmac-sha256 (text "Jefe") jefe-text) (hmac-sha256 (text "Jefe") jefe-text)))
+(test "a key of the same length, one byte other"
+    "f8d53118ce0680a281eda49c53a20bf1332f9440d35b08e3545dfb8877dde5a6"
+  (begin (hmac-sha256 (text "Jefe") jefe-text)
+         (hmac-sha256 (text "Jefd") jefe-text)))
+(test "back to the first key" jefe-mac
+  (begin (hmac-sha256 (text "Jefd") jefe-text)
+         (hmac-sha256 (text "Jefe") jefe-text)))
+(test "a prefix of the last key"
+    "b613679a0814d9ec772f95d778c35fc5ff1697c493715653c6c712144292c5ad"
+  (begin (hmac-sha256 (text "Jefe") "") (hmac-sha256 (bytevector) "")))
+(test "a bytevector changed in place is another key"
+    "f8d53118ce0680a281eda49c53a20bf1332f9440d35b08e3545dfb8877dde5a6"
+  (let ((k (text "Jefe")))
+    (hmac-sha256 k jefe-text)
+    (bytevector-u8-set! k 3 (char->integer #\d))
+    (hmac-sha256 k jefe-text)))
+(test "a string key and a bytevector key of the same bytes agree" jefe-mac
+  (begin (hmac-sha256 (text "Jefd") jefe-text) (hmac-sha256 "Jefe" jefe-text)))
+(test "alternating keys, as two processes' frames would" #t
+  (let loop ((i 0))
+    (or (= i 100)
+        (and (equal? (hmac-sha256 (text "Jefe") jefe-text) jefe-mac)
+             (equal? (hmac-sha256 (repeat #x0b 20) (text "Hi There"))
+                     "b0344c61d8db38535ca8afceaf0bf12b881dc200c9833da726e9376c2e32cff7")
+             (loop (+ i 1))))))
+(test "a call that failed on a part leaves nothing behind" jefe-mac
+  (begin (guard (e (#t #f)) (hmac-sha256 (text "Jefe") "half a message" 'what))
+         (hmac-sha256 (text "Jefe") jefe-text)))
+(test-error "a key that is neither bytes nor text"
+  (hmac-sha256 'jefe jefe-text))
+
 (test "a string message is its UTF-8 bytes"
     "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843"
   (hmac-sha256 (text "Jefe") "what do ya want for nothing?"))
