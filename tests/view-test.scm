@@ -93,6 +93,30 @@
       (test "the task's state is what its poser says" "running"
         (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0))))))
 
+;; An answer of remote-apply-all to report-source, from a robot at pose.
+(define (answer uid pose ranges fiducials)
+  (list uid #t (list (list uid 0 pose 136 '() '()) ranges fiducials)))
+
+(test-group "snapshots"
+  (let* ((the-lab (read-lab (test-lab-file lab)))
+         (state (new-view-state (lab-header the-lab)))
+         (snap (lambda (t answers)
+                 (string->json (json-text (view-snapshot the-lab t answers state)))))
+         (moseley (lambda (s) (vector-ref (assq-ref 'aspaces s) 0)))
+         (ring (make-list 16 1000)))
+    (snap 0 (list (answer 'moseley '(0 0 0 0) ring #f)))
+    (let ((s (snap 1 (list (answer 'moseley '(500 0 0 0) ring '((0 1000 0 0)))))))
+      (test "a sonar ring read again is drawn from where it was first read" '#(0 0 0)
+        (assq-ref 'sonar-at (moseley s)))
+      (test "a box a robot sees is where it sees it" '#(1500 0 400 400 0)
+        (vector-ref (assq-ref 'boxes s) 0)))
+    (let ((s (snap 2 (list (answer 'moseley '(800 0 0 0) (make-list 16 900) #f)))))
+      (test "a new ring is drawn from the pose it came with" '#(800 0 0)
+        (assq-ref 'sonar-at (moseley s))))
+    (test "an address space that did not answer is away, and why" '(#t "no answer")
+      (let ((a (vector-ref (assq-ref 'aspaces (snap 3 (list (list 'ernst #f "no answer")))) 0)))
+        (list (assq-ref 'away a) (assq-ref 'why a))))))
+
 ;;; A real lab
 
 ;; The body of an HTTP GET of path on port, or #f.
@@ -249,7 +273,7 @@
                   (display (string-append "screenshot: " shot "\n")))))
           (test "SIGTERM: the lab and its view stop" 0 (stop-process! pid))
           (let* ((trace (in-dir "logs/view.jsonl"))
-                 (replay-port (+ (test-lab-port-base lab) 147))
+                 (replay-port (+ (test-lab-port-base lab) 146))
                  (replay (start-process! (list (tool-path "bin/murdoch") "replay" trace
                                                (number->string replay-port))
                                          (in-dir "replay.out"))))

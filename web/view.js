@@ -118,7 +118,7 @@ function drawRoom(k) {
                      class: "path" }, svg, true);
   }
   const sel = state.aspaces.find((a) => a.name === selected);
-  if (sel && sel.pose && sel.sonar) drawSonar(el("g", {}, svg, true), sel.pose, sel.sonar, colour(sel.name));
+  if (sel && sel.sonar) drawSonar(el("g", {}, svg, true), sel["sonar-at"] || sel.pose, sel.sonar, colour(sel.name));
   for (const a of state.aspaces) {
     if (!a.pose) continue;
     const [x, y, h] = a.pose, c = colour(a.name), r = header.radius;
@@ -226,7 +226,7 @@ function drawLegend() {
   item((s) => el("line", { x1: 2, y1: 8, x2: 26, y2: 8, stroke: COLOURS[0], "stroke-width": 2,
                            "stroke-dasharray": "5 3" }, s, true), "path so far");
   item((s) => el("polygon", { points: "2,8 26,2 26,14", fill: COLOURS[0], "fill-opacity": 0.15,
-                              stroke: COLOURS[0] }, s, true), "sonar of the chosen robot");
+                              stroke: COLOURS[0] }, s, true), "the chosen robot's last sonar reading, from where it was read");
   item((s) => el("line", { x1: 2, y1: 8, x2: 26, y2: 8, stroke: "#37474f", "stroke-width": 4 }, s, true), "wall");
   item((s) => el("rect", { x: 6, y: 2, width: 16, height: 12, fill: "#d7ccc8", stroke: "#795548" }, s, true), "box");
   item((s) => el("path", { d: "M9,3 l10,10 m0,-10 l-10,10", stroke: COLOURS[0], "stroke-width": 2 }, s, true), "goto target, when known");

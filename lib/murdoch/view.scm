@@ -290,21 +290,53 @@
            (guard (e (#t #f)) (sonar-read))
            (guard (e (#t #f)) (fiducials)))))
 
+;; What the view remembers from one poll to the next: where the boxes
+;; are, the task table, and for each robot its last sonar ring with the
+;; pose it was first seen at.  A ring stays readable after sonar-stop, so
+;; a robot that stopped its sonar and drove on still answers the ring it
+;; read back there, which is drawn from there.
+(define-record-type view-state
+  (make-view-state boxes table sonars)
+  view-state?
+  (boxes view-state-boxes)
+  (table view-state-table)
+  (sonars view-state-sonars view-state-sonars-set!))  ; ((UID RANGES POSE) ...)
+
+;;> The view's memory, at the start, for the room \var{header} (see
+;;> lab-header).
+(define (new-view-state header)
+  (make-view-state (list->vector (vector->list (cdr (assq 'boxes header))))
+                   (make-task-table) '()))
+
 ;;> The snapshot at \var{t} seconds of the lab: \var{answers} are
 ;;> remote-apply-all's, for the lab's address spaces, of report-source;
-;;> \var{boxes} the vector of boxes (x y w d heading), which the robots'
-;;> fiducials move; \var{table} the task table, brought up to date.
-(define (view-snapshot lab t answers boxes table)
+;;> \var{state} what the view remembers (new-view-state), brought up to
+;;> date.
+(define (view-snapshot lab t answers state)
   (let ((reports (filter-map (lambda (a) (and (cadr a) (list (car a) (car (car (cddr a))))))
-                             answers)))
-    (task-table-update! table t reports)
+                             answers))
+        (boxes (view-state-boxes state)))
+    (task-table-update! (view-state-table state) t reports)
     (for-each (lambda (a) (if (cadr a) (move-boxes! boxes (car (cddr a))))) answers)
+    (for-each (lambda (a) (if (cadr a) (note-sonar! state (car a) (car (cddr a))))) answers)
     `((kind . "state")
       (t . ,(num t))
       (clock . ,(num (current-second)))
-      (aspaces . ,(list->vector (map aspace-json answers)))
+      (aspaces . ,(list->vector (map (lambda (a) (aspace-json a state)) answers)))
       (boxes . ,(vector-map (lambda (b) b) boxes))
-      (tasks . ,(task-table->json table 12)))))
+      (tasks . ,(task-table->json (view-state-table state) 12)))))
+
+;; Remembers uid's sonar ring, with its pose now when the ring is new.
+(define (note-sonar! state uid answer)
+  (let ((ranges (cadr answer))
+        (pose (list-ref (car answer) 2))
+        (old (assq uid (view-state-sonars state))))
+    (if (and (list? ranges) (pair? ranges) (every real? ranges) (list? pose)
+             (>= (length pose) 3)
+             (not (and old (equal? (cadr old) ranges))))
+        (view-state-sonars-set!
+         state (cons (list uid ranges (take pose 3))
+                     (remove (lambda (s) (eq? (car s) uid)) (view-state-sonars state)))))))
 
 (define (move-boxes! boxes answer)
   (let ((pose (list-ref (car answer) 2))
@@ -322,7 +354,7 @@
                                         (num (car (cddr at)))))))))
          seen))))
 
-(define (aspace-json answer)
+(define (aspace-json answer state)
   (let ((name (text (car answer))))
     (if (not (cadr answer))
         `((name . ,name) (away . #t) (why . ,(text (car (cddr answer)))))
@@ -337,9 +369,13 @@
             (battery . ,(if (real? battery) (num (/ battery 10)) 'null))
             (held . ,(list->vector (map (lambda (h) (vector (text (car h)) (text (cadr h))))
                                         (list-ref report 4))))
-            (sonar . ,(if (and (list? (cadr value)) (every real? (cadr value)))
-                          (numbers (cadr value))
-                          'null))
+            ;; The last sonar ring, and the pose it was read at.
+            (sonar . ,(cond ((assq (car answer) (view-state-sonars state))
+                             => (lambda (s) (numbers (cadr s))))
+                            (else 'null)))
+            (sonar-at . ,(cond ((assq (car answer) (view-state-sonars state))
+                                => (lambda (s) (numbers (car (cddr s)))))
+                               (else 'null)))
             ;; A report that tells where the robot's goto-xy is going, as
             ;; a seventh element (x y), has it drawn.
             (goal . ,(let ((goal (and (> (length report) 6) (list-ref report 6))))
@@ -466,7 +502,7 @@
   (flush-output-port (current-output-port)))
 
 ;;> `murdoch view LAB [PORT]`: joins the running lab at \var{lab-file} as
-;;> a guest, polls it twice a second, appends each snapshot to
+;;> a guest (listening on port-base + 147), polls it twice a second, appends each snapshot to
 ;;> \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl), and serves the
 ;;> page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
 ;;> lab's port-base + 148), until killed.
@@ -477,12 +513,14 @@
          (listener (listen-on port))
          (trace (or trace (default-trace lab)))
          (uid (string->symbol (string-append "view-" (number->string (current-process-id)))))
-         (env (join-lab lab-file uid (lab-guest-port lab)))
+         ;; Not a guest's port, which is one of fifty by process id: the
+         ;; view stays as long as the lab, and a REPL or pose that drew
+         ;; the same would not start.
+         (env (join-lab lab-file uid (+ (lab-port-base lab) 147)))
          (proc (eval report-source (make-repl-environment lab env)))
          (aspaces (map (lambda (a) (uid->aspace (lab-aspace-uid a))) (lab-aspaces lab)))
          (header (or (trace-header trace) (lab-header lab)))
-         (boxes (list->vector (vector->list (cdr (assq 'boxes header)))))
-         (table (make-task-table))
+         (state (new-view-state header))
          (out (open-trace trace header))
          (feed (make-feed trace out (max 0 (- (trace-line-count trace) 1)) '()))
          (start (cdr (assq 'started header))))
@@ -496,7 +534,7 @@
                              (view-snapshot lab (- t0 start)
                                             (parameterize ((remote-timeout 1))
                                               (remote-apply-all aspaces proc))
-                                            boxes table)))
+                                            state)))
             (thread-sleep! (max 0.05 (- (+ t0 poll-seconds) (current-second))))
             (loop))))
       'view-poll))

@@ -5,7 +5,7 @@
 (define-library (murdoch view)
   (export run-view run-replay
           ;; the parts, for tests
-          lab-header view-snapshot make-task-table task-table-update!
+          lab-header view-snapshot new-view-state make-task-table task-table-update!
           task-table->json reservation-task json-text box-seen)
   (import (scheme base) (scheme write) (scheme file) (scheme eval)
           (scheme time) (scheme inexact) (scheme char)
