@@ -12,8 +12,9 @@
  *  OS thread, and a call into C is not interrupted by them.  The context
  *  keeps the key it was last given, hashed into its inner and outer pads,
  *  and a call under the same key (every frame of a process is under one)
- *  starts from those: keying a context afresh cost a 200-byte MAC 1.6 us
- *  where starting from the pads costs 0.9 us.
+ *  starts from those.  Signing a 200-byte frame cost 2.6 us of CPU over
+ *  our own SHA-256 in C, 1.7 us by HMAC_CTX keyed afresh each call, and
+ *  costs 1.0 us so; a 64 KB message 290 us over our SHA-256, 47 us here.
  */
 
 #include <chibi/eval.h>
