@@ -26,11 +26,20 @@ need_root() {
     fi
 }
 
+# Whether Debian package $1 is installed: "ii", where dpkg -s also answers
+# for a package removed but for its configuration files.
+installed() {
+    case $(dpkg-query -W -f='${db:Status-Abbrev}' "$1" 2>/dev/null) in
+        ii*) return 0 ;;
+        *) return 1 ;;
+    esac
+}
+
 install_debian_packages() {
     missing=""
     for p in build-essential g++ libbox2d-dev netcat-openbsd clang libssl-dev \
              iproute2 chromium; do
-        dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
+        installed "$p" || missing="$missing $p"
     done
     [ -z "$missing" ] && return 0
     sudo=$(need_root "$missing")
