@@ -7,7 +7,7 @@
 (import (scheme base) (scheme write) (scheme process-context) (scheme eval) (srfi 1)
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
-        (only (chibi ast) setenv)
+        (only (chibi ast) setenv unsetenv)
         (murdoch lab) (murdoch command) (murdoch launch))
 
 (define version "0.3")
@@ -37,9 +37,10 @@
 (define (run-lab* cfg lab-file)
   (let ((option (lambda (name) (conf-get cfg (list 'command 'lab name)))))
     ;; bin/murdoch-lab starts the view, on this port (0: the lab's
-    ;; port-base + 148), when MURDOCH_VIEW is set.
+    ;; port-base + 148), when MURDOCH_VIEW is set: by this, and only this.
     (if (option 'view)
-        (setenv "MURDOCH_VIEW" (number->string (option 'view))))
+        (setenv "MURDOCH_VIEW" (number->string (option 'view)))
+        (unsetenv "MURDOCH_VIEW"))
     (run-lab bin lab-file (except (option 'except)) (option 'logs) (option 'trace)
              (let ((speed (option 'speed)))
                (and speed (number->string speed))))))
