@@ -18,4 +18,4 @@
           (only (srfi 151) bitwise-ior)
           (chibi json)
           (murdoch process-name) (murdoch lab) (murdoch command) (murdoch remote))
-  (include "view.scm"))
+  (include "view.scm" "view-tasks.scm"))

@@ -1,0 +1,188 @@
+;;;; The live view's table of tasks, part of (murdoch view): who holds
+;;;; what, for which task, from what the address spaces report.
+
+;;; The tasks: what the address spaces say they hold and run
+;;
+;; A robot tells the subjects it holds and for whom -- a reservation
+;; name, NAME@POSER#N (pose-task.scm) -- and the components of started
+;; tasks that it runs, (running ID INDEX POSER) with ID NAME@POSER/N
+;; (task.scm).  The table remembers each component from when it is first
+;; seen on a robot to when that robot no longer shows it; a component of
+;; a started task seen on another robot than before was reassigned.  A
+;; task's own state is what its poser says, when the poser is an address
+;; space of the lab; else running while a component is seen, then done.
+
+(define-record-type task-entry
+  (make-task-entry key name poser state components)
+  task-entry?
+  (key task-entry-key)
+  (name task-entry-name)
+  (poser task-entry-poser)
+  (state task-entry-state task-entry-state-set!)
+  (components task-entry-components task-entry-components-set!))
+
+(define-record-type component-entry
+  (make-component-entry index robot subjects since until end from)
+  component-entry?
+  (index component-entry-index)
+  (robot component-entry-robot)
+  (subjects component-entry-subjects component-entry-subjects-set!)
+  (since component-entry-since)
+  (until component-entry-until component-entry-until-set!)
+  (end component-entry-end component-entry-end-set!)
+  (from component-entry-from))
+
+;;> A table of the tasks seen so far, empty.
+(define (make-task-table) (list 'tasks))
+
+(define (table-tasks table) (cdr table))
+
+;;> The task name and poser that reservation name or task id \var{key}
+;;> (a string, NAME@POSER#N or NAME@POSER/N) holds, as a list, or the key
+;;> and #f when it is neither.
+(define (reservation-task key)
+  (let* ((n (string-length key))
+         (mark (last-index key (lambda (c) (memv c '(#\# #\/))) n))
+         (at (and mark (last-index key (lambda (c) (char=? c #\@)) mark))))
+    (if at
+        (list (substring key 0 at) (substring key (+ at 1) mark))
+        (list key #f))))
+
+(define (last-index s pred end)
+  (let loop ((i (- end 1)))
+    (cond ((< i 0) #f)
+          ((pred (string-ref s i)) i)
+          (else (loop (- i 1))))))
+
+;; NAME@POSER of a key: what a started task's id and its reservations share.
+(define (key-base key)
+  (let ((nt (reservation-task key)))
+    (if (cadr nt) (string-append (car nt) "@" (cadr nt)) key)))
+
+;; What one address space's report shows running there: (KEY INDEX
+;; SUBJECTS) for each component, INDEX #f when only held subjects show it.
+(define (report-components report)
+  (let* ((held (map (lambda (h) (cons (text (car h)) (text (cadr h))))
+                    (list-ref report 4)))
+         (running (filter-map (lambda (t)
+                                (and (pair? t) (eq? (car t) 'running)
+                                     (>= (length t) 3)
+                                     (list (text (cadr t)) (list-ref t 2))))
+                              (list-ref report 5)))
+         (subjects-of (lambda (pred)
+                        (map car (filter (lambda (h) (pred (cdr h))) held))))
+         (covered? (lambda (holder)
+                     (any (lambda (r) (equal? (key-base (car r)) (key-base holder)))
+                          running))))
+    (append
+     (map (lambda (r)
+            (list (car r) (cadr r)
+                  (subjects-of (lambda (holder)
+                                 (equal? (key-base holder) (key-base (car r)))))))
+          running)
+     (map (lambda (holder)
+            (list holder #f (subjects-of (lambda (h) (equal? h holder)))))
+          (delete-duplicates (remove covered? (map cdr held)))))))
+
+;; (KEY STATE) for each task the report says this address space posed.
+(define (report-posed report)
+  (filter-map (lambda (t)
+                (and (pair? t) (eq? (car t) 'posed) (= (length t) 3)
+                     (list (text (cadr t)) (text (car (cddr t))))))
+              (list-ref report 5)))
+
+(define (task-named table key)
+  (or (find (lambda (t) (equal? (task-entry-key t) key)) (table-tasks table))
+      (let* ((nt (reservation-task key))
+             (t (make-task-entry key (car nt) (cadr nt) #f '())))
+        (set-cdr! table (append (table-tasks table) (list t)))
+        t)))
+
+(define (open? c) (not (component-entry-until c)))
+
+;;> Brings \var{table} up to the time \var{t} (seconds) with
+;;> \var{reports}: (UID REPORT) for each address space that answered,
+;;> REPORT as aspace-report makes it.  Components that an address space
+;;> that answered no longer shows have ended.
+(define (task-table-update! table t reports)
+  (let ((seen '()))                     ; the component entries seen now
+    (for-each
+     (lambda (uid+report)
+       (let ((robot (text (car uid+report)))
+             (report (cadr uid+report)))
+         (for-each (lambda (posed)
+                     (task-entry-state-set! (task-named table (car posed))
+                                            (cadr posed)))
+                   (report-posed report))
+         (for-each
+          (lambda (obs)
+            (set! seen (cons (observe! (task-named table (car obs)) t robot
+                                       (cadr obs) (car (cddr obs)))
+                             seen)))
+          (report-components report))))
+     reports)
+    (let ((answered (map (lambda (r) (text (car r))) reports)))
+      (for-each
+       (lambda (task)
+         (for-each (lambda (c)
+                     (when (and (open? c) (not (memq c seen))
+                                (member (component-entry-robot c) answered))
+                       (component-entry-until-set! c t)
+                       (component-entry-end-set! c "done")))
+                   (task-entry-components task)))
+       (table-tasks table)))))
+
+;; The component entry of task that robot shows at t, made if new.
+(define (observe! task t robot index subjects)
+  (let* ((cs (task-entry-components task))
+         (same (find (lambda (c)
+                       (and (open? c)
+                            (if index
+                                (eqv? (component-entry-index c) index)
+                                (and (not (component-entry-index c))
+                                     (equal? (component-entry-robot c) robot)))))
+                     cs)))
+    (cond
+     ((and same (equal? (component-entry-robot same) robot))
+      (component-entry-subjects-set!
+       same (lset-union equal? (component-entry-subjects same) subjects))
+      same)
+     (else
+      (when same                        ; its index moved to another robot
+        (component-entry-until-set! same t)
+        (component-entry-end-set! same (string-append "moved to " robot)))
+      (let* ((before (and index
+                          (find (lambda (c)
+                                  (and (eqv? (component-entry-index c) index)
+                                       (not (equal? (component-entry-robot c) robot))))
+                                (reverse cs))))
+             (c (make-component-entry index robot subjects t #f #f
+                                      (and before (component-entry-robot before)))))
+        (task-entry-components-set! task (append cs (list c)))
+        c)))))
+
+;;> The table as JSON: the newest \var{most} tasks, each with its name,
+;;> poser, state and components (index, robot, subjects, since, until,
+;;> how it ended, and the robot it was reassigned from).
+(define (task-table->json table most)
+  (list->vector
+   (map (lambda (task)
+          (let ((cs (task-entry-components task)))
+            `((id . ,(task-entry-key task))
+              (name . ,(task-entry-name task))
+              (poser . ,(or (task-entry-poser task) 'null))
+              (state . ,(or (task-entry-state task)
+                            (if (any open? cs) "running" "done")))
+              (components
+               . ,(list->vector
+                   (map (lambda (c)
+                          `((index . ,(or (component-entry-index c) 'null))
+                            (robot . ,(component-entry-robot c))
+                            (subjects . ,(list->vector (component-entry-subjects c)))
+                            (since . ,(num (component-entry-since c)))
+                            (until . ,(if (open? c) 'null (num (component-entry-until c))))
+                            (end . ,(or (component-entry-end c) 'null))
+                            (from . ,(or (component-entry-from c) 'null))))
+                        cs))))))
+        (let ((all (table-tasks table)))
+          (reverse (if (> (length all) most) (take-right all most) all))))))
