@@ -3,7 +3,7 @@
 ;;; `bin/murdoch repl` with the transcript's input piped in.
 (import (scheme base) (scheme char) (scheme write) (scheme file) (srfi 1) (chibi test)
         (only (chibi filesystem) directory-files delete-file-hierarchy)
-        (only (chibi process) system?)
+        (only (chibi process) system? call-with-process-io waitpid)
         (murdoch testing) (murdoch transcript))
 
 (define (transcript-files)
@@ -42,15 +42,38 @@
           (number->string base))))
 
 ;; The REPL's whole output for t's input, stdout and stderr together.
-(define (replay t dir base)
-  (let ((in (string-append dir "/input")) (out (string-append dir "/output")))
-    (write-text in (transcript-input t))
-    (system? "sh" "-c"
-             "MURDOCH_PORT_BASE=$1 timeout -s KILL 60 \"$2\" repl \"$3\" $4 <\"$5\" >\"$6\" 2>&1"
-             "replay" base (tool-path "bin/murdoch") (tool-path (transcript-lab t))
-             (if (transcript-as t) (symbol->string (transcript-as t)) "")
-             in out)
+;; Its input is typed through a pipe, a line at a time, so that a shell
+;; command runs only once the REPL has answered every input before it.
+(define (replay t dir base lab-pid)
+  (let ((out (string-append dir "/output")))
+    (call-with-process-io
+     (list "sh" "-c"
+           "MURDOCH_PORT_BASE=$1 exec timeout -s KILL 90 \"$2\" repl \"$3\" $4 >\"$5\" 2>&1"
+           "replay" base (tool-path "bin/murdoch") (tool-path (transcript-lab t))
+           (if (transcript-as t) (symbol->string (transcript-as t)) "")
+           out)
+     (lambda (pid in . _)
+       (for-each (lambda (item) (perform! item t in out base lab-pid))
+                 (transcript-script t))
+       (close-output-port in)
+       (waitpid pid 0)))
     (file-text out)))
+
+;; An input line is typed; a shell command waits for the REPL's answers
+;; (at most 60 s), then runs with LAB_PID and MURDOCH_PORT_BASE set.
+(define (perform! item t in out base lab-pid)
+  (cond
+   ((string? item)
+    (write-string (string-append item "\n") in)
+    (flush-output-port in))
+   (else
+    (let ((k (car (cddr item))))
+      (wait-until 60 (lambda ()
+                       (let ((output (file-text out)))
+                         (> (prompt-count (prompt-of t output) output) k))))
+      (system? "env" (string-append "LAB_PID=" (number->string lab-pid))
+               (string-append "MURDOCH_PORT_BASE=" base)
+               "sh" "-c" (cadr item))))))
 
 ;; The REPL's prompt: its uid, which for a guest holds its process id.
 (define (prompt-of t output)
@@ -101,7 +124,7 @@
     (dynamic-wind
      (lambda () #f)
      (lambda ()
-       (let* ((output (replay t dir (cdr lab)))
+       (let* ((output (replay t dir (cdr lab) (car lab)))
               (mismatches (transcript-mismatches t (prompt-of t output) output)))
          (report file mismatches output)
          mismatches))

@@ -17,26 +17,21 @@
 
 ;; A robot's address space drives its robot through trip, at the port the
 ;; lab gives it; a workstation answers safe-reckon from its lab position.
+;; The lab starts the simulator, and waits until it listens, before any
+;; address space: one attempt is enough, and a failed one says why.
 (define (take-body! lab entry)
   (cond
    ((lab-aspace-clause entry 'robot)
     (let ((host (lab-trip-host lab entry))
           (port (lab-trip-port lab entry)))
       (set-current-robot!
-       (or (wait-for (lambda ()
-                       (guard (e (#t #f))
-                         (trip-connect host port))))
-           (error "cannot reach the robot's trip server"
-                  (lab-aspace-uid entry) host port)))
+       (guard (e (#t (error "cannot reach the robot's trip server (is the simulator running?)"
+                            (lab-aspace-uid entry) host port
+                            (if (error-object? e) (error-object-message e) e))))
+         (trip-connect host port)))
       (im)))
    ((lab-aspace-clause entry 'position)
     => (lambda (clause) (workstation-position (cdr clause))))))
-
-;; The simulator may still be starting: try for ten seconds.
-(define (wait-for thunk)
-  (let loop ((tries 100))
-    (or (thunk)
-        (and (> tries 0) (begin (thread-sleep! 0.1) (loop (- tries 1)))))))
 
 ;;> `murdoch aspace LAB NAME`: be address space NAME until killed.
 (define (run-aspace lab-file uid)
@@ -83,6 +78,9 @@
           'in: (waiting-input-port)
           'environment: (make-repl-environment lab lab-env)
           'raw?: (not (is-a-tty? (current-input-port)))
+          ;; write, not (chibi repl)'s write/ss: labels for cycles only,
+          ;; so a value met twice (task-status's outcomes) reads as itself.
+          'printer: (lambda (value out) (write value out))
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))
     (exit 0)))

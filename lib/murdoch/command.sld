@@ -1,7 +1,7 @@
 (define-library (murdoch command)
   (export join-lab run-aspace run-repl tell-who-is-away make-lab-environment
           make-repl-environment)
-  (import (scheme base) (scheme read) (scheme eval) (scheme file)
+  (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context)
           (srfi 1) (srfi 18)
           (only (chibi process) current-process-id)

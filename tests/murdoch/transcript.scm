@@ -1,11 +1,12 @@
 ;;;; Transcripts: what to type at a REPL, and what it should answer.
 
 (define-record-type transcript
-  (make-transcript lab as steps)
+  (make-transcript lab as steps shell)
   transcript?
   (lab transcript-lab)          ; the lab file, relative to the repository
   (as transcript-as)            ; the address space to join as, or #f
-  (steps transcript-steps))     ; ((input expected-line ...) ...)
+  (steps transcript-steps)      ; ((input expected-line ...) ...)
+  (shell transcript-shell))     ; ((K . command) ...): run after K inputs
 
 (define (prefixed? prefix line)
   (and (>= (string-length line) (string-length prefix))
@@ -22,33 +23,45 @@
 
 ;;> Reads the transcript \var{file}.  Comments (";;") and blank lines are
 ;;> dropped; "lab:" and "as:" lines are the header; "> " lines are input,
-;;> and the lines after each are what it should print.
+;;> and the lines after each are what it should print; a "$ " line is a
+;;> shell command, run once the REPL has answered the inputs before it.
 (define (read-transcript file)
-  (let loop ((lines (read-lines file)) (lab #f) (as #f) (steps '()))
+  (let loop ((lines (read-lines file)) (lab #f) (as #f) (steps '()) (shell '()))
     (cond
      ((null? lines)
       (if (not lab) (error "a transcript needs a lab: line" file))
-      (make-transcript lab as (reverse (map reverse steps))))
+      (make-transcript lab as (reverse (map reverse steps)) (reverse shell)))
      (else
       (let ((line (car lines)) (rest (cdr lines)))
         (cond
          ((or (prefixed? ";;" line) (string=? "" (string-trim line)))
-          (loop rest lab as steps))
+          (loop rest lab as steps shell))
          ((and (null? steps) (prefixed? "lab:" line))
-          (loop rest (after "lab:" line) as steps))
+          (loop rest (after "lab:" line) as steps shell))
          ((and (null? steps) (prefixed? "as:" line))
-          (loop rest lab (string->symbol (after "as:" line)) steps))
+          (loop rest lab (string->symbol (after "as:" line)) steps shell))
          ((prefixed? "> " line)
-          (loop rest lab as (cons (list (after "> " line)) steps)))
+          (loop rest lab as (cons (list (after "> " line)) steps) shell))
+         ((prefixed? "$ " line)
+          (loop rest lab as steps
+                (cons (cons (length steps) (after "$ " line)) shell)))
          ((null? steps) (error "output before any input" file line))
+         ((and (pair? shell) (= (caar shell) (length steps)))
+          (error "output after a shell command, which is not compared" file line))
          (else
-          (loop rest lab as (cons (cons line (car steps)) (cdr steps))))))))))
+          (loop rest lab as (cons (cons line (car steps)) (cdr steps))
+                shell))))))))
 
-;;> The text to pipe into the REPL: every input line.
-(define (transcript-input t)
-  (apply string-append
-         (map (lambda (step) (string-append (car step) "\n"))
-              (transcript-steps t))))
+;;> What to do, in order: each input line as a string, typed at the REPL,
+;;> and each shell command as (shell COMMAND K), to run once the REPL has
+;;> answered its first K inputs.
+(define (transcript-script t)
+  (let loop ((k 0) (steps (transcript-steps t)) (shell (transcript-shell t)))
+    (cond ((and (pair? shell) (= k (caar shell)))
+           (cons (list 'shell (cdar shell) k) (loop k steps (cdr shell))))
+          ((pair? steps)
+           (cons (caar steps) (loop (+ k 1) (cdr steps) shell)))
+          (else '()))))
 
 ;;> Compares the REPL's \var{output} with transcript \var{t}; the REPL's
 ;;> prompt is \var{prompt}.  Answers a list of readable mismatches, empty
@@ -60,6 +73,11 @@
         (list (list 'prompts-expected (+ 1 (length steps))
                     'prompts-seen (length answers)))
         (append-map step-mismatches steps (take answers (length steps))))))
+
+;;> How many times the REPL has printed \var{prompt} in \var{output}: one
+;;> more than the inputs it has answered.
+(define (prompt-count prompt output)
+  (length (split-at-prompts output prompt)))
 
 ;; What the REPL printed after each prompt, as lists of lines; what came
 ;; before the first prompt (the lab's start) is left out.

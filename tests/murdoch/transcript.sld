@@ -2,7 +2,8 @@
 ;;> and comparing what a REPL printed with what it expects.
 (define-library (murdoch transcript)
   (export read-transcript transcript-lab transcript-as transcript-steps
-          transcript-input transcript-mismatches line-matches?)
+          transcript-shell transcript-script
+          prompt-count transcript-mismatches line-matches?)
   (import (scheme base) (scheme char) (scheme file) (srfi 1)
           (only (murdoch testing) read-lines))
   (include "transcript.scm"))
