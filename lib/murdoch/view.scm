@@ -200,23 +200,47 @@
 ;;; The feed: snapshots for the trace file and the pages that follow
 
 ;; The trace is written as the run goes, a line at a time, so that a
-;; lab stopped any way leaves a trace to replay.
+;; lab stopped any way leaves a trace to replay.  The pages that follow
+;; it wait on changed for the next snapshot.
 (define-record-type feed
-  (make-feed trace out count recent)
+  (%make-feed trace out count recent lock changed)
   feed?
   (trace feed-trace)                    ; the trace file's path
   (out feed-out)                        ; and its port
   (count feed-count feed-count-set!)    ; snapshots so far
-  (recent feed-recent feed-recent-set!)) ; ((INDEX . JSON) ...), newest first
+  (recent feed-recent feed-recent-set!) ; ((INDEX . JSON) ...), newest first
+  (lock feed-lock)
+  (changed feed-changed))
+
+(define (make-feed trace out count)
+  (%make-feed trace out count '() (make-mutex 'feed) (make-condition-variable 'feed)))
 
 (define (feed-add! feed line)
   (write-string line (feed-out feed))
   (newline (feed-out feed))
   (flush-output-port (feed-out feed))
-  (let ((k (feed-count feed)))
-    (feed-recent-set! feed (let ((r (cons (cons k line) (feed-recent feed))))
-                             (if (> (length r) kept-snapshots) (take r kept-snapshots) r)))
-    (feed-count-set! feed (+ k 1))))
+  (with-lock (feed-lock feed)
+    (lambda ()
+      (let ((k (feed-count feed)))
+        (feed-recent-set! feed (let ((r (cons (cons k line) (feed-recent feed))))
+                                 (if (> (length r) kept-snapshots) (take r kept-snapshots) r)))
+        (feed-count-set! feed (+ k 1))
+        (condition-variable-broadcast! (feed-changed feed))))))
+
+;; The snapshots numbered next or later that the feed still keeps, oldest
+;; first, as soon as there is one, or none once seconds have passed.
+(define (feed-after feed next seconds)
+  (let ((deadline (+ (monotonic-seconds) seconds)))
+    (let loop ()
+      (mutex-lock! (feed-lock feed))
+      (let ((new (filter (lambda (r) (>= (car r) next)) (feed-recent feed)))
+            (left (seconds-until deadline)))
+        (cond ((or (pair? new) (zero? left))
+               (mutex-unlock! (feed-lock feed))
+               (reverse new))
+              (else
+               (mutex-unlock! (feed-lock feed) (feed-changed feed) left)
+               (loop)))))))
 
 ;;; Serving
 
@@ -269,35 +293,35 @@
 
 ;; Server-sent events: each snapshot from the one the page asks for
 ;; (?from=N, or the one after its Last-Event-ID when it reconnects), as
-;; "id: N" and "data: JSON", until the page goes.  A comment every 10 s
-;; finds out a page that went quietly.  With ?once=1, only those there
-;; are now, and the stream ends: a page that polls.
+;; "id: N" and "data: JSON", until the page goes.  A comment after 10 s
+;; without a snapshot finds out a page that went quietly.  With ?once=1,
+;; only those there are now, and the stream ends: a page that polls.
 (define (send-events request feed)
   (let ((out (request-out request))
-        (from (or (let ((id (assq 'last-event-id (request-headers request))))
-                    (and id (string? (cdr id))
-                         (let ((n (string->number (cdr id)))) (and n (+ n 1)))))
-                  (let ((p (request-param request "from")))
-                    (and p (string->number p)))
-                  (feed-count feed)))
         (once? (request-param request "once")))
     (servlet-respond request 200 "OK"
                      '((Content-Type . "text/event-stream")
                        (Cache-Control . "no-cache")))
     (guard (e (#t #f))                  ; the page went away
-      (let loop ((next from) (quiet 0))
-        (let ((new (reverse (filter (lambda (r) (>= (car r) next)) (feed-recent feed)))))
+      (let loop ((next (first-event request feed)))
+        (let ((new (feed-after feed next (if once? 0 10))))
           (for-each (lambda (r)
                       (write-string (string-append "id: " (number->string (car r))
                                                    "\ndata: " (cdr r) "\n\n")
                                     out))
                     new)
-          (cond ((pair? new) (flush-output-port out))
-                ((> quiet 50) (write-string ":\n\n" out) (flush-output-port out)))
+          (if (and (null? new) (not once?)) (write-string ":\n\n" out))
+          (flush-output-port out)
           (unless once?
-            (thread-sleep! 0.2)
-            (loop (if (pair? new) (+ 1 (car (last new))) next)
-                  (if (or (pair? new) (> quiet 50)) 0 (+ quiet 1)))))))))
+            (loop (if (pair? new) (+ 1 (car (last new))) next))))))))
+
+(define (first-event request feed)
+  (or (let ((id (assq 'last-event-id (request-headers request))))
+        (and id (string? (cdr id))
+             (let ((n (string->number (cdr id)))) (and n (+ n 1)))))
+      (let ((p (request-param request "from")))
+        (and p (string->number p)))
+      (feed-count feed)))
 
 ;; A listening socket on 127.0.0.1:port, or an error that says so.
 (define (listen-on port)
@@ -336,7 +360,7 @@
          (header (or (trace-header trace) (lab-header lab)))
          (state (new-view-state header))
          (out (open-trace trace header))
-         (feed (make-feed trace out (max 0 (- (trace-line-count trace) 1)) '()))
+         (feed (make-feed trace out (max 0 (- (trace-line-count trace) 1))))
          (start (cdr (assq 'started header))))
     (tell-who-is-away lab)
     (thread-start!

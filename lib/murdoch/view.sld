@@ -17,5 +17,7 @@
                 open-output-file-descriptor)
           (only (srfi 151) bitwise-ior)
           (chibi json)
+          (only (murdoch scheduler) monotonic-seconds)
+          (only (murdoch wait) with-lock seconds-until)
           (murdoch process-name) (murdoch lab) (murdoch command) (murdoch remote))
   (include "view.scm" "view-tasks.scm"))
