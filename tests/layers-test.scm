@@ -23,7 +23,7 @@
     (remote (murdoch remote))
     (messaging (murdoch pubsub))
     (monitors (murdoch monitor))
-    (task-parts (murdoch assign) (murdoch progress) (murdoch metric))
+    (task-parts (murdoch assign) (murdoch progress) (murdoch metric) (murdoch takers))
     (team (murdoch team))
     (tasks (murdoch pose-task) (murdoch component))
     (life-cycle (murdoch task) (murdoch status))

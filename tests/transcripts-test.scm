@@ -31,7 +31,7 @@
 ;; address space the REPL will be, if it is one of the lab's; answers
 ;; (pid . port-base) once it is ready.
 (define (start-lab! t dir)
-  (let ((base (free-port-base)))
+  (let ((base (free-port-base dir)))
     (cons (start-murdoch-lab!
            (cons* (tool-path (transcript-lab t)) "--logs" (string-append dir "/logs")
                   (if (transcript-as t)

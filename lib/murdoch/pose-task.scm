@@ -152,7 +152,9 @@
                 (or (memq outcome '(waiting outranked)) (contended! task)))
            (back-off! n outcome)
            (negotiate-by-tries task (+ n 1)))
-          (else 'not-enough-takers))))
+          (else
+           (explain-no-takers (pose-name task) (pose-layouts task) (current-error-port))
+           'not-enough-takers))))
 
 ;; One round of negotiation: (winners type-list), or not-enough-takers, or
 ;; outranked when a rival outranks this pose; on failure everything is

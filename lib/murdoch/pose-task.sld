@@ -20,5 +20,5 @@
           (only (chibi process) current-process-id)
           (murdoch log) (murdoch abandon) (murdoch sendable) (murdoch sandbox)
           (murdoch remote) (murdoch pubsub) (murdoch assign)
-          (murdoch progress) (murdoch metric) (murdoch team))
+          (murdoch progress) (murdoch metric) (murdoch takers) (murdoch team))
   (include "pose-task.scm"))

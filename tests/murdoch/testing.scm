@@ -50,9 +50,11 @@
                (list "mktemp" "-d" (string-append base "/murdoch-test.XXXXXX")))))
     dir))
 
-;;> A port base B such that nothing listens on B to B + 199.
-(define (free-port-base)
-  (string->number (command-output (list (tool-path "tools/free-port-base")))))
+;;> A port base B such that nothing listens on B to B + 199, claimed for
+;;> as long as this process lives, or, given a \var{folder}, as long as
+;;> that folder exists (tools/free-port-base).
+(define (free-port-base . folder)
+  (string->number (command-output (cons (tool-path "tools/free-port-base") folder))))
 
 ;;> The whole text of \var{file}, or "" when there is none yet.
 (define (file-text file)
@@ -94,7 +96,7 @@
 ;;> list of (name . text) written beside it (code files).
 (define (make-test-lab clauses . files)
   (let* ((dir (temporary-directory))
-         (base (free-port-base))
+         (base (free-port-base dir))
          (file (string-append dir "/lab.scm")))
     (call-with-output-file file
       (lambda (out)

@@ -1,0 +1,100 @@
+;;;; Why a task found not enough takers.
+;;
+;; pose-task answers the thesis's not-enough-takers; a person at a REPL
+;; then wants to know who could have taken each component and why none
+;; did.  Asked once the negotiation has given up, so it costs nothing on
+;; the way to a winner: each component's subjects are requested afresh,
+;; each capable robot answering the holders of its exclusive subjects,
+;; and the lab file says who should have answered.
+
+;;> Writes to \var{port} why task \var{task-name} found no takers: for
+;;> each of \var{layouts} (a component's (EXCLUSIVE SHARED) subjects), the
+;;> address spaces capable of it, each free, held (and by which
+;;> reservation, TASK@POSER#N) or away.
+(define (explain-no-takers task-name layouts port)
+  (let* ((live (map car (request 'all (sendable-lambda () #t))))
+         (lines (map (lambda (i layout) (explain-component i layout live))
+                     (iota (length layouts) 1) layouts)))
+    (write-string (string-append "pose-task: not enough takers for "
+                                 (name task-name) ":\n"
+                                 (apply string-append (map car lines))
+                                 (too-few-line layouts (map cdr lines)))
+                  port)
+    (flush-output-port port)))
+
+;; A line on component i, and the robots free for it.
+(define (explain-component i layout live)
+  (let* ((exclusive (car layout))
+         (answers (in-lab-order
+                   (request (apply append layout)
+                            (sendable-lambda () (map topic-status exclusive)))))
+         (silent (remove (lambda (uid) (assq uid answers))
+                         (file-capable (apply append layout)))))
+    (cons (string-append
+           "  component " (number->string i) " needs " (name layout) ": "
+           (if (and (null? answers) (null? silent))
+               "no address space of the lab is capable of it"
+               (join (append (map robot-state answers)
+                             (map (lambda (uid) (silent-state uid live)) silent))))
+           "\n")
+          (filter-map (lambda (a) (and (free? a) (car a))) answers))))
+
+;; When each component that needs a robot to itself has a free one, but
+;; there are fewer free robots than such components, a line that says so.
+(define (too-few-line layouts frees)
+  (let* ((needing (filter-map (lambda (l f) (and (pair? (car l)) f)) layouts frees))
+         (free (delete-duplicates (apply append needing))))
+    (if (and (every pair? needing) (< (length free) (length needing)))
+        (string-append "  " (number->string (length needing))
+                       " components each need a robot of their own; "
+                       (if (= 1 (length free))
+                           "1 capable robot is free\n"
+                           (string-append (number->string (length free))
+                                          " capable robots are free\n")))
+        "")))
+
+(define (holders answer)
+  (delete-duplicates (filter (lambda (s) (and s (not (null? s)))) (cadr answer))))
+
+(define (free? answer) (null? (holders answer)))
+
+;; (UID STATUSES): free when no exclusive subject is held, else who holds
+;; them.
+(define (robot-state answer)
+  (string-append (name (car answer))
+                 (if (free? answer)
+                     " free"
+                     (string-append " held by " (join (map name (holders answer)))))))
+
+;; Answers (UID ...) in the order the lab file gives the address spaces,
+;; guests last.
+(define (in-lab-order answers)
+  (let ((order (map lab-aspace-uid (lab-aspaces (current-lab)))))
+    (append (filter-map (lambda (uid) (assq uid answers)) order)
+            (remove (lambda (a) (memq (car a) order)) answers))))
+
+;; A capable robot that did not answer: away, or there but without one of
+;; the subjects now (not idle, say, or tethered).
+(define (silent-state uid live)
+  (string-append (name uid)
+                 (if (memq uid live) " not subscribed to all of them now" " away")))
+
+;; The lab's address spaces whose capabilities, as the lab file gives them
+;; (with their uid, all, and the subjects monitors add), cover subjects.
+(define (file-capable subjects)
+  (filter-map
+   (lambda (a)
+     (let ((has (append (list (lab-aspace-uid a) 'all 'idle 'untethered)
+                        (cond ((lab-aspace-clause a 'capabilities) => cdr)
+                              (else '())))))
+       (and (every (lambda (s) (memq s has)) subjects)
+            (lab-aspace-uid a))))
+   (lab-aspaces (current-lab))))
+
+(define (name x)
+  (if (symbol? x) (symbol->string x) (call-with-output-string (lambda (o) (write x o)))))
+
+(define (join strings)
+  (if (null? strings)
+      ""
+      (fold (lambda (s acc) (string-append acc ", " s)) (car strings) (cdr strings))))
