@@ -28,7 +28,7 @@
     (tasks (murdoch pose-task) (murdoch component))
     (life-cycle (murdoch task) (murdoch status))
     (interface (murdoch))
-    (commands (murdoch command) (murdoch launch) (murdoch view))))
+    (commands (murdoch hints) (murdoch command) (murdoch launch) (murdoch view))))
 
 (define (layer-of name)
   (list-index (lambda (layer) (member name (cdr layer))) layers))

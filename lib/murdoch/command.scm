@@ -77,6 +77,7 @@
     ((eval 'repl (environment '(chibi repl)))
           'in: (waiting-input-port)
           'environment: (make-repl-environment lab lab-env)
+          'eval: eval-with-hints
           'raw?: (not (is-a-tty? (current-input-port)))
           ;; write, not (chibi repl)'s write/ss: labels for cycles only,
           ;; so a value met twice (task-status's outcomes) reads as itself.

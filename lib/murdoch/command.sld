@@ -9,7 +9,7 @@
                 open-input-file-descriptor)
           (only (srfi 151) bitwise-ior)
           (murdoch log)
-          (murdoch sandbox) (murdoch guard) (murdoch process-name) (murdoch lab) (murdoch remote) (murdoch pubsub)
+          (murdoch sandbox) (murdoch hints) (murdoch guard) (murdoch process-name) (murdoch lab) (murdoch remote) (murdoch pubsub)
           (murdoch monitor)
           (murdoch trip-client))
   (include "command.scm"))

@@ -185,6 +185,8 @@
         (list winners type-list))))))
 
 (define (check-task task-name num-robots capability-list metrics procs priorities)
+  (if (not (and (exact-integer? num-robots) (>= num-robots 0)))
+      (error "pose-task: num-robots is a whole number" num-robots))
   (if (not (symbol? task-name))
       (error "pose-task: the task name is not a symbol" task-name))
   (if (not (and (list? capability-list) (list? metrics) (list? procs)))
@@ -344,7 +346,7 @@
                         (loop (cdr order) (cons pick chosen)))))))))
 
 ;; The thesis's priorities of n components: their order, first highest.
-(define (thesis-priorities n) (iota n n -1))
+(define (thesis-priorities n) (if (exact-integer? n) (iota n n -1) '()))
 
 ;; The indices of priorities, highest first; equals keep their order.
 (define (priority-order priorities)

@@ -1,0 +1,95 @@
+;;;; Hints: the REPL's eval, for a person who typed something wrong.
+;;
+;; Chibi reports an error with the line of the file it was raised in:
+;; a wrong number of arguments to remote-apply shows a line of init-7.scm,
+;; a var-ref without its quote a line of remote.scm.  Neither is where the
+;; person went wrong.  Three mistakes come first at Murdoch's REPL, and get
+;; a hint:
+;;   - code sent elsewhere names something defined at the REPL, which the
+;;     receiver does not have (it sees (murdoch) and the lab's code);
+;;   - a value that cannot travel (a port, a mutex) is sent;
+;;   - a procedure is given the wrong number of arguments: said in words,
+;;     not as Chibi's "not enough args" with the procedure and a count.
+
+;;> Evaluates \var{expr} in \var{env} as the REPL's eval: an error raised
+;;> in Murdoch's or Chibi's own files is raised again without that place,
+;;> and with a hint when one of the mistakes above caused it.
+(define (eval-with-hints expr env)
+  (guard (e ((and (exception? e) (arity-error? e)) (raise (arity-recast e)))
+            ((and (exception? e) (library-source? e))
+             (raise (recast e (hint e env)))))
+    (eval expr env)))
+
+(define (library-source? e)
+  (or (remote-error? e) (send-error? e)
+      (let ((source (exception-source e)))
+        (and (pair? source) (string? (car source))
+             (or (string-contains (car source) "/lib/murdoch/")
+                 (string-contains (car source) "/chibi/"))))))
+
+;; e again, with no procedure or file, and hint, when there is one, after
+;; its message.
+(define (recast e hint)
+  (make-exception (exception-kind e)
+                  (if hint
+                      (string-append (error-object-message e) "\n  hint: " hint)
+                      (error-object-message e))
+                  (error-object-irritants e) #f #f))
+
+(define (hint e env)
+  (cond
+   ((send-error? e)
+    (string-append "a value travels when it is data, or a procedure; make the"
+                   " rest inside the procedure, where it runs"))
+   ((and (remote-raised-error? e) (undefined-name (remote-error-message e)))
+    => (lambda (name) (and (defined-here? name env) (definition-hint name e))))
+   (else #f)))
+
+(define (arity-error? e)
+  (and (member (error-object-message e) '("not enough args" "too many args"))
+       (= 2 (length (error-object-irritants e)))
+       (procedure? (car (error-object-irritants e)))))
+
+;; "remote-apply takes at least 2 arguments, and was given 1".
+(define (arity-recast e)
+  (let* ((p (car (error-object-irritants e)))
+         (n (procedure-arity p)))
+    (make-exception
+     (exception-kind e)
+     (string-append (let ((name (procedure-name p)))
+                      (if (symbol? name) (symbol->string name) "the procedure"))
+                    " takes " (if (procedure-variadic? p) "at least " "")
+                    (arguments n) ", and was given "
+                    (arguments (cadr (error-object-irritants e)))
+                    "\n  hint: docs/reference.md says what each procedure of"
+                    " (murdoch) takes")
+     '() #f #f)))
+
+(define (arguments n)
+  (string-append (number->string n) (if (= n 1) " argument" " arguments")))
+
+;; NAME of the message "undefined variable NAME", or #f.
+(define (undefined-name message)
+  (let ((prefix "undefined variable "))
+    (and (string? message)
+         (> (string-length message) (string-length prefix))
+         (string=? prefix (substring message 0 (string-length prefix)))
+         (string->symbol (substring message (string-length prefix)
+                                    (string-length message))))))
+
+(define (defined-here? name env)
+  (guard (e (#t #f)) (eval name env) #t))
+
+(define (definition-hint name e)
+  (let ((n (symbol->string name)))
+    (string-append n " is defined at this REPL, and code sent to "
+                   (symbol->string (remote-error-uid e))
+                   " sees only (murdoch) and the lab's code: define " n
+                   " inside the procedure, pass its value as an argument,"
+                   " or put it in the lab's code file")))
+
+(define (string-contains s part)
+  (let ((n (string-length part)))
+    (let loop ((i 0))
+      (and (<= (+ i n) (string-length s))
+           (or (string=? part (substring s i (+ i n))) (loop (+ i 1)))))))

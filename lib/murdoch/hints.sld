@@ -1,0 +1,12 @@
+;;> What the REPL adds to an error that a person's own mistake caused: the
+;;> error as the person's, not as the library's line where it surfaced,
+;;> and a hint for the mistakes a newcomer meets first.
+
+(define-library (murdoch hints)
+  (export eval-with-hints)
+  (import (scheme base) (scheme eval)
+          (only (chibi) make-exception exception? exception-kind)
+          (only (chibi ast) exception-source procedure-arity procedure-variadic?
+                procedure-name)
+          (murdoch remote-error) (only (murdoch sendable) send-error?))
+  (include "hints.scm"))
