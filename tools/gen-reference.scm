@@ -96,22 +96,41 @@
         (loop (cdr lines) '() (if entry (cons entry acc) acc))))
      (else (loop (cdr lines) '() acc)))))
 
-;; A record type's procedures, which a comment on the type does not
-;; describe one by one: (NAME NAME "") each.
+;; A record type's procedures: (NAME NAME TEXT) each, TEXT the ;;>
+;; comment right above the line of the form that names it ("" when none).
 (define (record-entries lines)
-  (let ((form (guard (e (#t #f))
-                (read (open-input-string
-                       (apply string-append
-                              (map (lambda (l) (string-append l "\n"))
-                                   (take lines (min 40 (length lines))))))))))
+  (let* ((form-lines (take lines (min 40 (length lines))))
+         (form (guard (e (#t #f))
+                 (read (open-input-string
+                        (apply string-append
+                               (map (lambda (l) (string-append l "\n")) form-lines)))))))
     (if (and (list? form) (>= (length form) 3))
-        (map (lambda (name) (list name (symbol->string name) ""))
+        (map (lambda (name)
+               (list name (symbol->string name) (field-doc name (cdr form-lines))))
              (filter symbol?
                      (append (if (pair? (list-ref form 2)) (list (car (list-ref form 2))) '())
                              (if (> (length form) 3) (list (list-ref form 3)) '())
                              (append-map (lambda (f) (if (pair? f) (cdr f) '()))
                                          (if (> (length form) 4) (drop form 4) '())))))
         '())))
+
+;; The ;;> lines right above the first of lines that names name.
+(define (field-doc name lines)
+  (let loop ((lines lines) (doc '()))
+    (cond ((null? lines) "")
+          ((doc-line? (car lines)) (loop (cdr lines) (cons (doc-text (car lines)) doc)))
+          ((names? (car lines) name)
+           (squeeze (apply string-append (map (lambda (l) (string-append l "\n")) (reverse doc)))))
+          (else (loop (cdr lines) '())))))
+
+;; Whether line has name as a whole word, before any comment.
+(define (names? line name)
+  (let ((words (guard (e (#t '()))
+                 (let ((in (open-input-string line)))
+                   (let loop ((acc '()))
+                     (let ((x (read in)))
+                       (if (eof-object? x) acc (loop (cons x acc)))))))))
+    (any (lambda (w) (or (eq? w name) (and (pair? w) (memq name w) #t))) words)))
 
 ;; The head of the definition that starts lines: (define NAME-OR-FORMALS)
 ;; or (define-syntax NAME TRANSFORMER), the transformer when its first

@@ -9,7 +9,9 @@
 
 (define-record-type aspace
   (make-aspace uid host port)
+  ;;> True for an address space, as uid->aspace and local-aspace answer.
   aspace?
+  ;;> The uid of an address space, a symbol.
   (uid aspace-uid)
   (host aspace-host)
   (port aspace-port))

@@ -4,11 +4,16 @@
 
 ;;; Monitors (A.6): capabilities that come and go with the machine's state
 
-(define *battery-charging* 130)         ; tenths of a volt
+;;> The voltage, in tenths, above which a robot is taken to be on its
+;;> charging tether; below it, the battery monitor subscribes to untethered.
+(define *battery-charging* 130)
+;;> The voltage, in tenths, below which a robot's battery is low.
 (define *battery-low* 100)
 
 ;; A string, as in the thesis, where it crossed differently byte-ordered
 ;; machines.
+;;> The load, a string such as ".75", below which the load monitor
+;;> subscribes to idle.
 (define *load-threshold* ".75")
 
 ;; Received code reads these and cannot assign them (sandbox.scm): a

@@ -33,8 +33,11 @@
 
 (define-record-type task
   (make-task id name components done)
+  ;;> True for a task record, as start-task and start-steps answer.
   task?
+  ;;> A task's id, NAME@UID/N: unique in the lab, as (tasks) shows it.
   (id task-id)
+  ;;> The name a task was posed under, a symbol.
   (name task-name)
   (components task-components)          ; a list of components
   (done task-done)                      ; a mailbox: the results, once done

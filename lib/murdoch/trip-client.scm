@@ -305,24 +305,33 @@
 
 ;;> Translation (mm/s) and rotation (deg/s) velocities, until changed.
 (define (set-velocity tv rv) (device 'base "vel" tv rv) #t)
+;;> Stops the base at once: both velocities zero.
 (define (stop-base) (device 'base "stop") #t)
 
 ;;> The odometry pose: (x y theta 0), millimetres and degrees.
 (define (reckon)
   (append (device 'base "reckon") '(0)))
 
+;;> Sets the odometry's position to (\var{x} \var{y}), millimetres.
 (define (set-reckon-position! x y) (device 'base "set-position" x y) #t)
+;;> Sets the odometry's heading to \var{theta}, degrees.
 (define (set-reckon-heading! theta) (device 'base "set-heading" theta) #t)
 
 ;;; Sensors and the rest
 
+;;> Starts the sonar ring firing.
 (define (sonar-start) (device 'sonar "start") #t)
+;;> Stops the sonar ring.
 (define (sonar-stop) (device 'sonar "stop") #t)
 ;;> The 16 sonar ranges in mm, sonar 0 facing ahead, counter-clockwise;
 ;;> the latest reading, which stays after \scheme{sonar-stop}.
 (define (sonar-read) (device 'sonar "read"))
+;;> The 16 infrared ranges in mm, as sonar-read's; the longest range
+;;> means nothing seen.
 (define (ir-read) (device 'ir "read"))
+;;> The 12 front bumpers: 1 for each one pressed, else 0.
 (define (bumpers-read) (device 'bumpers "read"))
+;;> The bump skirt's 6 segments round the robot: 1 for each pressed, else 0.
 (define (skirt-read) (device 'skirt "read"))
 ;;> The buttons pressed since the last call, as four 0/1.
 (define (buttons-read) (device 'buttons "read"))
@@ -366,7 +375,9 @@
 (define (battery-voltage)
   (exact (round (* 10 (car (device 'battery "read"))))))
 
+;;> True when the robot is tethered (on its charger's cable).
 (define (tethered?) (= 1 (cadr (device 'battery "read"))))
+;;> Tethers the robot (\var{on?} true) or frees it, in the simulator.
 (define (set-tether! on?) (device 'battery "tether" on?) #t)
 
 ;;; safe.scm: answers any address space can give
