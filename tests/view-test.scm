@@ -94,8 +94,9 @@
         (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0))))))
 
 ;; An answer of remote-apply-all to report-source, from a robot at pose.
-(define (answer uid pose ranges fiducials)
-  (list uid #t (list (list uid 0 pose 136 '() '()) ranges fiducials)))
+(define (answer uid pose ranges fiducials . goal)
+  (list uid #t (list (list uid 0 pose 136 '() '() (and (pair? goal) (car goal)))
+                     ranges fiducials)))
 
 (test-group "snapshots"
   (let* ((the-lab (read-lab (test-lab-file lab)))
@@ -110,9 +111,10 @@
         (assq-ref 'sonar-at (moseley s)))
       (test "a box a robot sees is where it sees it" '#(1500 0 400 400 0)
         (vector-ref (assq-ref 'boxes s) 0)))
-    (let ((s (snap 2 (list (answer 'moseley '(800 0 0 0) (make-list 16 900) #f)))))
+    (let ((s (snap 2 (list (answer 'moseley '(800 0 0 0) (make-list 16 900) #f '(900 50))))))
       (test "a new ring is drawn from the pose it came with" '#(800 0 0)
-        (assq-ref 'sonar-at (moseley s))))
+        (assq-ref 'sonar-at (moseley s)))
+      (test "a robot's goto target is drawn" '#(900 50) (assq-ref 'goal (moseley s))))
     (test "an address space that did not answer is away, and why" '(#t "no answer")
       (let ((a (vector-ref (assq-ref 'aspaces (snap 3 (list (list 'ernst #f "no answer")))) 0)))
         (list (assq-ref 'away a) (assq-ref 'why a))))))
@@ -228,7 +230,7 @@
       (call-with-output-file (in-dir "task.scm")
         (lambda (out)
           (write-string "(start-task 'drive-a-while 1 (list (list (list 'mobile) '())) (list #f)
-                          (list (lambda () (translate 600) (thread-sleep! 1) (local-aspace-uid))))\n"
+                          (list (lambda () (goto-xy '(0 -1000)) (thread-sleep! 1) (local-aspace-uid))))\n"
                         out)))
       (system? "sh" "-c" "timeout 60 \"$0\" pose \"$1\" \"$2\" >\"$3\" 2>&1"
                (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "task.scm") (in-dir "pose.out"))
@@ -245,6 +247,14 @@
                   tasks
                   (list (assq-ref 'name (car tasks))
                         (assq-ref 'robot (vector-ref (assq-ref 'components (car tasks)) 0))))))
+          (test "while it drove, the trace has its goto target" #t
+            (any (lambda (line)
+                   (let ((s (string->json line)))
+                     (and (equal? "state" (assq-ref 'kind s))
+                          (any (lambda (a) (and (equal? winner (assq-ref 'name a))
+                                                (equal? '#(0 -1000) (assq-ref 'goal a))))
+                               (vector->list (assq-ref 'aspaces s))))))
+                 (cdr (text-lines (http-get view-port "/trace")))))
           (if (not chromium)
               (display "skipped: no chromium on this machine, so the page is not tried in a browser\n")
               (let ((dom (browser-dom (string-append "http://127.0.0.1:" (number->string view-port)

@@ -2,11 +2,11 @@
 ;;;; what they all say, asked at once.
 
 ;;> What this address space says of itself: (UID UP-SINCE POSE BATTERY
-;;> HELD TASKS), UP-SINCE the wall-clock second it joined the lab, POSE
-;;> what safe-reckon answers, BATTERY safe-battery-voltage in tenths of a
-;;> volt, HELD the (subject holder) of each subject held here, and TASKS
+;;> HELD TASKS GOAL), UP-SINCE the wall-clock second it joined the lab,
+;;> POSE what safe-reckon answers, BATTERY safe-battery-voltage in tenths
+;;> of a volt, HELD the (subject holder) of each subject held here, TASKS
 ;;> what (tasks) answers: the tasks it started that are not over, and the
-;;> components it runs.
+;;> components it runs; GOAL where goto-xy is driving its robot, or #f.
 (define (aspace-report)
   (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
         (safe-battery-voltage)
@@ -14,7 +14,8 @@
                 (subscription-statuses '>))
         (remove (lambda (t) (and (eq? (car t) 'posed)
                                  (memq (car (cddr t)) '(done failed cancelled))))
-                (tasks))))
+                (tasks))
+        (goto-goal)))
 
 ;;> The lab's status: for each address space of \var{lab}, in file order,
 ;;> its report (see aspace-report) when it answered within

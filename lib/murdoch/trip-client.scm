@@ -120,7 +120,8 @@
   (opened trip-connection-opened trip-connection-opened-set!)
   (name trip-connection-name trip-connection-name-set!)
   (tag trip-connection-tag trip-connection-tag-set!)       ; the last sent
-  (open? trip-connection-open? trip-connection-open?-set!))
+  (open? trip-connection-open? trip-connection-open?-set!)
+  (goal trip-connection-goal trip-connection-goal-set!))   ; goto-xy's (x y)
 
 (define (robot-name c)
   (or (trip-connection-name c)
@@ -139,6 +140,7 @@
       (trip-connection-name-set! c #f)
       (trip-connection-tag-set! c 0)
       (trip-connection-open?-set! c #t)
+      (trip-connection-goal-set! c #f)
       (guard (e (#t (trip-close c) (raise e)))
         (trip-connection-name-set! c (car (request c "who"))))
       c)))
@@ -278,8 +280,19 @@
 ;;> Drives to \var{xy}, a list (x y) in millimetres of the odometry frame:
 ;;> turns to face it, then goes.  Returns the pose reached, as reckon.
 (define (goto-xy xy)
-  (device 'base "goto" (car xy) (cadr xy))
-  (await-motion "goto-xy"))
+  (let ((c (robot)))
+    (dynamic-wind
+     (lambda () (trip-connection-goal-set! c (list (car xy) (cadr xy))))
+     (lambda ()
+       (device 'base "goto" (car xy) (cadr xy))
+       (await-motion "goto-xy"))
+     (lambda () (trip-connection-goal-set! c #f)))))
+
+;;> Where the robot's goto-xy is driving it, (x y), or #f when it is not:
+;;> the live view draws it.
+(define (goto-goal)
+  (let ((c (current-robot)))
+    (and c (trip-connection-goal c))))
 
 ;;> \scheme{(rotate 'by degrees)} turns in place by an angle (counter-
 ;;> clockwise positive); \scheme{(rotate 'to heading)} turns to a heading.

@@ -5,7 +5,7 @@
   (export trip-connect trip-close trip-request trip-connection? trip-timeout trip-motion-timeout
           current-robot set-current-robot!
           trip-error? trip-error-robot trip-error-code trip-error-text
-          im goto-xy rotate translate angle-to-heading set-velocity stop-base
+          im goto-xy goto-goal rotate translate angle-to-heading set-velocity stop-base
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether! fiducials

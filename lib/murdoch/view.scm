@@ -190,8 +190,7 @@
             (sonar-at . ,(cond ((assq (car answer) (view-state-sonars state))
                                 => (lambda (s) (numbers (car (cddr s)))))
                                (else 'null)))
-            ;; A report that tells where the robot's goto-xy is going, as
-            ;; a seventh element (x y), has it drawn.
+            ;; Where the robot's goto-xy is going (aspace-report's GOAL).
             (goal . ,(let ((goal (and (> (length report) 6) (list-ref report 6))))
                        (if (and (list? goal) (>= (length goal) 2) (every real? (take goal 2)))
                            (numbers (take goal 2))
