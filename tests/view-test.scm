@@ -6,7 +6,7 @@
 (import (scheme base) (scheme write) (scheme file) (scheme char) (scheme process-context)
         (srfi 1) (srfi 18) (chibi test)
         (only (chibi process) system?)
-        (only (chibi filesystem) delete-file-hierarchy file-size)
+        (only (chibi filesystem) delete-file-hierarchy file-size directory-files)
         (chibi json)
         (murdoch lab) (murdoch view) (murdoch connect) (murdoch testing))
 
@@ -300,6 +300,21 @@
                          (list "<tr data-name=\"moseley\"" "<tr data-name=\"ernst\""
                                "drive-a-while")))))
             (stop-process! replay))))))
+
+;; A lab whose user named no --logs folder keeps the view's trace in the
+;; runs/ of the folder it was started from.
+(if (file-exists? (tool-path "sim/b14"))
+    (let* ((out (in-dir "lab-runs.out"))
+           (pid (start-process! (list "sh" "-c" "cd \"$0\" && exec \"$1\" lab \"$2\" --view"
+                                      dir (tool-path "bin/murdoch") (test-lab-file lab))
+                                out)))
+      (wait-until 90 (lambda () (text-contains? (file-text out) "lab: ready")))
+      (test "without --logs, the lab names a trace in runs/" #t
+        (text-contains? (file-text out) "lab: the view's trace: runs/test-"))
+      (stop-process! pid)
+      (test "and it is there, under the folder the lab started in" #t
+        (any (lambda (f) (string-prefix? "test-" f))
+             (if (file-exists? (in-dir "runs")) (directory-files (in-dir "runs")) '())))))
 
 (test-end)
 (remove-test-lab! lab)
