@@ -3,6 +3,7 @@
 ;;; record kept on quiet, so the order is seen from inside them.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (chibi test)
+        (only (chibi process) kill signal/stop signal/continue)
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define lab-code "
@@ -41,12 +42,14 @@
   (make-test-lab
    '((code "code.scm") (heartbeat 0.3)
      (aspace tester)
-     (aspace near (position 100 100 0) (capabilities mobile) (load 0.5))
-     (aspace far (position 3000 3000 0) (capabilities mobile) (load 0.5))
-     (aspace quiet (position 0 0 0) (load 0.1)))
+     (aspace near (position 100 100 0) (capabilities mobile wheels) (load 0.5))
+     (aspace far (position 3000 3000 0) (capabilities mobile wheels) (load 0.5))
+     (aspace quiet (position 0 0 0) (load 0.1))
+     (aspace spare (position 9000 9000 0) (capabilities wheels) (load 0.5)))
    `(("code.scm" . ,lab-code))))
 
-(for-each (lambda (uid) (start-lab-aspace! lab uid)) '(near far quiet))
+(define pids
+  (map (lambda (uid) (cons uid (start-lab-aspace! lab uid))) '(near far quiet spare)))
 (join-lab (test-lab-file lab) 'tester)
 
 (define (lab-proc name) (eval name (lab-environment)))
@@ -114,6 +117,38 @@
       (let ((e (find (lambda (e) (eq? (cadr e) (task-id t))) (tasks))))
         (list (car e) (car (cddr e)))))
     (test "every subject is free" #t (wait-until 5 all-free?))))
+
+;; far does component 2 at once, then takes component 1 when near is lost;
+;; lost there too, it gives component 1 to spare and stays the robot of
+;; component 2, which step 2 asks for again.  A robot is lost here by
+;; freezing its process (SIGSTOP) until its silence is noticed.
+(test-group "a robot twice in a team is replaced only where it was lost"
+  (let* ((hold (lambda (previous)
+                 (let loop ((n 40)) (if (> n 0) (begin (thread-sleep! 0.1) (loop (- n 1)))))
+                 (local-aspace-uid)))
+         (t (start-steps 'twice
+                         (task-step '(((wheels) ()) ((wheels) ())) (list near-first far-first)
+                                    (list hold (lambda (previous) (local-aspace-uid)))
+                                    '(2 1) '(#t #f))
+                         (task-step '((same 1 1) (same 1 2)) '(#f #f)
+                                    (list (lambda (previous) (local-aspace-uid))
+                                          (lambda (previous) (local-aspace-uid))))))
+         ;; The robot component 1 of step 1 runs on, or #f.
+         (runs-1 (lambda ()
+                   (let ((steps (task-status t)))
+                     (and (pair? steps) (pair? (car (cddr (car steps))))
+                          (let ((state (cadr (car (car (cddr (car steps)))))))
+                            (and (eq? 'running (car state)) (cadr state)))))))
+         (freeze-until-moved!
+          (lambda (uid)
+            (wait-until 10 (lambda () (eq? uid (runs-1))))
+            (kill (cdr (assq uid pids)) signal/stop)
+            (wait-until 10 (lambda () (let ((now (runs-1))) (and now (not (eq? uid now))))))
+            (kill (cdr (assq uid pids)) signal/continue))))
+    (freeze-until-moved! 'near)
+    (freeze-until-moved! 'far)
+    (test "step 2 runs on the robots step 1 ended with: spare, and far" '((spare far) (spare far))
+      (let ((r (task-wait t 60))) (list (car r) (cadr r))))))
 
 (test-group "wrong arguments"
   (test-assert "(same J K) must name an earlier step"

@@ -180,8 +180,7 @@
         (cond
          (next
           (component-state-set! c (list 'reassigned uid (car next)))
-          (task-team-set! t (map (lambda (u) (if (eq? u uid) (car next) u))
-                                 (task-team t)))
+          (replace-member! t (component-index c) (car next))
           (progress "  component " (component-index c) " reassigned from "
                     uid " to " (car next))
           (supervise t c (car next) (cdr next)))
@@ -191,6 +190,16 @@
                                           "; no other capable robot is free")))))))
      ((eq? (car outcome) 'done) (component-state-set! c outcome))
      (else (component-state-set! c (list 'failed (cadr outcome)))))))
+
+;; Puts uid in t's team as the robot of component k.  By index, not by
+;; the robot it replaces: a robot whose component is done may take
+;; another of the task's, and so be in the team twice.  Under the lock:
+;; two components may be lost at once.
+(define (replace-member! t k uid)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-team-set! t (map (lambda (u i) (if (= i k) uid u))
+                             (task-team t) (iota (length (task-team t)) 1))))))
 
 (define (restart? c)
   (and (component-restartable? c)
