@@ -84,12 +84,20 @@ int physics_add_box(physics *p, pose at, double w, double d, double mass, double
     fix.density = mass / (w * d * MM * MM);
     fix.friction = 0.3f;
     box->CreateFixture(&fix);
-    b2FrictionJointDef joint;
-    joint.Initialize(p->ground, box, box->GetWorldCenter());
-    joint.maxForce = mu * mass * G;
-    // a rough lever arm for top-down friction of a rectangle
-    joint.maxTorque = mu * mass * G * hypot(w, d) * MM / 3;
-    p->world.CreateJoint(&joint);
+    // Friction with the floor, seen from above: the box's weight rests on
+    // a 3 x 3 grid of points, each holding its share of mu m g against
+    // sliding.  One joint at the centre, with a torque of its own, would
+    // let a push off the centre slide the box without turning it, so that
+    // pushers could never steer it; spread out, a push at a corner turns
+    // the box about the far side, as on a real floor.
+    for (int i = -1; i <= 1; i++)
+        for (int j = -1; j <= 1; j++) {
+            b2FrictionJointDef joint;
+            joint.Initialize(p->ground, box, box->GetWorldPoint(b2Vec2(i * w / 3 * MM, j * d / 3 * MM)));
+            joint.maxForce = mu * mass * G / 9;
+            joint.maxTorque = 0;
+            p->world.CreateJoint(&joint);
+        }
     return keep(p->boxes, box);
 }
 

@@ -147,6 +147,34 @@ static void test_push_box(void)
     lab_free(&l);
 }
 
+/* A push at a corner turns the box about its far side, and a push at the
+ * middle of a face does not: pushers steer a box by pushing unevenly. */
+static double box_turned_by_push(double offset)
+{
+    lab l = room();
+    lab_box b = { 800, 0, 600, 600, 0, 5 };
+    int r;
+    world *w;
+    double turned;
+    lab_add_box(&l, &b);
+    r = add(&l, "a", 300, offset, 0);
+    w = world_new(&l);
+    robot_velocity(w, r, 200, 0);
+    run(w, 3);
+    turned = physics_box_pose(w->phys, 0).heading;
+    world_free(w);
+    lab_free(&l);
+    return turned;
+}
+
+static void test_steer_box(void)
+{
+    CHECK("a push at the middle of a face drives the box straight",
+          fabs(box_turned_by_push(0)) < 2);
+    CHECK("a push at its left corner turns it clockwise", box_turned_by_push(200) < -5);
+    CHECK("a push at its right corner turns it counter-clockwise", box_turned_by_push(-200) > 5);
+}
+
 /* ---- the fiducial finder ----------------------------------------------
  * Each case is a room of its own, 16 m across so that its walls are out of
  * the way, with a robot at the origin facing `heading` and the boxes given. */
@@ -383,6 +411,7 @@ int main(void)
     test_odometry_frame();
     test_sonar_wall();
     test_push_box();
+    test_steer_box();
     test_fiducials();
     test_stall();
     test_battery();
