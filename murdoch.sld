@@ -37,7 +37,7 @@
           start-task task? task-id task-name task-status task-wait cancel-task
           tasks run-component component-heartbeat! stop-component!
           task-step start-steps pose-steps with-coordinator team-barrier
-          team-send! team-receive
+          team-send! team-receive step-team
           ;; what the lab is doing (lib/murdoch/status.scm)
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/trip-client.scm)
@@ -48,5 +48,5 @@
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch sendable) (murdoch remote) (murdoch pubsub) (murdoch monitor)
           (murdoch pose-task) (murdoch task) (murdoch component) (murdoch trip-client)
-          (only (murdoch team) with-coordinator team-barrier team-send! team-receive)
+          (only (murdoch team) with-coordinator team-barrier team-send! team-receive step-team)
           (murdoch status)))

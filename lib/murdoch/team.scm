@@ -153,6 +153,12 @@
                  (current-team (coordinator 'team)))
     (thunk)))
 
+;;> The step's robots as they are now, in component order: a member lost
+;;> and replaced (a restartable component given to another robot) is
+;;> replaced here, where (current-team) keeps the robots the member started
+;;> with.
+(define (step-team) ((team-coordinator "step-team") 'team))
+
 (define (team-coordinator who)
   (or (current-coordinator)
       (error (string-append who ": not inside a team's step"))))

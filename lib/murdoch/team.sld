@@ -4,7 +4,7 @@
 (define-library (murdoch team)
   (export with-team on-list current-team with-team-proc-maker exec-on
           task-timeout t sort-list make-maxrandom
-          with-coordinator team-barrier team-send! team-receive make-coordinator)
+          with-coordinator team-barrier team-send! team-receive step-team make-coordinator)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) thread-interrupt!)
           (murdoch scheduler) (murdoch wait) (murdoch log) (murdoch abandon) (murdoch sendable) (murdoch sandbox)
