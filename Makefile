@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-sim bench-alloc bench-chaos demo clean
+.PHONY: all deps native sim test bench bench-sim bench-alloc bench-chaos demo demo-box clean
 
 all: deps
 	$(MAKE) native
@@ -34,6 +34,14 @@ bench-chaos: all
 
 demo: all
 	bin/murdoch demo examples/tulane-lab.scm
+
+# A team moves a box along a path (docs/box-move.md); FAULT=1 kills one
+# pusher midway, and a spare takes its place.
+demo-box: all
+	MURDOCH_DEMO_TASK=examples/pose-box-move.scm \
+	MURDOCH_DEMO_JUDGE=examples/box-judge.scm \
+	MURDOCH_DEMO_FAULT=$(if $(FAULT),moseley) \
+	bin/murdoch demo examples/box-lab.scm
 
 clean: native-clean
 	$(MAKE) -C sim clean
