@@ -175,6 +175,45 @@ static void test_steer_box(void)
     CHECK("a push at its right corner turns it counter-clockwise", box_turned_by_push(-200) > 5);
 }
 
+/* The stall rule against a pushed box: a base is blocked only when it
+ * makes under a fifth of its commanded progress, and a box that slides
+ * lets it make all of it.  Two pushers side by side (MURDOCH's box move)
+ * drive it at their speed and never stall; pushing a box into a wall
+ * stalls, as pushing the wall itself does. */
+static void test_push_box_stall(void)
+{
+    lab l = room();
+    lab_box b = { 0, 0, 600, 600, 0, 5 };
+    int r, stalled = 0, k;
+    world *w;
+    lab_add_box(&l, &b);
+    add(&l, "a", -485, 190, 0);
+    add(&l, "b", -485, -190, 0);
+    w = world_new(&l);
+    robot_velocity(w, 0, 200, 0);
+    robot_velocity(w, 1, 200, 0);
+    for (k = 0; k < 5 * 60; k++) {
+        world_step(w);
+        stalled |= w->robots[0].m.stalled || w->robots[1].m.stalled;
+    }
+    CHECK("two pushers drive a box at their speed", fabs(physics_box_pose(w->phys, 0).x - 1000) < 50);
+    CHECK("and neither stalls", !stalled);
+    world_free(w);
+    lab_free(&l);
+
+    l = room();
+    b.x = 2500;
+    lab_add_box(&l, &b);
+    r = add(&l, "a", 1700, 0, 0);
+    w = world_new(&l);
+    robot_translate(w, r, 2000);
+    settle(w, r, 30);
+    CHECK("pushing a box into a wall stalls and ends the motion",
+          idle(w, r) && w->robots[r].m.stalled);
+    world_free(w);
+    lab_free(&l);
+}
+
 /* ---- the fiducial finder ----------------------------------------------
  * Each case is a room of its own, 16 m across so that its walls are out of
  * the way, with a robot at the origin facing `heading` and the boxes given. */
@@ -412,6 +451,7 @@ int main(void)
     test_sonar_wall();
     test_push_box();
     test_steer_box();
+    test_push_box_stall();
     test_fiducials();
     test_stall();
     test_battery();
