@@ -40,7 +40,7 @@ demo: all
 demo-box: all
 	MURDOCH_DEMO_TASK=examples/pose-box-move.scm \
 	MURDOCH_DEMO_JUDGE=examples/box-judge.scm \
-	MURDOCH_DEMO_FAULT=$(if $(FAULT),moseley) \
+	MURDOCH_DEMO_FAULT=$(if $(filter-out 0,$(FAULT)),moseley) \
 	bin/murdoch demo examples/box-lab.scm
 
 clean: native-clean
