@@ -77,7 +77,7 @@
         (set! *multicast*
               (cons (open-multicast-socket group port (aspace-host (local-aspace)))
                     (get-address-info group port)))
-        (set! *started* (clock-microseconds))
+        (set! *started* (wall-microseconds))
         (spawn listen-to-group 'multicast)
         (spawn send-beacons 'beacon)))))
 
@@ -87,15 +87,13 @@
 
 ;;; Sending
 
-;; The wall clock, which other hosts can compare, in microseconds.
-(define (clock-microseconds) (exact (round (* 1000000 (current-second)))))
 
 ;; The sequence of the next datagram: two threads sending at once take
 ;; two, else the receivers would drop the second as a replay.
 (define (next-sequence!)
   (with-lock *sequence-lock*
     (lambda ()
-      (set! *sequence* (max (+ *sequence* 1) (clock-microseconds)))
+      (set! *sequence* (max (+ *sequence* 1) (wall-microseconds)))
       *sequence*)))
 
 ;; Sends body to the group; #f when it is too large for a datagram.
@@ -194,7 +192,7 @@
          (frame-fail "replayed or out of order"))
         ((< sequence *started*)
          (frame-fail "sent before this address space started"))
-        ((< sequence (- (clock-microseconds) (* 1000000 (frame-timeout))))
+        ((< sequence (- (wall-microseconds) (* 1000000 (frame-timeout))))
          (frame-fail "older than frame-timeout"))))
 
 (define (serve-datagram s call d)

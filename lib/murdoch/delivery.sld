@@ -4,7 +4,7 @@
 
 (define-library (murdoch delivery)
   (export broadcast-apply broadcast-run! start-multicast! delivery-mode)
-  (import (scheme base) (scheme write) (scheme time) (srfi 1) (srfi 18)
+  (import (scheme base) (scheme write) (srfi 1) (srfi 18)
           (srfi 69)
           (only (chibi) call-with-output-string)
           (chibi net) (chibi match)

@@ -586,6 +586,17 @@ static sexp monotonic_seconds (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_flonum(ctx, now.tv_sec + now.tv_nsec / 1e9);
 }
 
+/* (wall-microseconds): microseconds since 1970 by CLOCK_REALTIME, as an
+ * exact integer: a moment other hosts can compare, for the multicast
+ * sequence.  current-second takes 2 us with warm caches, through TAI
+ * tables in exact arithmetic, and every datagram received reads it. */
+static sexp wall_microseconds (sexp ctx, sexp self, sexp_sint_t n) {
+  struct timespec now;
+  clock_gettime(CLOCK_REALTIME, &now);
+  return sexp_make_fixnum((sexp_sint_t)now.tv_sec * 1000000
+                          + now.tv_nsec / 1000);
+}
+
 /* (port-wait! PORT SECONDS): pauses the calling thread until PORT's
  * descriptor is ready (for reading an input port, for writing an output
  * port) or SECONDS have passed, through Chibi's own blocker, as a read
@@ -612,6 +623,7 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "poll-scheduler-installed?", 0,
                       poll_scheduler_installedp);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
+  sexp_define_foreign(ctx, env, "wall-microseconds", 0, wall_microseconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);
   sexp_define_foreign(ctx, env, "%port-wait!", 2, port_wait);
   return install(ctx);

@@ -21,6 +21,11 @@
 ;;> forward: for deadlines.  (scheme time)'s \scheme{current-second} costs
 ;;> some microseconds a call and jumps when the wall clock is set.
 ;;>
+;;> \procedure{(wall-microseconds)}
+;;> Microseconds since 1970 by the system's real-time clock, as an exact
+;;> integer: a moment that other hosts can compare, read in a tenth of
+;;> a microsecond where \scheme{current-second} takes two.
+;;>
 ;;> \procedure{(port-wait! port seconds)}
 ;;> Pauses the calling thread, and only it, until \var{port}'s descriptor
 ;;> is ready (to read, for an input port; to write, for an output port)
@@ -28,7 +33,8 @@
 ;;> looks again at what it waits for: readiness is a hint.
 
 (define-library (murdoch scheduler)
-  (export poll-scheduler-installed? monotonic-seconds stack-guard-tripped?
+  (export poll-scheduler-installed? monotonic-seconds wall-microseconds
+          stack-guard-tripped?
           port-wait!)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
   (import (scheme base) (srfi 18))
