@@ -87,7 +87,6 @@
 
 ;;; Sending
 
-
 ;; The sequence of the next datagram: two threads sending at once take
 ;; two, else the receivers would drop the second as a replay.
 (define (next-sequence!)
