@@ -17,6 +17,7 @@
     (robot (murdoch trip-client))
     (aspace (murdoch aspace))
     (call (murdoch connection) (murdoch worker) (murdoch call))
+    (group (murdoch group))
     (serve (murdoch serve))
     (proxy (murdoch proxy))
     (delivery (murdoch delivery))

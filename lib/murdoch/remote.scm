@@ -2,10 +2,10 @@
 ;;
 ;; The remote layer, bottom to top: the wire (frame.scm, the protocol and
 ;; its message kinds), address spaces (aspace.scm), calls
-;; (connection.scm, worker.scm, call.scm), serving them (serve.scm),
-;; proxies (proxy.scm) and delivery to the whole lab (delivery.scm).
-;; This library starts them, in that order, and is what the layers above
-;; import.
+;; (connection.scm, worker.scm, call.scm), the lab's multicast group
+;; (group.scm), serving calls (serve.scm), proxies (proxy.scm) and
+;; delivery to the whole lab (delivery.scm).  This library starts them,
+;; in that order, and is what the layers above import.
 
 ;;> Makes this process the address space \var{uid} of \var{lab} (a lab
 ;;> record, see read-lab), with \var{environment} as the environment that
@@ -28,7 +28,7 @@
     (set-sandbox-ports! (current-output-port) (current-error-port))
     (start-serving! lab)
     (spawn prober 'prober)
-    (start-multicast! lab)
+    (start-group! lab serve-group)
     (local-aspace)))
 
 ;;; From aux.scm

@@ -19,5 +19,5 @@
           (murdoch log) (murdoch wait) (murdoch remote-error) (murdoch frame)
           (murdoch lab) (murdoch sendable) (murdoch sandbox)
           (murdoch aspace) (murdoch worker) (murdoch call) (murdoch serve)
-          (murdoch proxy) (murdoch delivery))
+          (murdoch group) (murdoch proxy) (murdoch delivery))
   (include "remote.scm"))

@@ -1,0 +1,159 @@
+;;;; The lab's multicast group: datagrams that prove the lab's key and
+;;;; cannot be replayed, and beacons that keep the live set.
+;;
+;; The thesis wished for IP multicast (§1.2).  With (delivery multicast
+;; GROUP [PORT]) in the lab file, every address space joins the group.
+;; A datagram is 64 hex digits of HMAC-SHA256 under the lab's key over
+;; "mcast:" and the text, then the text: (SENDER SEQUENCE BODY).  SEQUENCE
+;; is the sender's clock when it sent, in microseconds since 1970, and
+;; grows with every datagram of a sender, so a restarted sender does not go
+;; back.  A recorded datagram cannot be replayed, to any receiver: one
+;; drops a datagram
+;;   - whose sequence it has passed (it heard that one, or a later one);
+;;   - sent before it started (it joined late, or restarted, since);
+;;   - sent more than frame-timeout ago (the window a datagram may take,
+;;     and the most that the hosts' clocks may differ).
+;; BODY is one of
+;;   (beacon UID HOST PORT)         every beacon period: here I am
+;;   (call ID KIND PROC ARGS)       KIND run or apply, as on a connection
+;;
+;; Beacons are live membership without a registry: an address space not
+;; heard from for three beacon periods leaves the live set, and its next
+;; beacon brings it back.  The period is a second in a lab of up to 16
+;; address spaces and grows with the lab beyond (as RTCP's report interval
+;; grows with a session), so that the lab as a whole sends about 16
+;; beacons a second: with every one beaconing each second, each address
+;; space of a lab of N would receive N a second, and the lab N squared.
+;;
+;; The group knows nothing of what a call means.  start-group! is handed
+;; the procedure that serves the group's calls, as Chibi's run-net-server
+;; is handed its handler: serving (delivery.scm) imports the group, and
+;; the group imports nothing above it.
+
+(define *socket* #f)                    ; the group's, or #f: not joined
+(define *address* #f)                   ; the group's address and port
+(define *buffer* #f)                    ; datagrams are received into it
+(define *sequence* 0)                   ; of the last datagram sent
+(define *sequence-lock* (make-mutex 'sequence))
+(define *started* 0)                    ; microseconds, at start-group!
+(define *window* 5)                     ; the lab's frame-timeout, seconds
+(define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
+(define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
+(define *last-heard-lock* (make-mutex 'last-heard))
+(define max-datagram 60000)
+(define lab-beacons-per-second 16)
+
+;;> Joins \var{lab}'s multicast group when the lab's delivery is
+;;> multicast, and starts its beacons and a thread that applies
+;;> \var{serve} to \scheme{receive-call}: a procedure of no arguments that
+;;> waits for the group's next datagram and returns the call it carries,
+;;> \scheme{(SENDER ID KIND PROC ARGS)}, or #f when it carried none (a
+;;> beacon, or our own datagram looped back).  It raises for a datagram
+;;> that is not authentic or not fresh.  Only one thread at a time may
+;;> call it: the datagram is read into one buffer.
+(define (start-group! lab serve)
+  ;; (multicast GROUP [PORT]) or (broadcast)
+  (let ((delivery (lab-setting lab 'delivery)))
+    (when (eq? (car delivery) 'multicast)
+      (let ((group (cadr delivery))
+            (port (if (pair? (cddr delivery))
+                      (car (cddr delivery))
+                      (+ (lab-port-base lab) 149))))
+        (set! *socket*
+              (open-multicast-socket group port (aspace-host (local-aspace))))
+        (set! *address* (get-address-info group port))
+        ;; A new 64 KB bytevector for each datagram, dozens a second,
+        ;; would cost more than serving them.
+        (set! *buffer* (make-bytevector 65536))
+        (set! *window* (lab-setting lab 'frame-timeout))
+        (set! *started* (wall-microseconds))
+        (spawn (lambda () (serve receive-call)) 'multicast)
+        (spawn send-beacons 'beacon)))))
+
+;;> How publish and request reach the lab: \scheme{multicast} or
+;;> \scheme{broadcast}.
+(define (delivery-mode) (if *socket* 'multicast 'broadcast))
+
+;;; Sending
+
+;; The sequence of the next datagram: two threads sending at once take
+;; two, else the receivers would drop the second as a replay.
+(define (next-sequence!)
+  (with-lock *sequence-lock*
+    (lambda ()
+      (set! *sequence* (max (+ *sequence* 1) (wall-microseconds)))
+      *sequence*)))
+
+;;> Sends \var{body} to the group; #f when it is too large for a datagram.
+(define (send-datagram! body)
+  (let* ((sequence (next-sequence!))
+         (text (call-with-output-string
+                 (lambda (o)
+                   (write-simple (list (local-aspace-uid) sequence body) o))))
+         (bytes (datagram-bytes text)))
+    (and (<= (bytevector-length bytes) max-datagram)
+         (begin (send *socket* bytes 0 *address*) #t))))
+
+(define (beacon-seconds)
+  (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
+
+;; A beacon each period, and out of the live set with whoever has not
+;; sent one for three.
+(define (send-beacons)
+  (let ((me (local-aspace)))
+    (send-datagram! (make-message 'beacon (aspace-uid me) (aspace-host me)
+                                  (aspace-port me))))
+  (let ((now (monotonic-seconds))
+        (period (beacon-seconds)))
+    (for-each (lambda (uid)
+                (if (< (with-lock *last-heard-lock*
+                         (lambda ()
+                           (hash-table-ref/default *last-heard* uid now)))
+                       (- now (* 3 period)))
+                    (note-unreachable! uid)))
+              (known-uids))
+    (thread-sleep! period))
+  (send-beacons))
+
+;;; Receiving
+
+(define (receive-call)
+  (let ((n (receive! *socket* *buffer*)))
+    (and (>= n 0)
+         (match (open-datagram *buffer* n)
+           ((sender sequence body)
+            (with-lock *last-heard-lock*
+              (lambda ()
+                (hash-table-set! *last-heard* sender (monotonic-seconds))))
+            ;; Else our own, looped back.
+            (and (not (eq? sender (local-aspace-uid)))
+                 (datagram-call sender body)))))))
+
+;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
+;; bytes of buffer.
+(define (open-datagram buffer n)
+  (let ((d (check-datagram (open-datagram-text buffer n))))
+    (match d
+      ((sender sequence body)
+       (check-fresh sender sequence)
+       (hash-table-set! *last-sequence* sender sequence)
+       d))))
+
+(define (check-fresh sender sequence)
+  (cond ((<= sequence (hash-table-ref/default *last-sequence* sender 0))
+         (frame-fail "replayed or out of order"))
+        ((< sequence *started*)
+         (frame-fail "sent before this address space started"))
+        ((< sequence (- (wall-microseconds) (* 1000000 *window*)))
+         (frame-fail "older than frame-timeout"))))
+
+;; A beacon brings its sender (back) into the live set; a call is the
+;; caller's to serve.
+(define (datagram-call sender body)
+  (match (check-message body '(beacon call) "a beacon or a call")
+    (('beacon uid host port)
+     (learn-aspace! (make-aspace uid host port))
+     (note-reachable! sender)
+     #f)
+    (('call id kind proc-code args-code)
+     (list sender id kind proc-code args-code))))
