@@ -1,10 +1,9 @@
 # Murdoch's C outside the simulator, for the top Makefile to include; paths
 # are from the top of the repository.
 #   make native         builds lib/murdoch/scheduler.so, multicast.so,
-#                       hmac.so, netstring.so and connect.so, the C of
-#                       (murdoch scheduler), (murdoch multicast), (murdoch
-#                       hmac), (murdoch netstring) and (murdoch connect),
-#                       and bench/c-pingpong
+#                       hmac.so, netstring.so, connect.so, guard.so,
+#                       process-name.so and sendable.so, the C of the
+#                       libraries of those names, and bench/c-pingpong
 #   make native-clean   removes them
 
 # tools/chibi-cflags names the directory of Chibi's headers, which in the
@@ -18,7 +17,8 @@ NATIVE_CFLAGS ?= -O2 -g -Wall
 
 NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
                   lib/murdoch/hmac.so lib/murdoch/netstring.so lib/murdoch/connect.so \
-                  lib/murdoch/guard.so lib/murdoch/process-name.so
+                  lib/murdoch/guard.so lib/murdoch/process-name.so \
+                  lib/murdoch/sendable.so
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 

@@ -1,6 +1,6 @@
 ;;; Murdoch's lambda and the encoding of values, in one process.
 (import (except (scheme base) lambda define) (scheme eval) (scheme read)
-        (scheme write) (chibi test)
+        (scheme write) (scheme cxr) (srfi 1) (chibi test)
         (rename (murdoch sendable) (sendable-lambda lambda)
                 (sendable-define define)))
 
@@ -39,5 +39,26 @@
   (guard (e ((send-error? e) (error-object-message e)))
     (let ((port (current-output-port)))
       (encode (lambda () port) env "it"))))
+(define (send-error-of thunk)
+  (guard (e ((send-error? e) (error-object-message e))) (thunk) 'sent))
+(define (nested n) (if (= n 0) '() (list (nested (- n 1)))))
+(test-group "the limits, through the look that passes plain data as it is"
+  (set-value-limits! 50 1000)
+  (test "plain data nested to the limit goes as it is" (nested 49)
+    (encode (nested 49) env "it"))
+  (test "deeper is refused" "it nests deeper than the lab's max-depth, 50"
+    (send-error-of (lambda () (encode (nested 51) env "it"))))
+  (test "a circular list is refused"
+      "cannot send it: it is larger than a frame holds, or circular"
+    (send-error-of (lambda () (let ((c (list 1 2))) (set-cdr! (cdr c) c)
+                                (encode c env "it")))))
+  (test "so is a value, not plain, with more pairs than the limit"
+      "cannot send it: it is larger than a frame holds, or circular"
+    (send-error-of (lambda () (encode (cons car (iota 1000)) env "it"))))
+  (test "a list of plain data beside a closure round-trips"
+      '(1 (2 "three") four)
+    (let ((p (round-trip (list '(1 (2 "three")) (lambda () 'four)))))
+      (list (caar p) (cadr (car p)) ((cadr p)))))
+  (set-value-limits! 4000 524288))
 (test-end)
 (test-exit)

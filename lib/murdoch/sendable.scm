@@ -210,21 +210,11 @@
 
 ;; True of data that stands for itself on the wire, pairs of it included:
 ;; encode and decode give it back as it is instead of copying it, which
-;; on a receiver's path was most of their cost.  The look stops after a
-;; budget of pairs, or at the depth limit, so that a long, deep or
-;; circular value goes the general way, which says what is wrong with it.
-(define (plain? x) (and (plain-pairs x 100000 0) #t))
-
-;; The budget left after looking through x, or #f when x is not plain or
-;; the budget or the depth runs out.  Down cdrs the call is a tail call.
-(define (plain-pairs x budget depth)
-  (cond ((not budget) #f)
-        ((pair? x)
-         (and (positive? budget) (< depth *max-depth*)
-              (plain-pairs (cdr x) (plain-pairs (car x) (- budget 1) (+ depth 1))
-                           depth)))
-        ((plain-atom? x) budget)
-        (else #f)))
+;; on a receiver's path was most of their cost.  The look (plain-within?,
+;; in sendable.c) stops after a budget of pairs, or at the depth limit, so
+;; that a long, deep or circular value goes the general way, which says
+;; what is wrong with it.
+(define (plain? x) (plain-within? x 100000 *max-depth*))
 
 (define (plain-atom? x)
   (or (number? x) (string? x) (symbol? x) (char? x) (boolean? x)
@@ -236,57 +226,70 @@
 (define (encode x env what)
   (if (plain? x) x (encode-compound x env what)))
 
+;; The walk's procedures are defined at the top, not inside
+;; encode-compound: Chibi would make each of them anew for every value
+;; sent, a microsecond of every call.  left is a one-element vector, the
+;; pairs the value may still hold.
 (define (encode-compound x env what)
-  (define pairs-left *max-pairs*)
-  (define (spend! n what)
-    (set! pairs-left (- pairs-left n))
-    (if (negative? pairs-left)
-        (send-fail "cannot send " (what-string what)
-                   ": it is larger than a frame holds, or circular")))
-  (define (enc x what depth)
-    (cond
-     ((plain-atom? x) x)
-     ((pair? x) (check-depth (+ depth 1) what)
-                (map-elements (lambda (e) (spend! 1 what) (enc e what (+ depth 1)))
-                              x))
-     ((vector? x)
-      (check-depth (+ depth 1) what)
-      (spend! (vector-length x) what)
-      (list->vector
-       (cons 'murdoch:vector
-             (map-elements (lambda (e) (enc e what (+ depth 1)))
-                           (vector->list x)))))
-     ((eof-object? x) (vector 'murdoch:eof))
-     ((eq? x void-value) (vector 'murdoch:void))
-     ((procedure? x) (enc-procedure x what depth))
-     (else (send-fail "cannot send " (what-string what) ": it is "
-                      (describe x)))))
-  (define (enc-procedure p what depth)
-    (cond
-     ((proxy-procedure-ref p)
-      => (lambda (ref) (vector 'murdoch:proxy (proxy-ref-uid ref)
-                               (proxy-ref-id ref))))
-     ((global-name p env) => (lambda (name) (vector 'murdoch:global name)))
-     ((and (not (opcode? p)) (closure-info p))
-      => (lambda (info) (enc-closure info depth)))
-     (else (send-fail "cannot send " (what-string what) ": it is "
-                      (describe p)))))
-  ;; A captured value is written inside the closure's vector, its list of
-  ;; bindings and its binding: three levels down.
-  (define (enc-closure info depth)
-    (let* ((source+names (sendable-info-source+names info))
-           (source (car source+names)))
-      (vector 'murdoch:closure source
-              (map (lambda (name value)
-                     (cons name
-                           (enc value (lambda ()
-                                        (string-append
-                                         "variable " (symbol->string name)
-                                         " of " (abridged source 60)))
-                                (+ depth 3))))
-                   (cdr source+names)
-                   ((sendable-info-values info))))))
-  (enc x what 0))
+  (enc x env what 0 (make-vector 1 *max-pairs*)))
+
+(define (spend! left n what)
+  (vector-set! left 0 (- (vector-ref left 0) n))
+  (if (negative? (vector-ref left 0))
+      (send-fail "cannot send " (what-string what)
+                 ": it is larger than a frame holds, or circular")))
+
+(define (enc x env what depth left)
+  (cond
+   ((plain-atom? x) x)
+   ((pair? x) (check-depth (+ depth 1) what)
+              (map-elements (lambda (e)
+                              (spend! left 1 what)
+                              (enc e env what (+ depth 1) left))
+                            x))
+   ((vector? x)
+    (check-depth (+ depth 1) what)
+    (spend! left (vector-length x) what)
+    (list->vector
+     (cons 'murdoch:vector
+           (map-elements (lambda (e) (enc e env what (+ depth 1) left))
+                         (vector->list x)))))
+   ((eof-object? x) (vector 'murdoch:eof))
+   ((eq? x void-value) (vector 'murdoch:void))
+   ((procedure? x) (enc-procedure x env what depth left))
+   (else (send-fail "cannot send " (what-string what) ": it is "
+                    (describe x)))))
+
+(define (enc-procedure p env what depth left)
+  (cond
+   ((proxy-procedure-ref p)
+    => (lambda (ref) (vector 'murdoch:proxy (proxy-ref-uid ref)
+                             (proxy-ref-id ref))))
+   ((global-name p env) => (lambda (name) (vector 'murdoch:global name)))
+   ((and (not (opcode? p)) (closure-info p))
+    => (lambda (info) (enc-closure info env depth left)))
+   (else (send-fail "cannot send " (what-string what) ": it is "
+                    (describe p)))))
+
+;; A captured value is written inside the closure's vector, its list of
+;; bindings and its binding: three levels down.
+(define (enc-closure info env depth left)
+  (let ((source+names (sendable-info-source+names info)))
+    (vector 'murdoch:closure (car source+names)
+            (enc-bindings (car source+names) (cdr source+names)
+                          ((sendable-info-values info)) env (+ depth 3) left))))
+
+;; ((NAME . VALUE) ...) of a closure's captured variables.
+(define (enc-bindings source names values env depth left)
+  (if (null? names)
+      '()
+      (cons (cons (car names)
+                  (enc (car values) env
+                       (lambda ()
+                         (string-append "variable " (symbol->string (car names))
+                                        " of " (abridged source 60)))
+                       depth left))
+            (enc-bindings source (cdr names) (cdr values) env depth left))))
 
 ;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters,
 ;;> ending in "...", when it is longer: for messages and progress lines.

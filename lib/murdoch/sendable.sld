@@ -11,4 +11,5 @@
                 make-exception exception? exception-kind)
           (chibi ast)
           (srfi 1) (srfi 18) (srfi 69))
+  (include-shared "sendable")
   (include "sendable.scm"))
