@@ -60,5 +60,13 @@
     (let ((p (round-trip (list '(1 (2 "three")) (lambda () 'four)))))
       (list (caar p) (cadr (car p)) ((cadr p)))))
   (set-value-limits! 4000 524288))
+(test "a receiver's table of compiled sources, emptied when full, compiles again"
+    '(0 4100 0)
+  ;; 4,101 sources, more than the table holds, through one decoder.
+  (let ((decode (make-decoder env (lambda (uid id) #f)))
+        (code (lambda (n) (vector 'murdoch:closure `(lambda () ,n) '()))))
+    (let ((first ((decode (code 0)))))
+      (do ((n 1 (+ n 1))) ((= n 4100)) (decode (code n)))
+      (list first ((decode (code 4100))) ((decode (code 0)))))))
 (test-end)
 (test-exit)

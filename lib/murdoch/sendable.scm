@@ -304,13 +304,19 @@
 ;;; Decoding
 
 ;; Compiling a closure's source is the dear part of decoding, and the same
-;; closure is sent again and again, so makers are kept by source.
+;; closure is sent again and again, so makers are kept by source.  A peer
+;; could send sources without end, so the table is emptied when it holds
+;; max-makers: a program sends far fewer lambdas than that.
+(define max-makers 4096)
+
 (define (make-closure-compiler env)
   (let ((makers (make-hash-table equal?)))
     (lambda (source names)
       (let ((key (cons source names)))
         (or (hash-table-ref/default makers key #f)
             (let ((maker (eval `(lambda ,names ,source) env)))
+              (if (>= (hash-table-size makers) max-makers)
+                  (set! makers (make-hash-table equal?)))
               (hash-table-set! makers key maker)
               maker))))))
 
@@ -334,8 +340,10 @@
         ((murdoch:global) (global-ref (vector-ref v 1)))
         ((murdoch:closure)
          (let ((bindings (vector-ref v 2)))
-           (apply (compile (vector-ref v 1) (map car bindings))
-                  (map (lambda (b) (dec (cdr b) (+ depth 1))) bindings))))
+           (if (null? bindings)            ; the common case, made cheap
+               ((compile (vector-ref v 1) '()))
+               (apply (compile (vector-ref v 1) (map car bindings))
+                      (map (lambda (b) (dec (cdr b) (+ depth 1))) bindings)))))
         ((murdoch:proxy) (proxy (vector-ref v 1) (vector-ref v 2)))
         ((murdoch:void) void-value)
         ((murdoch:eof) (eof-object))
