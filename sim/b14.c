@@ -176,18 +176,29 @@ static void accept_client(server *sv, int robot)
     sv->clients[k] = c;
 }
 
-/* Asynchronous readings, stalled clients, and the writes that are due. */
+/* Queue every message due to c apart from replies (trip_event); 0, or -1
+ * when the client is too far behind to keep. */
+static int send_events(client *c)
+{
+    char event[512];
+    size_t n;
+    while ((n = trip_event(&c->session, event, sizeof event)) > 0)
+        if (send_payload(c, event, n) < 0)
+            return -1;
+    return 0;
+}
+
+/* Deferred replies, asynchronous readings, stalled clients, and the writes
+ * that are due. */
 static void after_step(server *sv)
 {
     double now = wall_now();
-    char event[512];
     int k;
     for (k = 0; k < MAX_CLIENTS; k++) {
         client *c = sv->clients[k];
-        size_t n;
         if (!c)
             continue;
-        if ((n = trip_event(&c->session, event, sizeof event)) > 0 && send_payload(c, event, n) < 0) {
+        if (send_events(c) < 0) {
             drop(sv, k);
             continue;
         }

@@ -33,6 +33,7 @@ typedef struct {
     size_t restlen;
     char *out;
     size_t cap, len;
+    int deferred;               /* no reply now: trip_event sends it later */
 } request;
 
 static void put(request *q, const char *fmt, ...)
@@ -169,6 +170,35 @@ static int base_reckon(request *q)
     pose p = robot_reckon(q->w, q->r);
     put(q, " %.1f %.1f", p.x, p.y);
     put_heading(q, p.heading);
+    return 0;
+}
+
+/* The end of a motion, as base await answers it: the pose and whether
+ * the base stalled. */
+static void put_motion_end(request *q)
+{
+    base_reckon(q);
+    put(q, " %d", q->w->robots[q->r].m.stalled);
+}
+
+/* base await: answered at once when the base is idle, else once its motion
+ * is over (trip_event), so that a client waits for the end of a motion
+ * without asking again and again, and other requests go on meanwhile. */
+static int base_await(request *q)
+{
+    long *free_slot = NULL;
+    int i;
+    if (q->w->robots[q->r].m.kind == IDLE) {
+        put_motion_end(q);
+        return 0;
+    }
+    for (i = 0; i < MAX_AWAITS && !free_slot; i++)
+        if (q->s->awaits[i] == 0)
+            free_slot = &q->s->awaits[i];
+    if (!free_slot)
+        return fail(q, "busy", "%d awaits are already pending", MAX_AWAITS);
+    *free_slot = strtol(q->word[0], NULL, 10);
+    q->deferred = 1;
     return 0;
 }
 
@@ -323,6 +353,7 @@ static const struct command {
     { BASE, "stop", 0, 1, base_stop },
     { BASE, "status", 0, 1, base_status },
     { BASE, "reckon", 0, 1, base_reckon },
+    { BASE, "await", 0, 1, base_await },
     { BASE, "set-position", 2, 1, base_set_position },
     { BASE, "set-heading", 1, 1, base_set_heading },
     { SONAR, "start", 0, 1, sonar_start },
@@ -458,19 +489,40 @@ size_t trip_handle(trip_session *s, const char *req, size_t n, char *out, size_t
         connection_command(&q);
     }
     free(text);
-    return q.len;
+    return q.deferred ? 0 : q.len;
+}
+
+/* The reply of one pending base await, once the base is idle; 0 if none. */
+static size_t await_reply(request *q)
+{
+    int i;
+    if (q->w->robots[q->r].m.kind != IDLE)
+        return 0;
+    for (i = 0; i < MAX_AWAITS; i++)
+        if (q->s->awaits[i] != 0) {
+            put(q, "%ld ok", q->s->awaits[i]);
+            put_motion_end(q);
+            q->s->awaits[i] = 0;
+            return q->len;
+        }
+    return 0;
 }
 
 size_t trip_event(trip_session *s, char *out, size_t cap)
 {
     const robot *r = &s->w->robots[s->robot];
     request q;
+    memset(&q, 0, sizeof q);
+    q.s = s;
+    q.w = s->w;
+    q.r = s->robot;
+    q.out = out;
+    q.cap = cap;
+    if (await_reply(&q) > 0)
+        return q.len;
     if (!s->stream || r->sonar_seq == s->streamed)
         return 0;
     s->streamed = r->sonar_seq;
-    memset(&q, 0, sizeof q);
-    q.out = out;
-    q.cap = cap;
     put(&q, "0 sonar");
     put_ranges(&q, r->sonar, SONARS);
     return q.len;

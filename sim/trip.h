@@ -8,6 +8,8 @@
 enum device { BASE, SONAR, IR, BUMPERS_DEV, SKIRT, BUTTONS_DEV, LIGHTS_DEV, SPEECH, BATTERY,
               FIDUCIAL, DEVICES };
 
+enum { MAX_AWAITS = 8 };        /* base awaits one connection may have pending */
+
 typedef struct {
     world *w;
     int robot;
@@ -15,6 +17,7 @@ typedef struct {
     int lock[DEVICES];          /* flock'd file, or -1 */
     int stream;                 /* sonar stream on */
     int streamed;               /* sonar_seq last streamed */
+    long awaits[MAX_AWAITS];    /* tags of base awaits not yet answered, 0 free */
 } trip_session;
 
 const char *trip_device_name(int device);
@@ -23,6 +26,8 @@ void trip_begin(trip_session *s, world *w, int robot, const char *lockdir);
 void trip_end(trip_session *s);
 /* Answer one request; returns the reply's length (< cap). */
 size_t trip_handle(trip_session *s, const char *req, size_t n, char *out, size_t cap);
-/* An asynchronous message due to the client (tag 0), or 0 when none. */
+/* A message due to the client that no request of this turn answered: the
+ * deferred reply of a base await whose motion is over, or a tag 0 reading;
+ * 0 when none.  Call it until it answers 0. */
 size_t trip_event(trip_session *s, char *out, size_t cap);
 #endif

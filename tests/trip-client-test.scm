@@ -206,6 +206,31 @@ LAB
   (forget-abandoned! (current-thread))
   (test "and works again once the call is over" 4 (length (reckon))))
 
+(define (turned-from start heading)
+  (let ((a (- heading start)))
+    (abs (- a (* 360 (round (/ a 360)))))))
+
+(test-group "waiting for a motion"
+  ;; Two turns take the simulated robot 12 s, 1.2 s here.  Its connection
+  ;; is not held while the turner waits for the end (base await).
+  (let* ((start (car (cddr (reckon))))
+         (turner (make-thread (lambda () (rotate 'by 720)))))
+    (thread-start! turner)
+    (let ((status (let look ((n 0))     ; until a quarter turn shows
+                    (let ((status (trip-request moseley 'base 'status)))
+                      (if (or (> (turned-from start (car (cddr status))) 90) (> n 500))
+                          status
+                          (begin (thread-sleep! 0.01) (look (+ n 1))))))))
+      (test "another thread's request is answered while the motion goes on" 1
+            (list-ref status 5))
+      (let ((end (thread-join! turner)))
+        (test "then the turner has the pose the motion ended at"
+              (map round (reckon)) (map round end))
+        (test-assert "two whole turns" (< (turned-from start (car (cddr end))) 2)))))
+  (test "a motion over its time is stopped, and says so" '(timeout "motion took too long")
+        (parameterize ((trip-motion-timeout 0.2)) (error-of (lambda () (rotate 'by 720)))))
+  (test "and the base stands still" 0 (list-ref (trip-request moseley 'base 'status) 5)))
+
 (test-group "safe.scm"
   (test-assert "safe-reckon on a robot is reckon" (= 4 (length (safe-reckon '(1 2 3)))))
   (parameterize ((current-robot #f))

@@ -6,9 +6,12 @@
 ;; reached, which can leave a lock taken for good; so a marked thread stops
 ;; itself, where it waits on something of Murdoch's: each robot command
 ;; (trip-client.scm) and each remote call (remote.scm) raises in it.  A
-;; procedure that calls neither runs to its end.
+;; procedure that calls neither runs to its end.  A thread in a long wait
+;; (a robot's motion) is woken when it is marked, by the procedure it gave
+;; with-wake-on-abandon, rather than look at its mark again and again.
 
 (define *abandoned* '())                ; the marked threads
+(define *wakers* '())                   ; ((thread . wake) ...), innermost first
 (define *abandoned-lock* (make-mutex 'abandoned))
 
 (define (update-abandoned! change)
@@ -16,9 +19,27 @@
   (set! *abandoned* (change *abandoned*))
   (mutex-unlock! *abandoned-lock*))
 
+(define (update-wakers! change)
+  (mutex-lock! *abandoned-lock*)
+  (set! *wakers* (change *wakers*))
+  (mutex-unlock! *abandoned-lock*))
+
 ;;> Marks \var{thread}: the call it runs has been given up by its caller.
+;;> A thread in with-wake-on-abandon is woken.
 (define (abandon-thread! thread)
-  (update-abandoned! (lambda (ls) (if (memq thread ls) ls (cons thread ls)))))
+  (update-abandoned! (lambda (ls) (if (memq thread ls) ls (cons thread ls))))
+  (let ((waker (assq thread *wakers*)))
+    (if waker ((cdr waker)))))
+
+;;> Applies \var{thunk}, calling \var{wake} (from another thread, no
+;;> arguments) should the current thread be marked meanwhile: wake ends
+;;> thunk's wait, and thunk then calls check-not-abandoned.  So that no mark
+;;> is missed, thunk checks after wake is in place.
+(define (with-wake-on-abandon wake thunk)
+  (let ((waker (cons (current-thread) wake)))
+    (dynamic-wind (lambda () (update-wakers! (lambda (ls) (cons waker ls))))
+                  thunk
+                  (lambda () (update-wakers! (lambda (ls) (delete waker ls eq?)))))))
 
 ;;> Takes the mark off \var{thread}, whose call has ended.
 (define (forget-abandoned! thread)

@@ -7,15 +7,20 @@
 ;;;   reply    "TAG ok VALUE ..."  or  "TAG err CODE TEXT"
 ;;;   tag 0    the server's own messages (framing errors, streamed readings)
 ;;;
-;;; One connection per robot.  Requests on a connection are serialized by
-;;; its mutex, so green threads may call the primitives at once; the thread
-;;; that sent a request reads frames until its reply comes, skipping any
-;;; other (tag 0, or a reply that came too late).  It reads only bytes that
-;;; are already there and naps between looks, so nothing ever blocks in a
-;;; read: a reply not back within (trip-timeout) seconds, and a motion not
-;;; over within (trip-motion-timeout), raise a trip error naming robot and
-;;; command.  (No reader thread and no timed condition wait: Chibi 0.12's
-;;; scheduler was seen to lose threads once such a wait had timed out.)
+;;; One connection per robot, which the threads of the address space
+;;; share.  A thread sends its request under the connection's lock and
+;;; lets go at once; the connection's reader thread hands each reply to the
+;;; mailbox of the request with its tag (murdoch wait), and drops the rest
+;;; (tag 0, or a reply whose asker gave up).  So a request never holds the
+;;; connection while it waits, and a reply not back within (trip-timeout)
+;;; seconds raises a trip error naming robot and command.
+;;;
+;;; A motion (goto-xy, rotate, translate) ends with `base await', whose
+;;; reply the server holds back until the motion is over: the thread that
+;;; moves waits in its mailbox, up to (trip-motion-timeout), asking nothing
+;;; again and again, while other threads (the live view) read the robot on
+;;; the same connection.  A thread whose caller gives up (abandon.scm) is
+;;; woken in that wait and stops the robot.
 ;;;
 ;;; The primitives act on (current-robot), the connection of the address
 ;;; space's own robot (#f on a workstation).  Devices are opened on first
@@ -72,35 +77,34 @@
     (write-u8 etx out)
     (flush-output-port out)))
 
-;; The next byte, an eof object, or #f once the deadline has passed (on
-;; the monotonic clock); waits for the socket (port-wait!), never in a
-;; read, so that a deadline holds.
-(define (next-byte in deadline)
-  (let loop ()
-    (cond ((u8-ready? in) (read-u8 in))
-          ((>= (monotonic-seconds) deadline) #f)
-          (else (port-wait! in (- deadline (monotonic-seconds))) (loop)))))
+;; The next byte or an eof object.  Waits for the socket (port-wait!), so
+;; that only this thread waits; the wait is long since the reader has no
+;; deadline: each request has its own.
+(define (next-byte in)
+  (if (u8-ready? in)
+      (read-u8 in)
+      (begin (port-wait! in 3600) (next-byte in))))
 
-;; The next whole frame's payload as a string, an eof object, or #f at the
-;; deadline.  Bytes between frames and broken frames are skipped: the server
-;; never sends them.
-(define (read-frame in deadline)
+;; The next whole frame's payload as a string, or an eof object.  Bytes
+;; between frames and broken frames are skipped: the server never sends
+;; them.
+(define (read-frame in)
   (let outside ()
-    (let ((b (next-byte in deadline)))
+    (let ((b (next-byte in)))
       (cond
-       ((or (not b) (eof-object? b)) b)
+       ((eof-object? b) b)
        ((not (= b stx)) (outside))
        (else
         (let inside ((acc (open-output-bytevector)) (n 0))
-          (let ((b (next-byte in deadline)))
+          (let ((b (next-byte in)))
             (cond
-             ((or (not b) (eof-object? b)) b)
+             ((eof-object? b) b)
              ((= b etx) (utf8->string (get-output-bytevector acc)))
              ((or (= b stx) (> n max-reply)) (outside))
              ((= b dle)
-              (let ((c (next-byte in deadline)))
+              (let ((c (next-byte in)))
                 (cond
-                 ((or (not c) (eof-object? c)) c)
+                 ((eof-object? c) c)
                  ((special? (bitwise-xor c #x40))
                   (write-u8 (bitwise-xor c #x40) acc)
                   (inside acc (+ n 1)))
@@ -110,13 +114,14 @@
 ;;; Connections
 
 (define-record-type trip-connection
-  (make-trip-connection host port in out lock opened)
+  (make-trip-connection host port in out lock waiting opened)
   trip-connection?
   (host trip-connection-host)
   (port trip-connection-port)
   (in trip-connection-in)
   (out trip-connection-out)
-  (lock trip-connection-lock)              ; held from request to reply
+  (lock trip-connection-lock)              ; held to send, and for waiting
+  (waiting trip-connection-waiting)        ; tag -> the mailbox of its request
   (opened trip-connection-opened trip-connection-opened-set!)
   (name trip-connection-name trip-connection-name-set!)
   (tag trip-connection-tag trip-connection-tag-set!)       ; the last sent
@@ -136,27 +141,64 @@
         (trip-error (string-append host ":" (number->string port)) "connect"
                     "closed" (string-append "cannot connect: " io)))
     (let ((c (make-trip-connection host port (car io) (cadr io)
-                                   (make-mutex 'trip) '())))
+                                   (make-mutex 'trip) (make-hash-table eqv?) '())))
       (trip-connection-name-set! c #f)
       (trip-connection-tag-set! c 0)
       (trip-connection-open?-set! c #t)
       (trip-connection-goal-set! c #f)
+      (thread-start! (make-thread (lambda () (read-replies c)) 'trip-replies))
       (guard (e (#t (trip-close c) (raise e)))
         (trip-connection-name-set! c (car (request c "who"))))
       c)))
 
 ;;> Closes the connection; the server frees every device it held.
 (define (trip-close c)
-  (mutex-lock! (trip-connection-lock c))
-  (if (trip-connection-open? c) (shut! c))
-  (mutex-unlock! (trip-connection-lock c)))
+  (with-lock (trip-connection-lock c) (lambda () (shut! c))))
 
-;; Close the socket; the caller holds the lock.  Closing both ports closes
-;; it; closing its number again could close a socket that has taken it.
+;; Close the socket once; the caller holds the lock.  Closing both ports
+;; closes it; closing its number again could close a socket that has taken
+;; it.  The reader then finds the end of its input, and ends.
 (define (shut! c)
-  (trip-connection-open?-set! c #f)
-  (guard (e (#t #f)) (close-input-port (trip-connection-in c)))
-  (guard (e (#t #f)) (close-output-port (trip-connection-out c))))
+  (when (trip-connection-open? c)
+    (trip-connection-open?-set! c #f)
+    (guard (e (#t #f)) (close-input-port (trip-connection-in c)))
+    (guard (e (#t #f)) (close-output-port (trip-connection-out c)))))
+
+;; The connection's reader: each reply to the mailbox of its request, until
+;; the connection ends (or is closed here, which makes the port fail).
+(define (read-replies c)
+  (let ((frame (guard (e (#t (eof-object))) (read-frame (trip-connection-in c)))))
+    (if (eof-object? frame)
+        (for-each (lambda (mb) (mailbox-put! mb 'lost)) (close-for-good! c))
+        (let* ((reply (split-words frame))
+               (tag (and (pair? reply) (string->number (car reply))))
+               (mb (and tag (take-waiting! c tag))))
+          (if mb (mailbox-put! mb reply))
+          (read-replies c)))))
+
+;; The mailbox waiting for the reply tagged tag, which no longer waits, or
+;; #f if none does (tag 0, or a request that gave up).
+(define (take-waiting! c tag)
+  (with-lock (trip-connection-lock c)
+    (lambda ()
+      (let ((mb (hash-table-ref/default (trip-connection-waiting c) tag #f)))
+        (forget! c tag)
+        mb))))
+
+;; Close c at its end, and take the mailboxes of the requests that still
+;; wait: no reply will come to them.
+(define (close-for-good! c)
+  (with-lock (trip-connection-lock c)
+    (lambda ()
+      (shut! c)
+      (let ((waiting (hash-table-values (trip-connection-waiting c))))
+        (for-each (lambda (tag) (forget! c tag))
+                  (hash-table-keys (trip-connection-waiting c)))
+        waiting))))
+
+;; The caller holds the lock.
+(define (forget! c tag)
+  (hash-table-delete! (trip-connection-waiting c) tag))
 
 ;;> The words of \var{s}, separated by spaces.
 (define (split-words s)
@@ -189,40 +231,56 @@
 ;; error for an err reply, a lost connection or no reply in time.  In a
 ;; call whose caller gave up, raise instead of sending (abandon.scm).
 (define (request c . words)
-  (let ((command (join (map ->word words)))
-        (lock (trip-connection-lock c))
-        (deadline (+ (monotonic-seconds) (trip-timeout))))
-    (define (fail code text)
-      (mutex-unlock! lock)
-      (trip-error (robot-name c) command code text))
-    (check-not-abandoned command)
-    (mutex-lock! lock)
-    (if (not (trip-connection-open? c))
-        (fail "closed" "connection closed"))
-    (let ((tag (+ 1 (modulo (trip-connection-tag c) 999999998))))
-      (trip-connection-tag-set! c tag)
-      (guard (e (#t (shut! c) (fail "closed" "cannot send")))
-        (write-frame! (string-append (number->string tag) " " command)
-                      (trip-connection-out c)))
-      (let wait ()
-        (let ((frame (guard (e (#t (eof-object)))
-                       (read-frame (trip-connection-in c) deadline))))
-          (cond
-           ((eof-object? frame) (shut! c) (fail "closed" "connection lost"))
-           ((not frame)
-            (fail "timeout" (string-append "no reply within "
-                                           (number->string (trip-timeout)) " s")))
-           (else
-            (let ((reply (split-words frame)))
-              (cond
-               ((not (and (pair? reply) (equal? (string->number (car reply)) tag)))
-                (wait))
-               ((and (pair? (cdr reply)) (equal? (cadr reply) "ok"))
-                (mutex-unlock! lock)
-                (map reply-value (cddr reply)))
-               (else
-                (fail (if (pair? (cddr reply)) (car (cddr reply)) "protocol")
-                      (join (if (pair? (cddr reply)) (cdr (cddr reply)) reply)))))))))))))
+  (let ((command (join (map ->word words))))
+    (exchange c command (+ (monotonic-seconds) (trip-timeout))
+              (lambda ()
+                (trip-error (robot-name c) command "timeout"
+                            (string-append "no reply within "
+                                           (number->string (trip-timeout)) " s"))))))
+
+;; Send command, and return the values of its ok reply once it comes, by
+;; deadline (on the monotonic clock); else call too-late, which raises.
+;; The thread waits in a mailbox, not holding the connection, and is woken
+;; there should its caller give up.
+(define (exchange c command deadline too-late)
+  (let ((mb (make-mailbox)))
+    (define (fail code text) (trip-error (robot-name c) command code text))
+    (with-wake-on-abandon
+     (lambda () (mailbox-put! mb 'abandoned))
+     (lambda ()
+       (check-not-abandoned command)
+       (let* ((tag (send! c command mb fail))
+              (reply (mailbox-take mb deadline (lambda () 'late))))
+         ;; A reply that comes after all finds no mailbox, and is dropped.
+         (when (symbol? reply)
+           (with-lock (trip-connection-lock c) (lambda () (forget! c tag))))
+         (case reply
+           ((late) (too-late))
+           ;; Marked when woken: the mark stays until the call is over.
+           ((abandoned) (check-not-abandoned command))
+           ((lost) (fail "closed" "connection lost"))
+           (else (reply-values reply fail))))))))
+
+;; Write command under a new tag, whose reply mailbox mb is to get; the tag.
+(define (send! c command mb fail)
+  (with-lock (trip-connection-lock c)
+    (lambda ()
+      (if (not (trip-connection-open? c))
+          (fail "closed" "connection closed"))
+      (let ((tag (+ 1 (modulo (trip-connection-tag c) 999999998))))
+        (trip-connection-tag-set! c tag)
+        (hash-table-set! (trip-connection-waiting c) tag mb)
+        (guard (e (#t (shut! c) (fail "closed" "cannot send")))
+          (write-frame! (string-append (number->string tag) " " command)
+                        (trip-connection-out c)))
+        tag))))
+
+;; The values of an ok reply, (TAG ok VALUE ...); an err reply raises.
+(define (reply-values reply fail)
+  (if (and (pair? (cdr reply)) (equal? (cadr reply) "ok"))
+      (map reply-value (cddr reply))
+      (fail (if (pair? (cddr reply)) (car (cddr reply)) "protocol")
+            (join (if (pair? (cddr reply)) (cdr (cddr reply)) reply)))))
 
 ;;> One raw request on connection \var{c}: words are joined with spaces
 ;;> (numbers, symbols and strings); returns the values of the reply.  For
@@ -256,26 +314,21 @@
 
 ;;; Motion
 
-(define (sleep-a-little) (thread-sleep! 0.05))
-
-;; Wait until the base's motion is over; the final odometry pose.  In a
-;; call whose caller gave up, the robot is stopped where it is.
+;; Wait until the base's motion is over (base await); the final
+;; odometry pose.  A motion not over by (trip-motion-timeout) is stopped.
+;; In a call whose caller gave up, the robot is stopped where it is.
 (define (await-motion what)
-  (let ((deadline (+ (monotonic-seconds) (trip-motion-timeout))))
-    (let loop ()
-      (if (abandoned?)
-          (begin (despite-abandonment (lambda () (device 'base "stop")))
-                 (check-not-abandoned what)))
-      (let ((status (device 'base "status")))
-        (cond
-         ((zero? (list-ref status 5))
-          (if (= 1 (list-ref status 6))
-              (trip-error (robot-name (robot)) what "stalled" "the base is blocked"))
-          (list (car status) (cadr status) (car (cddr status)) 0))
-         ((> (monotonic-seconds) deadline)
-          (device 'base "stop")
-          (trip-error (robot-name (robot)) what "timeout" "motion took too long"))
-         (else (sleep-a-little) (loop)))))))
+  (let* ((c (robot))
+         (end (guard (e ((abandoned-error? e)
+                         (despite-abandonment stop-base)
+                         (check-not-abandoned what)))
+                (exchange c "base await" (+ (monotonic-seconds) (trip-motion-timeout))
+                          (lambda ()
+                            (stop-base)
+                            (trip-error (robot-name c) what "timeout" "motion took too long"))))))
+    (if (= 1 (list-ref end 3))
+        (trip-error (robot-name c) what "stalled" "the base is blocked"))
+    (list (car end) (cadr end) (car (cddr end)) 0)))
 
 ;;> Drives to \var{xy}, a list (x y) in millimetres of the odometry frame:
 ;;> turns to face it, then goes.  Returns the pose reached, as reckon.

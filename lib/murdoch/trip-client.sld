@@ -11,9 +11,10 @@
           buttons-read lights say battery-voltage tethered? set-tether! fiducials
           safe-im safe-battery-voltage safe-reckon workstation-position
           split-words)
-  (import (scheme base) (scheme write) (srfi 18) (srfi 151)
+  (import (scheme base) (scheme write) (srfi 18) (srfi 69) (srfi 151)
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
           (murdoch abandon) (murdoch connect)
+          (only (murdoch wait) with-lock make-mailbox mailbox-put! mailbox-take)
           (only (murdoch scheduler) monotonic-seconds port-wait!))
   (include "trip-client.scm"))

@@ -20,6 +20,7 @@
 #include <unistd.h>
 #include "check.h"
 #include "../../sim/frame.h"
+#include "../../sim/trip.h"
 
 static int port_base;
 static pid_t server;
@@ -381,6 +382,66 @@ static void test_motion(void)
     close(c.fd);
 }
 
+/* Frames sent in one write reach the server in one read, and it answers
+ * every request of a read before its next step: so the order of the
+ * replies below depends on no timing. */
+static void send_frames(conn *c, const char *const *payloads, int n)
+{
+    unsigned char out[8192];
+    size_t len = 0;
+    int i;
+    for (i = 0; i < n; i++)
+        len += frame_encode((const unsigned char *)payloads[i], strlen(payloads[i]), out + len);
+    send_raw(c, out, len);
+}
+
+/* base await: answered at once when idle, else once the motion is over,
+ * with other requests answered meanwhile. */
+static void test_await(void)
+{
+    static const char *const turn[] = { "3 base rotate 90", "4 base await", "5 base reckon" };
+    static const char *const spin[] = { "7 base rotate 3600", "8 base await", "9 base stop" };
+    conn c;
+    char reply[256];
+    double x, y, h, h0 = 0;
+    char crowd[MAX_AWAITS + 3][32];
+    const char *crowds[MAX_AWAITS + 3];
+    int stalled = -1, moving = -1, k, answered = 0;
+    dial(&c, 0);
+    ask(&c, "1 open base");
+    CHECK("await on an idle base answers at once",
+          sscanf(ask(&c, "2 base await"), "2 ok %lf %lf %lf %d", &x, &y, &h0, &stalled) == 4 && stalled == 0);
+    send_frames(&c, turn, 3);
+    CHECK("a motion is accepted", strcmp(next_reply(&c), "3 ok") == 0);
+    CHECK("a request after an await is answered before the motion ends",
+          starts(next_reply(&c), "5 ok "));
+    snprintf(reply, sizeof reply, "%s", next_reply(&c));
+    CHECK("the await is answered once it has", sscanf(reply, "4 ok %lf %lf %lf %d", &x, &y, &h, &stalled) == 4
+          && stalled == 0 && fabs(remainder(h - h0 - 90, 360)) < 1);
+    CHECK("and the base is idle then",
+          sscanf(ask(&c, "6 base status"), "6 ok %*f %*f %*f %*f %*f %d", &moving) == 1 && moving == 0);
+    send_frames(&c, spin, 3);
+    CHECK("a stop ends the motion an await waits for", strcmp(next_reply(&c), "7 ok") == 0
+          && strcmp(next_reply(&c), "9 ok") == 0 && starts(next_reply(&c), "8 ok "));
+    for (k = 0; k < MAX_AWAITS + 3; k++)
+        snprintf(crowd[k], sizeof crowd[k], "%d base await", 10 + k);
+    snprintf(crowd[0], sizeof crowd[0], "10 base rotate 3600");
+    snprintf(crowd[MAX_AWAITS + 2], sizeof crowd[0], "%d base stop", 12 + MAX_AWAITS);
+    for (k = 0; k < MAX_AWAITS + 3; k++)
+        crowds[k] = crowd[k];
+    send_frames(&c, crowds, MAX_AWAITS + 3);
+    snprintf(reply, sizeof reply, "%d err busy ", 11 + MAX_AWAITS);
+    CHECK("awaits beyond MAX_AWAITS are refused",
+          strcmp(next_reply(&c), "10 ok") == 0 && starts(next_reply(&c), reply));
+    next_reply(&c);
+    for (k = 0; k < MAX_AWAITS; k++) {
+        snprintf(reply, sizeof reply, "%d ok ", 11 + k);
+        answered += starts(next_reply(&c), reply);
+    }
+    CHECK("and the others all answered when the motion ends", answered == MAX_AWAITS);
+    close(c.fd);
+}
+
 /* The heading field of a reckon reply. */
 static const char *heading_of(const char *reply)
 {
@@ -479,6 +540,7 @@ int main(int argc, char **argv)
         test_dropped_base_stops();
         test_stream();
         test_motion();
+        test_await();
         test_heading_range();
         kill(server, SIGTERM);
         waitpid(server, &status, 0);
