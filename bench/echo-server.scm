@@ -11,31 +11,12 @@
 ;; for a lab of 64 on two cores, and a loaded machine then had the first
 ;; server late past the sender's patience.
 
-(import (scheme base) (scheme eval) (scheme process-context) (srfi 151)
-        (chibi net) (chibi filesystem)
-        (murdoch netstring))
-
-(define max-frame 64)
+(import (scheme base) (scheme eval) (scheme process-context)
+        (chibi net) (bench echo))
 
 (define (serve port poll?)
-  (let* ((addr (get-address-info "127.0.0.1" port))
-         (listener (make-listener-socket addr))
-         (sock (accept listener (address-info-address addr)
-                       (address-info-address-length addr)))
-         (in (open-input-file-descriptor sock))
-         (out (open-output-file-descriptor sock)))
-    ;; Then a read that finds nothing waits in the kernel, as in C, not in
-    ;; Chibi's scheduler.
-    (if (not poll?)
-        (set-file-descriptor-status!
-         sock (bitwise-and (get-file-descriptor-status sock)
-                           (bitwise-not open/non-block))))
-    (let loop ()
-      (let ((frame (read-netstring in max-frame)))
-        (unless (eof-object? frame)
-          (write-netstring frame out)
-          (flush-output-port out)
-          (loop))))))
+  (let ((addr (get-address-info "127.0.0.1" port)))
+    (echo-connection (make-listener-socket addr) port (not poll?) 64)))
 
 (let* ((args (cdr (command-line)))
        (poll? (equal? (cadr args) "poll")))

@@ -31,10 +31,10 @@
 ;; The sender waits in ppoll in both.  bench/c-pingpong N is the same in C.
 
 (import (scheme base) (scheme write) (scheme eval) (scheme process-context)
-        (srfi 1) (srfi 18) (srfi 132) (srfi 151)
+        (srfi 1) (srfi 18) (srfi 132)
         (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
-        (murdoch netstring)
+        (murdoch netstring) (bench echo)
         (only (murdoch testing) listen-on-free-port free-port-base tool-path
               start-process! stop-all-processes!))
 
@@ -54,25 +54,6 @@
 ;; child shares with the parent's reader of this script.
 (define (vanish)
   (kill (current-process-id) signal/kill))
-
-(define (echo-server listener port blocking?)
-  (let* ((addr (get-address-info "127.0.0.1" port))
-         (sock (accept listener (address-info-address addr)
-                       (address-info-address-length addr)))
-         (in (open-input-file-descriptor sock))
-         (out (open-output-file-descriptor sock)))
-    ;; Then a read that finds nothing waits in the kernel, as in C, not in
-    ;; Chibi's scheduler.
-    (if blocking?
-        (set-file-descriptor-status!
-         sock (bitwise-and (get-file-descriptor-status sock)
-                           (bitwise-not open/non-block))))
-    (let loop ()
-      (let ((frame (read-netstring in max-frame)))
-        (unless (eof-object? frame)
-          (write-netstring frame out)
-          (flush-output-port out)
-          (loop))))))
 
 (define (round-trip in out)
   (fan-out (list (list #f in out))))
@@ -119,7 +100,7 @@
          (pid (begin (flush-output-port) (fork))))
     (cond
      ((zero? pid)
-      (echo-server (car listener+port) (cdr listener+port) #f)
+      (echo-connection (car listener+port) (cdr listener+port) #f max-frame)
       (vanish))
      (else
       ;; The listener stays open here: close-file-descriptor would leave its

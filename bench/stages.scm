@@ -29,7 +29,8 @@
         (only (murdoch trip-client) split-words)
         (murdoch) (murdoch command) (murdoch testing)
         (murdoch netstring) (murdoch hmac) (murdoch frame) (murdoch sendable)
-        (murdoch aspace) (murdoch sandbox) (murdoch lab) (murdoch scheduler))
+        (murdoch aspace) (murdoch sandbox) (murdoch lab) (murdoch scheduler)
+        (bench echo))
 
 (define lab (make-test-lab '((aspace bencher) (aspace troy))))
 (define key (lab-key (read-lab (test-lab-file lab))))
@@ -220,17 +221,7 @@
          (pid (begin (flush-output-port) (fork))))
     (cond
      ((zero? pid)
-      (let* ((addr (get-address-info "127.0.0.1" (cdr listener+port)))
-             (sock (accept (car listener+port) (address-info-address addr)
-                           (address-info-address-length addr)))
-             (in (open-input-file-descriptor sock))
-             (out (open-output-file-descriptor sock)))
-        (let loop ()
-          (let ((frame (read-netstring in 1048576)))
-            (unless (eof-object? frame)
-              (write-netstring frame out)
-              (flush-output-port out)
-              (loop)))))
+      (echo-connection (car listener+port) (cdr listener+port) #f 1048576)
       (kill (current-process-id) signal/kill))
      (else
       (let* ((io (open-net-io "127.0.0.1" (cdr listener+port)))
