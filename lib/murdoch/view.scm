@@ -366,13 +366,16 @@
      (make-thread
       (lambda ()
         (let loop ()
-          (let ((t0 (current-second)))
+          ;; The trace counts wall-clock seconds from its start; the
+          ;; next look is due by the monotonic clock, as every deadline.
+          (let ((t0 (monotonic-seconds))
+                (at (- (current-second) start)))
             (feed-add! feed (json-text
-                             (view-snapshot lab (- t0 start)
+                             (view-snapshot lab at
                                             (parameterize ((remote-timeout 1))
                                               (remote-apply-all aspaces proc))
                                             state)))
-            (thread-sleep! (max 0.05 (- (+ t0 poll-seconds) (current-second))))
+            (thread-sleep! (max 0.05 (- (+ t0 poll-seconds) (monotonic-seconds))))
             (loop))))
       'view-poll))
     (say "view: http://127.0.0.1:" port "/ (trace " trace ")")
