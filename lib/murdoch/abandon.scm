@@ -14,21 +14,14 @@
 (define *wakers* '())                   ; ((thread . wake) ...), innermost first
 (define *abandoned-lock* (make-mutex 'abandoned))
 
-(define (update-abandoned! change)
-  (mutex-lock! *abandoned-lock*)
-  (set! *abandoned* (change *abandoned*))
-  (mutex-unlock! *abandoned-lock*))
-
-(define (update-wakers! change)
-  (mutex-lock! *abandoned-lock*)
-  (set! *wakers* (change *wakers*))
-  (mutex-unlock! *abandoned-lock*))
-
 ;;> Marks \var{thread}: the call it runs has been given up by its caller.
 ;;> A thread in with-wake-on-abandon is woken.
 (define (abandon-thread! thread)
-  (update-abandoned! (lambda (ls) (if (memq thread ls) ls (cons thread ls))))
-  (let ((waker (assq thread *wakers*)))
+  (let ((waker (with-lock *abandoned-lock*
+                 (lambda ()
+                   (if (not (memq thread *abandoned*))
+                       (set! *abandoned* (cons thread *abandoned*)))
+                   (assq thread *wakers*)))))
     (if waker ((cdr waker)))))
 
 ;;> Applies \var{thunk}, calling \var{wake} (from another thread, no
@@ -37,13 +30,18 @@
 ;;> is missed, thunk checks after wake is in place.
 (define (with-wake-on-abandon wake thunk)
   (let ((waker (cons (current-thread) wake)))
-    (dynamic-wind (lambda () (update-wakers! (lambda (ls) (cons waker ls))))
-                  thunk
-                  (lambda () (update-wakers! (lambda (ls) (delete waker ls eq?)))))))
+    (dynamic-wind
+     (lambda ()
+       (with-lock *abandoned-lock* (lambda () (set! *wakers* (cons waker *wakers*)))))
+     thunk
+     (lambda ()
+       (with-lock *abandoned-lock*
+         (lambda () (set! *wakers* (delete waker *wakers* eq?))))))))
 
 ;;> Takes the mark off \var{thread}, whose call has ended.
 (define (forget-abandoned! thread)
-  (update-abandoned! (lambda (ls) (delete thread ls eq?))))
+  (with-lock *abandoned-lock*
+    (lambda () (set! *abandoned* (delete thread *abandoned* eq?)))))
 
 ;;> Whether the current thread runs a call that its caller gave up.
 (define (abandoned?)

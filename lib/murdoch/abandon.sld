@@ -4,5 +4,6 @@
   (export abandon-thread! forget-abandoned! abandoned? check-not-abandoned
           abandoned-error? despite-abandonment with-wake-on-abandon)
   (import (scheme base) (only (srfi 1) delete) (srfi 18)
+          (only (murdoch wait) with-lock)
           (only (chibi) make-exception exception? exception-kind))
   (include "abandon.scm"))
