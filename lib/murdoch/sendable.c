@@ -1,8 +1,9 @@
 /* The C of (murdoch sendable): the look at a value that decides whether
- * it stands for itself on the wire (sendable.scm, "plain?").  Every call's
- * arguments and every answer's value are looked at so, at both ends; in
- * Scheme the look cost about a third of a microsecond a pair, a
- * microsecond and more of each message. */
+ * it stands for itself on the wire (sendable.scm, "plain?"), and the one
+ * list of the atoms that do, which encode's walk asks of each element
+ * too (plain-atom?).  Every call's arguments and every answer's value are
+ * looked at so, at both ends; in Scheme the look cost about a third of a
+ * microsecond a pair, a microsecond and more of each message. */
 
 #include <chibi/eval.h>
 
@@ -27,6 +28,10 @@ static long plain_pairs (sexp x, long budget, long depth, long max_depth) {
   }
 }
 
+static sexp plain_atom_p (sexp ctx, sexp self, sexp_sint_t n, sexp x) {
+  return sexp_make_boolean(plain_atom(x));
+}
+
 static sexp plain_p (sexp ctx, sexp self, sexp_sint_t n,
                      sexp x, sexp budget, sexp max_depth) {
   if (!sexp_fixnump(budget))
@@ -43,5 +48,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
         && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
     return SEXP_ABI_ERROR;
   sexp_define_foreign(ctx, env, "plain-within?", 3, plain_p);
+  sexp_define_foreign(ctx, env, "plain-atom?", 1, plain_atom_p);
   return SEXP_VOID;
 }

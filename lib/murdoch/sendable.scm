@@ -211,14 +211,10 @@
 ;; True of data that stands for itself on the wire, pairs of it included:
 ;; encode and decode give it back as it is instead of copying it, which
 ;; on a receiver's path was most of their cost.  The look (plain-within?,
-;; in sendable.c) stops after a budget of pairs, or at the depth limit, so
+;; in sendable.c, beside plain-atom?, the atoms that do) stops after a budget of pairs, or at the depth limit, so
 ;; that a long, deep or circular value goes the general way, which says
 ;; what is wrong with it.
 (define (plain? x) (plain-within? x 100000 *max-depth*))
-
-(define (plain-atom? x)
-  (or (number? x) (string? x) (symbol? x) (char? x) (boolean? x)
-      (null? x) (bytevector? x)))
 
 ;;> The S-expression that stands for \var{x} on the wire.  \var{env} is the
 ;;> environment whose procedures travel by name; \var{what} names \var{x}
