@@ -19,7 +19,7 @@
           publish request request-exclusive request-non-exclusive
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive
+          receive-request-non-exclusive receive-components
           get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!

@@ -5,7 +5,8 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (srfi 132) (chibi test)
         (only (chibi ast) thread-interrupt!)
-        (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
+        (murdoch) (murdoch remote) (murdoch command) (murdoch testing)
+        (only (murdoch pubsub) request-components))
 
 (define lab-code "
 ;; A component that says who ran it, holding its robot a moment.
@@ -169,6 +170,30 @@
              (list (metric-by-asking local-aspace-uid
                                      (lambda (uid) (if (eq? uid 'near) 'none 1))))
              (list who-am-i)))
+
+;; pose-task's round: one message to each address space for all the
+;; components, each candidate's promise with its answers to the askings.
+(define (round-of components)
+  (let ((round (request-components 'round@tester components)))
+    (for-each (lambda (component)
+                (for-each (lambda (entry)
+                            (if (procedure? (cadr entry)) ((cadr entry) #f)))
+                          (car component)))
+              round)
+    (map (lambda (component)
+           (list (list-sort symbol<? (map car (car component)))
+                 (list-sort (lambda (a b) (symbol<? (car a) (car b)))
+                            (cadr component))))
+         round)))
+(define (symbol<? a b) (string<? (symbol->string a) (symbol->string b)))
+(test "request-components: each component's candidates, and their answers to the askings"
+    '(((far near) ((far (#t far) (#f "no")) (near (#t near) (#f "no"))))
+      ((near) ((near))))
+  (round-of (list (list 'exclusive '((mobile) ()) who-am-i
+                        (list local-aspace-uid (lambda () (error "no"))))
+                  (list 'non-exclusive '(() (near)) t '()))))
+(test "and the round's promises, applied to #f, free what they reserved" #t
+  (all-free?))
 
 (test "a one-robot task frees its robot" #t
   (begin (pose-task 'one 1 (list '((mobile) ())) (list #f) (list who-am-i))

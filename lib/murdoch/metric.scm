@@ -149,21 +149,52 @@
     (map cdr (sort-measured (measured-response response keys) keys))))
 
 ;; Each candidate as (values . entry), its values by keys: each measure
-;; asked of every candidate at once, once.
-(define (measured-response response keys)
+;; asked of every candidate at once, once.  asked, when given, holds the
+;; candidates' answers to the keys' askings, ((uid answer ...) ...) as
+;; request-components answers them, so that none is asked again.
+(define (measured-response response keys . asked)
   (apply map
          (lambda (entry . values) (cons values entry))
          response
-         (map (lambda (key)
-                (if (measure-key? key)
-                    (measured-told (measure-key-measure key) (map car response))
-                    response))
-              keys)))
+         (key-columns response keys (and (pair? asked) (car asked)))))
 
-(define (measured-told measure uids)
-  (let ((measures (measure-all measure uids)))
-    (progress "  measured " (map list uids measures))
-    measures))
+(define (key-columns response keys asked)
+  (let loop ((keys keys) (k 0))
+    (if (null? keys)
+        '()
+        (let ((measure (and (measure-key? (car keys))
+                            (measure-key-measure (car keys)))))
+          (cond ((not measure) (cons response (loop (cdr keys) k)))
+                ((and asked (asking? measure))
+                 (cons (measured-told (map car response)
+                                      (map (lambda (e) (asked-score measure asked e k))
+                                           response))
+                       (loop (cdr keys) (+ k 1))))
+                (else
+                 (cons (measured-told (map car response)
+                                      (measure-all measure (map car response)))
+                       (loop (cdr keys) k))))))))
+
+;; Candidate entry's score by an asking measure from its k-th answer.
+(define (asked-score measure asked entry k)
+  (let ((answers (assq (car entry) asked)))
+    (if (and answers (> (length answers) (+ k 1)) (list? (list-ref answers (+ k 1))))
+        (let ((answer (list-ref answers (+ k 1))))
+          (score measure (car answer) (and (pair? (cdr answer)) (cadr answer))))
+        +inf.0)))
+
+(define (measured-told uids measures)
+  (progress "  measured " (map list uids measures))
+  measures)
+
+;; The procedures that a candidate is asked for the measures among keys,
+;; in order (metric-by-asking's): what pose-task sends with its request,
+;; for measured-response to score.
+(define (asking-procs keys)
+  (filter-map (lambda (key)
+                (and (measure-key? key) (asking? (measure-key-measure key))
+                     (asking-proc (measure-key-measure key))))
+              keys))
 
 (define (sort-measured measured keys)
   (if (null? keys)
@@ -176,16 +207,19 @@
 (define (measure-all measure uids)
   (if (asking? measure)
       (map (lambda (answer)
-             (let ((score (and (cadr answer)
-                               (guard (e (#t #f))
-                                 ((asking-score measure) (car (cddr answer)))))))
-               (if (real? score) score +inf.0)))
+             (score measure (cadr answer) (and (cadr answer) (car (cddr answer)))))
            (remote-apply-all (map uid->aspace uids) (asking-proc measure)))
       (map thread-join!
            (map (lambda (uid)
                   (thread-start!
                    (make-thread (lambda () (guard (e (#t +inf.0)) (measure uid))))))
                 uids))))
+
+;; An asking measure's score of a candidate's answer, when ok?; +inf.0
+;; when it gave none, or one that does not score.
+(define (score measure ok? answer)
+  (let ((score (and ok? (guard (e (#t #f)) ((asking-score measure) answer)))))
+    (if (real? score) score +inf.0)))
 
 (define (shuffle ls)
   (map cdr (list-sort (lambda (a b) (< (car a) (car b)))

@@ -7,7 +7,7 @@
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between sort-response
           metric-keys measure-key?
-          measured-response sort-measured shuffle)
+          measured-response asking-procs sort-measured shuffle)
   (import (scheme base) (scheme inexact) (scheme cxr)
           (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) procedure-code procedure-vars opcode?)

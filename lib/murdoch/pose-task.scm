@@ -161,19 +161,15 @@
 ;; freed.
 (define (try task)
   (let* ((type-list (pose-type-list task))
-         (responses (map (lambda (layout type proc)
-                           (without-excluded
-                            type
-                            (if (eq? type 'exclusive)
-                                (request-exclusive layout (pose-name task) proc)
-                                (request (cadr layout) t))))
-                         (pose-layouts task) type-list (pose-procs task))))
+         (round (request-components (pose-name task) (round-components task)))
+         (responses (map without-excluded type-list (map car round))))
     (for-each (lambda (i layout response)
                 (progress "  component " i " needs " layout ": candidates "
                           (map car response)))
               (iota (length responses) 1) (pose-layouts task) responses)
     (let ((winners (and (not (any null? responses))
-                        (choose (map measured-response responses (pose-keys-list task))
+                        (choose (map measured-response responses (pose-keys-list task)
+                                     (map cadr round))
                                 (pose-keys-list task) (pose-priorities task)))))
       (cond
        ((not winners) (give-up responses type-list 'not-enough-takers))
@@ -183,6 +179,15 @@
         (for-each (lambda (i w) (progress "  component " i " goes to " (car w)))
                   (iota (length winners) 1) winners)
         (list winners type-list))))))
+
+;; What request-components asks the lab for each component: the thesis's
+;; request-exclusive, or request of t for a non-exclusive component, with
+;; the askings of its metric.
+(define (round-components task)
+  (map (lambda (type layout proc keys)
+         (list type layout (if (eq? type 'exclusive) proc t) (asking-procs keys)))
+       (pose-type-list task) (pose-layouts task) (pose-procs task)
+       (pose-keys-list task)))
 
 (define (check-task task-name num-robots capability-list metrics procs priorities)
   (if (not (and (exact-integer? num-robots) (>= num-robots 0)))

@@ -224,6 +224,44 @@
              (broadcast-apply receive-request-non-exclusive subjects task-name
                               (local-aspace-uid) proc args))))
 
+;;> One message to the whole lab for every component of a negotiation
+;;> (pose-task's round), where the thesis sends each its own
+;;> request-exclusive or request, each to the whole lab: a lab of N then
+;;> reads N messages a round, not N for each component, and answers the
+;;> metrics' askings in the same message, not in a round of their own.
+;;> Each of \var{components} is (type layout proc askings): type
+;;> exclusive or non-exclusive, layout as capability-layout gives it, the
+;;> procedure a promise applies (request's, for a non-exclusive one), and
+;;> the procedures that each candidate is asked for its measures.
+;;> Answers, per component in order, (response asked): response as
+;;> request-exclusive, or request to the layout's non-exclusive subjects,
+;;> answers; asked, ((uid answer ...) ...), each candidate's answers to the
+;;> askings, (#t value) or (#f message) each.
+(define (request-components task-name components)
+  (let ((rows (broadcast-apply receive-components components task-name
+                               (local-aspace-uid)))
+        (n (length components)))
+    (map (lambda (c i)
+           (let ((entries (map (lambda (row) (component-entry row i n)) rows)))
+             (list (answers (if (eq? (car c) 'exclusive) 'request-exclusive 'request)
+                            entries)
+                   (filter-map (lambda (e)
+                                 (and (cadr e) (car (car (cddr e)))
+                                      (cons (car e) (cadr (cddr e)))))
+                               entries))))
+         components (iota n))))
+
+;; Receiver row's entry for component i of n, as remote-apply-all gives
+;; request its entries, with the askings' answers after the answer:
+;; (uid #t answer asked) or (uid #f message).
+(define (component-entry row i n)
+  (let ((value (and (cadr row) (car (cddr row)))))
+    (cond ((not (cadr row)) row)
+          ((not (and (list? value) (= (length value) n) (every list? value)))
+           (list (car row) #f "a malformed answer to request-components"))
+          ((car (list-ref value i)) (cons (car row) (list-ref value i)))
+          (else (list (car row) #f (cadr (list-ref value i)))))))
+
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).
 (define (request-status topic)
@@ -266,6 +304,27 @@
 ;;> The shared counterpart of receive-request-exclusive.
 (define (receive-request-non-exclusive topics task-name uid proc args)
   (promise-for (reserve-shared! topics task-name) proc args))
+
+;;> What request-components runs in each address space: for each (type
+;;> layout proc askings) of \var{components}, in order, (#t answer asked),
+;;> or (#f message) where it raised here.  answer is what
+;;> receive-request-exclusive answers for an exclusive component and
+;;> receive-request, addressed to the layout's non-exclusive subjects, for
+;;> another; asked, when answer makes this address space a candidate, its
+;;> answer to each asking, (#t value) or (#f message).
+(define (receive-components components task-name uid)
+  (map (lambda (c)
+         (guard (e (#t (list #f (error-message e))))
+           (let ((answer (if (eq? (car c) 'exclusive)
+                             (receive-request-exclusive (cadr c) task-name uid
+                                                        (car (cddr c)) '())
+                             (receive-request (cadr (cadr c)) uid (car (cddr c)) '()))))
+             (list #t answer (if (car answer) (map ask-here (cadr (cddr c))) '())))))
+       components))
+
+(define (ask-here proc)
+  (guard (e (#t (list #f (error-message e))))
+    (list #t (proc))))
 
 ;;; Reservations
 

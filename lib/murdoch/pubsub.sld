@@ -2,11 +2,13 @@
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote
           publish request request-exclusive request-non-exclusive
+          request-components
           capability-layout check-subjects
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive set-lease! start-leases!)
+          receive-request-non-exclusive receive-components set-lease! start-leases!)
   (import (scheme base) (only (murdoch scheduler) monotonic-seconds)
           (srfi 1) (srfi 18)
-          (murdoch log) (murdoch lab) (murdoch remote))
+          (murdoch log) (murdoch lab) (murdoch remote)
+          (only (murdoch remote-error) error-message))
   (include "pubsub.scm"))
