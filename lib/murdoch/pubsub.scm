@@ -257,10 +257,11 @@
 (define (component-entry row i n)
   (let ((value (and (cadr row) (car (cddr row)))))
     (cond ((not (cadr row)) row)
-          ((not (and (list? value) (= (length value) n) (every list? value)))
+          ((not (and (list? value) (= (length value) n)
+                     (every (lambda (c) (and (list? c) (= (length c) 2) (pair? (car c))))
+                            value)))
            (list (car row) #f "a malformed answer to request-components"))
-          ((car (list-ref value i)) (cons (car row) (list-ref value i)))
-          (else (list (car row) #f (cadr (list-ref value i)))))))
+          (else (cons* (car row) #t (list-ref value i))))))
 
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).
@@ -306,22 +307,22 @@
   (promise-for (reserve-shared! topics task-name) proc args))
 
 ;;> What request-components runs in each address space: for each (type
-;;> layout proc askings) of \var{components}, in order, (#t answer asked),
-;;> or (#f message) where it raised here.  answer is what
-;;> receive-request-exclusive answers for an exclusive component and
-;;> receive-request, addressed to the layout's non-exclusive subjects, for
-;;> another; asked, when answer makes this address space a candidate, its
-;;> answer to each asking, (#t value) or (#f message).
+;;> layout proc askings) of \var{components}, in order, (answer asked).
+;;> answer is what receive-request-exclusive answers for an exclusive
+;;> component and receive-request, addressed to the layout's non-exclusive
+;;> subjects, for another; asked, when answer makes this address space a
+;;> candidate, its answer to each asking, (#t value) or (#f message).
 (define (receive-components components task-name uid)
   (map (lambda (c)
-         (guard (e (#t (list #f (error-message e))))
-           (let ((answer (if (eq? (car c) 'exclusive)
-                             (receive-request-exclusive (cadr c) task-name uid
-                                                        (car (cddr c)) '())
-                             (receive-request (cadr (cadr c)) uid (car (cddr c)) '()))))
-             (list #t answer (if (car answer) (map ask-here (cadr (cddr c))) '())))))
+         (let ((answer (if (eq? (car c) 'exclusive)
+                           (receive-request-exclusive (cadr c) task-name uid
+                                                      (car (cddr c)) '())
+                           (receive-request (cadr (cadr c)) uid (car (cddr c)) '()))))
+           (list answer (if (car answer) (map ask-here (cadr (cddr c))) '()))))
        components))
 
+;; An asking is the user's code, so that one raising costs only its own
+;; answer (a guard takes a continuation: one only where user code runs).
 (define (ask-here proc)
   (guard (e (#t (list #f (error-message e))))
     (list #t (proc))))
