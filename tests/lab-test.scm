@@ -164,6 +164,12 @@
     (stop-process! repl)
     (stop-process! pid)))
 
+(test "a lab removed after a failed test shows its logs' last lines first"
+    "the last line"
+  (command-output
+   (list "/bin/sh" "-c"
+         "tools/chibi tests/failing-lab.scm 2>&1 | grep -A2 '^--- the last lines of a.log' | tail -1")))
+
 (test-end)
 (stop-all-processes!)
 (remove-test-lab! lab)

@@ -108,8 +108,26 @@
               (if (pair? files) (car files) '()))
     (%make-test-lab file dir base)))
 
+;;> Removes the lab's folder.  When a test of this process has failed, the
+;;> last lines of each log in it go to standard error first: an address
+;;> space that died in a CI run leaves no other trace.
 (define (remove-test-lab! lab)
+  (if (positive? (test-failure-count))
+      (show-log-tails (test-lab-directory lab) 30))
   (delete-file-hierarchy (test-lab-directory lab)))
+
+(define (show-log-tails dir n)
+  (for-each
+   (lambda (name)
+     (let ((k (string-length name)))
+       (when (and (> k 4) (string=? (substring name (- k 4) k) ".log"))
+         (let ((lines (read-lines (string-append dir "/" name))))
+           (display (string-append "--- the last lines of " name ":\n")
+                    (current-error-port))
+           (for-each (lambda (line)
+                       (display (string-append line "\n") (current-error-port)))
+                     (list-tail lines (max 0 (- (length lines) n))))))))
+   (directory-files dir)))
 
 (define *children* '())
 

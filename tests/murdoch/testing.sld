@@ -13,7 +13,8 @@
           (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab) (murdoch connect)
           (only (murdoch remote) remote-error? remote-error-message)
-          (only (chibi filesystem) delete-file-hierarchy current-directory
+          (only (chibi test) test-failure-count)
+          (only (chibi filesystem) delete-file-hierarchy current-directory directory-files
                 open-input-file-descriptor open-output-file-descriptor
                 open-pipe duplicate-file-descriptor-to))
   (include "testing.scm"))
