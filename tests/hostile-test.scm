@@ -6,7 +6,7 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme file)
         (scheme eval) (scheme read) (scheme char)
         (srfi 1) (srfi 18) (srfi 132) (chibi test) (chibi net)
-        (only (chibi process) kill)
+        (only (chibi process) kill current-process-id)
         (only (chibi filesystem) directory-files)
         (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
         (murdoch multicast) (murdoch testing) (murdoch raw))
@@ -264,6 +264,22 @@
              (wait-until 5 (lambda () (let ((c (list (counter-of 'troy) (counter-of 'beta))))
                                         (and (equal? c '(1 1)) c))))))
     (still-fine "after the replays")))
+
+;; A write to a socket whose other end is gone raises SIGPIPE, whose
+;; default action ends the process without a word (exit 141): an address
+;; space answering a caller killed meanwhile, say.  A process that joins a
+;; lab ignores it, and sees the end of the connection instead.
+(define (ignores-sigpipe? pid)
+  (let ((line (find (lambda (line) (and (> (string-length line) 8)
+                                        (string=? (substring line 0 7) "SigIgn:")))
+                    (read-lines (string-append "/proc/" (number->string pid) "/status")))))
+    ;; A mask in hexadecimal; SIGPIPE is signal 13, its bit 12.
+    (odd? (quotient (string->number (substring line 8 (string-length line)) 16) 4096))))
+
+(test-group "writing to a peer that has died"
+  (test "an address space ignores SIGPIPE" #t (ignores-sigpipe? troy-pid))
+  (test "and so does a process that joined the lab, as this one" #t
+    (ignores-sigpipe? (current-process-id))))
 
 (test-end)
 (stop-all-processes!)

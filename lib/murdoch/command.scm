@@ -7,7 +7,14 @@
 (define (join-lab lab-file uid . port)
   (join-read-lab (read-lab lab-file) uid port))
 
+;; A process in a lab writes to peers that may die at any moment: a
+;; caller killed before its answer went back, a browser that closed the
+;; view.  Writing to a socket whose peer has gone raises SIGPIPE, and its
+;; default action ends the process without a word, so it is ignored, as
+;; the simulator ignores it (sim/b14.c): the peer's end shows as the end
+;; of its connection instead, to whoever reads it.
 (define (join-read-lab lab uid port)
+  (set-signal-action! signal/pipe #f)
   (let ((env (make-lab-environment lab))
         (entry (lab-aspace-by-uid lab uid)))
     (if entry (take-body! lab entry))

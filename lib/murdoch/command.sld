@@ -4,7 +4,7 @@
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context)
           (srfi 1) (srfi 18)
-          (only (chibi process) current-process-id)
+          (only (chibi process) current-process-id set-signal-action! signal/pipe)
           (only (chibi filesystem) is-a-tty? open open/read open/non-block
                 open-input-file-descriptor)
           (only (srfi 151) bitwise-ior)
