@@ -124,10 +124,7 @@
   (let* ((id (match (check-message answer '(ack value error) "an answer")
                ((kind id . value) id)))
          (mb (with-lock (connection-write-lock c)
-               (lambda ()
-                 (let ((mb (hash-table-ref/default (connection-pending c) id #f)))
-                   (hash-table-delete! (connection-pending c) id)
-                   mb)))))
+               (lambda () (take-mailbox! (connection-pending c) id)))))
     (if mb (mailbox-put! mb answer))))   ; else the caller gave up
 
 ;; Close once; every call still waiting hears that the connection is lost.
@@ -138,11 +135,7 @@
              (and (connection-open? c)
                   (begin
                     (connection-open?-set! c #f)
-                    (let ((mbs (hash-table-values (connection-pending c))))
-                      (for-each (lambda (id)
-                                  (hash-table-delete! (connection-pending c) id))
-                                (hash-table-keys (connection-pending c)))
-                      mbs)))))))
+                    (take-all-mailboxes! (connection-pending c))))))))
     (when waiting
       ;; Closing both ports closes the socket; closing it again could close
       ;; another connection's socket that has taken its number.

@@ -180,10 +180,7 @@
 ;; #f if none does (tag 0, or a request that gave up).
 (define (take-waiting! c tag)
   (with-lock (trip-connection-lock c)
-    (lambda ()
-      (let ((mb (hash-table-ref/default (trip-connection-waiting c) tag #f)))
-        (forget! c tag)
-        mb))))
+    (lambda () (take-mailbox! (trip-connection-waiting c) tag))))
 
 ;; Close c at its end, and take the mailboxes of the requests that still
 ;; wait: no reply will come to them.
@@ -191,14 +188,7 @@
   (with-lock (trip-connection-lock c)
     (lambda ()
       (shut! c)
-      (let ((waiting (hash-table-values (trip-connection-waiting c))))
-        (for-each (lambda (tag) (forget! c tag))
-                  (hash-table-keys (trip-connection-waiting c)))
-        waiting))))
-
-;; The caller holds the lock.
-(define (forget! c tag)
-  (hash-table-delete! (trip-connection-waiting c) tag))
+      (take-all-mailboxes! (trip-connection-waiting c)))))
 
 ;;> The words of \var{s}, separated by spaces.
 (define (split-words s)
@@ -253,7 +243,7 @@
               (reply (mailbox-take mb deadline (lambda () 'late))))
          ;; A reply that comes after all finds no mailbox, and is dropped.
          (when (symbol? reply)
-           (with-lock (trip-connection-lock c) (lambda () (forget! c tag))))
+           (take-waiting! c tag))
          (case reply
            ((late) (too-late))
            ;; Marked when woken: the mark stays until the call is over.

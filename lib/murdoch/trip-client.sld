@@ -15,6 +15,7 @@
           (only (chibi) make-exception exception? exception-kind
                 exception-irritants call-with-output-string)
           (murdoch abandon) (murdoch connect)
-          (only (murdoch wait) with-lock make-mailbox mailbox-put! mailbox-take)
+          (only (murdoch wait) with-lock make-mailbox mailbox-put! mailbox-take
+                take-mailbox! take-all-mailboxes!)
           (only (murdoch scheduler) monotonic-seconds port-wait!))
   (include "trip-client.scm"))

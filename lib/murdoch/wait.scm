@@ -68,3 +68,21 @@
            (else
             (mutex-unlock! (mailbox-mutex mb))
             (timed-out)))))))
+
+;;; Mailboxes by id: a connection's calls waiting for their answers
+
+;;> The mailbox that \var{table} (id -> mailbox, an SRFI 69 table) holds
+;;> for \var{id}, taken out of it; #f when it holds none.  The caller
+;;> holds the lock that guards the table.
+(define (take-mailbox! table id)
+  (let ((mb (hash-table-ref/default table id #f)))
+    (hash-table-delete! table id)
+    mb))
+
+;;> Every mailbox of \var{table}, taken out of it: the connection ended,
+;;> and no answer will come to them.  The caller holds the table's lock.
+(define (take-all-mailboxes! table)
+  (let ((mbs (hash-table-values table)))
+    (for-each (lambda (id) (hash-table-delete! table id))
+              (hash-table-keys table))
+    mbs))

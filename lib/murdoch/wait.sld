@@ -4,6 +4,7 @@
 
 (define-library (murdoch wait)
   (export with-lock with-lock-by seconds-until undo-on-raise
-          make-mailbox mailbox-put! mailbox-take)
-  (import (scheme base) (srfi 18) (murdoch scheduler))
+          make-mailbox mailbox-put! mailbox-take
+          take-mailbox! take-all-mailboxes!)
+  (import (scheme base) (srfi 18) (srfi 69) (murdoch scheduler))
   (include "wait.scm"))
