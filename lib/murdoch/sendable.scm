@@ -302,17 +302,22 @@
 ;; Compiling a closure's source is the dear part of decoding, and the same
 ;; closure is sent again and again, so makers are kept by source.  A peer
 ;; could send sources without end, so the table is emptied when it holds
-;; max-makers: a program sends far fewer lambdas than that.
+;; max-makers: a program sends far fewer lambdas than that.  The table
+;; compares keys with Chibi's own equal?, which srfi 69 runs in C: R7RS's,
+;; which (scheme base) gives, is Chibi's cycle-safe equiv?, written in
+;; Scheme, and a table called it from C, a fresh run of the VM, for 2 us a
+;; lookup.  A source nests no deeper than max-depth, below where Chibi's
+;; stops looking.
 (define max-makers 4096)
 
 (define (make-closure-compiler env)
-  (let ((makers (make-hash-table equal?)))
+  (let ((makers (make-hash-table chibi-equal?)))
     (lambda (source names)
       (let ((key (cons source names)))
         (or (hash-table-ref/default makers key #f)
             (let ((maker (eval `(lambda ,names ,source) env)))
               (if (>= (hash-table-size makers) max-makers)
-                  (set! makers (make-hash-table equal?)))
+                  (set! makers (make-hash-table chibi-equal?)))
               (hash-table-set! makers key maker)
               maker))))))
 

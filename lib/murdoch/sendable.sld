@@ -6,6 +6,7 @@
   (import (scheme base) (scheme eval) (scheme write)
           (rename (only (scheme base) lambda define)
                   (lambda %lambda) (define %define))
+          (rename (only (chibi) equal?) (equal? chibi-equal?))
           (only (chibi) er-macro-transformer make-syntactic-closure
                 strip-syntactic-closures
                 make-exception exception? exception-kind)
