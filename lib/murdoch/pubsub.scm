@@ -23,14 +23,18 @@
   (holds subscription-holds subscription-holds-set!))   ; live reservations
 
 ;; Guarded by *subscriptions-lock*, as in the thesis: monitor threads
-;; change the list while messages read it.
+;; change the list while messages read it.  The list itself is never
+;; changed, only replaced (add-subscription!, remove-subscription!), so
+;; that addressed-here?, on every message, can read it without the lock.
 (define *subscriptions* '())
 (define *subscriptions-lock* (make-mutex 'subscriptions))
 
 (define (with-subscriptions thunk) (with-lock *subscriptions-lock* thunk))
 
-(define (find-subscription topic)
-  (find (lambda (s) (eq? (subscription-topic s) topic)) *subscriptions*))
+(define (find-subscription topic) (subscription-in *subscriptions* topic))
+
+(define (subscription-in subscriptions topic)
+  (find (lambda (s) (eq? (subscription-topic s) topic)) subscriptions))
 
 (define (add-subscription! topic)
   (if (not (find-subscription topic))
@@ -119,24 +123,26 @@
 
 (define (levels-match? p t)
   (cond ((null? p) (null? t))
-        ((equal? (car p) ">") (pair? t))
+        ((string=? (car p) ">") (pair? t))
         ((null? t) #f)
-        ((or (equal? (car p) "*") (equal? (car p) (car t)))
+        ((or (string=? (car p) "*") (string=? (car p) (car t)))
          (levels-match? (cdr p) (cdr t)))
         (else #f)))
 
 ;; True when every subject of the address is among the subscriptions
-;; (the thesis says "proper subset"; it means subset).  Caller holds the lock.
+;; (the thesis says "proper subset"; it means subset).  It takes no lock:
+;; it reads the list once, and then only the topics, which never change.
 ;; A subject subscribed as it is matches itself, wildcards included, and
 ;; is the common case (all, a uid): found so, it costs no matcher, whose
 ;; splitting of the subject was most of a receiver's work on a request.
 (define (addressed-here? topic)
-  (every (lambda (pattern)
-           (or (find-subscription pattern)
-               (let ((matches? (subject-matcher pattern)))
-                 (any (lambda (s) (matches? (subscription-topic s)))
-                      *subscriptions*))))
-         (subject-list topic)))
+  (let ((subscriptions *subscriptions*))
+    (every (lambda (pattern)
+             (or (subscription-in subscriptions pattern)
+                 (let ((matches? (subject-matcher pattern)))
+                   (any (lambda (s) (matches? (subscription-topic s)))
+                        subscriptions))))
+           (subject-list topic))))
 
 ;;; Sending
 
@@ -285,14 +291,14 @@
 
 ;;> Evaluates a publication if it is addressed here.
 (define (receive-publication topic uid proc args)
-  (if (with-subscriptions (lambda () (addressed-here? topic)))
+  (if (addressed-here? topic)
       (apply proc args))
   #t)
 
 ;;> Evaluates a request if it is addressed here: (#t uid result) or
 ;;> (#f uid).
 (define (receive-request topic uid proc args)
-  (if (with-subscriptions (lambda () (addressed-here? topic)))
+  (if (addressed-here? topic)
       (list #t (local-aspace-uid) (apply proc args))
       (list #f (local-aspace-uid))))
 
