@@ -1,6 +1,7 @@
 ;;; Murdoch's lambda and the encoding of values, in one process.
 (import (except (scheme base) lambda define) (scheme eval) (scheme read)
         (scheme write) (scheme cxr) (srfi 1) (chibi test)
+        (only (meta) mutable-environment)
         (rename (murdoch sendable) (sendable-lambda lambda)
                 (sendable-define define)))
 
@@ -68,5 +69,27 @@
     (let ((first ((decode (code 0)))))
       (do ((n 1 (+ n 1))) ((= n 4100)) (decode (code n)))
       (list first ((decode (code 4100))) ((decode (code 0)))))))
+(test-group "the encodings kept by procedure"
+  (let ((genv (mutable-environment '(scheme base))))
+    (eval '(define (twice x) (* 2 x)) genv)
+    (let ((old (eval 'twice genv)))
+      (test "a global goes by its name, again and again"
+          '(#(murdoch:global twice) #(murdoch:global twice))
+        (list (encode old genv "it") (encode old genv "it")))
+      (eval '(define (twice x) (+ x x)) genv)
+      (test "and no more once the name is bound to another procedure"
+          "cannot send it: it is a procedure made without Murdoch's lambda"
+        (send-error-of (lambda () (encode old genv "it"))))
+      (test "the name goes with the procedure now bound to it"
+          '#(murdoch:global twice)
+        (encode (eval 'twice genv) genv "it"))
+      (test "in another environment, the encoding is that environment's"
+          "cannot send it: it is a procedure made without Murdoch's lambda"
+        (send-error-of (lambda () (encode (eval 'twice genv) env "it"))))))
+  (let ((constant (lambda () 'seven)))
+    (test "a closure that captures nothing goes as its source, again"
+        '(#(murdoch:closure (lambda () 'seven) ())
+          #(murdoch:closure (lambda () 'seven) ()))
+      (list (encode constant env "it") (encode constant env "it")))))
 (test-end)
 (test-exit)

@@ -220,7 +220,9 @@
 ;;> environment whose procedures travel by name; \var{what} names \var{x}
 ;;> in an error message (a string, or a thunk that makes one).
 (define (encode x env what)
-  (if (plain? x) x (encode-compound x env what)))
+  (cond ((plain? x) x)
+        ((and (procedure? x) (known-encoding x env)))
+        (else (encode-compound x env what))))
 
 ;; The walk's procedures are defined at the top, not inside
 ;; encode-compound: Chibi would make each of them anew for every value
@@ -261,11 +263,43 @@
    ((proxy-procedure-ref p)
     => (lambda (ref) (vector 'murdoch:proxy (proxy-ref-uid ref)
                              (proxy-ref-id ref))))
-   ((global-name p env) => (lambda (name) (vector 'murdoch:global name)))
+   ((global-name p env)
+    => (lambda (name)
+         (know-encoding! p env (env-cell env name)
+                         (vector 'murdoch:global name))))
    ((and (not (opcode? p)) (closure-info p))
-    => (lambda (info) (enc-closure info env depth left)))
+    => (lambda (info)
+         (let ((code (enc-closure info env depth left)))
+           (if (null? (cdr (sendable-info-source+names info)))
+               (know-encoding! p env #f code)
+               code))))
    (else (send-fail "cannot send " (what-string what) ": it is "
                     (describe p)))))
+
+;; The encodings of procedures that do not change, kept by procedure: a
+;; global's, while its name is bound to it, and a closure's that captures
+;; no variable (and was not a global when first sent: one bound to a
+;; global name afterwards still goes as its source, which means the same
+;; there).  The same procedures are sent again and again (a
+;; request's, its user's closure), and finding a global's name, or that a
+;; closure is one, was most of the 4 us their encoding took.  At most
+;; max-known are kept, so that closures made and sent once are let go.
+(define max-known 4096)
+(define *known* (make-hash-table eq?))  ; procedure -> (env cell . code)
+
+(define (known-encoding p env)
+  (let ((known (hash-table-ref/default *known* p #f)))
+    (and known
+         (eq? (car known) env)
+         (let ((cell (cadr known)))      ; a global's; #f for a closure
+           (or (not cell) (eq? (cdr cell) p)))
+         (cddr known))))
+
+(define (know-encoding! p env cell code)
+  (if (>= (hash-table-size *known*) max-known)
+      (set! *known* (make-hash-table eq?)))
+  (hash-table-set! *known* p (cons env (cons cell code)))
+  code)
 
 ;; A captured value is written inside the closure's vector, its list of
 ;; bindings and its binding: three levels down.
