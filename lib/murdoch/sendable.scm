@@ -357,28 +357,40 @@
 
 ;;> Returns a procedure that rebuilds values encoded by \scheme{encode}:
 ;;> globals and closure sources are resolved in \var{env}, and proxies
-;;> are made by \var{proxy}, a procedure of a uid and an id.
+;;> are made by \var{proxy}, a procedure of a uid and an id.  The value
+;;> given is rebuilt where it lies: it is one that the reader has just
+;;> made from a frame, for this decoding alone.
+;; Rebuilding in place, each tagged element put in the pair that held it,
+;; saves copying the lists around it, most of decoding a request's
+;; arguments beside its closure.
 (define (make-decoder env proxy)
   (let ((compile (make-closure-compiler env)))
     (define (dec x depth)
       (cond
        ((pair? x) (check-depth (+ depth 1) "a received value")
-                  (map-elements (lambda (e) (dec e (+ depth 1))) x))
+                  (dec-elements! x (+ depth 1))
+                  x)
        ((not (vector? x)) x)
        (else (dec-tagged x depth))))
+    ;; By iteration down the cdrs, and the tail that is not a pair.
+    (define (dec-elements! p depth)
+      (let ((e (car p)))
+        (if (or (pair? e) (vector? e)) (set-car! p (dec e depth))))
+      (let ((rest (cdr p)))
+        (cond ((pair? rest) (dec-elements! rest depth))
+              ((vector? rest) (set-cdr! p (dec rest depth))))))
     (define (dec-tagged v depth)
       (check-depth (+ depth 1) "a received value")
       (case (vector-ref v 0)
-        ((murdoch:vector)
-         (list->vector (map-elements (lambda (e) (dec e (+ depth 1)))
-                                     (cdr (vector->list v)))))
-        ((murdoch:global) (global-ref (vector-ref v 1)))
         ((murdoch:closure)
          (let ((bindings (vector-ref v 2)))
            (if (null? bindings)            ; the common case, made cheap
                ((compile (vector-ref v 1) '()))
                (apply (compile (vector-ref v 1) (map car bindings))
                       (map (lambda (b) (dec (cdr b) (+ depth 1))) bindings)))))
+        ((murdoch:global) (global-ref (vector-ref v 1)))
+        ((murdoch:vector)
+         (list->vector (dec (cdr (vector->list v)) depth)))
         ((murdoch:proxy) (proxy (vector-ref v 1) (vector-ref v 2)))
         ((murdoch:void) void-value)
         ((murdoch:eof) (eof-object))
