@@ -163,11 +163,17 @@
 (define (parse-message text)
   (if (not (nests-within? text (* 2 *max-depth*)))
       (frame-fail "nests deeper than twice max-depth, or has a datum label"))
-  (let* ((in (open-input-string text))
-         (message (read-datum in)))
-    (cond ((eof-object? message) (frame-fail "empty message"))
-          ((not (eof-object? (peek-char in))) (frame-fail "trailing data"))
-          (else message))))
+  (let ((in (open-input-string text)))
+    (whole-datum in (read-datum in))))
+
+;; The message read from in, when it is all there is.  A procedure of its
+;; own, not a let* inside parse-message: Chibi makes a closure for a let
+;; whose body uses a variable of the let around it, and that was a third
+;; of parsing a short answer.
+(define (whole-datum in message)
+  (cond ((eof-object? message) (frame-fail "empty message"))
+        ((not (eof-object? (peek-char in))) (frame-fail "trailing data"))
+        (else message)))
 
 ;; Whether e says that the other side broke the protocol.
 (define (protocol-fault? e)
