@@ -14,15 +14,24 @@
 ;; and of the fan-out), each from the process's own CPU clock, and the
 ;; caller's of each; what the stages leave of the whole is the wait and
 ;; wake, the thread's scheduling, the bookkeeping and the collector, with
-;; caches that other processes have emptied.  Prints
-;;   stage: SIDE NAME MURDOCH-US BARE-US RATIO
+;; caches that other processes have emptied.
+;;
+;; Three stages are work that a bare echo does not do at all: decoding a
+;; procedure sent as its source, running it with ports and parameters of
+;; its own, and encoding one.  For these a second floor does the same work
+;; the least way bare Chibi can, without Murdoch's checks: a procedure
+;; found by name in a table, a closure's maker found by its source in a
+;; table and applied, the list copied by map; the subscription found by
+;; memq and the user's procedure applied under a parameterize of the
+;; thirteen parameters the sandbox binds for each call; a name, or a source, found by the procedure in a table.  Prints
+;;   stage: SIDE NAME MURDOCH-US BARE-US RATIO [SAME-WORK-US RATIO]
 ;; for each stage, in microseconds of CPU per message.
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time)
         (scheme file) (scheme process-context) (scheme eval)
         (srfi 1) (srfi 18) (srfi 69) (srfi 132)
         (chibi net) (chibi process) (chibi filesystem)
-        (only (chibi) read)
+        (only (chibi) read) (rename (only (chibi) equal?) (equal? chibi-equal?))
         (only (chibi time) get-resource-usage resource-usage/self
               resource-usage-time resource-usage-system-time
               timeval-seconds timeval-microseconds)
@@ -30,6 +39,7 @@
         (murdoch) (murdoch command) (murdoch testing)
         (murdoch netstring) (murdoch hmac) (murdoch frame) (murdoch sendable)
         (murdoch aspace) (murdoch sandbox) (murdoch lab) (murdoch scheduler)
+        (only (murdoch call) encode-arguments)
         (bench echo))
 
 (define lab (make-test-lab '((aspace bencher) (aspace troy))))
@@ -71,10 +81,13 @@
   (let ((times (list-tabulate rounds (lambda (i) (one-round)))))
     (list-ref (list-sort < times) (quotient rounds 2))))
 
-(define (report side name murdoch bare)
-  (for-each display
-            (list "stage: " side " " name " " (round1 murdoch) " " (round1 bare)
-                  " " (if (> bare 0.05) (round1 (/ murdoch bare)) "-")))
+(define (report side name murdoch bare . same-work)
+  (define (ratio floor) (if (> floor 0.05) (round1 (/ murdoch floor)) "-"))
+  (for-each display (list "stage: " side " " name " " (round1 murdoch) " "
+                          (round1 bare) " " (ratio bare)))
+  (if (pair? same-work)
+      (for-each display (list " " (round1 (car same-work)) " "
+                              (ratio (car same-work)))))
   (newline))
 
 (define (round1 x) (/ (round (* 10 x)) 10.))
@@ -85,7 +98,7 @@
 (define args (list 'all 'bencher user '()))
 (define env (lab-environment))
 (define proc-code (encode receive-request env "the procedure"))
-(define args-code (map (lambda (a) (encode a env "an argument")) args))
+(define args-code (encode-arguments args))
 (define call-message (make-message 'apply 7 proc-code args-code))
 (define result (receive-request 'all 'bencher user '()))
 (define answer-message (make-message 'value 7 result))
@@ -125,6 +138,56 @@
 (define decode-cache (make-hash-table eqv?))
 (hash-table-set! decode-cache 1 (lambda () user))
 
+;; The same work as decode, sandbox and encode, the least way bare Chibi
+;; can (see the header).  A closure's maker is made by the plain lambda,
+;; as bare Chibi would, and its table compares with Chibi's C equal?.
+(define bare-globals (make-hash-table eq?))      ; name -> procedure
+(hash-table-set! bare-globals 'receive-request receive-request)
+(define bare-makers (make-hash-table chibi-equal?)) ; source -> maker
+(hash-table-set! bare-makers '(lambda () #t)
+                 (eval '(lambda () (lambda () #t)) (environment '(scheme base))))
+(define bare-names (make-hash-table eq?))        ; procedure -> encoding
+(hash-table-set! bare-names receive-request '#(murdoch:global receive-request))
+(hash-table-set! bare-names user (vector 'murdoch:closure '(lambda () #t) '()))
+
+(define (bare-decode x)
+  (cond ((pair? x) (map bare-decode x))
+        ((not (vector? x)) x)
+        ((eq? (vector-ref x 0) 'murdoch:global)
+         (hash-table-ref/default bare-globals (vector-ref x 1) #f))
+        (else ((hash-table-ref/default bare-makers (vector-ref x 1) #f)))))
+
+(define bare-subscriptions '(all bencher))
+(define bare-ports (list (current-input-port) (current-output-port)
+                         (current-error-port)))
+
+(define coordinator (make-parameter #f))  ; team.scm keeps its own
+
+;; A call's own binding of each parameter that the sandbox binds: the
+;; three ports and Murdoch's ten (sandbox-parameter!).
+(define (bare-receive topic uid proc args)
+  (parameterize ((current-input-port (car bare-ports))
+                 (current-output-port (cadr bare-ports))
+                 (current-error-port (car (cddr bare-ports)))
+                 (remote-timeout (remote-timeout))
+                 (pose-task-progress (pose-task-progress))
+                 (current-team (current-team))
+                 (task-timeout (task-timeout))
+                 (coordinator (coordinator))
+                 (pose-task-assignment (pose-task-assignment))
+                 (pose-task-priority (pose-task-priority))
+                 (pose-task-retries (pose-task-retries))
+                 (pose-task-backoff (pose-task-backoff))
+                 (pose-task-excluded (pose-task-excluded)))
+    (if (memq topic bare-subscriptions)
+        (list #t 'troy (apply proc args))
+        (list #f 'troy))))
+
+(define (bare-encode x)
+  (cond ((pair? x) (map bare-encode x))
+        ((procedure? x) (hash-table-ref/default bare-names x #f))
+        (else x)))
+
 (define (stages side message text payload user)
   (define parsed (parse-message text))
   (report side "read"
@@ -152,11 +215,14 @@
             (report "receiver" "decode"
                     (per-run (lambda () (decode-value (list-ref parsed 2))
                                (decode-value (list-ref parsed 3))))
-                    (per-run (lambda () ((hash-table-ref/default decode-cache 1 #f)))))
+                    (per-run (lambda () ((hash-table-ref/default decode-cache 1 #f))))
+                    (per-run (lambda () (bare-decode (list-ref parsed 2))
+                               (bare-decode (list-ref parsed 3)))))
             (report "receiver" "subject match, sandbox, user procedure"
                     (per-run (lambda () (call-in-sandbox
                                          (lambda () (apply receive-request args)))))
-                    (per-run (lambda () (apply user '()))))
+                    (per-run (lambda () (apply user '())))
+                    (per-run (lambda () (apply bare-receive args))))
             (report "receiver" "encode"
                     (per-run (lambda () (encode result env "the result")))
                     0)
@@ -165,8 +231,9 @@
 (define (sender-stages)
   (report "sender" "encode"
           (per-run (lambda () (encode receive-request env "the procedure")
-                     (map (lambda (a) (encode a env "an argument")) args)))
-          (per-run (lambda () (hash-table-ref/default decode-cache 1 #f))))
+                     (encode-arguments args)))
+          (per-run (lambda () (hash-table-ref/default decode-cache 1 #f)))
+          (per-run (lambda () (bare-encode receive-request) (bare-encode args))))
   (write-stages "sender" call-message)
   (let ((answer-text (text-of answer-message)))
     (stages "sender" answer-message answer-text (string->utf8 (signed answer-text))
@@ -176,13 +243,15 @@
                       (per-run (lambda () (list-ref parsed 2))))))))
 
 ;; The text, its MAC and the write: Murdoch writes each message to a text
-;; port, and signs it; the bare way writes the datum and nothing else.
+;; port, checks its size, and signs it; the bare way writes the datum and
+;; takes the text to sign.
 (define (write-stages side message)
   (let ((text (text-of message)))
     (report side "message text"
             (per-run (lambda () (frame-text text-port message)))
             (per-run (lambda () (reset-output-string! text-port)
-                       (write-simple message text-port))))
+                       (write-simple message text-port)
+                       (get-output-string text-port))))
     (report side "sign"
             (per-run (lambda () (signed text)))
             (per-run (lambda () (signed text))))
