@@ -23,7 +23,8 @@
 ;; found by name in a table, a closure's maker found by its source in a
 ;; table and applied, the list copied by map; the subscription found by
 ;; memq and the user's procedure applied under a parameterize of the
-;; thirteen parameters the sandbox binds for each call; a name, or a source, found by the procedure in a table.  Prints
+;; thirteen parameters the sandbox binds for each call; a name, or a
+;; source, found by the procedure in a table.  Prints
 ;;   stage: SIDE NAME MURDOCH-US BARE-US RATIO [SAME-WORK-US RATIO]
 ;; for each stage, in microseconds of CPU per message.
 
@@ -145,7 +146,8 @@
 (hash-table-set! bare-globals 'receive-request receive-request)
 (define bare-makers (make-hash-table chibi-equal?)) ; source -> maker
 (hash-table-set! bare-makers '(lambda () #t)
-                 (eval '(lambda () (lambda () #t)) (environment '(scheme base))))
+                 (eval '(lambda () (lambda () #t))
+                       (environment '(scheme base))))
 (define bare-names (make-hash-table eq?))        ; procedure -> encoding
 (hash-table-set! bare-names receive-request '#(murdoch:global receive-request))
 (hash-table-set! bare-names user (vector 'murdoch:closure '(lambda () #t) '()))
@@ -215,7 +217,8 @@
             (report "receiver" "decode"
                     (per-run (lambda () (decode-value (list-ref parsed 2))
                                (decode-value (list-ref parsed 3))))
-                    (per-run (lambda () ((hash-table-ref/default decode-cache 1 #f))))
+                    (per-run (lambda ()
+                               ((hash-table-ref/default decode-cache 1 #f))))
                     (per-run (lambda () (bare-decode (list-ref parsed 2))
                                (bare-decode (list-ref parsed 3)))))
             (report "receiver" "subject match, sandbox, user procedure"
@@ -233,7 +236,8 @@
           (per-run (lambda () (encode receive-request env "the procedure")
                      (encode-arguments args)))
           (per-run (lambda () (hash-table-ref/default decode-cache 1 #f)))
-          (per-run (lambda () (bare-encode receive-request) (bare-encode args))))
+          (per-run (lambda ()
+                     (bare-encode receive-request) (bare-encode args))))
   (write-stages "sender" call-message)
   (let ((answer-text (text-of answer-message)))
     (stages "sender" answer-message answer-text (string->utf8 (signed answer-text))
