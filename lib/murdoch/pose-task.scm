@@ -140,7 +140,8 @@
   (type-list pose-type-list)
   (keys-list pose-keys-list)
   (procs pose-procs)
-  (priorities pose-priorities))
+  (priorities pose-priorities)
+  (tried pose-tried pose-tried-set!))    ; the last try's candidates' uids
 
 ;; The task's tries, from try number n on.
 (define (negotiate-by-tries task n)
@@ -163,6 +164,7 @@
   (let* ((type-list (pose-type-list task))
          (round (request-components (pose-name task) (round-components task)))
          (responses (map without-excluded type-list (map car round))))
+    (pose-tried-set! task (append-map (lambda (r) (map car r)) responses))
     (for-each (lambda (i layout response)
                 (progress "  component " i " needs " layout ": candidates "
                           (map car response)))
@@ -431,30 +433,44 @@
                              pose-negotiations))
          #t)))
 
-;; After a try that found too few robots: whether other poses hold robots
-;; it could use, and if so tells those poses of this one's rank.
+;; After a try that found too few robots: whether another may do better.
+;; It may when other poses hold robots it could use, and those poses are
+;; told of this one's rank; or when such a robot is free now that was no
+;; candidate in the try: its holder let it go in between, as a pose that
+;; gives way does a moment after it is told (a try then found it held and
+;; this look found it free, and the pose gave up with the robots free).
 (define (contended! task)
-  (let ((holders (rival-holders (pose-name task) (pose-layouts task)
-                                (pose-type-list task))))
+  (let* ((statuses (capable-statuses (pose-layouts task) (pose-type-list task)))
+         (holders (rival-holders (pose-name task) statuses)))
     (for-each (lambda (holder) (tell-rival! holder (own-rank (pose-name task))))
               holders)
-    (pair? holders)))
+    (or (pair? holders) (freed-since? (pose-tried task) statuses))))
 
-;; The names under which other tasks hold the exclusive subjects of
-;; robots capable of the exclusive components.
-(define (rival-holders name layouts type-list)
+;; (uid status ...) of each robot capable of an exclusive component, a
+;; status for each of the component's exclusive subjects.
+(define (capable-statuses layouts type-list)
+  (append-map
+   (lambda (layout type)
+     (if (eq? type 'exclusive)
+         (let ((subjects (car layout)))
+           (map (lambda (answer) (cons (car answer) (cadr answer)))
+                (request (apply append layout)
+                         (sendable-lambda () (map topic-status subjects)))))
+         '()))
+   layouts type-list))
+
+;; The names under which other tasks hold those subjects.
+(define (rival-holders name statuses)
   (delete-duplicates
    (filter (lambda (status)
              (and (symbol? status) (not (memq status (list name 'shared)))))
-           (append-map
-            (lambda (layout type)
-              (if (eq? type 'exclusive)
-                  (let ((subjects (car layout)))
-                    (append-map cadr (request (apply append layout)
-                                              (sendable-lambda ()
-                                                (map topic-status subjects)))))
-                  '()))
-            layouts type-list))))
+           (append-map cdr statuses))))
+
+(define (freed-since? tried statuses)
+  (any (lambda (s) (and (every null? (cdr s))
+                        (not (memq (car s) tried))
+                        (not (memq (car s) (pose-task-excluded)))))
+       statuses))
 
 (define (tell-rival! holder rank)
   (let ((uid (reservation-aspace-uid holder)))
