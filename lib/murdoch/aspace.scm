@@ -97,7 +97,9 @@
 ;;> lab's code files; no file, process, load or eval primitives.
 (define (lab-environment) *environment*)
 
-;; The value that received code, an encoded value, stands for here.
+;; The value that received code, an encoded value, stands for here.  The
+;; code is rebuilt in place (make-decoder): it must be the reader's, fresh
+;; from a frame, and is not used again.
 (define (decode-value code) (*decode* code))
 
 (define (describe-procedure proc)
