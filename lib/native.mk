@@ -22,8 +22,20 @@ NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 
+# The bindings are .stub files, from which chibi-ffi writes the C: the
+# procedures' argument checks, their errors and sexp_init_library.  What
+# real C they bind is in the stub, or in a file of plain C it includes.
+# Only the scheduler's C is written by hand (scheduler.c says why).
+NATIVE_STUBS := $(wildcard lib/murdoch/*.stub)
+
+lib/murdoch/%.c: lib/murdoch/%.stub
+	tools/chibi-ffi $< $@
+
 lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
 	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< $(NATIVE_LIBS_$*)
+
+# Kept, so that a look at what chibi-ffi wrote needs no rebuild.
+.SECONDARY: $(NATIVE_STUBS:.stub=.c)
 
 # HMAC-SHA256 and the constant-time comparison are OpenSSL's.
 NATIVE_LIBS_hmac = -lcrypto
@@ -32,6 +44,6 @@ bench/c-pingpong: bench/c-pingpong.c
 	$(CC) $(NATIVE_CFLAGS) -o $@ bench/c-pingpong.c
 
 native-clean:
-	rm -f $(NATIVE_MODULES) bench/c-pingpong
+	rm -f $(NATIVE_MODULES) $(NATIVE_STUBS:.stub=.c) bench/c-pingpong
 
 .PHONY: native native-clean

@@ -4,10 +4,11 @@
 # 1. Debian 12 packages: a C/C++ tool chain, Box2D (for the simulator),
 #    OpenSSL's libcrypto (HMAC), iproute2 (the network-namespace test) and
 #    Chromium (the browser test of the live view).
-# 2. Chibi-Scheme >= 0.10: used as is when on PATH; otherwise Debian
-#    unstable's 0.12 binaries are unpacked into .deps/chibi together with
-#    unstable's libc (they need glibc >= 2.38), and .deps/bin/chibi-scheme
-#    runs them through that libc's loader.  The library path is given to the
+# 2. Chibi-Scheme >= 0.10 with its chibi-ffi (which makes the C of our
+#    libraries from their .stub files): used as is when on PATH; otherwise
+#    Debian unstable's 0.12 binaries are unpacked into .deps/chibi together
+#    with unstable's libc (they need glibc >= 2.38), and .deps/bin/chibi-scheme
+#    and chibi-ffi run them through that libc's loader.  The library path is given to the
 #    loader, not through LD_LIBRARY_PATH, so that processes Chibi starts keep
 #    the system's libc.
 #
@@ -50,6 +51,7 @@ install_debian_packages() {
 
 chibi_on_path_is_enough() {
     command -v chibi-scheme >/dev/null 2>&1 || return 1
+    command -v chibi-ffi >/dev/null 2>&1 || return 1   # make native needs it
     v=$(chibi-scheme -V 2>/dev/null | sed -n 's/.*chibi-scheme \([0-9]*\)\.\([0-9]*\).*/\1 \2/p')
     [ -n "$v" ] || return 1
     set -- $v
