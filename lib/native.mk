@@ -34,6 +34,9 @@ lib/murdoch/%.c: lib/murdoch/%.stub
 lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
 	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< $(NATIVE_LIBS_$*)
 
+# The plain C that a stub includes.
+lib/murdoch/guard.so: lib/murdoch/heap-watch.c
+
 # Kept, so that a look at what chibi-ffi wrote needs no rebuild.
 .SECONDARY: $(NATIVE_STUBS:.stub=.c)
 

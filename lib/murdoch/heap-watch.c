@@ -1,4 +1,4 @@
-/*  guard.c -- the C of (murdoch guard): the heap's ceiling
+/*  heap-watch.c -- the C of (murdoch guard): the heap's ceiling
  *
  *  Received code can ask for any amount of memory, and Chibi's own
  *  ceiling (-h SIZE/MAX) does not hold it: the heap grows whenever it is
@@ -14,6 +14,8 @@
  *  comes even while the VM is inside one long allocation or collection.
  *  It reads only the heaps' sizes, which the VM writes as it grows them;
  *  a size read mid-write is at worst one look late.
+ *
+ *  guard.stub binds it, and chibi-ffi makes the binding's C.
  */
 
 #include <chibi/eval.h>
@@ -49,20 +51,20 @@ static void *watch (void *unused) {
 
 /* (start-heap-guard! bytes line): ends the process, writing line to
  * standard error, once its heap passes bytes.  Once per process. */
-static sexp start_heap_guard (sexp ctx, sexp self, sexp_sint_t n,
-                              sexp bytes, sexp line) {
+static sexp start_heap_guard (sexp ctx, sexp self, long bytes,
+                              const char *line) {
   pthread_t thread;
   pthread_attr_t attr;
   sigset_t all, old;
   int started;
-  if (!sexp_fixnump(bytes) || sexp_unbox_fixnum(bytes) <= 0)
-    return sexp_type_exception(ctx, self, SEXP_FIXNUM, bytes);
-  if (!sexp_stringp(line))
-    return sexp_type_exception(ctx, self, SEXP_STRING, line);
+  if (bytes <= 0)
+    return sexp_user_exception(ctx, self, "not a heap size",
+                               sexp_make_integer(ctx, bytes));
   if (watched)
-    return sexp_user_exception(ctx, self, "the heap guard is already on", bytes);
-  ceiling = sexp_unbox_fixnum(bytes);
-  snprintf(message, sizeof message, "%s\n", sexp_string_data(line));
+    return sexp_user_exception(ctx, self, "the heap guard is already on",
+                               SEXP_FALSE);
+  ceiling = bytes;
+  snprintf(message, sizeof message, "%s\n", line);
   watched = sexp_context_heap(ctx);
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, 64 * 1024);
@@ -75,17 +77,9 @@ static sexp start_heap_guard (sexp ctx, sexp self, sexp_sint_t n,
   pthread_attr_destroy(&attr);
   if (!started) {
     watched = NULL;
-    return sexp_user_exception(ctx, self, "cannot start the heap guard", bytes);
+    return sexp_user_exception(ctx, self, "cannot start the heap guard",
+                               SEXP_FALSE);
   }
   pthread_detach(thread);
-  return SEXP_VOID;
-}
-
-sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
-                        const char *version, const sexp_abi_identifier_t abi) {
-  if (!(sexp_version_compatible(ctx, version, sexp_version)
-        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
-    return SEXP_ABI_ERROR;
-  sexp_define_foreign(ctx, env, "start-heap-guard!", 2, start_heap_guard);
   return SEXP_VOID;
 }
