@@ -1,4 +1,5 @@
-/*  multicast.c -- a UDP socket on an IP multicast group, for (murdoch multicast)
+/*  multicast-socket.c -- a UDP socket on an IP multicast group, the C of
+ *  (murdoch multicast), which multicast.stub binds
  *
  *  Chibi's (chibi net) sends and receives datagrams, and does so without
  *  blocking its other threads, but it cannot join a multicast group: that
@@ -15,28 +16,25 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-static sexp fail (sexp ctx, sexp self, const char *what, sexp irritant) {
-  return sexp_user_exception(ctx, self, what, irritant);
+static sexp fail (sexp ctx, sexp self, const char *what, const char *irritant) {
+  return sexp_user_exception(ctx, self, what, sexp_c_string(ctx, irritant, -1));
 }
 
 /* (open-multicast-socket GROUP PORT INTERFACE): a non-blocking UDP socket
  * bound to PORT, member of GROUP on the interface whose address is
  * INTERFACE, sending there with its own datagrams looped back, so that
  * address spaces on one machine hear each other. */
-static sexp open_multicast_socket (sexp ctx, sexp self, sexp_sint_t n,
-                                   sexp group, sexp port, sexp interface) {
+static sexp open_multicast_socket (sexp ctx, sexp self, const char *group,
+                                   int port, const char *interface) {
   struct sockaddr_in addr;
   struct ip_mreq mreq;
   struct in_addr ifaddr;
   int fd, one = 1, rcvbuf = 1 << 20;
   unsigned char loop = 1, ttl = 1;
-  sexp_assert_type(ctx, sexp_stringp, SEXP_STRING, group);
-  sexp_assert_type(ctx, sexp_fixnump, SEXP_FIXNUM, port);
-  sexp_assert_type(ctx, sexp_stringp, SEXP_STRING, interface);
-  if (inet_pton(AF_INET, sexp_string_data(group), &mreq.imr_multiaddr) != 1
+  if (inet_pton(AF_INET, group, &mreq.imr_multiaddr) != 1
       || !IN_MULTICAST(ntohl(mreq.imr_multiaddr.s_addr)))
     return fail(ctx, self, "not an IPv4 multicast group", group);
-  if (inet_pton(AF_INET, sexp_string_data(interface), &ifaddr) != 1)
+  if (inet_pton(AF_INET, interface, &ifaddr) != 1)
     return fail(ctx, self, "not an IPv4 interface address", interface);
   mreq.imr_interface = ifaddr;
   fd = socket(AF_INET, SOCK_DGRAM, 0);
@@ -49,7 +47,7 @@ static sexp open_multicast_socket (sexp ctx, sexp self, sexp_sint_t n,
   setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
   memset(&addr, 0, sizeof addr);
   addr.sin_family = AF_INET;
-  addr.sin_port = htons((unsigned short)sexp_unbox_fixnum(port));
+  addr.sin_port = htons((unsigned short)port);
   addr.sin_addr = mreq.imr_multiaddr;
   if (setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) < 0
       || bind(fd, (struct sockaddr *)&addr, sizeof addr) < 0
@@ -63,14 +61,4 @@ static sexp open_multicast_socket (sexp ctx, sexp self, sexp_sint_t n,
     return err;
   }
   return sexp_make_fileno(ctx, sexp_make_fixnum(fd), SEXP_FALSE);
-}
-
-sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
-                        const char *version, const sexp_abi_identifier_t abi) {
-  if (!(sexp_version_compatible(ctx, version, sexp_version)
-        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
-    return SEXP_ABI_ERROR;
-  sexp_define_foreign(ctx, env, "open-multicast-socket", 3,
-                      open_multicast_socket);
-  return SEXP_VOID;
 }
