@@ -1,8 +1,8 @@
 ;;;; A TCP connect that gives up at a timeout without holding the process.
 ;;
 ;; The socket is made and closed here, as (chibi net) makes and closes
-;; its own; lib/murdoch/connect.c starts its connect, non-blocking, and says when
-;; the connect is done.  This side waits for the socket to turn writable,
+;; its own; the C of connect.stub starts its connect, non-blocking, and says
+;; when the connect is done.  This side waits for the socket to turn writable,
 ;; which is when a connect ends, pausing only its own green thread
 ;; (port-wait!), so the process's other threads run on.
 

@@ -1,7 +1,8 @@
 ;;> A TCP connect that gives up at a timeout: \scheme{open-connection},
 ;;> the non-blocking replacement of (chibi net)'s \scheme{open-net-io}.
-;;> The C is lib/murdoch/connect.c, built into lib/murdoch/connect.so by
-;;> \scheme{make native}; the waiting is lib/murdoch/connect.scm.
+;;> The C is lib/murdoch/connect.stub and nonblocking-connect.c, built into
+;;> lib/murdoch/connect.so by \scheme{make native}; the waiting is
+;;> lib/murdoch/connect.scm.
 
 (define-library (murdoch connect)
   (export open-connection)

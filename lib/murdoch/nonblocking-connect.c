@@ -1,4 +1,5 @@
-/*  connect.c -- the C of (murdoch connect): a TCP connect that does not wait
+/*  nonblocking-connect.c -- the C of (murdoch connect), which connect.stub
+ *  binds: a TCP connect that does not wait
  *
  *  (chibi net)'s open-net-io connects in blocking mode: a host that drops
  *  our SYN holds the whole process, every green thread, for the kernel's
@@ -34,7 +35,8 @@ static sexp reason (sexp ctx, const char *text) {
 /* The first IPv4 address of host, port; NULL and a reason in *why when
  * there is none.  getaddrinfo may ask DNS, which blocks the process:
  * names in a lab are addresses or in /etc/hosts. */
-static struct addrinfo *resolve (sexp ctx, sexp host, sexp port, sexp *why) {
+static struct addrinfo *resolve (sexp ctx, const char *host, long port,
+                                  sexp *why) {
   struct addrinfo hints, *found;
   char service[8];
   int err;
@@ -42,8 +44,8 @@ static struct addrinfo *resolve (sexp ctx, sexp host, sexp port, sexp *why) {
   hints.ai_family = AF_INET;
   hints.ai_socktype = SOCK_STREAM;
   hints.ai_flags = AI_NUMERICSERV;
-  snprintf(service, sizeof service, "%ld", (long)sexp_unbox_fixnum(port));
-  err = getaddrinfo(sexp_string_data(host), service, &hints, &found);
+  snprintf(service, sizeof service, "%ld", port);
+  err = getaddrinfo(host, service, &hints, &found);
   if (err == 0) return found;
   if (err == EAI_NONAME)
     *why = reason(ctx, "no such host");
@@ -57,19 +59,17 @@ static struct addrinfo *resolve (sexp ctx, sexp host, sexp port, sexp *why) {
 /* (connect-start SOCKET HOST PORT): starts the connect of SOCKET, a
  * non-blocking IPv4 stream socket, to HOST:PORT.  Answers #t when the
  * connect is done or under way, or a string saying why it failed. */
-static sexp connect_start (sexp ctx, sexp self, sexp_sint_t n,
-                           sexp sock, sexp host, sexp port) {
+static sexp connect_start (sexp ctx, sexp self, int sock, const char *host,
+                           long port) {
   struct addrinfo *addr;
   sexp why = SEXP_FALSE;
   int err;
-  sexp_assert_type(ctx, sexp_filenop, SEXP_FILENO, sock);
-  sexp_assert_type(ctx, sexp_stringp, SEXP_STRING, host);
-  sexp_assert_type(ctx, sexp_fixnump, SEXP_FIXNUM, port);
-  if (sexp_unbox_fixnum(port) < 1 || sexp_unbox_fixnum(port) > 65535)
-    return sexp_user_exception(ctx, self, "not a TCP port", port);
+  if (port < 1 || port > 65535)
+    return sexp_user_exception(ctx, self, "not a TCP port",
+                               sexp_make_fixnum(port));
   addr = resolve(ctx, host, port, &why);
   if (!addr) return why;
-  err = connect(sexp_fileno_fd(sock), addr->ai_addr, addr->ai_addrlen) < 0
+  err = connect(sock, addr->ai_addr, addr->ai_addrlen) < 0
     ? errno : 0;
   freeaddrinfo(addr);
   /* EINTR leaves the connect going on, as EINPROGRESS does. */
@@ -80,12 +80,11 @@ static sexp connect_start (sexp ctx, sexp self, sexp_sint_t n,
 
 /* (connect-poll SOCKET): #f while the connect of SOCKET is under way; once
  * it is done, #t, or a string saying why it failed.  Never waits. */
-static sexp connect_poll (sexp ctx, sexp self, sexp_sint_t n, sexp sock) {
+static sexp connect_poll (sexp ctx, int sock) {
   struct pollfd p;
   int ready, err = 0;
   socklen_t len = sizeof err;
-  sexp_assert_type(ctx, sexp_filenop, SEXP_FILENO, sock);
-  p.fd = sexp_fileno_fd(sock);
+  p.fd = sock;
   p.events = POLLOUT;
   ready = poll(&p, 1, 0);
   if (ready == 0 || (ready < 0 && errno == EINTR))
@@ -94,14 +93,4 @@ static sexp connect_poll (sexp ctx, sexp self, sexp_sint_t n, sexp sock) {
   if (ready < 0 || getsockopt(p.fd, SOL_SOCKET, SO_ERROR, &err, &len) < 0)
     err = errno;
   return err == 0 ? SEXP_TRUE : reason(ctx, strerror(err));
-}
-
-sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
-                        const char *version, const sexp_abi_identifier_t abi) {
-  if (!(sexp_version_compatible(ctx, version, sexp_version)
-        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
-    return SEXP_ABI_ERROR;
-  sexp_define_foreign(ctx, env, "connect-start", 3, connect_start);
-  sexp_define_foreign(ctx, env, "connect-poll", 1, connect_poll);
-  return SEXP_VOID;
 }
