@@ -39,7 +39,7 @@
         (netstring-fail "length over " (number->string max) " bytes"))
        (else (loop (+ (* n 10) (- b 48)) (+ digits 1)))))))
 
-;; What the port's buffer holds is copied at once (lib/murdoch/netstring.c); when
+;; What the port's buffer holds is copied at once (netstring-scan.c); when
 ;; it is empty, read-u8 waits for more and refills it.  The end of the port
 ;; before the last byte is a fault.
 (define (read-payload in n)
@@ -59,7 +59,7 @@
 ;;> payload as a bytevector, or an eof object when the port ends cleanly
 ;;> between frames.  Raises a protocol remote-error on anything else.
 (define (read-netstring in max)
-  (or (take-buffered-netstring in max)  ; lib/murdoch/netstring.c: a whole frame
+  (or (take-buffered-netstring in max)  ; netstring-scan.c: a whole frame
       (read-netstring-bytewise in max)))
 
 (define (read-netstring-bytewise in max)

@@ -1,4 +1,4 @@
-/*  netstring.c -- the C of (murdoch netstring)
+/*  netstring-scan.c -- the C of (murdoch netstring), which netstring.stub binds
  *
  *  Chibi's read-bytevector! is a Scheme loop of read-u8, about a third of
  *  a microsecond a byte: 50 us for a small frame, more than the rest of a
@@ -7,12 +7,19 @@
  *  when the buffer is empty the Scheme side calls read-u8, which refills
  *  it and, on a socket with nothing to read, blocks only its own green
  *  thread, as every Chibi port read does.
+ *
+ *  The ports come unchecked and are looked at here: chibi-ffi's port
+ *  types are for ports on a C stream (FILE *), which a socket's are not.
  */
 
 #include <chibi/eval.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define assert_input_port(port)                                 \
+  if (!sexp_iportp(port))                                       \
+    return sexp_type_exception(ctx, self, SEXP_IPORT, port)
 
 /* How many bytes the input port's buffer holds, read from the descriptor
  * but not yet from the port. */
@@ -26,24 +33,18 @@ static sexp_sint_t buffered (sexp port) {
  * port's buffer holds, up to end - start bytes, into bytevector from
  * start; answers how many (0 when the buffer is empty or the port has
  * none). */
-static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
-                                 sexp port, sexp bv, sexp start, sexp end) {
-  sexp_sint_t from, to, have;
-  if (!sexp_iportp(port))
-    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
-  if (!sexp_bytesp(bv))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, bv);
-  if (!sexp_fixnump(start) || !sexp_fixnump(end))
-    return sexp_type_exception(ctx, self, SEXP_FIXNUM,
-                               sexp_fixnump(start) ? end : start);
-  from = sexp_unbox_fixnum(start);
-  to = sexp_unbox_fixnum(end);
-  if (from < 0 || to < from || (sexp_uint_t)to > sexp_bytes_length(bv))
-    return sexp_user_exception(ctx, self, "bad range", sexp_list2(ctx, start, end));
+static sexp read_buffered_bytes (sexp ctx, sexp self, sexp port, char *bytes,
+                                 long size, long from, long to) {
+  sexp_sint_t have;
+  assert_input_port(port);
+  if (from < 0 || to < from || to > size)
+    return sexp_user_exception(ctx, self, "bad range",
+                               sexp_list2(ctx, sexp_make_integer(ctx, from),
+                                          sexp_make_integer(ctx, to)));
   have = buffered(port);
   if (have == 0) return SEXP_ZERO;
   if (have > to - from) have = to - from;
-  memcpy(sexp_bytes_data(bv) + from,
+  memcpy(bytes + from,
          sexp_port_buf(port) + sexp_port_offset(port), have);
   sexp_port_offset(port) += have;
   return sexp_make_fixnum(have);
@@ -56,16 +57,12 @@ static sexp read_buffered_bytes (sexp ctx, sexp self, sexp_sint_t n,
  * which waits for the rest and says what is wrong.  A frame usually
  * arrives whole, and this saves reading its length a byte at a time in
  * Scheme. */
-static sexp take_buffered_netstring (sexp ctx, sexp self, sexp_sint_t n,
-                                     sexp port, sexp max) {
+static sexp take_buffered_netstring (sexp ctx, sexp self, sexp port,
+                                     long most) {
   const unsigned char *start, *p, *end;
-  sexp_sint_t len = 0, most;
+  sexp_sint_t len = 0;
   sexp payload;
-  if (!sexp_iportp(port))
-    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
-  if (!sexp_fixnump(max))
-    return sexp_type_exception(ctx, self, SEXP_FIXNUM, max);
-  most = sexp_unbox_fixnum(max);
+  assert_input_port(port);
   if (buffered(port) == 0) return SEXP_FALSE;
   p = start = (const unsigned char *)sexp_port_buf(port) + sexp_port_offset(port);
   end = (const unsigned char *)sexp_port_buf(port) + sexp_port_size(port);
@@ -87,9 +84,8 @@ static sexp take_buffered_netstring (sexp ctx, sexp self, sexp_sint_t n,
 
 /* (buffered-byte-count port): what the buffer holds (see buffered).  Lets
  * a reader see that more frames have arrived without waiting for them. */
-static sexp buffered_byte_count (sexp ctx, sexp self, sexp_sint_t n, sexp port) {
-  if (!sexp_iportp(port))
-    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
+static sexp buffered_byte_count (sexp ctx, sexp self, sexp port) {
+  assert_input_port(port);
   return sexp_make_fixnum(buffered(port));
 }
 
@@ -97,7 +93,7 @@ static sexp buffered_byte_count (sexp ctx, sexp self, sexp_sint_t n, sexp port) 
  * buffer, so that one port can build frame after frame.  A new string
  * port costs a 4 KB buffer from Chibi's heap, and allocating that much
  * at a time, a frame at a time, was a good part of a message's cost. */
-static sexp reset_output_string (sexp ctx, sexp self, sexp_sint_t n, sexp port) {
+static sexp reset_output_string (sexp ctx, sexp self, sexp port) {
   if (!sexp_oportp(port) || !sexp_pairp(sexp_port_cookie(port))
       || sexp_filenop(sexp_port_fd(port)))
     return sexp_xtype_exception(ctx, self, "not a string output port", port);
@@ -108,13 +104,9 @@ static sexp reset_output_string (sexp ctx, sexp self, sexp_sint_t n, sexp port) 
 
 /* (fixnum->decimal n): n in decimal.  Chibi's number->string writes to
  * a string port, which costs 25 us; a frame's length needs it each time. */
-static sexp fixnum_to_decimal (sexp ctx, sexp self, sexp_sint_t n, sexp x) {
+static sexp fixnum_to_decimal (sexp ctx, long x) {
   char digits[32];
-  if (!sexp_fixnump(x))
-    return sexp_type_exception(ctx, self, SEXP_FIXNUM, x);
-  return sexp_c_string(ctx, digits,
-                       snprintf(digits, sizeof digits, "%ld",
-                                (long)sexp_unbox_fixnum(x)));
+  return sexp_c_string(ctx, digits, snprintf(digits, sizeof digits, "%ld", x));
 }
 
 /* Nesting.  Chibi's reader, in C, recurses for each level of nesting of
@@ -221,31 +213,10 @@ static int nests_within (const unsigned char *p, const unsigned char *end,
   return ok && !label;
 }
 
-/* (nests-within? string limit): whether the text of string, read as a
- * datum, nests at most limit deep and has no datum label (see Nesting). */
-static sexp nests_within_p (sexp ctx, sexp self, sexp_sint_t n,
-                            sexp str, sexp limit) {
-  const unsigned char *p;
-  if (!sexp_stringp(str))
-    return sexp_type_exception(ctx, self, SEXP_STRING, str);
-  if (!sexp_fixnump(limit))
-    return sexp_type_exception(ctx, self, SEXP_FIXNUM, limit);
-  p = (const unsigned char *)sexp_string_data(str);
-  return sexp_make_boolean(nests_within(p, p + sexp_string_size(str),
-                                        sexp_unbox_fixnum(limit)));
-}
-
-sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
-                        const char *version, const sexp_abi_identifier_t abi) {
-  if (!(sexp_version_compatible(ctx, version, sexp_version)
-        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
-    return SEXP_ABI_ERROR;
-  sexp_define_foreign(ctx, env, "read-buffered-bytes!", 4, read_buffered_bytes);
-  sexp_define_foreign(ctx, env, "fixnum->decimal", 1, fixnum_to_decimal);
-  sexp_define_foreign(ctx, env, "buffered-byte-count", 1, buffered_byte_count);
-  sexp_define_foreign(ctx, env, "take-buffered-netstring", 2,
-                      take_buffered_netstring);
-  sexp_define_foreign(ctx, env, "reset-output-string!", 1, reset_output_string);
-  sexp_define_foreign(ctx, env, "nests-within?", 2, nests_within_p);
-  return SEXP_VOID;
+/* (nests-within? string limit): whether the text of string, of size
+ * bytes, read as a datum, nests at most limit deep and has no datum label
+ * (see Nesting). */
+static int nests_within_text (const char *text, long size, long limit) {
+  const unsigned char *p = (const unsigned char *)text;
+  return nests_within(p, p + size, limit);
 }
