@@ -110,7 +110,7 @@
 (define nonce "0123456789abcdef")
 
 ;; The bytes of a netstring on the wire, and its payload.
-(define (signed text) (hmac-sha256-sign key text nonce ":" 1 ":"))
+(define (signed text) (hmac-sha256-sign key text (list nonce ":" 1 ":")))
 (define call-payload (string->utf8 (signed call-text)))
 
 ;; A connected pair of sockets in this process: frames are written to one
@@ -199,8 +199,10 @@
           (per-run (lambda () (read-netstring in 1048576)) (fill! payload)))
   (let ((n (bytevector-length payload)))
     (report side "MAC"
-            (per-run (lambda () (hmac-sha256-open key payload n nonce ":" 1 ":")))
-            (per-run (lambda () (hmac-sha256-open key payload n nonce ":" 1 ":")))))
+            (per-run (lambda ()
+                       (hmac-sha256-open key payload n (list nonce ":" 1 ":"))))
+            (per-run (lambda ()
+                       (hmac-sha256-open key payload n (list nonce ":" 1 ":"))))))
   (report side "parse"
           (per-run (lambda () (parse-message text)))
           (per-run (lambda () (read (open-input-string text)))))

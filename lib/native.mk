@@ -36,6 +36,7 @@ lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
 
 # The plain C that a stub includes.
 lib/murdoch/guard.so: lib/murdoch/heap-watch.c
+lib/murdoch/hmac.so: lib/murdoch/hmac-sha256.c
 lib/murdoch/netstring.so: lib/murdoch/netstring-scan.c
 lib/murdoch/sendable.so: lib/murdoch/plain.c
 lib/murdoch/connect.so: lib/murdoch/nonblocking-connect.c

@@ -102,12 +102,12 @@
 
 ;; Signed texts, as frames carry them: the MAC, then the text.
 (define key (text "Jefe"))
-(define (signed t . parts) (string->utf8 (apply hmac-sha256-sign key t parts)))
+(define (signed t . parts) (string->utf8 (hmac-sha256-sign key t parts)))
 (define (open-all bytes . parts)
-  (apply hmac-sha256-open key bytes (bytevector-length bytes) parts))
+  (hmac-sha256-open key bytes (bytevector-length bytes) parts))
 (test "a signature is the MAC of the parts and the text, then the text"
   (string-append (hmac-sha256 key "n:" 7 ":" "(hello)") "(hello)")
-  (hmac-sha256-sign key "(hello)" "n:" 7 ":"))
+  (hmac-sha256-sign key "(hello)" '("n:" 7 ":")))
 (test "a signed text opens with the same parts" "(hello)"
   (open-all (signed "(hello)" "n:" 7 ":") "n:" 7 ":"))
 (test "a non-ASCII text opens as it was" "caf\xe9;"
@@ -119,14 +119,18 @@
     (bytevector-u8-set! b 65 (char->integer #\j))
     (open-all b "n:")))
 (test "not under another key" #f
-  (hmac-sha256-open (text "other") (signed "(hello)") 71))
+  (hmac-sha256-open (text "other") (signed "(hello)") 71 '()))
 (test "fewer than 64 bytes do not open" #f
-  (hmac-sha256-open key (bytevector 1 2 3) 3))
+  (hmac-sha256-open key (bytevector 1 2 3) 3 '()))
 (test "only the first end bytes are the message" "(hello)"
   (let ((b (signed "(hello)")))
     (hmac-sha256-open key (bytevector-append b (bytevector 0 0))
-                      (bytevector-length b))))
+                      (bytevector-length b) '())))
 (test-error "an end past the bytes"
-  (hmac-sha256-open key (signed "(hello)") 100))
+  (hmac-sha256-open key (signed "(hello)") 100 '()))
+(test-error "parts that are not a list"
+  (hmac-sha256-sign key "(hello)" "n:"))
+(test-error "a text that is not a string"
+  (hmac-sha256-sign key 'hello '()))
 (test-end)
 (test-exit)

@@ -123,7 +123,7 @@
     text))
 
 (define (write-frame! out text nonce count)
-  (write-netstring (hmac-sha256-sign *key* text nonce ":" count ":") out))
+  (write-netstring (hmac-sha256-sign *key* text (list nonce ":" count ":")) out))
 
 (define (send-frame! out text-port nonce count message)
   (write-frame! out (frame-text text-port message) nonce count)
@@ -144,12 +144,12 @@
         payload
         (parse-message
          (authentic-text payload (bytevector-length payload)
-                         nonce ":" count ":")))))
+                         (list nonce ":" count ":"))))))
 
 ;; The text after the MAC in the first end bytes of bytes, once the MAC is
-;; that of the parts followed by the text.
-(define (authentic-text bytes end . parts)
-  (or (apply hmac-sha256-open *key* bytes end parts)
+;; that of the list parts followed by the text.
+(define (authentic-text bytes end parts)
+  (or (hmac-sha256-open *key* bytes end parts)
       (frame-fail "bad MAC")))
 
 ;; Chibi's own reader, in C: (scheme read) is SRFI 38's, written in
@@ -193,8 +193,8 @@
 
 ;;> The bytes of a datagram carrying \var{text}, with its MAC.
 (define (datagram-bytes text)
-  (string->utf8 (hmac-sha256-sign *key* text "mcast:")))
+  (string->utf8 (hmac-sha256-sign *key* text '("mcast:"))))
 
 ;;> The message of the authentic datagram in the first n bytes of buffer.
 (define (open-datagram-text buffer n)
-  (parse-message (authentic-text buffer n "mcast:")))
+  (parse-message (authentic-text buffer n '("mcast:"))))

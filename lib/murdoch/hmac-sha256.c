@@ -1,4 +1,5 @@
-/*  hmac.c -- HMAC-SHA256 (RFC 2104) for (murdoch hmac), by OpenSSL's libcrypto
+/*  hmac-sha256.c -- HMAC-SHA256 (RFC 2104) for (murdoch hmac), by OpenSSL's
+ *  libcrypto; hmac.stub binds it
  *
  *  Every frame of the remote layer is MAC'd once when sent and once when
  *  received.  Over Chibi's SHA-256 that cost 40 us a frame, nearly all of
@@ -15,6 +16,9 @@
  *  starts from those.  Signing a 200-byte frame cost 2.6 us of CPU over
  *  our own SHA-256 in C, 1.7 us by HMAC_CTX keyed afresh each call, and
  *  costs 1.0 us so; a 64 KB message 290 us over our SHA-256, 47 us here.
+ *
+ *  The key and the parts come unchecked, and are looked at here: each may
+ *  be of more than one type, which chibi-ffi's checks cannot say.
  */
 
 #include <chibi/eval.h>
@@ -90,14 +94,17 @@ static int hmac_begin (sexp key) {
   return 1;
 }
 
-/* Hashes the parts of a Scheme list; the first that is not bytes, text or
- * a fixnum, or SEXP_NULL when all are. */
+/* Hashes the parts of a Scheme list: the empty list when all are bytes,
+ * text or fixnums; else the pair of the first that is not, or the list's
+ * end that is not the empty list. */
 static sexp hash_parts (sexp ls) {
   for ( ; sexp_pairp(ls); ls = sexp_cdr(ls))
     if (!hash_part(sexp_car(ls)))
-      return sexp_car(ls);
-  return SEXP_NULL;
+      return ls;
+  return ls;
 }
+
+static EVP_MAC_CTX *new_mac_context (void);
 
 /* Begins HMAC under key and hashes the parts: SEXP_VOID, or the type
  * exception that names the key or the first part that is neither bytes,
@@ -106,12 +113,16 @@ static sexp hmac_begin_parts (sexp ctx, sexp self, sexp key, sexp parts) {
   const unsigned char *p;
   size_t n;
   sexp bad;
+  if (!mac_context && !(mac_context = new_mac_context()))
+    return sexp_user_exception(ctx, self, "libcrypto: no HMAC-SHA256", SEXP_NULL);
   if (!hmac_begin(key))
     return bytes_of(key, &p, &n)
       ? sexp_user_exception(ctx, self, "libcrypto: HMAC failed", key)
       : sexp_type_exception(ctx, self, SEXP_BYTES, key);
   if ((bad = hash_parts(parts)) != SEXP_NULL)
-    return sexp_type_exception(ctx, self, SEXP_BYTES, bad);
+    return sexp_pairp(bad)
+      ? sexp_type_exception(ctx, self, SEXP_BYTES, sexp_car(bad))
+      : sexp_type_exception(ctx, self, SEXP_PAIR, parts);
   return SEXP_VOID;
 }
 
@@ -134,37 +145,29 @@ static sexp libcrypto_failed (sexp ctx, sexp self) {
   return sexp_user_exception(ctx, self, "libcrypto: HMAC failed", SEXP_NULL);
 }
 
-/* (hmac-sha256 key part ...): the MAC under key (a bytevector or string)
+/* (%hmac-sha256 key parts): the MAC under key (a bytevector or string)
  * of the parts one after the other (bytevectors, strings as UTF-8, and
  * fixnums in decimal), as a lowercase hex string. */
-static sexp hmac_sha256 (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
+static sexp hmac_sha256 (sexp ctx, sexp self, sexp key, sexp parts) {
   char text[64];
   sexp res;
-  if (!sexp_pairp(args))
-    return sexp_user_exception(ctx, self, "no key", args);
-  res = hmac_begin_parts(ctx, self, sexp_car(args), sexp_cdr(args));
+  res = hmac_begin_parts(ctx, self, key, parts);
   if (res != SEXP_VOID) return res;
   if (!hmac_end(text)) return libcrypto_failed(ctx, self);
   return sexp_c_string(ctx, text, 64);
 }
 
-/* (hmac-sha256-sign key text part ...): text signed, a string of the MAC
- * under key of the parts followed by text, then text itself.  One call
- * where a frame took a MAC and a string-append. */
-static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
+/* (hmac-sha256-sign key text parts): text, of tn bytes at tp, signed: a
+ * string of the MAC under key of the parts followed by text, then text
+ * itself.  One call where a frame took a MAC and a string-append. */
+static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp key,
+                              const char *tp, long tn, sexp parts) {
   char mac[64];
-  const unsigned char *tp;
-  size_t tn;
   sexp res;
-  if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args)))
-    return sexp_user_exception(ctx, self, "expected a key and a text", args);
-  if (!sexp_stringp(sexp_cadr(args)))
-    return sexp_type_exception(ctx, self, SEXP_STRING, sexp_cadr(args));
-  res = hmac_begin_parts(ctx, self, sexp_car(args), sexp_cddr(args));
+  res = hmac_begin_parts(ctx, self, key, parts);
   if (res != SEXP_VOID) return res;
-  tp = (const unsigned char *)sexp_string_data(sexp_cadr(args));
-  tn = sexp_string_size(sexp_cadr(args));
-  if (!EVP_MAC_update(mac_context, tp, tn) || !hmac_end(mac))
+  if (!EVP_MAC_update(mac_context, (const unsigned char *)tp, tn)
+      || !hmac_end(mac))
     return libcrypto_failed(ctx, self);
   /* Built in place, as sexp_c_string builds a string: the collector does
    * not move the text, so tp stays good. */
@@ -177,36 +180,27 @@ static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
   return res;
 }
 
-/* (hmac-sha256-open key bytes end part ...): the text that follows the 64
- * hex digits of a MAC in the first end bytes of bytes, as a string, when
- * the MAC is that under key of the parts followed by the text; #f when it
- * is not, or there are fewer than 64 bytes.  The text's bytes are taken as
- * they are: bytes that are not UTF-8 fail the MAC or the reader. */
-static sexp hmac_sha256_open (sexp ctx, sexp self, sexp_sint_t n, sexp args) {
+/* (hmac-sha256-open key bytes end parts): the text that follows the 64
+ * hex digits of a MAC in the first end bytes of bytes (of size bytes at
+ * data), as a string, when the MAC is that under key of the parts
+ * followed by the text; #f when it is not, or there are fewer than 64
+ * bytes.  The text's bytes are taken as they are: bytes that are not
+ * UTF-8 fail the MAC or the reader. */
+static sexp hmac_sha256_open (sexp ctx, sexp self, sexp key, const char *data,
+                              long size, long end, sexp parts) {
   char mac[64];
-  sexp bytes, end, res;
-  sexp_sint_t e;
-  if (!sexp_pairp(args) || !sexp_pairp(sexp_cdr(args))
-      || !sexp_pairp(sexp_cddr(args)))
-    return sexp_user_exception(ctx, self, "expected a key, bytes and an end", args);
-  bytes = sexp_cadr(args);
-  end = sexp_car(sexp_cddr(args));
-  if (!sexp_bytesp(bytes))
-    return sexp_type_exception(ctx, self, SEXP_BYTES, bytes);
-  if (!sexp_fixnump(end))
-    return sexp_type_exception(ctx, self, SEXP_FIXNUM, end);
-  e = sexp_unbox_fixnum(end);
-  if (e < 0 || (sexp_uint_t)e > sexp_bytes_length(bytes))
-    return sexp_user_exception(ctx, self, "end out of range", end);
-  if (e < 64) return SEXP_FALSE;
-  res = hmac_begin_parts(ctx, self, sexp_car(args), sexp_cdr(sexp_cddr(args)));
+  sexp res;
+  if (end < 0 || end > size)
+    return sexp_user_exception(ctx, self, "end out of range",
+                               sexp_make_integer(ctx, end));
+  if (end < 64) return SEXP_FALSE;
+  res = hmac_begin_parts(ctx, self, key, parts);
   if (res != SEXP_VOID) return res;
-  if (!EVP_MAC_update(mac_context,
-                      (const unsigned char *)sexp_bytes_data(bytes) + 64, e - 64)
+  if (!EVP_MAC_update(mac_context, (const unsigned char *)data + 64, end - 64)
       || !hmac_end(mac))
     return libcrypto_failed(ctx, self);
-  if (CRYPTO_memcmp(mac, sexp_bytes_data(bytes), 64) != 0) return SEXP_FALSE;
-  return sexp_c_string(ctx, sexp_bytes_data(bytes) + 64, e - 64);
+  if (CRYPTO_memcmp(mac, data, 64) != 0) return SEXP_FALSE;
+  return sexp_c_string(ctx, data + 64, end - 64);
 }
 
 /* A context for HMAC over SHA-256, not yet keyed; NULL when libcrypto has
@@ -224,17 +218,4 @@ static EVP_MAC_CTX *new_mac_context (void) {
     c = NULL;
   }
   return c;
-}
-
-sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
-                        const char *version, const sexp_abi_identifier_t abi) {
-  if (!(sexp_version_compatible(ctx, version, sexp_version)
-        && sexp_abi_compatible(ctx, abi, SEXP_ABI_IDENTIFIER)))
-    return SEXP_ABI_ERROR;
-  if (!mac_context && !(mac_context = new_mac_context()))
-    return sexp_user_exception(ctx, self, "libcrypto: no HMAC-SHA256", SEXP_NULL);
-  sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256", 0, hmac_sha256);
-  sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256-sign", 0, hmac_sha256_sign);
-  sexp_define_foreign_proc_rest(ctx, env, "hmac-sha256-open", 0, hmac_sha256_open);
-  return SEXP_VOID;
 }
