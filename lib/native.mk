@@ -4,7 +4,7 @@
 #                       hmac.so, netstring.so, connect.so, guard.so,
 #                       process-name.so and sendable.so, the C of the
 #                       libraries of those names, and bench/c-pingpong
-#   make native-clean   removes them
+#   make native-clean   removes them, and the C that chibi-ffi wrote
 
 # tools/chibi-cflags names the directory of Chibi's headers, which in the
 # private install also holds a newer libc's headers; searched after the
@@ -22,10 +22,11 @@ NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 
-# The bindings are .stub files, from which chibi-ffi writes the C: the
-# procedures' argument checks, their errors and sexp_init_library.  What
-# real C they bind is in the stub, or in a file of plain C it includes.
-# Only the scheduler's C is written by hand (scheduler.c says why).
+# The bindings are .stub files, as Chibi's own libraries' are: from X.stub
+# chibi-ffi writes X.c (not kept in git), with the procedures' argument
+# checks, their type errors and sexp_init_library.  The C they bind is in
+# a file of plain C that the stub includes.  Only the scheduler is C
+# written by hand through and through (scheduler.c says why).
 NATIVE_STUBS := $(wildcard lib/murdoch/*.stub)
 
 lib/murdoch/%.c: lib/murdoch/%.stub

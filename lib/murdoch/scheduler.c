@@ -17,6 +17,10 @@
  *  Everything it reads or writes -- the paused list, the run queue, each
  *  thread's wait flag, deadline, event, fuel and interrupt mark -- is
  *  public in sexp.h.
+ *
+ *  Written by hand, not made from a .stub by chibi-ffi as the other
+ *  libraries' C is: its heart is an opcode that the VM calls in its own
+ *  convention, and loading must install it or fail, which a stub cannot say.
  */
 
 #include <chibi/eval.h>
