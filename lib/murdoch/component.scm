@@ -19,21 +19,35 @@
 
 ;;> Runs component \var{k} of task \var{id} here, for \var{poser}, which
 ;;> sends a heartbeat every \var{period} seconds: work is (PROC ARG ...).
-;;> A robot failure comes back as (robot-failure WHY).
+;;> A robot failure comes back as (robot-failure WHY); any other condition
+;;> is raised again once the component has left its dynamic extent.
 (define (run-component id k poser period work)
   (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
     (running-over?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
     (thread-start! (make-thread (lambda () (watch-poser r period)) 'watch-poser))
-    (dynamic-wind
-     (lambda () #f)
-     (lambda ()
-       (guard (e ((robot-failure? e) (list 'robot-failure (error-message e))))
-         (apply (car work) (cdr work))))
-     (lambda ()
-       (running-over?-set! r #t)
-       (with-lock *running-lock*
-         (lambda () (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+    (let ((outcome
+           (dynamic-wind
+            (lambda () #f)
+            (lambda ()
+              ;; Every condition is caught: a guard that lets one through
+              ;; raises it again inside the extent it left, and so runs the
+              ;; component's own dynamic-wind before and after a second time.
+              (guard (e ((robot-failure? e) (list 'robot-failure (error-message e)))
+                        (#t (make-raised e)))
+                (apply (car work) (cdr work))))
+            (lambda ()
+              (running-over?-set! r #t)
+              (with-lock *running-lock*
+                (lambda ()
+                  (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+      (if (raised? outcome) (raise (raised-condition outcome)) outcome))))
+
+;; A condition that a component raised, held until it is outside.
+(define-record-type raised
+  (make-raised condition)
+  raised?
+  (condition raised-condition))
 
 ;; A trip connection closed or a stalled base: the robot, not the task,
 ;; failed.
