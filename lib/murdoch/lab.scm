@@ -99,6 +99,8 @@
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" (,size-bytes . "bytes, or a size in quotes such as \"512M\""))
+    ;; Chibi grows its heap by twice one allocation (sandbox.scm).
+    (max-alloc "32M" (,size-bytes . "bytes, or a size in quotes such as \"32M\""))
     (code () (,(lambda (x) (and (every string? x) x)) . "file names, in quotes"))
     (delivery (broadcast) (,delivery-clause . "broadcast, or multicast \"GROUP\" [PORT]"))))
 
