@@ -1,4 +1,5 @@
-/*  connect.c -- the C of (murdoch connect): a TCP connect that does not wait
+/*  connect.c -- the C of (murdoch connect): a TCP connect that does not wait,
+ *  and the port a listener was given
  *
  *  (chibi net)'s open-net-io connects in blocking mode: a host that drops
  *  our SYN holds the whole process, every green thread, for the kernel's
@@ -20,6 +21,7 @@
 #include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 
 /* Why a connect failed, as a Scheme string starting lowercase, so that the
@@ -96,6 +98,18 @@ static sexp connect_poll (sexp ctx, sexp self, sexp_sint_t n, sexp sock) {
   return err == 0 ? SEXP_TRUE : reason(ctx, strerror(err));
 }
 
+/* (socket-port SOCKET): the local port SOCKET is bound to, as the kernel
+ * chose it for a listener bound to port 0; #f when it cannot say. */
+static sexp socket_port (sexp ctx, sexp self, sexp_sint_t n, sexp sock) {
+  struct sockaddr_in addr;
+  socklen_t len = sizeof addr;
+  sexp_assert_type(ctx, sexp_filenop, SEXP_FILENO, sock);
+  if (getsockname(sexp_fileno_fd(sock), (struct sockaddr *)&addr, &len) < 0
+      || addr.sin_family != AF_INET)
+    return SEXP_FALSE;
+  return sexp_make_fixnum(ntohs(addr.sin_port));
+}
+
 sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
                         const char *version, const sexp_abi_identifier_t abi) {
   if (!(sexp_version_compatible(ctx, version, sexp_version)
@@ -103,5 +117,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
     return SEXP_ABI_ERROR;
   sexp_define_foreign(ctx, env, "connect-start", 3, connect_start);
   sexp_define_foreign(ctx, env, "connect-poll", 1, connect_poll);
+  sexp_define_foreign(ctx, env, "socket-port", 1, socket_port);
   return SEXP_VOID;
 }
