@@ -195,7 +195,7 @@
   (at 'poser 'start-spinning)
   (test "it runs on near" #t (wait-until 10 (lambda () (> (spins-at 'near) 0))))
   (kill-process! (cdr (assq 'poser pids)))
-  (test "within three heartbeats and a little, it stops" #t
+  (test "within two heartbeats and a little, it stops" #t
     (wait-until 5 (lambda () (stopped-at? 'near))))
   (test "its setup and cleanup ran once" '(1 1) (counts-after-stop 'near))
   (test "and its subjects are free" #t (wait-until 5 all-free?)))

@@ -54,11 +54,22 @@
 (define (robot-failure? e)
   (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
 
-;; Stops r when its poser is silent for three periods.
+;; No ghosts, with a margin: a component stops on its robot once its
+;; poser has been silent for orphan-periods heartbeat periods, looked at
+;; every quarter period, so by 2.25 periods after the last heartbeat the
+;; robot heard; its poser declares the robot lost only when no heartbeat
+;; was answered for lost-periods (task.scm), and the robot heard that
+;; heartbeat before its answer reached the poser.  The stale copy has
+;; stopped 1.75 periods before the poser can start another: one full
+;; period, and more, for a loaded robot that is late to look.
+(define orphan-periods 2)
+(define lost-periods 4)
+
+;; Stops r when its poser is silent for orphan-periods.
 (define (watch-poser r period)
-  (thread-sleep! period)
+  (thread-sleep! (/ period 4))
   (cond ((running-over? r) #t)
-        ((> (- (monotonic-seconds) (running-heard r)) (* 3 period))
+        ((> (- (monotonic-seconds) (running-heard r)) (* orphan-periods period))
          (log-warn "the poser " (running-poser r) " of " (running-id r)
                    " is silent: component " (running-index r) " stops")
          (stop-running! r))
