@@ -159,8 +159,8 @@
 
 ;; An exact power takes as many bits as its exponent times its base's.
 (define (sized-expt base power)
-  (if (and (exact? base) (exact? power) (rational? base) (integer? power)
-           (> (abs power) 1))
+  (if (and (number? base) (number? power) (exact? base) (exact? power)
+           (rational? base) (integer? power) (> (abs power) 1))
       (let ((digits (max (abs (numerator base)) (denominator base))))
         (if (> digits 1)
             (check-alloc! "expt" (abs power) (/ (log digits 2) 8)))))
