@@ -7,8 +7,14 @@
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define lab-code "
+;; Setup and cleanup count, here, how often they run.
+(define ins 0)
+(define outs 0)
 ;; Drives a metre ahead: moseley meets the wall in front of it.
-(define (drive) (translate 1000) (local-aspace-uid))
+(define (drive)
+  (dynamic-wind (lambda () (set! ins (+ ins 1)))
+                (lambda () (translate 1000) (local-aspace-uid))
+                (lambda () (set! outs (+ outs 1)))))
 ;; Reads its odometry until stopped.
 (define (watch)
   (let loop ((n 400)) (reckon) (thread-sleep! 0.05) (if (> n 0) (loop (- n 1)) 'watched)))
@@ -51,7 +57,12 @@
          (r (task-wait t 60)))
     (test "the component moves to ernst, which drives its metre" '(ernst) r)
     (test "moseley is recorded as lost, not as failed" '(moseley lost)
-      (let ((a (car (attempts-of t)))) (list (car a) (cadr a))))))
+      (let ((a (car (attempts-of t)))) (list (car a) (cadr a))))
+    (test "the component's setup and cleanup ran once on each" '((1 1) (1 1))
+      (map (lambda (uid)
+             (remote-apply (uid->aspace uid)
+                           (eval '(lambda () (list ins outs)) (lab-environment))))
+           '(moseley ernst)))))
 
 (test-group "a trip server that dies is a robot failure"
   (let ((t (start-task 'watch 1 (list '((mobile) ())) (list moseley-first)

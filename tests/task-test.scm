@@ -10,22 +10,29 @@
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define lab-code "
-(define (who-am-i) (thread-sleep! 0.2) (local-aspace-uid))
-(define (fail) (error \"the component broke\"))
+;; Each component's setup and cleanup count, here, how often they run.
+(define ins 0)
+(define outs 0)
+(define (counted thunk)
+  (dynamic-wind (lambda () (set! ins (+ ins 1)))
+                thunk
+                (lambda () (set! outs (+ outs 1)))))
+(define (who-am-i) (counted (lambda () (thread-sleep! 0.2) (local-aspace-uid))))
+(define (fail) (counted (lambda () (error \"the component broke\"))))
 ;; A component that runs until stopped, calling out all the time; spins
 ;; counts its rounds here, stopped says how it ended.
 (define spins 0)
 (define stopped #f)
 (define (spin-for rounds)
   (dynamic-wind
-   (lambda () #f)
+   (lambda () (set! ins (+ ins 1)))
    (lambda ()
      (let loop ((n rounds))
        (set! spins (+ spins 1))
        (remote-apply (uid->aspace 'quiet) (lambda () #t))
        (thread-sleep! 0.05)
        (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
-   (lambda () (set! stopped #t))))
+   (lambda () (set! stopped #t) (set! outs (+ outs 1)))))
 ;; A component that counts how many components run here at once.
 (define inside 0)
 (define most-inside 0)
@@ -71,6 +78,21 @@
 (define (stopped-at? uid)
   (remote-apply (uid->aspace uid) (eval '(lambda () stopped) (lab-environment))))
 (define (all-free?) ((lab-proc 'free-everywhere?) '(mobile)))
+;; How often components' setup and cleanup ran on uid since it was last
+;; asked: (INS OUTS).
+(define (counts-at uid)
+  (remote-apply (uid->aspace uid)
+                (eval '(lambda ()
+                         (let ((c (list ins outs))) (set! ins 0) (set! outs 0) c))
+                      (lab-environment))))
+;; The same, once a component stopped from outside has run its cleanup,
+;; and a moment after, when a second setup and cleanup would have run.
+(define (counts-after-stop uid)
+  (wait-until 5 (lambda ()
+                  (positive? (remote-apply (uid->aspace uid)
+                                           (eval '(lambda () outs) (lab-environment))))))
+  (thread-sleep! 0.5)
+  (counts-at uid))
 (define near-first (location-metric-maker '(0 0 0 0)))
 (define (state-of task k) (cadr (list-ref (task-status task) (- k 1))))
 (define (attempts-of task k) (car (cddr (list-ref (task-status task) (- k 1)))))
@@ -93,6 +115,8 @@
       (every (lambda (s) (and (memq (car (cadr s)) '(negotiating running)) #t))
              (task-status t)))
     (test "task-wait gives the results" '(near far) (task-wait t 10))
+    (test "each one's setup and cleanup ran once" '((1 1) (1 1))
+      (list (counts-at 'near) (counts-at 'far)))
     (test "each is done, with its value" '((done near) (done far))
       (list (state-of t 1) (state-of t 2)))
     (test-assert "tasks lists it" (assq 'posed (tasks)))
@@ -104,7 +128,8 @@
     (let ((r (task-wait t 10)))
       (test "(error UID WHY), even when restartable" '(error near)
         (list (car (car r)) (cadr (car r))))
-      (test "failed, tried once" 1 (length (attempts-of t 1))))))
+      (test "failed, tried once" 1 (length (attempts-of t 1)))
+      (test "its setup and cleanup ran once" '(1 1) (counts-at 'near)))))
 
 (test-group "task-wait with a timeout"
   (let ((t (start-task 'spinner 1 (list '((mobile) ())) (list near-first)
@@ -114,6 +139,7 @@
     (test "then the task ends by itself" '(near) (task-wait t 20))))
 
 (test-group "cancel-task"
+  (counts-at 'near)
   (let ((t (start-task 'cancelled 1 (list '((mobile) ())) (list near-first)
                        (list (lab-proc 'spin-long)))))
     (test-assert "it runs on near" (running-on? t 1 'near))
@@ -127,6 +153,7 @@
     (test "cancel-task answers #t" #t (cancel-task t))
     (test "the component stops on its robot within a second" #t
       (wait-until 1 (lambda () (stopped-at? 'near))))
+    (test "its setup and cleanup ran once" '(1 1) (counts-after-stop 'near))
     (test-assert "task-wait answers, the component failed as cancelled"
       (let ((r (task-wait t 5)))
         (and (eq? (car (car r)) 'error) (equal? (state-of t 1) '(failed "cancelled")))))
@@ -164,11 +191,13 @@
       (test "tried once" 1 (length (attempts-of t 1))))))
 
 (test-group "no orphans: a component whose poser dies stops"
+  (counts-at 'near)
   (at 'poser 'start-spinning)
   (test "it runs on near" #t (wait-until 10 (lambda () (> (spins-at 'near) 0))))
   (kill-process! (cdr (assq 'poser pids)))
-  (test "within three heartbeats and a little, it stops" #t
+  (test "within two heartbeats and a little, it stops" #t
     (wait-until 5 (lambda () (stopped-at? 'near))))
+  (test "its setup and cleanup ran once" '(1 1) (counts-after-stop 'near))
   (test "and its subjects are free" #t (wait-until 5 all-free?)))
 
 (test-group "no ghosts: a frozen robot, declared lost, stops its component"
@@ -182,6 +211,7 @@
     (kill near-pid signal/continue)
     (test "near, back, stops its stale copy" #t
       (wait-until 5 (lambda () (stopped-at? 'near))))
+    (test "whose setup and cleanup ran once" '(1 1) (counts-after-stop 'near))
     (let ((before (spins-at 'near)))
       (thread-sleep! 0.5)
       (test "and runs it no more" before (spins-at 'near)))

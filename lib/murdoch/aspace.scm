@@ -26,6 +26,12 @@
 (define (local-aspace)
   (or *local* (error "this process has not joined a lab")))
 
+;;> Makes \var{port} the local address space's: the free one the kernel
+;;> chose for a guest, which listens on port 0 and says where in its hellos.
+(define (local-aspace-port-set! port)
+  (set! *local* (make-aspace (aspace-uid *local*) (aspace-host *local*) port))
+  (learn-aspace! *local*))
+
 ;;> The (current-second) at which this address space joined its lab.
 (define (aspace-started-at) *started-at*)
 

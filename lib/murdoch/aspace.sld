@@ -3,7 +3,8 @@
 
 (define-library (murdoch aspace)
   (export aspace? aspace-uid aspace-host aspace-port make-aspace
-          local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
+          local-aspace local-aspace-uid local-aspace-port-set!
+          aspace-started-at uid->aspace known-uids
           learn-aspace! note-unreachable! note-reachable! unreachable-uids
           live-uids current-lab join-lab!
           remote-timeout set-remote-timeout! current-timeout

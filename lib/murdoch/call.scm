@@ -106,7 +106,11 @@
                         s))
                   started)))
 
+;; A call to this address space is a remote call too: an abandoned thread
+;; stops at it (abandon.scm), as a component cut off from its poser whose
+;; commands go to its own address space must.
 (define (local-call kind proc args)
+  (check-not-abandoned (if (eq? kind 'run) "remote-run!" "remote-apply"))
   (if (eq? kind 'run)
       (begin (run-in-worker (lambda () (apply proc args))) #t)
       (apply-here (local-aspace-uid) proc args)))

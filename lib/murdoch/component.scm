@@ -19,32 +19,57 @@
 
 ;;> Runs component \var{k} of task \var{id} here, for \var{poser}, which
 ;;> sends a heartbeat every \var{period} seconds: work is (PROC ARG ...).
-;;> A robot failure comes back as (robot-failure WHY).
+;;> A robot failure comes back as (robot-failure WHY); any other condition
+;;> is raised again once the component has left its dynamic extent.
 (define (run-component id k poser period work)
   (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
     (running-over?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
     (thread-start! (make-thread (lambda () (watch-poser r period)) 'watch-poser))
-    (dynamic-wind
-     (lambda () #f)
-     (lambda ()
-       (guard (e ((robot-failure? e) (list 'robot-failure (error-message e))))
-         (apply (car work) (cdr work))))
-     (lambda ()
-       (running-over?-set! r #t)
-       (with-lock *running-lock*
-         (lambda () (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+    (let ((outcome
+           (dynamic-wind
+            (lambda () #f)
+            (lambda ()
+              ;; Every condition is caught: a guard that lets one through
+              ;; raises it again inside the extent it left, and so runs the
+              ;; component's own dynamic-wind before and after a second time.
+              (guard (e ((robot-failure? e) (list 'robot-failure (error-message e)))
+                        (#t (make-raised e)))
+                (apply (car work) (cdr work))))
+            (lambda ()
+              (running-over?-set! r #t)
+              (with-lock *running-lock*
+                (lambda ()
+                  (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
+      (if (raised? outcome) (raise (raised-condition outcome)) outcome))))
+
+;; A condition that a component raised, held until it is outside.
+(define-record-type raised
+  (make-raised condition)
+  raised?
+  (condition raised-condition))
 
 ;; A trip connection closed or a stalled base: the robot, not the task,
 ;; failed.
 (define (robot-failure? e)
   (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
 
-;; Stops r when its poser is silent for three periods.
+;; No ghosts, with a margin: a component stops on its robot once its
+;; poser has been silent for orphan-periods heartbeat periods, looked at
+;; every quarter period, so by 2.25 periods after the last heartbeat the
+;; robot heard; its poser declares the robot lost only when no heartbeat
+;; was answered for lost-periods (task.scm), and the robot heard that
+;; heartbeat before its answer reached the poser.  The stale copy has
+;; stopped 1.75 periods before the poser can start another: one full
+;; period, and more, for a loaded robot that is late to look.
+(define orphan-periods 2)
+(define lost-periods 4)
+
+;; Stops r when its poser is silent for orphan-periods.
 (define (watch-poser r period)
-  (thread-sleep! period)
+  (thread-sleep! (/ period 4))
   (cond ((running-over? r) #t)
-        ((> (- (monotonic-seconds) (running-heard r)) (* 3 period))
+        ((> (- (monotonic-seconds) (running-heard r)) (* orphan-periods period))
          (log-warn "the poser " (running-poser r) " of " (running-id r)
                    " is silent: component " (running-index r) " stops")
          (stop-running! r))

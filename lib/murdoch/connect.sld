@@ -3,9 +3,13 @@
 ;;> The C is lib/murdoch/connect.stub and nonblocking-connect.c, built into
 ;;> lib/murdoch/connect.so by \scheme{make native}; the waiting is
 ;;> lib/murdoch/connect.scm.
+;;>
+;;> \procedure{(socket-port socket)}
+;;> The local port \var{socket} is bound to: for a listener bound to port
+;;> 0, the free one the kernel chose.
 
 (define-library (murdoch connect)
-  (export open-connection)
+  (export open-connection socket-port)
   (import (scheme base) (srfi 18) (srfi 151)
           (only (chibi net) socket address-family/inet socket-type/stream)
           (only (chibi) fileno?)

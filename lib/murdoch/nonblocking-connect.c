@@ -1,5 +1,5 @@
 /*  nonblocking-connect.c -- the C of (murdoch connect), which connect.stub
- *  binds: a TCP connect that does not wait
+ *  binds: a TCP connect that does not wait, and the port a listener was given
  *
  *  (chibi net)'s open-net-io connects in blocking mode: a host that drops
  *  our SYN holds the whole process, every green thread, for the kernel's
@@ -21,6 +21,7 @@
 #include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 
 /* Why a connect failed, as a Scheme string starting lowercase, so that the
@@ -93,4 +94,15 @@ static sexp connect_poll (sexp ctx, int sock) {
   if (ready < 0 || getsockopt(p.fd, SOL_SOCKET, SO_ERROR, &err, &len) < 0)
     err = errno;
   return err == 0 ? SEXP_TRUE : reason(ctx, strerror(err));
+}
+
+/* (socket-port SOCKET): the local port SOCKET is bound to, as the kernel
+ * chose it for a listener bound to port 0; #f when it cannot say. */
+static sexp socket_port (int sock) {
+  struct sockaddr_in addr;
+  socklen_t len = sizeof addr;
+  if (getsockname(sock, (struct sockaddr *)&addr, &len) < 0
+      || addr.sin_family != AF_INET)
+    return SEXP_FALSE;
+  return sexp_make_fixnum(ntohs(addr.sin_port));
 }

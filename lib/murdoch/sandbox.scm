@@ -23,15 +23,33 @@
 ;;    bindings are its own too, Murdoch's among them (see
 ;;    sandbox-parameter!): (remote-timeout 0) in one call sets nothing for
 ;;    the next.
+;; 5. A constructor told a size (make-vector, make-string, iota, expt ...)
+;;    refuses one whose result would take more than the lab's max-alloc
+;;    bytes, with an error answered to the call: Chibi would grow the heap
+;;    by twice that at once, past heap-max, and the heap guard would end
+;;    the address space with every call it runs.
+;; 6. A thread that received code makes, and one that serves calls, says
+;;    in one line of the log that it died, and of what (make-logged-thread),
+;;    where Chibi writes its own objects and a backtrace.
 
 (define sandbox-libraries
-  '((except (scheme base) lambda define set!) (scheme char) (scheme cxr)
+  '((except (scheme base) lambda define set! make-vector make-string
+            make-bytevector make-list read-bytevector expt)
+    (scheme char) (scheme cxr)
     (scheme inexact) (scheme complex) (scheme lazy) (scheme case-lambda)
-    (scheme write) (srfi 1)
-    (except (srfi 18) thread-terminate!) (murdoch)
-    (rename (only (murdoch sandbox) guarded-set! guarded-thread-terminate!)
+    (scheme write) (except (srfi 1) make-list list-tabulate iota)
+    (except (srfi 18) thread-terminate! make-thread) (murdoch)
+    (rename (only (murdoch sandbox) guarded-set! guarded-thread-terminate!
+                  make-logged-thread sized-make-vector sized-make-string
+                  sized-make-bytevector sized-make-list sized-list-tabulate
+                  sized-iota sized-read-bytevector sized-expt)
             (guarded-set! set!)
-            (guarded-thread-terminate! thread-terminate!))))
+            (guarded-thread-terminate! thread-terminate!)
+            (make-logged-thread make-thread)
+            (sized-make-vector make-vector) (sized-make-string make-string)
+            (sized-make-bytevector make-bytevector) (sized-make-list make-list)
+            (sized-list-tabulate list-tabulate) (sized-iota iota)
+            (sized-read-bytevector read-bytevector) (sized-expt expt))))
 
 ;;; Assignment
 
@@ -74,12 +92,79 @@
 
 ;;> A thread, as make-thread makes, that received code cannot end.
 (define (make-guarded-thread thunk name)
-  (make-thread (lambda ()
-                 (protect! (current-thread) #t)
-                 (dynamic-wind (lambda () #f)
-                               thunk
-                               (lambda () (protect! (current-thread) #f))))
-               name))
+  (make-logged-thread (lambda ()
+                        (protect! (current-thread) #t)
+                        (dynamic-wind (lambda () #f)
+                                      thunk
+                                      (lambda () (protect! (current-thread) #f))))
+                      name))
+
+;;> make-thread inside the sandbox: a thread that ends by raising says so
+;;> in one line of the log, naming the address space, the thread and the
+;;> error, and thread-join! raises the error as before.
+(define (make-logged-thread thunk . name)
+  (apply make-thread
+         (lambda ()
+           (guard (e (#t (log-thread-death e) (raise e)))
+             (thunk)))
+         name))
+
+;; Chibi writes a thread's uncaught error to the thread's current error
+;; port, as "ERROR in child thread: #<Context ...>" and a backtrace; the
+;; thread's last binding of that port is made a sink, so that the line
+;; logged here is the only one.
+(define (log-thread-death e)
+  (parameterize ((current-error-port (or *err* (current-error-port))))
+    (log-warn "thread " (thread-label (current-thread)) " died: " (error-message e)))
+  (thread-parameters-set! (cons (cons current-error-port (open-output-string))
+                                (thread-parameters))))
+
+(define (thread-label thread)
+  (let ((name (thread-name thread)))
+    (if name
+        (call-with-output-string (lambda (out) (write name out)))
+        "without a name")))
+
+;;; Allocation
+
+(define *max-alloc* #f)                 ; the lab's max-alloc, in bytes
+
+;; Refuses count items of unit bytes each, past the lab's max-alloc.
+(define (check-alloc! who count unit)
+  (if (and *max-alloc* (real? count) (> (* count unit) *max-alloc*))
+      (error (string-append who ": " (number->string count)
+                            " would take more than the lab's max-alloc, "
+                            (number->string *max-alloc*) " bytes"))))
+
+;; A constructor whose first argument is a count of unit bytes each.
+(define (sized who unit make)
+  (lambda (count . rest)
+    (check-alloc! who count unit)
+    (apply make count rest)))
+
+;; In Chibi a vector's slot and a pair each take a word or more.
+(define sized-make-vector (sized "make-vector" 8 make-vector))
+(define sized-make-bytevector (sized "make-bytevector" 1 make-bytevector))
+(define sized-make-list (sized "make-list" 32 make-list))
+(define sized-list-tabulate (sized "list-tabulate" 32 list-tabulate))
+(define sized-iota (sized "iota" 32 iota))
+(define sized-read-bytevector (sized "read-bytevector" 1 read-bytevector))
+
+(define (sized-make-string count . fill)
+  (check-alloc! "make-string" count
+                (if (and (pair? fill) (char? (car fill)))
+                    (bytevector-length (string->utf8 (string (car fill))))
+                    1))
+  (apply make-string count fill))
+
+;; An exact power takes as many bits as its exponent times its base's.
+(define (sized-expt base power)
+  (if (and (number? base) (number? power) (exact? base) (exact? power)
+           (rational? base) (integer? power) (> (abs power) 1))
+      (let ((digits (max (abs (numerator base)) (denominator base))))
+        (if (> digits 1)
+            (check-alloc! "expt" (abs power) (/ (log digits 2) 8)))))
+  (expt base power))
 
 ;;> thread-terminate! inside the sandbox: for the threads received code
 ;;> made, not for those that serve calls.
@@ -170,6 +255,7 @@
 ;;> loaded.  Each file is read here and evaluated in the environment, so
 ;;> the files themselves can use no more than received code can.
 (define (make-lab-environment lab)
+  (set! *max-alloc* (lab-setting lab 'max-alloc))
   (let ((env (apply mutable-environment sandbox-libraries)))
     (set! *guarded* (cons env *guarded*))
     (for-each (lambda (file) (load-into (lab-path lab file) env))

@@ -327,7 +327,8 @@
               " or max-connections-per-host")))
 
 ;;> Starts serving calls to the local address space, under the limits of
-;;> \var{lab}: listens on its port, and starts the janitor.
+;;> \var{lab}: listens on its port, or on a free one for port 0, and starts
+;;> the janitor.
 (define (start-serving! lab)
   (set! *frame-timeout* (lab-setting lab 'frame-timeout))
   (set! *max-connections* (lab-setting lab 'max-connections))
@@ -341,6 +342,7 @@
                                                (number->string port)
                                                " (is another process there?)"))))
              (make-listener-socket addr))))
+      (if (zero? port) (local-aspace-port-set! (socket-port listener)))
       (spawn (lambda () (accept-loop listener addr)) 'accept)
       (spawn janitor 'janitor))))
 

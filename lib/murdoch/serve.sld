@@ -12,6 +12,7 @@
           (chibi net) (chibi match)
           (murdoch scheduler) (murdoch wait) (murdoch log) (murdoch abandon)
           (murdoch remote-error) (murdoch netstring) (murdoch frame)
+          (only (murdoch connect) socket-port)
           (murdoch lab) (murdoch sendable) (murdoch sandbox)
           (murdoch aspace) (murdoch worker) (murdoch call))
   (include "serve.scm"))

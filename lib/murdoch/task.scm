@@ -11,19 +11,20 @@
 ;;     poser remote-applies component-heartbeat! on the robot: an answer
 ;;     tells the poser that the robot lives, its arrival tells the robot
 ;;     that its poser does.
-;;  3. A component's robot is lost when it is silent for three heartbeat
-;;     periods, when its address space is gone (the call's connection is
+;;  3. A component's robot is lost when it is silent for lost-periods (four)
+;;     heartbeat periods, when its address space is gone (the call's connection is
 ;;     lost), or when the component raises a robot failure: its trip
 ;;     connection closed, or its base stalled.  A restartable component
 ;;     is then negotiated again, without the robots it had and those of
 ;;     the task's other components, and started again, on at most
 ;;     max-attempts robots in all.  Any other component is failed, as is
 ;;     one that raises an ordinary error, as pose-task reports it.
-;;  4. A component whose poser is silent for three periods stops on its
+;;  4. A component whose poser is silent for two periods stops on its
 ;;     robot, at its next robot command or remote call (abandon.scm), and
 ;;     so frees its reservation: no orphans.  The same rule stops the
-;;     component of a robot cut off from its poser, which the poser
-;;     declares lost, before it can come back: no ghosts.
+;;     component of a robot cut off from its poser at least one full
+;;     period before the poser can declare it lost and start the component
+;;     elsewhere: no ghosts (component.scm gives the margin).
 ;;  5. cancel-task stops every component on its robot so, at once, and
 ;;     what is still being negotiated is freed when the negotiation ends.
 ;;
@@ -237,10 +238,10 @@
          (got (outcome-of got))
          ((heartbeat a (task-id t) (component-index c) period)
           (watch (monotonic-seconds)))
-         ((> (- (monotonic-seconds) heard) (* 3 period))
+         ((>= (- (monotonic-seconds) heard) (* lost-periods period))
           (thread-interrupt! runner)    ; its call is given up
-          (list 'lost (string-append (symbol->string uid)
-                                     " silent for three heartbeats")))
+          (list 'lost (string-append (symbol->string uid) " silent for "
+                                     (number->string lost-periods) " heartbeats")))
          (else (watch heard)))))))
 
 ;; A thunk that runs work on a inside run-component, and puts (value V)
