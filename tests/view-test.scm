@@ -35,6 +35,11 @@
         (list (first walls) (third walls))))
     (test "boxes" '#(#(1500 1500 400 400 30)) (assq-ref 'boxes header))
     (test "the robots' radius" 180 (assq-ref 'radius header))
+    ;; Chibi's current-second is TAI, 37 s ahead of the clock on the wall.
+    (test "started: seconds since 1970, UTC, as date says" #t
+      (< (abs (- (assq-ref 'started header)
+                 (string->number (command-output (list "date" "+%s")))))
+         10))
     (test "which address spaces are robots" '(("moseley" . #t) ("ernst" . #t) ("troy" . #f))
       (map (lambda (a) (cons (assq-ref 'name a) (assq-ref 'robot a)))
            (vector->list (assq-ref 'aspaces header))))))

@@ -31,7 +31,7 @@
 ;;> lab-status) as a person reads it: a line per address space, then one
 ;;> per subject held.
 (define (show-status . port)
-  (display-lab-status (lab-status (current-lab)) (current-second)
+  (display-lab-status (lab-status (current-lab)) (utc-seconds)
                       (if (pair? port) (car port) (current-output-port))))
 
 (define (display-lab-status status now out)

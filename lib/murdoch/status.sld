@@ -2,7 +2,7 @@
 ;;> command and REPL procedure.
 (define-library (murdoch status)
   (export aspace-report lab-status show-status)
-  (import (scheme base) (scheme write) (scheme time) (srfi 1)
+  (import (scheme base) (scheme write) (srfi 1) (only (murdoch log) utc-seconds)
           (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch trip-client)
           (murdoch task))
   (include "status.scm"))

@@ -80,7 +80,7 @@
                         `((name . ,(symbol->string (lab-aspace-uid a)))
                           (robot . ,(if (lab-aspace-clause a 'robot) #t #f))))
                       (lab-aspaces lab))))
-    (started . ,(num (current-second)))))
+    (started . ,(num (utc-seconds)))))
 
 (define (degrees->radians d) (* d (/ (acos -1) 180)))
 
@@ -135,7 +135,7 @@
     (for-each (lambda (a) (if (cadr a) (note-sonar! state (car a) (car (cddr a))))) answers)
     `((kind . "state")
       (t . ,(num t))
-      (clock . ,(num (current-second)))
+      (clock . ,(num (utc-seconds)))
       (aspaces . ,(list->vector (map (lambda (a) (aspace-json a state)) answers)))
       (boxes . ,(vector-map (lambda (b) b) boxes))
       (tasks . ,(task-table->json (view-state-table state) 12)))))
@@ -369,7 +369,7 @@
           ;; The trace counts wall-clock seconds from its start; the
           ;; next look is due by the monotonic clock, as every deadline.
           (let ((t0 (monotonic-seconds))
-                (at (- (current-second) start)))
+                (at (- (utc-seconds) start)))
             (feed-add! feed (json-text
                              (view-snapshot lab at
                                             (parameterize ((remote-timeout 1))
@@ -416,7 +416,7 @@
   (let ((dir "runs"))
     (if (not (file-exists? dir)) (create-directory* dir))
     (string-append dir "/" (symbol->string (lab-name lab)) "-"
-                   (number->string (exact (floor (current-second)))) ".jsonl")))
+                   (number->string (exact (floor (utc-seconds)))) ".jsonl")))
 
 ;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
 ;;> (default 7248) to play the run that \var{trace} holds.
