@@ -29,10 +29,12 @@
 
 ;;> Writes the status of the lab this address space is in (see
 ;;> lab-status) as a person reads it: a line per address space, then one
-;;> per subject held.
+;;> per subject held.  Answers how many address spaces answered.
 (define (show-status . port)
-  (display-lab-status (lab-status (current-lab)) (utc-seconds)
-                      (if (pair? port) (car port) (current-output-port))))
+  (let ((status (lab-status (current-lab))))
+    (display-lab-status status (utc-seconds)
+                        (if (pair? port) (car port) (current-output-port)))
+    (count (lambda (r) (not (eq? (cadr r) 'away))) status)))
 
 (define (display-lab-status status now out)
   (for-each (lambda (r) (write-report r now out)) status))
