@@ -74,6 +74,40 @@
     (let ((r (murdoch "check" (string-append dir "/lab.scm"))))
       (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?")))))
 
+;; A lab of workstations, which needs no simulator, and two tasks: one
+;; that troy takes, and one that nobody can.
+(define demo-lab
+  (make-test-lab '((aspace troy (capabilities camera)) (aspace praline))
+                 '(("camera.scm" . "(list 'snap 1 (list (list '() (list 'camera)))
+                                         (list #f) (list (lambda () 'snapped)))\n")
+                   ("laser.scm" . "(list 'scan 1 (list (list '() (list 'laser)))
+                                        (list #f) (list (lambda () 'scanned)))\n"))))
+
+;; (exit-status whole-output) of `bin/murdoch demo` posing task, run in
+;; the lab's folder, where the view writes runs/.
+(define (demo task)
+  (let* ((lab-dir (test-lab-directory demo-lab))
+         (status (system "sh" "-c"
+                         (string-append "cd \"$1\" && MURDOCH_DEMO_TASK=\"$1/$2\""
+                                        " timeout -s KILL 200 \"$0/bin/murdoch\""
+                                        " demo lab.scm >demo.out 2>&1")
+                         (tool-path ".") lab-dir task)))
+    (list (quotient (if (pair? status) (cadr status) status) 256)
+          (file-text (string-append lab-dir "/demo.out")))))
+
+(test-group "demo: its output, always, and its exit status"
+  (let ((r (demo "camera.scm")))
+    (test "a task done: exit 0" 0 (status r))
+    (test "the pose's output is shown, to its result" #t
+      (text-contains? (cadr r) "(snapped)"))
+    (test "and no file is read before it is made" #f
+      (text-contains? (cadr r) "No such file")))
+  (let ((r (demo "laser.scm")))
+    (test "a task nobody takes: exit non-zero" #t (positive? (status r)))
+    (test "its output is shown" #t (text-contains? (cadr r) "not-enough-takers"))
+    (test "and the demo says so" #t (text-contains? (cadr r) "the task did not complete"))))
+
 (test-end)
+(remove-test-lab! demo-lab)
 (delete-file-hierarchy dir)
 (test-exit)
