@@ -163,6 +163,85 @@
 
 (define (help-flag? arg) (member arg '("--help" "-h")))
 
+(define (option-word? arg)
+  (and (> (string-length arg) 2) (string=? "--" (substring arg 0 2))))
+
+;; "--speed=2" names speed, as "--speed" does.
+(define (option-name arg)
+  (let ((end (or (string-index arg #\=) (string-length arg))))
+    (string->symbol (substring arg 2 end))))
+
+(define (inline-value arg)
+  (let ((i (string-index arg #\=)))
+    (and i (substring arg (+ i 1) (string-length arg)))))
+
+(define (string-index s ch)
+  (let loop ((i 0))
+    (cond ((= i (string-length s)) #f)
+          ((char=? (string-ref s i) ch) i)
+          (else (loop (+ i 1))))))
+
+;; Each option of c on the command line args, and its value, checked
+;; before (chibi app) reads them: it would call a bad number an unknown
+;; option, and take an unknown option's value for an argument.  --view's
+;; port may be left out, so a word after it that is no number is an
+;; argument, unless that leaves one too many.
+(define (check-options c args)
+  (let loop ((rest args))
+    (when (pair? rest)
+      (let ((arg (car rest)))
+        (cond
+         ((not (option-word? arg)) (loop (cdr rest)))
+         ((assq (option-name arg) (command-options c))
+          => (lambda (o)
+               (let ((value (or (inline-value arg)
+                                (and (pair? (cdr rest)) (cadr rest))))
+                     (next (if (inline-value arg) (cdr rest) (cddr* rest))))
+                 (cond
+                  ((and (eq? (car o) 'view) (not (inline-value arg))
+                        (not (and value (string->number value))))
+                   (if (and value (not (option-word? value))
+                            (> (length (positional args)) (length (command-args c))))
+                       (mistake c (value-mistake o value)))
+                   (loop (cdr rest)))
+                  ((not (and value (value-fits? (cadr o) value)))
+                   (mistake c (value-mistake o value)))
+                  (else (loop next))))))
+         (else
+          (mistake c (string-append "unknown option " arg (nearest-option c arg)))))))))
+
+(define (cddr* ls) (if (pair? (cdr ls)) (cddr ls) '()))
+
+(define (value-fits? type text)
+  (let ((n (string->number text)))
+    (case type
+      ((real) (and (real? n) (positive? n)))
+      ((integer) (and (exact-integer? n) (< 0 n 65536)))
+      (else (not (option-word? text))))))
+
+(define (value-mistake o value)
+  (string-append "--" (symbol->string (car o)) " takes "
+                 (case (cadr o)
+                   ((real) "a positive number")
+                   ((integer) (if (eq? (car o) 'view) "a port number, or nothing"
+                                  "a port number"))
+                   ((string) "a name")
+                   (else "names, as a,b,..."))
+                 (if value (string-append ", not " value) "")))
+
+(define (nearest-option c arg)
+  (let* ((names (map (lambda (o) (string-append "--" (symbol->string (car o))))
+                     (command-options c)))
+         (near (find-nearest-edits arg names)))
+    ;; Two edits from a name of another first letter is another word.
+    (if (and (pair? near)
+             (let ((d (edit-distance arg (car near))))
+               (or (<= d 1)
+                   (and (= d 2) (> (string-length arg) 2)
+                        (char=? (string-ref arg 2) (string-ref (car near) 2))))))
+        (string-append "; did you mean " (car near) "?")
+        "")))
+
 ;; (chibi app) wants a command's options before its arguments; people
 ;; write `murdoch lab LAB --trace FILE` too.  Every option takes a value
 ;; but --view, whose port may be left out: it is then 0.
@@ -202,6 +281,7 @@
 ;; mistake, a port in use) is one ERROR line, which bin/murdoch-lab shows
 ;; of a child that dies; either exits 2.
 (define (run c args)
+  (check-options c args)
   (check-arity c (positional args))
   (let ((started? #f))
     (guard (e ((and (error-object? e) started?)

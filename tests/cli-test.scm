@@ -55,6 +55,16 @@
   (mistake '("lab" "examples/tulane-lab.scm" "--bogus" "1") "murdoch lab: unknown option --bogus")
   (mistake '("lab" "--view") "murdoch lab: missing LAB")
   (mistake '("view" "examples/tulane-lab.scm" "http") "murdoch view: not a port number: http")
+  (mistake '("check" "examples/tulane-lab.scm" "--bogus") "murdoch check: unknown option --bogus")
+  (mistake '("lab" "--bogus" "examples/tulane-lab.scm") "murdoch lab: unknown option --bogus")
+  (mistake '("lab" "--spede" "2" "examples/tulane-lab.scm")
+           "murdoch lab: unknown option --spede; did you mean --speed?")
+  (mistake '("lab" "--speed" "abc" "examples/tulane-lab.scm")
+           "murdoch lab: --speed takes a positive number, not abc")
+  (mistake '("lab" "--view" "abc" "examples/tulane-lab.scm")
+           "murdoch lab: --view takes a port number, or nothing, not abc")
+  (mistake '("lab" "examples/tulane-lab.scm" "--trace") "murdoch lab: --trace takes a name")
+  (mistake '("repl" "examples/tulane-lab.scm" "--x") "murdoch repl: unknown option --x")
   (test "a mistake in what a command reads is one ERROR line" '(2 #t)
     (let ((r (murdoch "check" "/no/such/lab.scm")))
       (list (status r)
@@ -63,6 +73,21 @@
   (test "a replay of a trace that is not there" '(2 "murdoch replay: ERROR: no such trace /no/such.jsonl")
     (let ((r (murdoch "replay" "/no/such.jsonl")))
       (list (status r) (first-line r)))))
+
+(test-group "before anything is built"
+  ;; A copy of bin/ and tools/chibi with no Chibi beside it or on PATH,
+  ;; and C not yet compiled.
+  (let ((fresh (string-append dir "/fresh")))
+    (system "sh" "-c" (string-append "mkdir -p \"$1/bin\" \"$1/tools\" \"$1/lib/murdoch\""
+                                     " && cp bin/murdoch bin/murdoch.scm \"$1/bin\""
+                                     " && cp tools/chibi \"$1/tools\""
+                                     " && touch \"$1/lib/murdoch/glue.c\"")
+            (tool-path ".") fresh)
+    (let ((status (system "sh" "-c" "PATH=/usr/bin:/bin \"$1/bin/murdoch\" --help >\"$0\" 2>&1"
+                          out fresh)))
+      (test "--help says what to run, and exits 1" '(1 #t)
+        (list (quotient (if (pair? status) (cadr status) status) 256)
+              (text-contains? (file-text out) "run `make all`"))))))
 
 (test-group "check"
   (test "a good lab file" '(0 "examples/tulane-lab.scm: no mistakes found")
