@@ -45,10 +45,6 @@
              (let ((speed (option 'speed)))
                (and speed (number->string speed))))))
 
-(define (check lab-file)
-  (read-lab lab-file)
-  (display (string-append lab-file ": no mistakes found\n")))
-
 ;; name, arguments (those in parentheses may be left out), what it does, its
 ;; options as (chibi app) writes them, and what runs it: a procedure of
 ;; the config and the arguments.
@@ -80,7 +76,7 @@
                ((view-procedure 'run-replay)
                 web trace (and (pair? port) (port-argument (command-named "replay") (car port))))))
     (check (LAB) "check the lab file for mistakes, and start nothing" ()
-           ,(lambda (cfg lab) (check lab)))
+           ,(lambda (cfg lab) (run-check lab)))
     (status (LAB) "show each address space of the running lab: up since, pose, battery, the subjects held and by whom" ()
             ,(lambda (cfg lab) (run-status lab)))
     (help ((COMMAND)) "show this help, or a command's" ()

@@ -22,6 +22,10 @@
 (define (first-line r) (cadr r))
 (define (no-trace? r) (not (text-contains? (car (cddr r)) "called from")))
 
+(define (write-file name text)
+  (call-with-output-file (string-append dir "/" name)
+    (lambda (o) (write-string text o))))
+
 (test-begin "cli")
 
 (test-group "help and version"
@@ -69,7 +73,7 @@
     (let ((r (murdoch "check" "/no/such/lab.scm")))
       (list (status r)
             (string=? (car (cddr r))
-                      "murdoch check: ERROR: cannot read the lab file /no/such/lab.scm couldn't open input file\n"))))
+                      "murdoch check: ERROR: cannot read /no/such/lab.scm: couldn't open input file\n"))))
   (test "a replay of a trace that is not there" '(2 "murdoch replay: ERROR: no such trace /no/such.jsonl")
     (let ((r (murdoch "replay" "/no/such.jsonl")))
       (list (status r) (first-line r)))))
@@ -97,7 +101,31 @@
     (lambda (o) (write-string "(lab x (timout 3))\n" o)))
   (test "a misspelt setting" #t
     (let ((r (murdoch "check" (string-append dir "/lab.scm"))))
-      (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?")))))
+      (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?"))))
+  (write-file "inside.scm" "(lab x\n  (aspace a (robot (pose 0 0 0)\n    (tetherd #f))))\n")
+  (test "check and lab name the same mistake inside a robot, with its line"
+      (list (list 2 (string-append "murdoch check: ERROR: " dir "/inside.scm:3: (tetherd #f):"
+                                   " no such clause in robot; did you mean tethered?"))
+            (list 2 (string-append "murdoch lab: ERROR: " dir "/inside.scm:3: (tetherd #f):"
+                                   " no such clause in robot; did you mean tethered?")))
+    (map (lambda (command)
+           (let ((r (murdoch command (string-append dir "/inside.scm"))))
+             (list (status r) (first-line r))))
+         '("check" "lab")))
+  ;; A code file is loaded as an address space loads it.
+  (write-file "open.scm" "(define (f x)\n  (+ x 1)\n\n(define (g) 2)\n")
+  (write-file "raises.scm" "(define a 1)\n(car '())\n")
+  (write-file "code1.scm" "(lab x (code \"open.scm\"))\n")
+  (write-file "code2.scm" "(lab x (code \"raises.scm\"))\n")
+  (test "a code file whose list is not closed: its file and line" #t
+    (let ((r (murdoch "check" (string-append dir "/code1.scm"))))
+      (and (= 2 (status r))
+           (text-contains? (first-line r)
+                           "/open.scm:1: this list has no closing ): the file ends inside it"))))
+  (test "a code file that raises as it loads: its file, line and error" #t
+    (let ((r (murdoch "check" (string-append dir "/code2.scm"))))
+      (and (= 2 (status r))
+           (text-contains? (first-line r) "/raises.scm:2: car: not a pair ()")))))
 
 ;; A lab of workstations, which needs no simulator, and two tasks: one
 ;; that troy takes, and one that nobody can.

@@ -45,6 +45,14 @@
                     (if (pair? (lab-robots lab)) "sim" "")
                     (lab-lines lab except)))))
 
+;;> `murdoch check LAB`: reads the lab file at \var{lab-file} as every
+;;> peer does, and loads its code files into an environment of received
+;;> code, as an address space does: a mistake in either is an error that
+;;> names the file and the line.  Starts nothing.
+(define (run-check lab-file)
+  (make-lab-environment (read-lab lab-file))
+  (write-string (string-append lab-file ": no mistakes found\n")))
+
 ;;> `murdoch demo LAB`: becomes bin/murdoch-demo, found in \var{bin}.
 (define (run-demo bin lab-file)
   (execute "/bin/sh" (list "/bin/sh" (string-append bin "/murdoch-demo")

@@ -4,7 +4,7 @@
   (export make-lab-environment make-repl-environment lab-code-files
           guarded-set! guarded-thread-terminate! make-guarded-thread
           call-in-sandbox sandbox-parameter! set-sandbox-ports!)
-  (import (scheme base) (scheme read) (scheme eval) (scheme file)
+  (import (scheme base) (scheme write) (scheme eval) (scheme file)
           (srfi 1) (srfi 18) (srfi 69)
           (only (chibi) env-parent identifier? identifier->symbol port-open?
                 thread-parameters thread-parameters-set!
