@@ -11,7 +11,7 @@
 ;; (exit-status first-line whole-output) of bin/murdoch with args.
 (define (murdoch . args)
   (let ((status (apply system "sh" "-c"
-                       "cd \"$1\" && shift && exec bin/murdoch \"$@\" >\"$0\" 2>&1"
+                       "cd \"$1\" && shift && exec timeout -s KILL 60 bin/murdoch \"$@\" >\"$0\" 2>&1"
                        out (tool-path ".") args)))
     (let ((text (file-text out)))
       (list (quotient (if (pair? status) (cadr status) status) 256)
@@ -74,9 +74,28 @@
       (list (status r)
             (string=? (car (cddr r))
                       "murdoch check: ERROR: cannot read /no/such/lab.scm: couldn't open input file\n"))))
+  (test "a replay of a file that is not a trace, such as a lab file" #t
+    (let ((r (murdoch "replay" "examples/tulane-lab.scm")))
+      (and (= 2 (status r))
+           (equal? (text-lines (car (cddr r)))
+                   '("murdoch replay: ERROR: not a trace of the view: examples/tulane-lab.scm (a trace's first line is the view's header of the room)")))))
   (test "a replay of a trace that is not there" '(2 "murdoch replay: ERROR: no such trace /no/such.jsonl")
     (let ((r (murdoch "replay" "/no/such.jsonl")))
       (list (status r) (first-line r)))))
+
+(test-group "replay follows MURDOCH_PORT_BASE, as lab and view do"
+  (let* ((base (free-port-base dir))
+         (trace (string-append dir "/trace.jsonl"))
+         (replay-out (string-append dir "/replay.out")))
+    (write-file "trace.jsonl" "{\"kind\":\"lab\",\"lab\":\"x\",\"radius\":180,\"walls\":[],\"boxes\":[],\"aspaces\":[],\"started\":0}\n")
+    (let ((pid (start-process! (list "env" (string-append "MURDOCH_PORT_BASE=" (number->string base))
+                                     (tool-path "bin/murdoch") "replay" trace)
+                               replay-out)))
+      (test "it serves on port-base + 148" #t
+        (wait-until 30 (lambda () (text-contains? (file-text replay-out)
+                                                  (string-append "http://127.0.0.1:"
+                                                                 (number->string (+ base 148)) "/")))))
+      (stop-process! pid))))
 
 (test-group "before anything is built"
   ;; A copy of bin/ and tools/chibi with no Chibi beside it or on PATH,

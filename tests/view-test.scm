@@ -6,7 +6,8 @@
 (import (scheme base) (scheme write) (scheme file) (scheme char) (scheme process-context)
         (srfi 1) (srfi 18) (chibi test)
         (only (chibi process) system?)
-        (only (chibi filesystem) delete-file-hierarchy file-size directory-files)
+        (only (chibi filesystem) delete-file-hierarchy file-size directory-files
+              current-directory change-directory)
         (chibi json)
         (murdoch lab) (murdoch view) (murdoch connect) (murdoch testing))
 
@@ -43,6 +44,17 @@
     (test "which address spaces are robots" '(("moseley" . #t) ("ernst" . #t) ("troy" . #f))
       (map (lambda (a) (cons (assq-ref 'name a) (assq-ref 'robot a)))
            (vector->list (assq-ref 'aspaces header))))))
+
+(test-group "two views of one lab, started in one second, have a trace each"
+  (let ((here (current-directory)))
+    (change-directory dir)
+    (let* ((lab (read-lab (test-lab-file lab)))
+           (a (default-trace lab))
+           (b (default-trace lab)))
+      (change-directory here)
+      (test "two names" #t (not (equal? a b)))
+      (test "each a file made for it" '(#t #t)
+        (map (lambda (f) (file-exists? (in-dir f))) (list a b))))))
 
 (test-group "a box where a robot's fiducial finder sees it"
   (define (mm ls) (map (lambda (x) (exact (round x))) ls))

@@ -280,6 +280,11 @@
 (define (lab-port-base lab)
   (settings-port-base (lab-settings lab)))
 
+;;> The port base where no lab file is read (murdoch replay):
+;;> MURDOCH_PORT_BASE, else port-base's default.
+(define (unread-lab-port-base)
+  (settings-port-base (list (cons 'port-base (cadr (assq 'port-base settings-table))))))
+
 (define (settings-port-base settings)
   (cond ((get-environment-variable "MURDOCH_PORT_BASE") => string->number)
         (else (cdr (assq 'port-base settings)))))

@@ -5,7 +5,7 @@
 (define-library (murdoch view)
   (export run-view run-replay
           ;; the parts, for tests
-          lab-header view-snapshot new-view-state make-task-table task-table-update!
+          lab-header default-trace view-snapshot new-view-state make-task-table task-table-update!
           task-table->json reservation-task json-text box-seen)
   (import (scheme base) (scheme write) (scheme file) (scheme eval)
           (scheme inexact) (scheme char)
@@ -14,6 +14,7 @@
           (only (chibi config) make-conf)
           (only (chibi process) current-process-id)
           (only (chibi filesystem) create-directory* open open/write open/append
+                open/create open/exclusive
                 open-output-file-descriptor)
           (only (srfi 151) bitwise-ior)
           (chibi json)
