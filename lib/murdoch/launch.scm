@@ -110,7 +110,7 @@
     (join-lab lab-file (string->symbol (string-append
                                         "status-" (number->string (current-process-id))))
               (lab-guest-port lab))
-    (cond ((zero? (parameterize ((remote-timeout 2)) (show-status)))
+    (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
            (write-string (string-append "murdoch status: no address space of the lab"
                                         " answers (is the lab running, with the same"
                                         " MURDOCH_PORT_BASE?)\n")

@@ -8,5 +8,5 @@
           (srfi 1)
           (only (chibi process) execute current-process-id)
           (murdoch lab) (murdoch command)
-          (only (murdoch remote) remote-timeout) (only (murdoch sandbox) make-lab-environment) (only (murdoch status) show-status))
+          (only (murdoch remote) remote-timeout) (only (murdoch sandbox) make-lab-environment) (only (murdoch status) write-lab-status))
   (include "launch.scm"))
