@@ -132,5 +132,12 @@
 
 (test-begin "transcripts")
 (for-each check-transcript (transcript-files))
+;; The REPL sessions of the tutorial and the README, replayed as they are
+;; written there, so that neither drifts from the code.
+(for-each (lambda (doc)
+            (let ((dir (temporary-directory)))
+              (test doc '() (mismatches-of doc (read-doc-transcript (tool-path doc)) dir))
+              (delete-file-hierarchy dir)))
+          '("docs/tutorial.md" "README.md"))
 (test-end)
 (test-exit)

@@ -52,6 +52,93 @@
           (loop rest lab as (cons (cons line (car steps)) (cdr steps))
                 shell))))))))
 
+;;> The REPL sessions a document shows, as one transcript: every code
+;;> block whose first line starts with a prompt ("guest-1234> ") is a step
+;;> of it, its prompt lines input and the lines after each what that
+;;> prints, in the order of the document, at one REPL of one lab: the lab
+;;> that the line "<!-- transcript lab: FILE -->" names.  The document
+;;> shows what a run printed, so a number in it stands for any number
+;;> ({number}) and "..." for any text ({any}).
+(define (read-doc-transcript file)
+  (let ((lines (read-lines file)))
+    (make-transcript
+     (or (any (lambda (l) (and (prefixed? "<!-- transcript lab: " l)
+                               (string-trim (substring l 21 (- (string-length l) 4)))))
+              lines)
+         (error "a document to replay names its lab" file))
+     #f
+     (append-map block-steps (code-blocks lines))
+     '())))
+
+;; The code blocks of a markdown text's lines, each a list of its lines:
+;; fenced by ``` or indented by four spaces.
+(define (code-blocks lines)
+  (let loop ((lines lines) (blocks '()))
+    (cond
+     ((null? lines) (reverse blocks))
+     ((prefixed? "```" (car lines))
+      (let ((end (or (list-index (lambda (l) (prefixed? "```" l)) (cdr lines))
+                     (length (cdr lines)))))
+        (loop (drop (cdr lines) (min (+ end 1) (length (cdr lines))))
+              (cons (take (cdr lines) end) blocks))))
+     ((prefixed? "    " (car lines))
+      (let-values (((block rest) (span (lambda (l) (prefixed? "    " l)) lines)))
+        (loop rest (cons (map (lambda (l) (substring l 4 (string-length l))) block)
+                         blocks))))
+     (else (loop (cdr lines) blocks)))))
+
+(define (prompt-end line)
+  (let loop ((i 0))
+    (cond ((>= (+ i 1) (string-length line)) #f)
+          ((and (char=? (string-ref line i) #\>) (char=? (string-ref line (+ i 1)) #\space))
+           (and (> i 0) i))
+          ((or (char-alphabetic? (string-ref line i)) (char-numeric? (string-ref line i))
+               (char=? (string-ref line i) #\-))
+           (loop (+ i 1)))
+          (else #f))))
+
+(define (block-steps block)
+  (if (and (pair? block) (prompt-end (car block)))
+      (let loop ((lines block) (steps '()))
+        (cond ((null? lines) (reverse (map reverse steps)))
+              ((prompt-end (car lines))
+               => (lambda (i)
+                    (loop (cdr lines)
+                          (cons (list (substring (car lines) (+ i 2)
+                                                 (string-length (car lines))))
+                                steps))))
+              (else (loop (cdr lines)
+                          (cons (cons (loosen (car lines)) (car steps)) (cdr steps))))))
+      '()))
+
+;; A line a run printed as a pattern for any run: numbers as {number},
+;; "..." as {any}.
+(define (loosen line)
+  (let loop ((i 0) (acc '()))
+    (cond
+     ((= i (string-length line)) (apply string-append (reverse acc)))
+     ((and (<= (+ i 3) (string-length line)) (string=? "..." (substring line i (+ i 3))))
+      (loop (+ i 3) (cons "{any}" acc)))
+     ((number-start? line i)
+      (let ((end (number-end line i)))
+        (loop end (cons "{number}" acc))))
+     (else (loop (+ i 1) (cons (string (string-ref line i)) acc))))))
+
+(define (digit-at? line i)
+  (and (< i (string-length line)) (char-numeric? (string-ref line i))))
+
+(define (number-start? line i)
+  (or (digit-at? line i)
+      (and (char=? (string-ref line i) #\-) (digit-at? line (+ i 1)))))
+
+(define (number-end line i)
+  (let loop ((j (+ i 1)))
+    (if (and (< j (string-length line))
+             (or (char-numeric? (string-ref line j))
+                 (and (char=? (string-ref line j) #\.) (digit-at? line (+ j 1)))))
+        (loop (+ j 1))
+        j)))
+
 ;;> What to do, in order: each input line as a string, typed at the REPL,
 ;;> and each shell command as (shell COMMAND K), to run once the REPL has
 ;;> answered its first K inputs.
