@@ -95,6 +95,23 @@
         '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
                (null "ernst" ("mobile") null null null)))
       (components table))
+    (task-table-update! table 3 (list (list 'moseley (report 'moseley '() '()))))
+    (task-table-update! table 4 (list (list 'moseley (report 'moseley '() '()))))
+    (test "one silent for three looks in a row was lost, and its task failed"
+        '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
+               (null "ernst" ("mobile") 4 "lost: ernst does not answer" null)))
+      (components table))
+    (test "the task's state" "failed"
+      (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0)))
+    ;; A robot killed and started again answers at once, holding nothing.
+    (let ((table (make-task-table)))
+      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |u@pose-3#1|))
+                                                              '()))))
+      (task-table-update! table 2 (list (list 'moseley (cons 'moseley
+                                                             (cons 99 (cddr (report 'moseley '() '())))))))
+      (test "one that started again lost what it ran"
+          '(("u" (null "moseley" ("mobile") 2 "lost: moseley started again" null)))
+        (components table)))
     ;; start-task: components by index, and a reassignment.
     (let ((table (make-task-table)))
       (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |s@tester#4|))
