@@ -9,5 +9,6 @@
           remote-timeout set-remote-timeout! current-timeout
           lab-environment decode-value describe-procedure)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 69)
-          (only (murdoch log) utc-seconds) (murdoch wait) (murdoch lab) (murdoch sendable) (murdoch sandbox))
+          (only (murdoch log) utc-seconds) (murdoch wait) (murdoch lab) (murdoch sendable)
+          (murdoch sandbox))
   (include "aspace.scm"))

@@ -77,8 +77,9 @@
                                                 (current-process-id))))))
          (lab-env (join-read-lab lab uid
                                  (if guest? (list (lab-guest-port lab)) '()))))
-    (write-string (string-append "murdoch: a REPL in the lab " (symbol->string (lab-name lab))
-                                 ", as " (symbol->string uid) "; (help) says what to type,"
+    (write-string (string-append "murdoch: a REPL in the lab "
+                                 (symbol->string (lab-name lab)) ", as "
+                                 (symbol->string uid) "; (help) says what to type,"
                                  " Ctrl-D leaves\n"))
     (tell-who-is-away lab)
     (set-remote-timeout! (lab-setting lab 'repl-timeout))

@@ -103,7 +103,8 @@
          (car near))))
 
 (define (nearest text names)
-  (cond ((nearest-name text names) => (lambda (n) (string-append "; did you mean " n "?")))
+  (cond ((nearest-name text names)
+         => (lambda (n) (string-append "; did you mean " n "?")))
         (else ";")))
 
 ;; "no address space troyy is known; did you mean troy?": in one line.

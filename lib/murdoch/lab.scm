@@ -127,7 +127,8 @@
 (define (load-value? x)
   (or (non-negative? x)
       (and (list? x) (pair? x)
-           (every (lambda (p) (and (list? p) (= (length p) 2) (every non-negative? p))) x))))
+           (every (lambda (p) (and (list? p) (= (length p) 2) (every non-negative? p)))
+                  x))))
 
 (define robot-table
   `((pose ,@(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
@@ -156,16 +157,16 @@
                         "a positive number, or fast"))
     (stall-timeout ,@(values-of 1 positive-real? "a positive number of seconds"))))
 
-(define (increasing? xs) (< (car xs) (cadr xs)))
+(define (increasing-pair)
+  (list (lambda (xs) (and (= (length xs) 2) (every real? xs) (< (car xs) (cadr xs))))
+        "two numbers, the first the smaller"))
 
 (define b14-table
   `(,@(map (lambda (name) `(,name ,@(values-of 1 non-negative? "a number, 0 or more")))
            '(radius mass max-speed max-turn speed turn-speed sonar-cone sonar-noise
              sonar-hz ir-range fiducial-range battery-drain battery-idle battery-charge))
-    (sonar-range ,(lambda (xs) (and (= (length xs) 2) (every real? xs) (increasing? xs)))
-                 "two numbers, the first the smaller")
-    (battery-range ,(lambda (xs) (and (= (length xs) 2) (every real? xs) (increasing? xs)))
-                   "two numbers, the first the smaller")
+    (sonar-range ,@(increasing-pair))
+    (battery-range ,@(increasing-pair))
     (fiducial-fov ,@(values-of 1 (lambda (x) (and (real? x) (< 0 x) (<= x 360)))
                                "degrees, above 0 and at most 360"))
     (sonar-rays ,@(values-of 1 (lambda (x) (and (exact-integer? x) (<= 1 x 16)))
@@ -187,11 +188,13 @@
          (cond ((not (procedure? (cadr entry)))
                 (check-within path item (cdr item) (cadr entry)))
                ((not ((cadr entry) (cdr item)))
-                (lab-file-error path item (string-append (symbol->string (car item))
-                                                         " takes " (car (cddr entry))))))))
+                (lab-file-error path item
+                                (string-append (symbol->string (car item))
+                                               " takes " (car (cddr entry))))))))
    (else
-    (lab-file-error path item (string-append "no such clause in " (symbol->string (car outer))
-                                             (did-you-mean (car item) (map car table)))))))
+    (lab-file-error path item
+                    (string-append "no such clause in " (symbol->string (car outer))
+                                   (did-you-mean (car item) (map car table)))))))
 
 ;; A top-level clause that holds clauses of its own.
 (define (check-inside path c)
@@ -305,7 +308,8 @@
                                    " (lab NAME CLAUSE ...) form")))
             ((pair? (cdr data))
              (lab-file-error path (car (cadr data))
-                             "a second form; a lab file holds one (lab NAME CLAUSE ...) form"))
+                             (string-append "a second form; a lab file holds one"
+                                            " (lab NAME CLAUSE ...) form")))
             ((not (let ((form (car (car data))))
                     (and (pair? form) (eq? (car form) 'lab) (pair? (cdr form))
                          (symbol? (cadr form)) (list? (cddr form)))))
@@ -351,7 +355,8 @@
             (c (peek-char in)))
         (set! fresh-line? #f)
         (if (and col (not suspect))
-            (set! suspect (find (lambda (o) (and (cadr o) (< (car o) line) (<= col (cadr o))))
+            (set! suspect (find (lambda (o)
+                                  (and (cadr o) (< (car o) line) (<= col (cadr o))))
                                 (reverse open))))
         (cond
          ((eof-object? c) c)
@@ -377,7 +382,8 @@
             (if (delimiter? (peek-char in))
                 (let ((tail (datum open)))
                   (skip!)
-                  (if (not (eqv? (peek-char in) #\))) (fail line "a dotted list ends after one datum"))
+                  (if (not (eqv? (peek-char in) #\)))
+                      (fail line "a dotted list ends after one datum"))
                   (read-char in)
                   (let ((form (append-reverse items tail)))
                     (set! lines (cons (cons form line) lines))
@@ -428,11 +434,13 @@
 (define (check-lab path lab)
   (let loop ((as (lab-aspaces lab)))
     (when (pair? as)
-      (cond ((find (lambda (b) (eq? (lab-aspace-uid b) (lab-aspace-uid (car as)))) (cdr as))
+      (cond ((find (lambda (b) (eq? (lab-aspace-uid b) (lab-aspace-uid (car as))))
+                   (cdr as))
              => (lambda (b)
-                  (lab-file-error path (lab-aspace-form b)
-                                  (string-append "two address spaces of this name: the other"
-                                                 (line-words (lab-aspace-form (car as))))))))
+                  (lab-file-error
+                   path (lab-aspace-form b)
+                   (string-append "two address spaces of this name: the other"
+                                  (line-words (lab-aspace-form (car as))))))))
       (loop (cdr as))))
   (let loop ((ports (lab-ports lab)))
     (when (pair? ports)
@@ -441,7 +449,8 @@
                   (lab-file-error path (car (cddr p))
                                   (string-append
                                    "two things on port " (number->string (car p)) ": "
-                                   (cadr (car ports)) (line-words (car (cddr (car ports))))
+                                   (cadr (car ports))
+                                   (line-words (car (cddr (car ports))))
                                    ", and " (cadr p)
                                    " (address spaces listen at port-base + i, robots'"
                                    " trip servers at port-base + 100 + i)")))))

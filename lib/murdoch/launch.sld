@@ -8,5 +8,7 @@
           (srfi 1)
           (only (chibi process) execute current-process-id)
           (murdoch lab) (murdoch command)
-          (only (murdoch remote) remote-timeout) (only (murdoch sandbox) make-lab-environment) (only (murdoch status) write-lab-status))
+          (only (murdoch remote) remote-timeout)
+          (only (murdoch sandbox) make-lab-environment)
+          (only (murdoch status) write-lab-status))
   (include "launch.scm"))

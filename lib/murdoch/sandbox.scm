@@ -218,7 +218,9 @@
     (for-each (lambda (x) (write-char #\space out) (write x out))
               (error-object-irritants e))
     (let ((text (get-output-string out)))
-      (if (> (string-length text) 200) (string-append (substring text 0 196) " ...") text))))
+      (if (> (string-length text) 200)
+          (string-append (substring text 0 196) " ...")
+          text))))
 
 (define (defined-names file)
   (filter-map (lambda (form)

@@ -112,7 +112,8 @@
 
 (define (lost? c)
   (let ((end (component-entry-end c)))
-    (and (string? end) (>= (string-length end) 5) (string=? "lost:" (substring end 0 5)))))
+    (and (string? end) (>= (string-length end) 5)
+         (string=? "lost:" (substring end 0 5)))))
 
 ;;> Brings \var{table} up to the time \var{t} (seconds) with
 ;;> \var{reports}: (UID REPORT) for each address space that answered,

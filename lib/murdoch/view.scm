@@ -421,7 +421,8 @@
                              (number->string (exact (floor (utc-seconds)))))))
     (if (not (file-exists? dir)) (create-directory* dir))
     (let claim ((n 1))
-      (let* ((name (string-append stem (if (= n 1) "" (string-append "-" (number->string n)))
+      (let* ((name (string-append stem
+                                  (if (= n 1) "" (string-append "-" (number->string n)))
                                   ".jsonl"))
              (fd (open name (bitwise-ior open/write open/create open/exclusive) #o644)))
         (cond (fd (close-port (open-output-file-descriptor fd)) name)
@@ -435,8 +436,8 @@
   (if (not (file-exists? trace)) (error "no such trace" trace))
   (let ((header (trace-header trace)))
     (if (not (and (list? header) (equal? (assq 'kind header) '(kind . "lab"))))
-        (error (string-append "not a trace of the view: " trace
-                              " (a trace's first line is the view's header of the room)"))))
+        (error (string-append "not a trace of the view: " trace " (a trace's first"
+                              " line is the view's header of the room)"))))
   (let* ((port (or port (+ (unread-lab-port-base) 148)))
          (listener (listen-on port)))
     (say "view: http://127.0.0.1:" port "/ (replaying " trace ")")

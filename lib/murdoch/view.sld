@@ -5,7 +5,8 @@
 (define-library (murdoch view)
   (export run-view run-replay
           ;; the parts, for tests
-          lab-header default-trace view-snapshot new-view-state make-task-table task-table-update!
+          lab-header default-trace view-snapshot new-view-state make-task-table
+          task-table-update!
           task-table->json reservation-task json-text box-seen)
   (import (scheme base) (scheme write) (scheme file) (scheme eval)
           (scheme inexact) (scheme char)
