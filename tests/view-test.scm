@@ -56,6 +56,39 @@
       (test "each a file made for it" '(#t #t)
         (map (lambda (f) (file-exists? (in-dir f))) (list a b))))))
 
+;; "#1565c0" ... in the order text holds them.
+(define (hex-colours text)
+  (let loop ((i 0) (acc '()))
+    (cond ((> (+ i 9) (string-length text)) (reverse acc))
+          ((and (char=? (string-ref text i) #\") (char=? (string-ref text (+ i 1)) #\#)
+                (char=? (string-ref text (+ i 8)) #\"))
+           (loop (+ i 9) (cons (substring text (+ i 1) (+ i 8)) acc)))
+          (else (loop (+ i 1) acc)))))
+
+(test-group "the simulator's SVG: the view's colours, and the robots' names"
+  (test "one palette in both"
+      (take (hex-colours (file-text (tool-path "web/view.js"))) 10)
+    (let* ((c (file-text (tool-path "sim/trace.c")))
+           (from (let loop ((i 0))
+                   (if (string=? "colour(const world" (substring c i (+ i 18))) i (loop (+ i 1))))))
+      (take (hex-colours (substring c from (string-length c))) 10)))
+  (let* ((svg (in-dir "sim.svg"))
+         (log (in-dir "b14.log"))
+         (pid (start-process! (list (tool-path "sim/b14") (test-lab-file lab)
+                                    "--lock-dir" (in-dir "locks") "--trace" svg)
+                              log)))
+    (wait-until 60 (lambda () (text-contains? (file-text log) "b14: ready")))
+    (thread-sleep! 1)                   ; a step or more, for a sample
+    (stop-process! pid)
+    (let ((text (file-text svg)))
+      (test "each robot named" '(#t #t)
+        (map (lambda (name) (text-contains? text (string-append ">" name "</text>")))
+             '("moseley" "ernst")))
+      (test "each in its view colour: moseley first, ernst second" '(#t #t)
+        (map (lambda (colour)
+               (text-contains? text (string-append "<circle r=\"180\" fill=\"" colour "\"")))
+             '("#1565c0" "#c62828"))))))
+
 (test-group "a box where a robot's fiducial finder sees it"
   (define (mm ls) (map (lambda (x) (exact (round x))) ls))
   (test "to the right of a robot facing +y, turned" '(2500 0 120)
