@@ -130,6 +130,9 @@
            "(speed slow): speed takes a positive number, or fast")
   (mistake "a b14 setting" "(lab x (b14 (sonar-rays 20)))"
            "(sonar-rays 20): sonar-rays takes a whole number from 1 to 16")
+  (mistake "a name longer than the simulator keeps"
+           (string-append "(lab x (aspace " (make-string 64 #\a) "))")
+           "an address space's name is at most 63 characters")
   (mistake "an item that is no clause" "(lab x (world wall))"
            "(world wall): wall is not a clause")
   (mistake "a missing ), named at the clause that lacks it"

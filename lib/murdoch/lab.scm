@@ -82,7 +82,9 @@
 
 (define settings-table
   `((port-base 7100 ,(whole-from 1 65535 "a port number"))
-    (interface "127.0.0.1" ,(text "an IPv4 address, in quotes"))
+    ;; sim/lab.c keeps an interface, and a robot's name, in 64 bytes.
+    (interface "127.0.0.1" (,(lambda (x) (and (string? x) (< (string-length x) 64) x))
+                            . "an IPv4 address, in quotes"))
     (key-file "murdoch.key" ,(text "a file name, in quotes"))
     (max-frame 1048576 ,positive-count)
     ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
@@ -202,6 +204,8 @@
     ((aspace)
      (if (not (and (pair? (cdr c)) (symbol? (cadr c))))
          (lab-file-error path c "an address space is (aspace NAME CLAUSE ...)"))
+     (if (>= (string-length (symbol->string (cadr c))) 64)
+         (lab-file-error path c "an address space's name is at most 63 characters"))
      (check-within path c (cddr c) aspace-table))
     ((world) (check-within path c (cdr c) world-table))
     ((simulator) (check-within path c (cdr c) simulator-table))
