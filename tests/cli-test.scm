@@ -68,6 +68,11 @@
   (mistake '("lab" "--view" "abc" "examples/tulane-lab.scm")
            "murdoch lab: --view takes a port number, or nothing, not abc")
   (mistake '("lab" "examples/tulane-lab.scm" "--trace") "murdoch lab: --trace takes a name")
+  (mistake '("lab" "--speed=abc" "examples/tulane-lab.scm")
+           "murdoch lab: --speed takes a positive number, not abc")
+  (test "--speed=2 takes its value with it, and leaves LAB an argument"
+      "murdoch lab: ERROR: cannot read /no/such.scm: couldn't open input file"
+    (first-line (murdoch "lab" "--speed=2" "/no/such.scm")))
   (mistake '("repl" "examples/tulane-lab.scm" "--x") "murdoch repl: unknown option --x")
   (test "a mistake in what a command reads is one ERROR line" '(2 #t)
     (let ((r (murdoch "check" "/no/such/lab.scm")))
