@@ -45,10 +45,6 @@
              (let ((speed (option 'speed)))
                (and speed (number->string speed))))))
 
-(define (check lab-file)
-  (read-lab lab-file)
-  (display (string-append lab-file ": no mistakes found\n")))
-
 ;; name, arguments (those in parentheses may be left out), what it does, its
 ;; options as (chibi app) writes them, and what runs it: a procedure of
 ;; the config and the arguments.
@@ -80,7 +76,7 @@
                ((view-procedure 'run-replay)
                 web trace (and (pair? port) (port-argument (command-named "replay") (car port))))))
     (check (LAB) "check the lab file for mistakes, and start nothing" ()
-           ,(lambda (cfg lab) (check lab)))
+           ,(lambda (cfg lab) (run-check lab)))
     (status (LAB) "show each address space of the running lab: up since, pose, battery, the subjects held and by whom" ()
             ,(lambda (cfg lab) (run-status lab)))
     (help ((COMMAND)) "show this help, or a command's" ()
@@ -163,6 +159,85 @@
 
 (define (help-flag? arg) (member arg '("--help" "-h")))
 
+(define (option-word? arg)
+  (and (> (string-length arg) 2) (string=? "--" (substring arg 0 2))))
+
+;; "--speed=2" names speed, as "--speed" does.
+(define (option-name arg)
+  (let ((end (or (string-index arg #\=) (string-length arg))))
+    (string->symbol (substring arg 2 end))))
+
+(define (inline-value arg)
+  (let ((i (string-index arg #\=)))
+    (and i (substring arg (+ i 1) (string-length arg)))))
+
+(define (string-index s ch)
+  (let loop ((i 0))
+    (cond ((= i (string-length s)) #f)
+          ((char=? (string-ref s i) ch) i)
+          (else (loop (+ i 1))))))
+
+;; Each option of c on the command line args, and its value, checked
+;; before (chibi app) reads them: it would call a bad number an unknown
+;; option, and take an unknown option's value for an argument.  --view's
+;; port may be left out, so a word after it that is no number is an
+;; argument, unless that leaves one too many.
+(define (check-options c args)
+  (let loop ((rest args))
+    (when (pair? rest)
+      (let ((arg (car rest)))
+        (cond
+         ((not (option-word? arg)) (loop (cdr rest)))
+         ((assq (option-name arg) (command-options c))
+          => (lambda (o)
+               (let ((value (or (inline-value arg)
+                                (and (pair? (cdr rest)) (cadr rest))))
+                     (next (if (inline-value arg) (cdr rest) (cddr* rest))))
+                 (cond
+                  ((and (eq? (car o) 'view) (not (inline-value arg))
+                        (not (and value (string->number value))))
+                   (if (and value (not (option-word? value))
+                            (> (length (positional args)) (length (command-args c))))
+                       (mistake c (value-mistake o value)))
+                   (loop (cdr rest)))
+                  ((not (and value (value-fits? (cadr o) value)))
+                   (mistake c (value-mistake o value)))
+                  (else (loop next))))))
+         (else
+          (mistake c (string-append "unknown option " arg (nearest-option c arg)))))))))
+
+(define (cddr* ls) (if (pair? (cdr ls)) (cddr ls) '()))
+
+(define (value-fits? type text)
+  (let ((n (string->number text)))
+    (case type
+      ((real) (and (real? n) (positive? n)))
+      ((integer) (and (exact-integer? n) (< 0 n 65536)))
+      (else (not (option-word? text))))))
+
+(define (value-mistake o value)
+  (string-append "--" (symbol->string (car o)) " takes "
+                 (case (cadr o)
+                   ((real) "a positive number")
+                   ((integer) (if (eq? (car o) 'view) "a port number, or nothing"
+                                  "a port number"))
+                   ((string) "a name")
+                   (else "names, as a,b,..."))
+                 (if value (string-append ", not " value) "")))
+
+(define (nearest-option c arg)
+  (let* ((names (map (lambda (o) (string-append "--" (symbol->string (car o))))
+                     (command-options c)))
+         (near (find-nearest-edits arg names)))
+    ;; Two edits from a name of another first letter is another word.
+    (if (and (pair? near)
+             (let ((d (edit-distance arg (car near))))
+               (or (<= d 1)
+                   (and (= d 2) (> (string-length arg) 2)
+                        (char=? (string-ref arg 2) (string-ref (car near) 2))))))
+        (string-append "; did you mean " (car near) "?")
+        "")))
+
 ;; (chibi app) wants a command's options before its arguments; people
 ;; write `murdoch lab LAB --trace FILE` too.  Every option takes a value
 ;; but --view, whose port may be left out: it is then 0.
@@ -173,9 +248,8 @@
      ((and (equal? (car rest) "--view")
            (or (null? (cdr rest)) (not (string->number (cadr rest)))))
       (loop (cdr rest) (cons* "0" "--view" options) positional))
-     ((and (> (string-length (car rest)) 2)
-           (string=? "--" (substring (car rest) 0 2)))
-      (if (null? (cdr rest))
+     ((option-word? (car rest))
+      (if (or (null? (cdr rest)) (inline-value (car rest)))
           (loop (cdr rest) (cons (car rest) options) positional)
           (loop (cddr rest) (cons* (cadr rest) (car rest) options) positional)))
      (else (loop (cdr rest) options (cons (car rest) positional))))))
@@ -186,8 +260,11 @@
           ((and (equal? (car rest) "--view")
                 (or (null? (cdr rest)) (not (string->number (cadr rest)))))
            (loop (cdr rest) acc))
-          ((and (> (string-length (car rest)) 2) (string=? "--" (substring (car rest) 0 2)))
-           (loop (if (pair? (cdr rest)) (cddr rest) '()) acc))
+          ((option-word? (car rest))
+           (loop (if (and (pair? (cdr rest)) (not (inline-value (car rest))))
+                     (cddr rest)
+                     (cdr rest))
+                 acc))
           (else (loop (cdr rest) (cons (car rest) acc))))))
 
 (define (app-spec c started!)
@@ -202,6 +279,7 @@
 ;; mistake, a port in use) is one ERROR line, which bin/murdoch-lab shows
 ;; of a child that dies; either exits 2.
 (define (run c args)
+  (check-options c args)
   (check-arity c (positional args))
   (let ((started? #f))
     (guard (e ((and (error-object? e) started?)

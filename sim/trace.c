@@ -82,10 +82,14 @@ void trace_say(struct trace *t, const world *w, int r, const char *text)
     t->says[t->nsays++] = (say_event){ seconds(w), w->robots[r].at, xstrdup(text), r };
 }
 
-static const char *colour(int i)
+/* Robot r's colour: that of its address space's place in the lab file,
+ * from the live view's palette (web/view.js COLOURS, the same list), so
+ * that a robot has one colour in both pictures. */
+static const char *colour(const world *w, int r)
 {
-    static const char *c[] = { "#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b" };
-    return c[i % 6];
+    static const char *c[] = { "#1565c0", "#c62828", "#2e7d32", "#6a1b9a", "#ef6c00",
+                               "#00838f", "#4e342e", "#ad1457", "#558b2f", "#283593" };
+    return c[w->lab->robots[r].aspace % 10];
 }
 
 static void xml_text(FILE *f, const char *s)
@@ -130,7 +134,7 @@ static void write_paths(FILE *f, const struct trace *t, const world *w)
 {
     int i, s;
     for (i = 0; i < w->nrobots; i++) {
-        fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-opacity=\"0.5\" stroke-width=\"40\" points=\"", colour(i));
+        fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-opacity=\"0.5\" stroke-width=\"40\" points=\"", colour(w, i));
         for (s = 0; s < t->nsamples; s++)
             fprintf(f, "%.0f,%.0f ", t->samples[(size_t)s * t->width + i].x, t->samples[(size_t)s * t->width + i].y);
         fputs("\"/>\n", f);
@@ -149,8 +153,13 @@ static void write_bodies(FILE *f, const struct trace *t, const world *w, double 
     for (i = 0; i < w->nrobots; i++) {
         double r = w->lab->b14.radius;
         animate(f, t, i, dur);
-        fprintf(f, "<circle r=\"%g\" fill=\"%s\" fill-opacity=\"0.8\"/><line x1=\"0\" y1=\"0\" x2=\"%g\" y2=\"0\" stroke=\"white\" stroke-width=\"30\"/></g></g>\n",
-                r, colour(i), r);
+        fprintf(f, "<circle r=\"%g\" fill=\"%s\" fill-opacity=\"0.8\"/><line x1=\"0\" y1=\"0\" x2=\"%g\" y2=\"0\" stroke=\"white\" stroke-width=\"30\"/></g>",
+                r, colour(w, i), r);
+        /* its name, beside it and the right way up, as the view writes it */
+        fprintf(f, "<text transform=\"scale(1,-1)\" x=\"%g\" y=\"%g\" font-size=\"220\" fill=\"%s\">",
+                r + 40, -r - 40, colour(w, i));
+        xml_text(f, w->robots[i].name);
+        fputs("</text></g>\n", f);
     }
 }
 
@@ -161,7 +170,7 @@ static void write_sonars(FILE *f, const struct trace *t, const world *w)
     for (e = 0; e < t->nsonars; e++) {
         const sonar_event *s = &t->sonars[e];
         fprintf(f, "<g visibility=\"hidden\" fill=\"%s\" fill-opacity=\"0.15\"><set attributeName=\"visibility\" to=\"visible\" begin=\"%.2fs\" dur=\"%.2fs\"/>",
-                colour(s->robot), s->t, 1.0 / SONAR_HZ);
+                colour(w, s->robot), s->t, 1.0 / SONAR_HZ);
         for (k = 0; k < SONARS; k++) {
             double a = (s->at.heading + 22.5 * k - p->sonar_cone / 2) * M_PI / 180;
             double b = (s->at.heading + 22.5 * k + p->sonar_cone / 2) * M_PI / 180;
@@ -180,7 +189,7 @@ static void write_says(FILE *f, const struct trace *t, const world *w)
     for (e = 0; e < t->nsays; e++) {
         const say_event *s = &t->says[e];
         fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" font-size=\"250\" fill=\"%s\" visibility=\"hidden\"><set attributeName=\"visibility\" to=\"visible\" begin=\"%.2fs\" dur=\"3s\"/>%s: ",
-                s->at.x + 250, -s->at.y - 250, colour(s->robot), s->t, w->robots[s->robot].name);
+                s->at.x + 250, -s->at.y - 250, colour(w, s->robot), s->t, w->robots[s->robot].name);
         xml_text(f, s->text);
         fputs("</text>\n", f);
     }

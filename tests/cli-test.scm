@@ -11,7 +11,7 @@
 ;; (exit-status first-line whole-output) of bin/murdoch with args.
 (define (murdoch . args)
   (let ((status (apply system "sh" "-c"
-                       "cd \"$1\" && shift && exec bin/murdoch \"$@\" >\"$0\" 2>&1"
+                       "cd \"$1\" && shift && exec timeout -s KILL 60 bin/murdoch \"$@\" >\"$0\" 2>&1"
                        out (tool-path ".") args)))
     (let ((text (file-text out)))
       (list (quotient (if (pair? status) (cadr status) status) 256)
@@ -21,6 +21,10 @@
 (define (status r) (car r))
 (define (first-line r) (cadr r))
 (define (no-trace? r) (not (text-contains? (car (cddr r)) "called from")))
+
+(define (write-file name text)
+  (call-with-output-file (string-append dir "/" name)
+    (lambda (o) (write-string text o))))
 
 (test-begin "cli")
 
@@ -55,14 +59,63 @@
   (mistake '("lab" "examples/tulane-lab.scm" "--bogus" "1") "murdoch lab: unknown option --bogus")
   (mistake '("lab" "--view") "murdoch lab: missing LAB")
   (mistake '("view" "examples/tulane-lab.scm" "http") "murdoch view: not a port number: http")
+  (mistake '("check" "examples/tulane-lab.scm" "--bogus") "murdoch check: unknown option --bogus")
+  (mistake '("lab" "--bogus" "examples/tulane-lab.scm") "murdoch lab: unknown option --bogus")
+  (mistake '("lab" "--spede" "2" "examples/tulane-lab.scm")
+           "murdoch lab: unknown option --spede; did you mean --speed?")
+  (mistake '("lab" "--speed" "abc" "examples/tulane-lab.scm")
+           "murdoch lab: --speed takes a positive number, not abc")
+  (mistake '("lab" "--view" "abc" "examples/tulane-lab.scm")
+           "murdoch lab: --view takes a port number, or nothing, not abc")
+  (mistake '("lab" "examples/tulane-lab.scm" "--trace") "murdoch lab: --trace takes a name")
+  (mistake '("lab" "--speed=abc" "examples/tulane-lab.scm")
+           "murdoch lab: --speed takes a positive number, not abc")
+  (test "--speed=2 takes its value with it, and leaves LAB an argument"
+      "murdoch lab: ERROR: cannot read /no/such.scm: couldn't open input file"
+    (first-line (murdoch "lab" "--speed=2" "/no/such.scm")))
+  (mistake '("repl" "examples/tulane-lab.scm" "--x") "murdoch repl: unknown option --x")
   (test "a mistake in what a command reads is one ERROR line" '(2 #t)
     (let ((r (murdoch "check" "/no/such/lab.scm")))
       (list (status r)
             (string=? (car (cddr r))
-                      "murdoch check: ERROR: cannot read the lab file /no/such/lab.scm couldn't open input file\n"))))
+                      "murdoch check: ERROR: cannot read /no/such/lab.scm: couldn't open input file\n"))))
+  (test "a replay of a file that is not a trace, such as a lab file" #t
+    (let ((r (murdoch "replay" "examples/tulane-lab.scm")))
+      (and (= 2 (status r))
+           (equal? (text-lines (car (cddr r)))
+                   '("murdoch replay: ERROR: not a trace of the view: examples/tulane-lab.scm (a trace's first line is the view's header of the room)")))))
   (test "a replay of a trace that is not there" '(2 "murdoch replay: ERROR: no such trace /no/such.jsonl")
     (let ((r (murdoch "replay" "/no/such.jsonl")))
       (list (status r) (first-line r)))))
+
+(test-group "replay follows MURDOCH_PORT_BASE, as lab and view do"
+  (let* ((base (free-port-base dir))
+         (trace (string-append dir "/trace.jsonl"))
+         (replay-out (string-append dir "/replay.out")))
+    (write-file "trace.jsonl" "{\"kind\":\"lab\",\"lab\":\"x\",\"radius\":180,\"walls\":[],\"boxes\":[],\"aspaces\":[],\"started\":0}\n")
+    (let ((pid (start-process! (list "env" (string-append "MURDOCH_PORT_BASE=" (number->string base))
+                                     (tool-path "bin/murdoch") "replay" trace)
+                               replay-out)))
+      (test "it serves on port-base + 148" #t
+        (wait-until 30 (lambda () (text-contains? (file-text replay-out)
+                                                  (string-append "http://127.0.0.1:"
+                                                                 (number->string (+ base 148)) "/")))))
+      (stop-process! pid))))
+
+(test-group "before anything is built"
+  ;; A copy of bin/ and tools/chibi with no Chibi beside it or on PATH,
+  ;; and C not yet compiled.
+  (let ((fresh (string-append dir "/fresh")))
+    (system "sh" "-c" (string-append "mkdir -p \"$1/bin\" \"$1/tools\" \"$1/lib/murdoch\""
+                                     " && cp bin/murdoch bin/murdoch.scm \"$1/bin\""
+                                     " && cp tools/chibi \"$1/tools\""
+                                     " && touch \"$1/lib/murdoch/glue.c\"")
+            (tool-path ".") fresh)
+    (let ((status (system "sh" "-c" "PATH=/usr/bin:/bin \"$1/bin/murdoch\" --help >\"$0\" 2>&1"
+                          out fresh)))
+      (test "--help says what to run, and exits 1" '(1 #t)
+        (list (quotient (if (pair? status) (cadr status) status) 256)
+              (text-contains? (file-text out) "run `make all`"))))))
 
 (test-group "check"
   (test "a good lab file" '(0 "examples/tulane-lab.scm: no mistakes found")
@@ -72,8 +125,66 @@
     (lambda (o) (write-string "(lab x (timout 3))\n" o)))
   (test "a misspelt setting" #t
     (let ((r (murdoch "check" (string-append dir "/lab.scm"))))
-      (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?")))))
+      (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?"))))
+  (write-file "inside.scm" "(lab x\n  (aspace a (robot (pose 0 0 0)\n    (tetherd #f))))\n")
+  (test "check and lab name the same mistake inside a robot, with its line"
+      (list (list 2 (string-append "murdoch check: ERROR: " dir "/inside.scm:3: (tetherd #f):"
+                                   " no such clause in robot; did you mean tethered?"))
+            (list 2 (string-append "murdoch lab: ERROR: " dir "/inside.scm:3: (tetherd #f):"
+                                   " no such clause in robot; did you mean tethered?")))
+    (map (lambda (command)
+           (let ((r (murdoch command (string-append dir "/inside.scm"))))
+             (list (status r) (first-line r))))
+         '("check" "lab")))
+  ;; A code file is loaded as an address space loads it.
+  (write-file "open.scm" "(define (f x)\n  (+ x 1)\n\n(define (g) 2)\n")
+  (write-file "raises.scm" "(define a 1)\n(car '())\n")
+  (write-file "code1.scm" "(lab x (code \"open.scm\"))\n")
+  (write-file "code2.scm" "(lab x (code \"raises.scm\"))\n")
+  (test "a code file whose list is not closed: its file and line" #t
+    (let ((r (murdoch "check" (string-append dir "/code1.scm"))))
+      (and (= 2 (status r))
+           (text-contains? (first-line r)
+                           "/open.scm:1: this list has no closing ): the file ends inside it"))))
+  (test "a code file that raises as it loads: its file, line and error" #t
+    (let ((r (murdoch "check" (string-append dir "/code2.scm"))))
+      (and (= 2 (status r))
+           (text-contains? (first-line r) "/raises.scm:2: car: not a pair ()")))))
+
+;; A lab of workstations, which needs no simulator, and two tasks: one
+;; that troy takes, and one that nobody can.
+(define demo-lab
+  (make-test-lab '((aspace troy (capabilities camera)) (aspace praline))
+                 '(("camera.scm" . "(list 'snap 1 (list (list '() (list 'camera)))
+                                         (list #f) (list (lambda () 'snapped)))\n")
+                   ("laser.scm" . "(list 'scan 1 (list (list '() (list 'laser)))
+                                        (list #f) (list (lambda () 'scanned)))\n"))))
+
+;; (exit-status whole-output) of `bin/murdoch demo` posing task, run in
+;; the lab's folder, where the view writes runs/.
+(define (demo task)
+  (let* ((lab-dir (test-lab-directory demo-lab))
+         (status (system "sh" "-c"
+                         (string-append "cd \"$1\" && MURDOCH_DEMO_TASK=\"$1/$2\""
+                                        " timeout -s KILL 200 \"$0/bin/murdoch\""
+                                        " demo lab.scm >demo.out 2>&1")
+                         (tool-path ".") lab-dir task)))
+    (list (quotient (if (pair? status) (cadr status) status) 256)
+          (file-text (string-append lab-dir "/demo.out")))))
+
+(test-group "demo: its output, always, and its exit status"
+  (let ((r (demo "camera.scm")))
+    (test "a task done: exit 0" 0 (status r))
+    (test "the pose's output is shown, to its result" #t
+      (text-contains? (cadr r) "(snapped)"))
+    (test "and no file is read before it is made" #f
+      (text-contains? (cadr r) "No such file")))
+  (let ((r (demo "laser.scm")))
+    (test "a task nobody takes: exit non-zero" #t (positive? (status r)))
+    (test "its output is shown" #t (text-contains? (cadr r) "not-enough-takers"))
+    (test "and the demo says so" #t (text-contains? (cadr r) "the task did not complete"))))
 
 (test-end)
+(remove-test-lab! demo-lab)
 (delete-file-hierarchy dir)
 (test-exit)

@@ -58,14 +58,17 @@
   (test "a delivery that is neither" #t
     (says? "(lab x (delivery carrier-pigeon))" "delivery takes broadcast, or multicast"))
   (test "the file is named" #t (says? "(lab x (timout 3))" file))
-  (test "two address spaces of one name" #t
-    (says? "(lab x (aspace a) (aspace b) (aspace a))" "(aspace a): two address spaces of this name"))
-  (test "two things on one port" #t
-    (says? "(lab x (port-base 7000) (aspace a) (aspace b (port 7000)))"
-           "(port 7000): two things on this port"))
+  (test "two address spaces of one name: the later, with the other's line" #t
+    (says? "(lab x\n (aspace a)\n (aspace b)\n (aspace a))"
+           ":4: (aspace a): two address spaces of this name: the other on line 2"))
+  (test "two things on one port: both named" #t
+    (says? "(lab x (port-base 7000)\n (aspace a)\n (aspace b (port 7000)))"
+           (string-append ":3: (aspace b (port 7000)): two things on port 7000: the address"
+                          " space a on line 2, and the address space b")))
   (test "a robot's trip server on an address space's port" #t
-    (says? "(lab x (port-base 7000) (aspace a (robot (trip-port 7001))) (aspace b))"
-           "(port 7001): two things on this port"))
+    (says? "(lab x (port-base 7000)\n (aspace a (robot (trip-port 7001)))\n (aspace b))"
+           (string-append ":3: (aspace b): two things on port 7001: the trip server of the"
+                          " robot a on line 2, and the address space b")))
   (test "a code file that is not there" #t
     (says? "(lab x (code \"nowhere.scm\"))" "(code \"nowhere.scm\"): no such file")))
 
@@ -83,14 +86,77 @@
   (test "on a box" #t
     (says? (string-append room "(aspace a (robot (pose 1500 1700 0))))")
            "the robot a stands on (box 1500 1500 600 600 30)"))
-  (test "on another robot, on its own line" #t
+  (test "on another robot: the later is named, on its line, with the other's" #t
     (says? (string-append room "(aspace a (robot (pose 0 0 0)))\n(aspace b (robot (pose 200 100 0))))")
-           ":2: (aspace a (robot (pose 0 0 0))): the robot a stands on the robot b"))
+           ":3: (aspace b (robot (pose 200 100 0))): the robot b stands on the robot a on line 2"))
   (test "apart, they are fine" #t
     (lab? (read-text (string-append room "(aspace a (robot (pose 0 0 0))) (aspace b (robot (pose 1000 0 0))))"))))
   (test "a larger radius from the b14 clause counts" #t
     (says? (string-append room "(b14 (radius 600)) (aspace a (robot (pose 0 0 0))) (aspace b (robot (pose 1000 0 0))))")
-           "stands on the robot b")))
+           "the robot b stands on the robot a"))
+  (test "outside the walls of a rectangular room" #t
+    (says? (string-append "(lab x (world (wall -3000 -3000 3000 -3000) (wall 3000 -3000 3000 3000)"
+                          " (wall 3000 3000 -3000 3000) (wall -3000 3000 -3000 -3000))\n"
+                          "(aspace a (robot (pose 9000 0 0))))")
+           ":2: (aspace a (robot (pose 9000 0 0))): the robot a stands outside the walls"))
+  (test "beside a lone wall is no room to be outside of" #t
+    (lab? (read-text "(lab x (world (wall 0 0 1000 0)) (aspace a (robot (pose 9000 0 0))))"))))
+
+(test-group "every clause is checked, within aspace, robot, world, simulator, b14"
+  (define (mistake name text what)
+    (test name #t (says? text what)))
+  (mistake "a misspelt clause of an address space, with the nearest"
+           "(lab x\n  (aspace a\n    (capabilites camera)))"
+           ":3: (capabilites camera): no such clause in aspace; did you mean capabilities?")
+  (mistake "a misspelt setting of a robot"
+           "(lab x (aspace a (robot (pose 0 0 0)\n (tetherd #f))))"
+           ":2: (tetherd #f): no such clause in robot; did you mean tethered?")
+  (mistake "a misspelt item of the world"
+           "(lab x (world (bx 0 0 100 100 0)))" "(bx 0 0 100 100 0): no such clause in world; did you mean box?")
+  (mistake "a coordinate that is no number" "(lab x (aspace a (robot (pose 1200 abc 180))))"
+           "(pose 1200 abc 180): pose takes x y heading, three numbers")
+  (mistake "a coordinate in quotes" "(lab x (aspace a (robot (pose \"1200\" 0 180))))"
+           "pose takes x y heading")
+  (mistake "a coordinate left out" "(lab x (aspace a (robot (pose 1200 -400))))"
+           "(pose 1200 -400): pose takes x y heading")
+  (mistake "a value of the wrong kind" "(lab x (aspace a (robot (battery \"full\"))))"
+           "(battery \"full\"): battery takes volts, a positive number")
+  (mistake "a wall of three numbers" "(lab x (world (wall 0 0 1000)))"
+           "(wall 0 0 1000): wall takes x1 y1 x2 y2")
+  (mistake "a workstation's position" "(lab x (aspace a (position 0 0)))"
+           "(position 0 0): position takes x y heading")
+  (mistake "a scripted load" "(lab x (aspace a (load ((0 high)))))" "(load ((0 high))): load takes")
+  (mistake "a simulator setting" "(lab x (simulator (speed slow)))"
+           "(speed slow): speed takes a positive number, or fast")
+  (mistake "a b14 setting" "(lab x (b14 (sonar-rays 20)))"
+           "(sonar-rays 20): sonar-rays takes a whole number from 1 to 16")
+  (mistake "a name longer than the simulator keeps"
+           (string-append "(lab x (aspace " (make-string 64 #\a) "))")
+           "an address space's name is at most 63 characters")
+  (mistake "an item that is no clause" "(lab x (world wall))"
+           "(world wall): wall is not a clause")
+  (mistake "a missing ), named at the clause that lacks it"
+           "(lab x\n  (timeout 3)\n  (aspace a (robot (pose 0 0 0))\n  (aspace b))\n"
+           (string-append file ":3: this list has no closing ): the file ends inside it"))
+  (mistake "the end of the file inside the last clause"
+           "(lab x\n  (timeout 3)\n  (load 0.5" ":3: this list has no closing )")
+  (mistake "a ) too many" "(lab x)\n)" ":2: a ) that closes nothing")
+  (mistake "an empty file" "" (string-append file ": the file is empty"))
+  (mistake "a file of comments only" "; nothing yet\n" "the file is empty")
+  (mistake "two forms" "(lab x)\n(lab y)" ":2: (lab y): a second form")
+  (test "a long clause is cut, to one line" #t
+    (let ((message (read-text (string-append "(lab x (aspace a (capabilities "
+                                             "sonar ir bumpers speech buttons lights mobile"
+                                             " camera) (colour blue)))"))))
+      (and (text-contains? message "(colour blue): no such clause in aspace")
+           (not (text-contains? message "\n")))))
+  (test "a clause past 60 characters is cut at 56, with ..." #t
+    (says? (string-append "(lab x (aspace a (capabilites sonar ir bumpers speech buttons"
+                          " lights mobile camera)))")
+           "(capabilites sonar ir bumpers speech buttons lights mobi ...: no such clause"))
+  (test "every example lab passes" '(#t #t)
+    (map (lambda (f) (lab? (read-lab (tool-path (string-append "examples/" f)))))
+         '("tulane-lab.scm" "box-lab.scm"))))
 
 (test-end)
 (delete-file-hierarchy dir)

@@ -2,7 +2,7 @@
 ;;; down whole, an address space that dies is started again, one that
 ;;; cannot start stops the lab, and pose poses the task a file names.
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
-        (only (chibi process) system? kill signal/kill)
+        (only (chibi process) system system? kill signal/kill)
         (chibi io) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor)
         (murdoch testing))
@@ -28,6 +28,16 @@
              (number->string pid) file)
     (map string->number (read-lines file))))
 
+;; The pid of the child of process `pid` that ps names `name`, or #f.
+(define (child-named pid name)
+  (let ((found (string->number
+                (command-output
+                 (list "sh" "-c" (string-append "ps -o pid=,comm= --ppid \"$0\" | awk"
+                                                " '$2 == \"" name "\" { p = $1 }"
+                                                " END { print p + 0 }'")
+                       (number->string pid))))))
+    (and (positive? found) found)))
+
 ;; The lines `bin/murdoch COMMAND LAB ARG ...` prints.
 (define (command-lines command . args)
   (let ((out (in-dir "command.out")))
@@ -35,6 +45,13 @@
            "out=$1; shift; timeout -s KILL 60 \"$@\" >\"$out\" 2>&1"
            "command" out (tool-path "bin/murdoch") command (test-lab-file lab) args)
     (read-lines out)))
+
+;; The exit status of `bin/murdoch COMMAND LAB ARG ...`.
+(define (command-status command . args)
+  (let ((status (apply system "sh" "-c" "timeout -s KILL 60 \"$@\" >/dev/null 2>&1"
+                       "command" (tool-path "bin/murdoch") command (test-lab-file lab)
+                       args)))
+    (quotient (if (pair? status) (cadr status) status) 256)))
 
 ;; The lines `bin/murdoch pose` prints for the task file `task`.
 (define (pose-output task) (command-lines "pose" (in-dir task)))
@@ -112,7 +129,15 @@
                      (if (pair? lines) (last lines) "")))
                  (iota 10 1))))
         (for-each (lambda (sock) (close-port (open-input-file-descriptor sock)))
-                  squatters)))
+                  squatters))
+      (test "a task done: pose exits 0" 0 (command-status "pose" (in-dir "task.scm")))
+      (call-with-output-file (in-dir "failing.scm")
+        (lambda (out)
+          (write-string "(list 'fails 1 (list (list '() (list 'camera))) (list #f)
+                               (list (lambda () (car '()))))\n"
+                        out)))
+      (test "a task whose component failed: pose exits 1" 1
+        (command-status "pose" (in-dir "failing.scm"))))
     (test "status: each address space, up" '(#t #t)
       (let ((lines (command-lines "status")))
         (map (lambda (uid)
@@ -126,20 +151,37 @@
     (let ((output (pose-output "task.scm")))
       (test "pose with the lab gone says that nobody answers" #t
         (text-contains? (car output) "no address space of the lab answers; away: (troy praline)"))
-      (test "and nobody takes the task" "not-enough-takers" (last output)))))
+      (test "and nobody takes the task" "not-enough-takers" (last output)))
+    (test "a task nobody took: pose exits 1" 1 (command-status "pose" (in-dir "task.scm")))
+    (test "status, when no address space answers, exits 1" 1
+      (command-status "status"))))
 
 (test-group "an address space that dies is started again"
   (let* ((pid (start-lab! (in-dir "lab2.out")))
          (troy (car (children-of pid))))
     (kill troy signal/kill)
-    (test "the lab names it" #t
+    (test "the lab names it, and how it died" #t
       (wait-until 10 (lambda () (text-contains? (file-text (in-dir "lab2.out"))
-                                                "troy died"))))
+                                                "troy died (killed by signal 9)"))))
+    (test "and not with its old log lines" #f
+      (text-contains? (file-text (in-dir "lab2.out")) "listening on"))
     (test "and starts it again" #t
       (wait-until 30 (lambda () (and (text-contains? (file-text (in-dir "lab2.out"))
                                                      "starting troy again")
                                      (listening? base)))))
     (test "the others carry on" #t (listening? (+ base 1)))
+    ;; Three restarts a minute: the fourth death is the last.
+    (let loop ((deaths 1) (killed troy))
+      (when (< deaths 4)
+        (let ((next #f))
+          (wait-until 30 (lambda ()
+                           (set! next (child-named pid "murdoch-troy"))
+                           (and next (not (= next killed)) (listening? base))))
+          (kill next signal/kill)
+          (loop (+ deaths 1) next))))
+    (test "the fourth death in a minute is counted as four" #t
+      (wait-until 30 (lambda () (text-contains? (file-text (in-dir "lab2.out"))
+                                                "troy died 4 times in a minute"))))
     (test "the lab runs on, and stops whole" 0 (stop-process! pid))))
 
 (test-group "a child that cannot start stops the lab, with its ERROR line"

@@ -6,7 +6,8 @@
 (import (scheme base) (scheme write) (scheme file) (scheme char) (scheme process-context)
         (srfi 1) (srfi 18) (chibi test)
         (only (chibi process) system?)
-        (only (chibi filesystem) delete-file-hierarchy file-size directory-files)
+        (only (chibi filesystem) delete-file-hierarchy file-size directory-files
+              current-directory change-directory)
         (chibi json)
         (murdoch lab) (murdoch view) (murdoch connect) (murdoch testing))
 
@@ -35,9 +36,58 @@
         (list (first walls) (third walls))))
     (test "boxes" '#(#(1500 1500 400 400 30)) (assq-ref 'boxes header))
     (test "the robots' radius" 180 (assq-ref 'radius header))
+    ;; Chibi's current-second is TAI, 37 s ahead of the clock on the wall.
+    (test "started: seconds since 1970, UTC, as date says" #t
+      (< (abs (- (assq-ref 'started header)
+                 (string->number (command-output (list "date" "+%s")))))
+         10))
     (test "which address spaces are robots" '(("moseley" . #t) ("ernst" . #t) ("troy" . #f))
       (map (lambda (a) (cons (assq-ref 'name a) (assq-ref 'robot a)))
            (vector->list (assq-ref 'aspaces header))))))
+
+(test-group "two views of one lab, started in one second, have a trace each"
+  (let ((here (current-directory)))
+    (change-directory dir)
+    (let* ((lab (read-lab (test-lab-file lab)))
+           (a (default-trace lab))
+           (b (default-trace lab)))
+      (change-directory here)
+      (test "two names" #t (not (equal? a b)))
+      (test "each a file made for it" '(#t #t)
+        (map (lambda (f) (file-exists? (in-dir f))) (list a b))))))
+
+;; "#1565c0" ... in the order text holds them.
+(define (hex-colours text)
+  (let loop ((i 0) (acc '()))
+    (cond ((> (+ i 9) (string-length text)) (reverse acc))
+          ((and (char=? (string-ref text i) #\") (char=? (string-ref text (+ i 1)) #\#)
+                (char=? (string-ref text (+ i 8)) #\"))
+           (loop (+ i 9) (cons (substring text (+ i 1) (+ i 8)) acc)))
+          (else (loop (+ i 1) acc)))))
+
+(test-group "the simulator's SVG: the view's colours, and the robots' names"
+  (test "one palette in both"
+      (take (hex-colours (file-text (tool-path "web/view.js"))) 10)
+    (let* ((c (file-text (tool-path "sim/trace.c")))
+           (from (let loop ((i 0))
+                   (if (string=? "colour(const world" (substring c i (+ i 18))) i (loop (+ i 1))))))
+      (take (hex-colours (substring c from (string-length c))) 10)))
+  (let* ((svg (in-dir "sim.svg"))
+         (log (in-dir "b14.log"))
+         (pid (start-process! (list (tool-path "sim/b14") (test-lab-file lab)
+                                    "--lock-dir" (in-dir "locks") "--trace" svg)
+                              log)))
+    (wait-until 60 (lambda () (text-contains? (file-text log) "b14: ready")))
+    (thread-sleep! 1)                   ; a step or more, for a sample
+    (stop-process! pid)
+    (let ((text (file-text svg)))
+      (test "each robot named" '(#t #t)
+        (map (lambda (name) (text-contains? text (string-append ">" name "</text>")))
+             '("moseley" "ernst")))
+      (test "each in its view colour: moseley first, ernst second" '(#t #t)
+        (map (lambda (colour)
+               (text-contains? text (string-append "<circle r=\"180\" fill=\"" colour "\"")))
+             '("#1565c0" "#c62828"))))))
 
 (test-group "a box where a robot's fiducial finder sees it"
   (define (mm ls) (map (lambda (x) (exact (round x))) ls))
@@ -78,6 +128,23 @@
         '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
                (null "ernst" ("mobile") null null null)))
       (components table))
+    (task-table-update! table 3 (list (list 'moseley (report 'moseley '() '()))))
+    (task-table-update! table 4 (list (list 'moseley (report 'moseley '() '()))))
+    (test "one silent for three looks in a row was lost, and its task failed"
+        '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
+               (null "ernst" ("mobile") 4 "lost: ernst does not answer" null)))
+      (components table))
+    (test "the task's state" "failed"
+      (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0)))
+    ;; A robot killed and started again answers at once, holding nothing.
+    (let ((table (make-task-table)))
+      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |u@pose-3#1|))
+                                                              '()))))
+      (task-table-update! table 2 (list (list 'moseley (cons 'moseley
+                                                             (cons 99 (cddr (report 'moseley '() '())))))))
+      (test "one that started again lost what it ran"
+          '(("u" (null "moseley" ("mobile") 2 "lost: moseley started again" null)))
+        (components table)))
     ;; start-task: components by index, and a reassignment.
     (let ((table (make-task-table)))
       (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |s@tester#4|))

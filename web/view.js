@@ -6,6 +6,7 @@
 "use strict";
 
 const SVG = "http://www.w3.org/2000/svg";
+// sim/trace.c draws the simulator's SVG with this same list.
 const COLOURS = ["#1565c0", "#c62828", "#2e7d32", "#6a1b9a", "#ef6c00",
                  "#00838f", "#4e342e", "#ad1457", "#558b2f", "#283593"];
 

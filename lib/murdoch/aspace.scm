@@ -17,7 +17,7 @@
   (port aspace-port))
 
 (define *local* #f)                     ; the local aspace, once started
-(define *started-at* #f)                ; (current-second) then
+(define *started-at* #f)                ; (utc-seconds) then
 (define *lab* #f)
 (define *peers* (make-hash-table eq?))  ; uid -> aspace, from lab and hellos
 (define *peers-lock* (make-mutex 'peers))
@@ -32,7 +32,7 @@
   (set! *local* (make-aspace (aspace-uid *local*) (aspace-host *local*) port))
   (learn-aspace! *local*))
 
-;;> The (current-second) at which this address space joined its lab.
+;;> The (utc-seconds) at which this address space joined its lab.
 (define (aspace-started-at) *started-at*)
 
 ;;> The uid of the local address space.
@@ -124,7 +124,7 @@
 ;;> it receives with \var{decode}; answers the local aspace.
 (define (join-lab! lab uid host port environment decode)
   (set! *lab* lab)
-  (set! *started-at* (current-second))
+  (set! *started-at* (utc-seconds))
   (set! *local* (make-aspace uid host port))
   (set! *environment* environment)
   (set! *decode* decode)

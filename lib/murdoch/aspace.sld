@@ -9,6 +9,7 @@
           live-uids current-lab join-lab!
           remote-timeout set-remote-timeout! current-timeout
           lab-environment decode-value describe-procedure)
-  (import (scheme base) (scheme time) (srfi 1) (srfi 18) (srfi 69)
-          (murdoch wait) (murdoch lab) (murdoch sendable) (murdoch sandbox))
+  (import (scheme base) (srfi 1) (srfi 18) (srfi 69)
+          (only (murdoch log) utc-seconds) (murdoch wait) (murdoch lab) (murdoch sendable)
+          (murdoch sandbox))
   (include "aspace.scm"))

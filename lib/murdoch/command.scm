@@ -77,13 +77,17 @@
                                                 (current-process-id))))))
          (lab-env (join-read-lab lab uid
                                  (if guest? (list (lab-guest-port lab)) '()))))
+    (write-string (string-append "murdoch: a REPL in the lab "
+                                 (symbol->string (lab-name lab)) ", as "
+                                 (symbol->string uid) "; (help) says what to type,"
+                                 " Ctrl-D leaves\n"))
     (tell-who-is-away lab)
     (set-remote-timeout! (lab-setting lab 'repl-timeout))
     ;; (chibi repl) is loaded here, not imported: it costs seconds, and
     ;; only a person at a REPL needs it.
     ((eval 'repl (environment '(chibi repl)))
           'in: (waiting-input-port)
-          'environment: (make-repl-environment lab lab-env)
+          'environment: (with-help (make-repl-environment lab lab-env))
           'eval: eval-with-hints
           'raw?: (not (is-a-tty? (current-input-port)))
           ;; write, not (chibi repl)'s write/ss: labels for cycles only,
@@ -92,6 +96,26 @@
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))
     (exit 0)))
+
+;; env, where (help) writes help-text.
+(define (with-help env)
+  (eval `(define (help) (write-string ,help-text) (if #f #f)) env)
+  env)
+
+(define help-text
+  "You are a peer of the lab, as any address space.  A few things to type:
+  (show-status)                      each address space: pose, battery, what it holds
+  (known-uids)                       the address spaces this one knows
+  (remote-apply (uid->aspace 'troy) (lambda () (+ 1 2)))
+                                     run a procedure on troy, and answer its value
+  (request '(sonar mobile) safe-reckon)
+                                     ask every robot with sonar where it is
+  (pose-task 'NAME N CAPABILITIES METRICS PROCEDURES)
+                                     pose a task: the best robots run its components
+  (define t (start-task ...))        the same, answering at once: then (task-status t),
+                                     (task-wait t), (cancel-task t)
+docs/tutorial.md walks through these; docs/reference.md has every procedure.
+")
 
 ;; Standard input, read so that the REPL's wait for a line lets the other
 ;; threads run: they serve the lab's calls to this peer, and a task's

@@ -9,13 +9,22 @@
 ;;     receiver does not have (it sees (murdoch) and the lab's code);
 ;;   - a value that cannot travel (a port, a mutex) is sent;
 ;;   - a procedure is given the wrong number of arguments: said in words,
-;;     not as Chibi's "not enough args" with the procedure and a count.
+;;     not as Chibi's "not enough args" with the procedure and a count;
+;;   - a name that is not defined, or a uid that is not the lab's: said in
+;;     one line, with the nearest name or uid, not as (chibi repl)'s search
+;;     of every module for it;
+;;   - a call that timed out: the procedure may still run there, and a
+;;     loop that never calls out cannot be stopped (README, "Failures").
 
 ;;> Evaluates \var{expr} in \var{env} as the REPL's eval: an error raised
 ;;> in Murdoch's or Chibi's own files is raised again without that place,
 ;;> and with a hint when one of the mistakes above caused it.
 (define (eval-with-hints expr env)
   (guard (e ((and (exception? e) (arity-error? e)) (raise (arity-recast e)))
+            ((and (exception? e) (undefined-variable e))
+             => (lambda (name) (raise (undefined-recast name env))))
+            ((and (exception? e) (unknown-uid e))
+             => (lambda (uid) (raise (unknown-uid-recast e uid))))
             ((and (exception? e) (library-source? e))
              (raise (recast e (hint e env)))))
     (eval expr env)))
@@ -38,12 +47,81 @@
 
 (define (hint e env)
   (cond
+   ((remote-timeout-error? e)
+    (let ((uid (symbol->string (remote-error-uid e))))
+      (string-append "the call may still be running on " uid ": a procedure that"
+                     " never calls out (a loop, a long thread-sleep!) runs to its end,"
+                     " and " uid " is busy with it until then")))
    ((send-error? e)
     (string-append "a value travels when it is data, or a procedure; make the"
                    " rest inside the procedure, where it runs"))
    ((and (remote-raised-error? e) (undefined-name (remote-error-message e)))
     => (lambda (name) (and (defined-here? name env) (definition-hint name e))))
    (else #f)))
+
+;; NAME of Chibi's error "undefined variable" NAME, or #f.
+(define (undefined-variable e)
+  (and (equal? (error-object-message e) "undefined variable")
+       (pair? (error-object-irritants e))
+       (let ((name (car (error-object-irritants e))))
+         (cond ((symbol? name) name)
+               ((identifier? name) (identifier->symbol name))
+               (else #f)))))
+
+;; "troyy is not defined; did you mean 'troy, a uid?": the nearest name
+;; defined in env, or the nearest uid, quoted, for one typed unquoted.
+(define (undefined-recast name env)
+  (let* ((text (symbol->string name))
+         (uids (map symbol->string (known-uids)))
+         (near-uid (nearest-name text uids))
+         (near (nearest-name text (map symbol->string (defined-names env)))))
+    (make-exception
+     'undefined
+     (string-append text " is not defined"
+                    (cond ((member text uids)
+                           (string-append "; " text " is a uid: quote it, '" text))
+                          ((and near-uid (or (not near)
+                                             (<= (edit-distance text near-uid)
+                                                 (edit-distance text near))))
+                           (string-append "; did you mean '" near-uid ", a uid?"))
+                          (near (string-append "; did you mean " near "?"))
+                          (else "")))
+     '() #f #f)))
+
+;; Every name env and the environments it imports from define.
+(define (defined-names env)
+  (let loop ((env env) (acc '()))
+    (if env (loop (env-parent env) (append (env-exports env) acc)) acc)))
+
+;; The name of names nearest text, at most two edits away and less than
+;; half of it, or #f.
+(define (nearest-name text names)
+  (let ((near (find-nearest-edits text names)))
+    (and (pair? near)
+         (let ((d (edit-distance text (car near))))
+           (and (<= d 2) (< (* 2 d) (string-length text))))
+         (car near))))
+
+(define (nearest text names)
+  (cond ((nearest-name text names)
+         => (lambda (n) (string-append "; did you mean " n "?")))
+        (else ";")))
+
+;; "no address space troyy is known; did you mean troy?": in one line.
+(define (unknown-uid-recast e uid)
+  (make-exception (exception-kind e)
+                  (string-append "no address space " (symbol->string uid) " is known"
+                                 (nearest (symbol->string uid)
+                                          (map symbol->string (known-uids)))
+                                 " (known-uids) lists those that are")
+                  '() #f #f))
+
+;; The uid of the error "no address space of this uid is known" UID, or #f.
+(define (unknown-uid e)
+  (and (equal? (error-object-message e) "no address space of this uid is known")
+       (pair? (error-object-irritants e))
+       (symbol? (car (error-object-irritants e)))
+       (car (error-object-irritants e))))
 
 (define (arity-error? e)
   (and (member (error-object-message e) '("not enough args" "too many args"))

@@ -5,7 +5,10 @@
 (define-library (murdoch hints)
   (export eval-with-hints)
   (import (scheme base) (scheme eval)
-          (only (chibi) make-exception exception? exception-kind)
+          (only (chibi) make-exception exception? exception-kind env-parent env-exports
+                identifier? identifier->symbol)
+          (only (chibi edit-distance) find-nearest-edits edit-distance)
+          (only (murdoch aspace) known-uids)
           (only (chibi ast) exception-source procedure-arity procedure-variadic?
                 procedure-name)
           (murdoch remote-error) (only (murdoch sendable) send-error?))

@@ -23,15 +23,17 @@
   (clause key (lab-clauses lab)))
 
 ;;> One address space of the lab file.  \var{clauses} keeps the clauses that
-;;> later layers read (robot, position, capabilities, load).
+;;> later layers read (robot, position, capabilities, load); \var{form} is
+;;> its whole (aspace NAME ...) clause, for errors to name with its line.
 (define-record-type lab-aspace
-  (make-lab-aspace uid index host port clauses)
+  (make-lab-aspace uid index host port clauses form)
   lab-aspace?
   (uid lab-aspace-uid)
   (index lab-aspace-index)
   (host lab-aspace-host)
   (port lab-aspace-port)
-  (clauses lab-aspace-clauses))
+  (clauses lab-aspace-clauses)
+  (form lab-aspace-form))
 
 (define (clause key clauses)
   (find (lambda (c) (and (pair? c) (eq? (car c) key))) clauses))
@@ -80,7 +82,9 @@
 
 (define settings-table
   `((port-base 7100 ,(whole-from 1 65535 "a port number"))
-    (interface "127.0.0.1" ,(text "an IPv4 address, in quotes"))
+    ;; sim/lab.c keeps an interface, and a robot's name, in 64 bytes.
+    (interface "127.0.0.1" (,(lambda (x) (and (string? x) (< (string-length x) 64) x))
+                            . "an IPv4 address, in quotes"))
     (key-file "murdoch.key" ,(text "a file name, in quotes"))
     (max-frame 1048576 ,positive-count)
     ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
@@ -108,6 +112,107 @@
 ;; spaces.
 (define other-clauses '(world simulator b14 aspace))
 
+;;; Within aspace, robot, world, simulator and b14
+;;
+;; What each may hold, as the address spaces and sim/lab.c read it: for
+;; each name, a check of the clause's values, the list after its name, and
+;; what will do; a robot's values are clauses of their own, in a table.
+
+(define (values-of n check what)
+  (list (lambda (xs) (and (= (length xs) n) (every check xs))) what))
+
+(define (reals low high what)
+  (list (lambda (xs) (and (<= low (length xs) high) (every real? xs))) what))
+
+(define (positive-real? x) (and (real? x) (positive? x)))
+(define (non-negative? x) (and (real? x) (>= x 0)))
+(define (port-number? x) (and (exact-integer? x) (< 0 x 65536)))
+
+(define (load-value? x)
+  (or (non-negative? x)
+      (and (list? x) (pair? x)
+           (every (lambda (p) (and (list? p) (= (length p) 2) (every non-negative? p)))
+                  x))))
+
+(define robot-table
+  `((pose ,@(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
+    (tethered ,@(values-of 1 boolean? "#t or #f"))
+    (battery ,@(values-of 1 positive-real? "volts, a positive number"))
+    (trip-port ,@(values-of 1 port-number? "a port number"))
+    (trip-host ,@(values-of 1 string? "an IPv4 address, in quotes"))))
+
+(define aspace-table
+  `((port ,@(values-of 1 port-number? "a port number"))
+    (host ,@(values-of 1 string? "an IPv4 address, in quotes"))
+    (robot ,robot-table)
+    (position ,@(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
+    (capabilities ,(lambda (xs) (every symbol? xs)) "subjects, as names")
+    (load ,@(values-of 1 load-value? "a number, or ((SECONDS LOAD) ...)"))))
+
+(define world-table
+  `((wall ,@(reals 4 5 "x1 y1 x2 y2 and a thickness if not 50: four or five numbers"))
+    (box ,@(reals 5 6 "x y width depth heading and a mass if not 5: five or six numbers"))
+    (friction ,@(values-of 1 non-negative? "a number"))))
+
+(define simulator-table
+  `((step-hz ,@(values-of 1 (lambda (x) (and (real? x) (>= x 1))) "a number from 1"))
+    (seed ,@(values-of 1 real? "a number"))
+    (speed ,@(values-of 1 (lambda (x) (or (positive-real? x) (eq? x 'fast)))
+                        "a positive number, or fast"))
+    (stall-timeout ,@(values-of 1 positive-real? "a positive number of seconds"))))
+
+(define (increasing-pair)
+  (list (lambda (xs) (and (= (length xs) 2) (every real? xs) (< (car xs) (cadr xs))))
+        "two numbers, the first the smaller"))
+
+(define b14-table
+  `(,@(map (lambda (name) `(,name ,@(values-of 1 non-negative? "a number, 0 or more")))
+           '(radius mass max-speed max-turn speed turn-speed sonar-cone sonar-noise
+             sonar-hz ir-range fiducial-range battery-drain battery-idle battery-charge))
+    (sonar-range ,@(increasing-pair))
+    (battery-range ,@(increasing-pair))
+    (fiducial-fov ,@(values-of 1 (lambda (x) (and (real? x) (< 0 x) (<= x 360)))
+                               "degrees, above 0 and at most 360"))
+    (sonar-rays ,@(values-of 1 (lambda (x) (and (exact-integer? x) (<= 1 x 16)))
+                             "a whole number from 1 to 16"))
+    (max-frame ,@(values-of 1 (lambda (x) (and (exact-integer? x) (<= 64 x 65536)))
+                            "a whole number from 64 to 65536"))))
+
+;; Each of the items of clause c against table.
+(define (check-within path c items table)
+  (for-each (lambda (item) (check-item path c item table)) items))
+
+(define (check-item path outer item table)
+  (cond
+   ((not (and (pair? item) (symbol? (car item)) (list? item)))
+    (lab-file-error path outer (string-append (clause-text item) " is not a clause"
+                                              " (NAME VALUE ...)")))
+   ((assq (car item) table)
+    => (lambda (entry)
+         (cond ((not (procedure? (cadr entry)))
+                (check-within path item (cdr item) (cadr entry)))
+               ((not ((cadr entry) (cdr item)))
+                (lab-file-error path item
+                                (string-append (symbol->string (car item))
+                                               " takes " (car (cddr entry))))))))
+   (else
+    (lab-file-error path item
+                    (string-append "no such clause in " (symbol->string (car outer))
+                                   (did-you-mean (car item) (map car table)))))))
+
+;; A top-level clause that holds clauses of its own.
+(define (check-inside path c)
+  (case (car c)
+    ((aspace)
+     (if (not (and (pair? (cdr c)) (symbol? (cadr c))))
+         (lab-file-error path c "an address space is (aspace NAME CLAUSE ...)"))
+     (if (>= (string-length (symbol->string (cadr c))) 64)
+         (lab-file-error path c "an address space's name is at most 63 characters"))
+     (check-within path c (cddr c) aspace-table))
+    ((world) (check-within path c (cdr c) world-table))
+    ((simulator) (check-within path c (cdr c) simulator-table))
+    ((b14) (check-within path c (cdr c) b14-table))))
+
 (define multi-valued '(code delivery))
 
 ;;> The value of setting \var{key} of the lab: what its file says, or the
@@ -132,7 +237,11 @@
   (if (not (and (pair? c) (symbol? (car c)) (list? c)))
       (lab-file-error path c "a clause is (NAME VALUE ...)"))
   (if (not (or (assq (car c) settings-table) (memq (car c) other-clauses)))
-      (lab-file-error path c (string-append "no such setting" (did-you-mean (car c))))))
+      (lab-file-error path c (string-append "no such setting"
+                                            (did-you-mean (car c)
+                                                          (append (map car settings-table)
+                                                                  other-clauses)))))
+  (check-inside path c))
 
 (define (setting-value path c entry)
   (let* ((reader (car (cddr entry)))
@@ -144,27 +253,33 @@
         (lab-file-error path c (string-append (symbol->string (car c)) " takes "
                                               (cdr reader))))))
 
-(define (did-you-mean name)
-  (let ((near (find-nearest-edits (symbol->string name)
-                                  (map (lambda (n) (symbol->string n))
-                                       (append (map car settings-table) other-clauses)))))
+(define (did-you-mean name names)
+  (let ((near (find-nearest-edits (symbol->string name) (map symbol->string names))))
     (if (and (pair? near) (<= (edit-distance (symbol->string name) (car near)) 3))
         (string-append "; did you mean " (car near) "?")
         "")))
 
-;; Where each clause of the lab file being read starts: ((CLAUSE . LINE) ...),
+;; Where each list of the lab file being read starts: ((LIST . LINE) ...),
 ;; by eq?, for its errors.
 (define clause-lines (make-parameter '()))
 
+(define (clause-line c)
+  (cond ((assq c (clause-lines)) => cdr) (else #f)))
+
+;; An error that names the file, the line of clause c, c shortened to one
+;; line, and why.
 (define (lab-file-error path c why)
-  (let ((line (assq c (clause-lines))))
-    (error (string-append path (if line (string-append ":" (number->string (cdr line))) "")
+  (let ((line (clause-line c)))
+    (error (string-append path (if line (string-append ":" (number->string line)) "")
                           ": " (clause-text c) ": " why))))
 
+;; c as written, on one line, cut at 60 characters.
 (define (clause-text c)
-  (let ((out (open-output-string)))
-    (write c out)
-    (get-output-string out)))
+  (let* ((out (open-output-string))
+         (text (begin (write c out) (get-output-string out))))
+    (if (> (string-length text) 60)
+        (string-append (substring text 0 56) " ...")
+        text)))
 
 ;;> The clause \scheme{(key ...)} of an address space, or #f.
 (define (lab-aspace-clause a key)
@@ -173,6 +288,11 @@
 ;;> The lab's port base: MURDOCH_PORT_BASE, else its port-base.
 (define (lab-port-base lab)
   (settings-port-base (lab-settings lab)))
+
+;;> The port base where no lab file is read (murdoch replay):
+;;> MURDOCH_PORT_BASE, else port-base's default.
+(define (unread-lab-port-base)
+  (settings-port-base (list (cons 'port-base (cadr (assq 'port-base settings-table))))))
 
 (define (settings-port-base settings)
   (cond ((get-environment-variable "MURDOCH_PORT_BASE") => string->number)
@@ -183,42 +303,117 @@
 ;;> guest says in its hellos; ports derived from process ids clashed.
 (define (lab-guest-port lab) 0)
 
-;;> Reads the lab file at \var{path}.  Errors name the file and the fault.
+;;> Reads the lab file at \var{path}.  Errors name the file, the line and
+;;> the fault.
 (define (read-lab path)
-  (let* ((read (guard (e (#t (error "cannot read the lab file" path
-                                   (condition-message e))))
-                 (call-with-input-file path read-lab-form)))
-         (form (car read)))
-    (if (not (and (pair? form) (eq? (car form) 'lab) (pair? (cdr form))
-                  (symbol? (cadr form)) (list? (cddr form))))
-        (error "a lab file holds one (lab NAME CLAUSE ...) form" path))
-    (parameterize ((clause-lines (cdr read)))
-      (parse-lab path form))))
+  (let* ((source (read-source path))
+         (data (car source)))
+    (parameterize ((clause-lines (cdr source)))
+      (cond ((null? data)
+             (error (string-append path ": the file is empty; a lab file holds one"
+                                   " (lab NAME CLAUSE ...) form")))
+            ((pair? (cdr data))
+             (lab-file-error path (car (cadr data))
+                             (string-append "a second form; a lab file holds one"
+                                            " (lab NAME CLAUSE ...) form")))
+            ((not (let ((form (car (car data))))
+                    (and (pair? form) (eq? (car form) 'lab) (pair? (cdr form))
+                         (symbol? (cadr form)) (list? (cddr form)))))
+             (lab-file-error path (car (car data))
+                             "a lab file holds one (lab NAME CLAUSE ...) form"))
+            (else (parse-lab path (car (car data))))))))
 
-;; The file's (lab NAME CLAUSE ...) form, and the line each clause starts
-;; on: (FORM (CLAUSE . LINE) ...).  Anything else is read whole, for
-;; read-lab to refuse.
-(define (read-lab-form in)
-  (skip-blanks in)
-  (if (not (eqv? (peek-char in) #\())
-      (list (read in))
-      (begin
-        (read-char in)
-        (let loop ((items '()) (lines '()))
-          (skip-blanks in)
-          (cond ((eof-object? (peek-char in)) (list (reverse items)))
-                ((eqv? (peek-char in) #\)) (read-char in) (cons (reverse items) lines))
-                (else (let* ((line (port-line in))
-                             (item (read in)))
-                        (loop (cons item items) (cons (cons item line) lines)))))))))
+;;> The data of the Scheme file at \var{path} and where they are:
+;;> (((DATUM . LINE) ...) (LIST . LINE) ...), every list within by eq?.
+;;> The end of the file inside a list is an error that names the list
+;;> most likely left open: the first whose column a later line starts at
+;;> or left of, as when a clause lacks its ), or else the innermost.
+;;> Lists are read here, for their lines; other data with read.
+(define (read-source path)
+  (let ((in (guard (e (#t (error (string-append "cannot read " path ": "
+                                                (condition-message e)))))
+              (open-input-file path))))
+    (let ((source (read-source-port path in)))
+      (close-input-port in)
+      source)))
 
-;; Skips white space and ; comments.
-(define (skip-blanks in)
-  (let ((c (peek-char in)))
-    (cond ((eof-object? c) c)
-          ((char-whitespace? c) (read-char in) (skip-blanks in))
-          ((char=? c #\;) (read-line in) (skip-blanks in))
-          (else c))))
+(define (read-source-port path in)
+  (let ((lines '())
+        (column 0)                      ; of the next datum, when it starts a line
+        (fresh-line? #t)
+        (suspect #f))                   ; (LINE COLUMN) of a list that looks open
+    (define (skip!)
+      (let ((c (peek-char in)))
+        (cond ((eof-object? c))
+              ((char=? c #\newline)
+               (read-char in) (set! column 0) (set! fresh-line? #t) (skip!))
+              ((char-whitespace? c) (read-char in) (set! column (+ column 1)) (skip!))
+              ((char=? c #\;)
+               (read-line in) (set! column 0) (set! fresh-line? #t) (skip!)))))
+    (define (fail line why)
+      (error (string-append path ":" (number->string line) ": " why)))
+    ;; The next datum; open: ((LINE COLUMN) ...) of the lists it is in,
+    ;; innermost first, COLUMN #f for one that did not start its line.
+    (define (datum open)
+      (skip!)
+      (let ((line (port-line in))
+            (col (and fresh-line? column))
+            (c (peek-char in)))
+        (set! fresh-line? #f)
+        (if (and col (not suspect))
+            (set! suspect (find (lambda (o)
+                                  (and (cadr o) (< (car o) line) (<= col (cadr o))))
+                                (reverse open))))
+        (cond
+         ((eof-object? c) c)
+         ((char=? c #\() (read-char in) (read-list line (cons (list line col) open)))
+         ((char=? c #\)) (read-char in) (fail line "a ) that closes nothing"))
+         (else
+          (guard (e (#t (fail line (string-append "cannot read this: "
+                                                  (condition-message e)))))
+            (read in))))))
+    (define (read-list line open)
+      (let loop ((items '()))
+        (skip!)
+        (let ((next (peek-char in)))
+          (cond
+           ((eof-object? next)
+            (fail (car (or suspect (car open)))
+                  "this list has no closing ): the file ends inside it"))
+           ((char=? next #\)) (read-char in)
+            (let ((form (reverse items)))
+              (set! lines (cons (cons form line) lines))
+              form))
+           ((char=? next #\.) (read-char in)
+            (if (delimiter? (peek-char in))
+                (let ((tail (datum open)))
+                  (skip!)
+                  (if (not (eqv? (peek-char in) #\)))
+                      (fail line "a dotted list ends after one datum"))
+                  (read-char in)
+                  (let ((form (append-reverse items tail)))
+                    (set! lines (cons (cons form line) lines))
+                    form))
+                (loop (cons (dotted-token in) items))))
+           (else (loop (cons (datum open) items)))))))
+    (let loop ((data '()))
+      (skip!)
+      (let* ((line (port-line in))
+             (d (datum '())))
+        (if (eof-object? d)
+            (cons (reverse data) lines)
+            (loop (cons (cons d line) data)))))))
+
+(define (delimiter? c)
+  (or (eof-object? c) (char-whitespace? c) (memv c '(#\( #\) #\" #\;))))
+
+;; A number or symbol that starts with the . already read, as .5 or ...
+(define (dotted-token in)
+  (let loop ((chars '(#\.)))
+    (if (delimiter? (peek-char in))
+        (let ((text (list->string (reverse chars))))
+          (or (string->number text) (string->symbol text)))
+        (loop (cons (read-char in) chars)))))
 
 (define (parse-lab path form)
   (let* ((clauses (cddr form))
@@ -240,44 +435,66 @@
     lab))
 
 ;; What no one clause shows: two address spaces of one name, two things
-;; on one port, a code file that is not there.
+;; on one port, a code file that is not there.  The one of two named is
+;; the later, with the line of the other.
 (define (check-lab path lab)
-  (let ((uids (map lab-aspace-uid (lab-aspaces lab))))
-    (cond ((find-duplicate uids)
-           => (lambda (uid)
-                (lab-file-error path (list 'aspace uid) "two address spaces of this name")))))
-  (cond ((find-duplicate (lab-ports lab))
-         => (lambda (port)
-              (lab-file-error path (list 'port port)
-                              "two things on this port (address spaces at port-base + i, robots' trip servers at port-base + 100 + i)"))))
+  (let loop ((as (lab-aspaces lab)))
+    (when (pair? as)
+      (cond ((find (lambda (b) (eq? (lab-aspace-uid b) (lab-aspace-uid (car as))))
+                   (cdr as))
+             => (lambda (b)
+                  (lab-file-error
+                   path (lab-aspace-form b)
+                   (string-append "two address spaces of this name: the other"
+                                  (line-words (lab-aspace-form (car as))))))))
+      (loop (cdr as))))
+  (let loop ((ports (lab-ports lab)))
+    (when (pair? ports)
+      (cond ((find (lambda (p) (= (car p) (car (car ports)))) (cdr ports))
+             => (lambda (p)
+                  (lab-file-error path (car (cddr p))
+                                  (string-append
+                                   "two things on port " (number->string (car p)) ": "
+                                   (cadr (car ports))
+                                   (line-words (car (cddr (car ports))))
+                                   ", and " (cadr p)
+                                   " (address spaces listen at port-base + i, robots'"
+                                   " trip servers at port-base + 100 + i)")))))
+      (loop (cdr ports))))
   (for-each (lambda (file)
               (if (not (file-exists? (lab-path lab file)))
-                  (lab-file-error path (list 'code file) "no such file")))
+                  (lab-file-error path (clause 'code (lab-clauses lab))
+                                  (string-append "no such file " file))))
             (lab-setting lab 'code)))
 
-(define (find-duplicate ls)
-  (let loop ((ls ls))
-    (cond ((null? ls) #f)
-          ((member (car ls) (cdr ls)) (car ls))
-          (else (loop (cdr ls))))))
+(define (line-words c)
+  (cond ((clause-line c) => (lambda (n) (string-append " on line " (number->string n))))
+        (else "")))
 
-;; Every port the lab's address spaces and robots listen on.
+;; Every port the lab's address spaces and robots listen on, in file
+;; order: (PORT WHAT CLAUSE) for each.
 (define (lab-ports lab)
-  (append (map lab-aspace-port (lab-aspaces lab))
-          (filter-map (lambda (a) (and (lab-aspace-clause a 'robot) (lab-trip-port lab a)))
-                      (lab-aspaces lab))))
+  (append-map
+   (lambda (a)
+     (let ((name (symbol->string (lab-aspace-uid a)))
+           (form (lab-aspace-form a)))
+       (cons (list (lab-aspace-port a) (string-append "the address space " name) form)
+             (if (lab-aspace-clause a 'robot)
+                 (list (list (lab-trip-port lab a)
+                             (string-append "the trip server of the robot " name) form))
+                 '()))))
+   (lab-aspaces lab)))
 
 (define (condition-message e)
   (if (error-object? e) (error-object-message e) e))
 
+;; form was checked by check-inside.
 (define (parse-aspace path form index base interface)
-  (if (not (and (pair? (cdr form)) (symbol? (cadr form)) (list? (cddr form))))
-      (error "an aspace clause is (aspace NAME CLAUSE ...)" path form))
   (let ((clauses (cddr form)))
     (make-lab-aspace (cadr form) index
                      (clause-value 'host clauses interface)
                      (clause-value 'port clauses (+ base index))
-                     clauses)))
+                     clauses form)))
 
 (define (path-directory path)
   (let loop ((i (- (string-length path) 1)))

@@ -45,6 +45,14 @@
                     (if (pair? (lab-robots lab)) "sim" "")
                     (lab-lines lab except)))))
 
+;;> `murdoch check LAB`: reads the lab file at \var{lab-file} as every
+;;> peer does, and loads its code files into an environment of received
+;;> code, as an address space does: a mistake in either is an error that
+;;> names the file and the line.  Starts nothing.
+(define (run-check lab-file)
+  (make-lab-environment (read-lab lab-file))
+  (write-string (string-append lab-file ": no mistakes found\n")))
+
 ;;> `murdoch demo LAB`: becomes bin/murdoch-demo, found in \var{bin}.
 (define (run-demo bin lab-file)
   (execute "/bin/sh" (list "/bin/sh" (string-append bin "/murdoch-demo")
@@ -53,7 +61,8 @@
 ;;> `murdoch pose LAB FILE`: joins the lab as a guest, evaluates the forms
 ;;> of \var{task-file} in a REPL's environment, poses the task its last
 ;;> form names (see task-of), and writes the result.  pose-task's progress
-;;> lines go to the standard output as it works.
+;;> lines go to the standard output as it works.  Exits 0 when the task
+;;> completed, else 1: not-enough-takers, or a component that failed.
 (define (run-pose lab-file task-file)
   (let* ((lab (read-lab lab-file))
          (uid (string->symbol (string-append
@@ -64,23 +73,50 @@
     (eval `(pose-task-progress (current-output-port)) env)
     ;; A task file answers pose-task's arguments, or a task already
     ;; started (start-task, start-steps), which is waited for.
-    (let ((task (task-of task-file env)))
-      (write (if ((eval 'task? env) task)
-                 ((eval 'task-wait env) task)
-                 (apply (eval 'pose-task env) task))))
-    (newline)
-    (exit 0)))
+    (let* ((task (task-of task-file env))
+           (record? ((eval 'task? env) task))
+           (result (if record?
+                       ((eval 'task-wait env) task)
+                       (apply (eval 'pose-task env) task))))
+      (write result)
+      (newline)
+      (cond ((task-failed? result (and record? ((eval 'task-status env) task)))
+             (write-string "murdoch pose: the task did not complete\n"
+                           (current-error-port))
+             (exit 1))
+            (else (exit 0))))))
+
+;; Whether what a pose answered says that its task did not complete:
+;; not-enough-takers, or a component that failed, by the task's status
+;; (see task-status) when it is a task record, else by its (error UID WHY).
+(define (task-failed? result status)
+  (or (symbol? result)
+      (if status
+          (any failed-status? status)
+          (any (lambda (r) (and (list? r) (= (length r) 3) (eq? (car r) 'error)
+                                (symbol? (cadr r))))
+               result))))
+
+(define (failed-status? s)
+  (if (eq? (car s) 'step)
+      (any failed-status? (car (cddr s)))
+      (eq? (car (cadr s)) 'failed)))
 
 ;;> `murdoch status LAB`: joins the lab as a guest and shows what each of
 ;;> its address spaces says of itself (see show-status); one that does not
-;;> answer within two seconds is shown away.
+;;> answer within two seconds is shown away.  Exits 1 when none answers.
 (define (run-status lab-file)
   (let ((lab (read-lab lab-file)))
     (join-lab lab-file (string->symbol (string-append
                                         "status-" (number->string (current-process-id))))
               (lab-guest-port lab))
-    (parameterize ((remote-timeout 2)) (show-status))
-    (exit 0)))
+    (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
+           (write-string (string-append "murdoch status: no address space of the lab"
+                                        " answers (is the lab running, with the same"
+                                        " MURDOCH_PORT_BASE?)\n")
+                         (current-error-port))
+           (exit 1))
+          (else (exit 0)))))
 
 ;;> The task \var{file} evaluates to in \var{env}: the value of its last
 ;;> form, or, when that form defines a procedure of no arguments, what the

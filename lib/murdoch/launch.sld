@@ -2,11 +2,13 @@
 ;;> poses a task to it from a file, \scheme{demo} does both for the thesis's
 ;;> dual-sonar task.
 (define-library (murdoch launch)
-  (export lab-lines run-lab run-pose run-demo run-status)
+  (export lab-lines run-lab run-pose run-demo run-status run-check)
   (import (scheme base) (scheme read) (scheme write) (scheme eval)
           (scheme file) (scheme process-context)
           (srfi 1)
           (only (chibi process) execute current-process-id)
           (murdoch lab) (murdoch command)
-          (only (murdoch remote) remote-timeout) (only (murdoch status) show-status))
+          (only (murdoch remote) remote-timeout)
+          (only (murdoch sandbox) make-lab-environment)
+          (only (murdoch status) write-lab-status))
   (include "launch.scm"))

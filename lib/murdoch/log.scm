@@ -15,9 +15,10 @@
 ;;> as they come.
 (define (stamp-log-lines!) (set! *stamped?* #t))
 
-;; Seconds since 1970 by the system's clock: (scheme time)'s
-;; current-second counts TAI seconds, 37 ahead.
-(define (now)
+;;> Seconds since 1970 by the system's clock, UTC: what a person or a
+;;> file is shown.  (scheme time)'s current-second counts TAI seconds,
+;;> 37 ahead of the clock on the wall.
+(define (utc-seconds)
   (let ((tv (car (get-time-of-day))))
     (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.))))
 
@@ -50,7 +51,7 @@
 
 (define (log-line level parts)
   (let ((err (current-error-port)))
-    (if *stamped?* (write-string (timestamp (now)) err))
+    (if *stamped?* (write-string (timestamp (utc-seconds)) err))
     (write-string *log-name* err)
     (write-string level err)
     (for-each (lambda (p) (if (string? p) (write-string p err) (display p err)))

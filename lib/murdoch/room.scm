@@ -1,6 +1,9 @@
 ;;;; The room, checked before anything starts: a robot placed inside a
 ;;;; wall, or on another robot or a box, is a mistake that the simulator
-;;;; would undo without a word, by pushing the bodies apart.
+;;;; would undo without a word, by pushing the bodies apart; one outside
+;;;; the walls of a rectangular room would drive about outside it.  Of
+;;;; two robots on each other, the later in the file is named, as the
+;;;; one placed where the other stood.
 
 (define default-robot-radius 180)       ; sim/lab.c's B14
 (define default-wall-thickness 50)
@@ -11,9 +14,11 @@
          (boxes (items 'box 5 (cdr world)))
          (radius (robot-radius clauses))
          (robots (filter-map robot-place clauses)))
-    (let loop ((robots robots))
+    (let loop ((robots robots) (before '()))
       (when (pair? robots)
         (let ((r (car robots)))
+          (if (outside? (cdr r) walls)
+              (room-error path r "outside the walls of the room" ""))
           (for-each (lambda (w)
                       (if (< (wall-distance (cadr r) (car (cddr r)) w)
                              (+ radius (/ (wall-thickness w) 2)))
@@ -25,17 +30,34 @@
                     boxes)
           (for-each (lambda (other)
                       (if (< (distance (cdr r) (cdr other)) (* 2 radius))
-                          (room-error path r "on the robot " (cadr (car other)))))
-                    (cdr robots))
-          (loop (cdr robots)))))))
+                          (room-error path r "on the robot "
+                                      (string-append (symbol->string (cadr (car other)))
+                                                     (line-words (car other))))))
+                    before)
+          (loop (cdr robots) (cons r before)))))))
+
+;; Whether (x y) is outside the bounding box of walls that enclose it: a
+;; wall along each of its four sides.
+(define (outside? p walls)
+  (and (pair? walls)
+       (let* ((xs (append-map (lambda (w) (list (list-ref w 1) (list-ref w 3))) walls))
+              (ys (append-map (lambda (w) (list (list-ref w 2) (list-ref w 4))) walls))
+              (x0 (apply min xs)) (x1 (apply max xs))
+              (y0 (apply min ys)) (y1 (apply max ys)))
+         (define (side? at x-or-y)
+           (any (lambda (w) (and (= (list-ref w x-or-y) at)
+                                 (= (list-ref w (+ x-or-y 2)) at)))
+                walls))
+         (and (side? x0 1) (side? x1 1) (side? y0 2) (side? y1 2)
+              (not (and (<= x0 (car p) x1) (<= y0 (cadr p) y1)))))))
 
 (define (room-error path r where thing)
   (let ((aspace (car r)))
     (lab-file-error path aspace
                     (string-append "the robot " (symbol->string (cadr aspace))
                                    " stands " where
-                                   (if (symbol? thing)
-                                       (symbol->string thing)
+                                   (if (string? thing)
+                                       thing
                                        (clause-text thing))))))
 
 ;; The world's items of kind with at least n numbers.

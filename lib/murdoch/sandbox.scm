@@ -285,14 +285,28 @@
     env))
 
 (define (read-forms file)
-  (call-with-input-file file
-    (lambda (in)
-      (let loop ((acc '()))
-        (let ((form (read in)))
-          (if (eof-object? form) (reverse acc) (loop (cons form acc))))))))
+  (map car (car (read-source file))))
 
+;; Evaluates each form of file in env, as a load would; an error, in
+;; reading or in evaluating, names the file and the line of its form.
 (define (load-into file env)
-  (for-each (lambda (form) (eval form env)) (read-forms file)))
+  (for-each (lambda (entry)
+              (guard (e ((error-object? e)
+                         (error (string-append file ":" (number->string (cdr entry))
+                                               ": " (error-line e)))))
+                (eval (car entry) env)))
+            (car (read-source file))))
+
+;; An error's message and irritants, on one line.
+(define (error-line e)
+  (let ((out (open-output-string)))
+    (write-string (error-object-message e) out)
+    (for-each (lambda (x) (write-char #\space out) (write x out))
+              (error-object-irritants e))
+    (let ((text (get-output-string out)))
+      (if (> (string-length text) 200)
+          (string-append (substring text 0 196) " ...")
+          text))))
 
 (define (defined-names file)
   (filter-map (lambda (form)

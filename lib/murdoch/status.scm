@@ -31,8 +31,16 @@
 ;;> lab-status) as a person reads it: a line per address space, then one
 ;;> per subject held.
 (define (show-status . port)
-  (display-lab-status (lab-status (current-lab)) (current-second)
-                      (if (pair? port) (car port) (current-output-port))))
+  (apply write-lab-status port)
+  (if #f #f))
+
+;;> show-status, answering how many address spaces answered: `murdoch
+;;> status` exits 1 when none did.
+(define (write-lab-status . port)
+  (let ((status (lab-status (current-lab))))
+    (display-lab-status status (utc-seconds)
+                        (if (pair? port) (car port) (current-output-port)))
+    (count (lambda (r) (not (eq? (cadr r) 'away))) status)))
 
 (define (display-lab-status status now out)
   (for-each (lambda (r) (write-report r now out)) status))

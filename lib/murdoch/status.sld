@@ -1,8 +1,8 @@
 ;;> What the lab is doing, asked of every address space: the \scheme{status}
 ;;> command and REPL procedure.
 (define-library (murdoch status)
-  (export aspace-report lab-status show-status)
-  (import (scheme base) (scheme write) (scheme time) (srfi 1)
+  (export aspace-report lab-status show-status write-lab-status)
+  (import (scheme base) (scheme write) (srfi 1) (only (murdoch log) utc-seconds)
           (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch trip-client)
           (murdoch task))
   (include "status.scm"))

@@ -55,7 +55,7 @@
   (proc component-proc)
   (restartable? component-restartable?)
   ;; (negotiating), (running UID SINCE), (done VALUE), (failed WHY) or
-  ;; (reassigned FROM TO); SINCE is a (current-second).
+  ;; (reassigned FROM TO); SINCE is a (utc-seconds).
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
@@ -167,7 +167,7 @@
 ;; Runs component c on uid, and again elsewhere while its robot is lost
 ;; and it may be restarted.
 (define (supervise t c uid work)
-  (component-state-set! c (list 'running uid (current-second)))
+  (component-state-set! c (list 'running uid (utc-seconds)))
   (progress "  component " (component-index c) " starts on " uid)
   (let ((outcome (attempt t c uid work)))
     (component-attempts-set! c (append (component-attempts c)
@@ -287,7 +287,7 @@
 
 ;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS):
 ;;> STATE is (negotiating), (running UID SINCE), (done VALUE), (failed
-;;> WHY) or (reassigned FROM TO), SINCE a (current-second); ATTEMPTS has
+;;> WHY) or (reassigned FROM TO), SINCE a (utc-seconds); ATTEMPTS has
 ;;> (UID . OUTCOME) for each robot that had the component and is done
 ;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
 (define (task-status task)

@@ -6,7 +6,7 @@
 (define-library (murdoch task)
   (export start-task task? task-id task-name task-status task-wait cancel-task
           tasks task-step start-steps pose-steps)
-  (import (scheme base) (scheme cxr) (scheme time) (srfi 1) (srfi 18)
+  (import (scheme base) (scheme cxr) (srfi 1) (srfi 18)
           (only (chibi ast) thread-interrupt!)
           (murdoch scheduler) (murdoch log) (murdoch wait) (murdoch abandon)
           (murdoch remote-error) (murdoch sendable) (murdoch lab)

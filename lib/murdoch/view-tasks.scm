@@ -10,7 +10,11 @@
 ;; seen on a robot to when that robot no longer shows it; a component of
 ;; a started task seen on another robot than before was reassigned.  A
 ;; task's own state is what its poser says, when the poser is an address
-;; space of the lab; else running while a component is seen, then done.
+;; space of the lab; else running while a component is seen, then done,
+;; or failed when a component was lost.  A component is lost when its
+;; robot started again (its up-since moved) or has not answered for
+;; away-polls looks in a row: a robot that died does not say that it
+;; stopped, and its poser was told "connection lost".
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)
@@ -33,9 +37,15 @@
   (from component-entry-from))
 
 ;;> A table of the tasks seen so far, empty.
-(define (make-task-table) (list 'tasks))
+(define (make-task-table) (list (list 'robots)))
 
+;; The car of a table holds, after 'robots, (ROBOT UP-SINCE AWAY) for each
+;; robot seen: when it last started, and how many looks in a row it has
+;; not answered.
 (define (table-tasks table) (cdr table))
+(define (table-robots table) (car table))
+
+(define away-polls 3)
 
 ;;> The task name and poser that reservation name or task id \var{key}
 ;;> (a string, NAME@POSER#N or NAME@POSER/N) holds, as a list, or the key
@@ -100,6 +110,11 @@
 
 (define (open? c) (not (component-entry-until c)))
 
+(define (lost? c)
+  (let ((end (component-entry-end c)))
+    (and (string? end) (>= (string-length end) 5)
+         (string=? "lost:" (substring end 0 5)))))
+
 ;;> Brings \var{table} up to the time \var{t} (seconds) with
 ;;> \var{reports}: (UID REPORT) for each address space that answered,
 ;;> REPORT as aspace-report makes it.  Components that an address space
@@ -121,16 +136,53 @@
                              seen)))
           (report-components report))))
      reports)
-    (let ((answered (map (lambda (r) (text (car r))) reports)))
+    (let* ((answered (map (lambda (r) (text (car r))) reports))
+           (gone (note-robots! table t reports)))
       (for-each
        (lambda (task)
          (for-each (lambda (c)
-                     (when (and (open? c) (not (memq c seen))
-                                (member (component-entry-robot c) answered))
-                       (component-entry-until-set! c t)
-                       (component-entry-end-set! c "done")))
+                     (cond ((and (open? c) (< (component-entry-since c) t)
+                                 (assoc (component-entry-robot c) gone))
+                            => (lambda (why)
+                                 (component-entry-until-set! c t)
+                                 (component-entry-end-set! c (cdr why))))
+                           ((and (open? c) (not (memq c seen))
+                                 (member (component-entry-robot c) answered))
+                            (component-entry-until-set! c t)
+                            (component-entry-end-set! c "done"))))
                    (task-entry-components task)))
        (table-tasks table)))))
+
+;; Brings the table's robots up to date with reports, and answers
+;; ((ROBOT . WHY) ...) for those whose components seen before were lost:
+;; started again, or silent for away-polls looks.
+(define (note-robots! table t reports)
+  (let ((robots (table-robots table))
+        (gone '()))
+    (for-each
+     (lambda (uid+report)
+       (let* ((robot (text (car uid+report)))
+              (since (cadr (cadr uid+report)))
+              (entry (assoc robot (cdr robots))))
+         (cond ((not entry) (set-cdr! robots (cons (list robot since 0) (cdr robots))))
+               (else
+                (if (not (equal? (cadr entry) since))
+                    (set! gone (cons (cons robot (string-append "lost: " robot
+                                                                " started again"))
+                                     gone)))
+                (set-car! (cdr entry) since)
+                (set-car! (cddr entry) 0)))))
+     reports)
+    (for-each (lambda (entry)
+                (when (not (any (lambda (r) (equal? (text (car r)) (car entry))) reports))
+                  (set-car! (cddr entry) (+ 1 (car (cddr entry))))
+                  (if (= (car (cddr entry)) away-polls)
+                      (set! gone (cons (cons (car entry)
+                                             (string-append "lost: " (car entry)
+                                                            " does not answer"))
+                                       gone)))))
+              (cdr robots))
+    gone))
 
 ;; The component entry of task that robot shows at t, made if new.
 (define (observe! task t robot index subjects)
@@ -172,7 +224,9 @@
               (name . ,(task-entry-name task))
               (poser . ,(or (task-entry-poser task) 'null))
               (state . ,(or (task-entry-state task)
-                            (if (any open? cs) "running" "done")))
+                            (cond ((any open? cs) "running")
+                                  ((any lost? cs) "failed")
+                                  (else "done"))))
               (components
                . ,(list->vector
                    (map (lambda (c)

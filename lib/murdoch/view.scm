@@ -80,7 +80,7 @@
                         `((name . ,(symbol->string (lab-aspace-uid a)))
                           (robot . ,(if (lab-aspace-clause a 'robot) #t #f))))
                       (lab-aspaces lab))))
-    (started . ,(num (current-second)))))
+    (started . ,(num (utc-seconds)))))
 
 (define (degrees->radians d) (* d (/ (acos -1) 180)))
 
@@ -135,7 +135,7 @@
     (for-each (lambda (a) (if (cadr a) (note-sonar! state (car a) (car (cddr a))))) answers)
     `((kind . "state")
       (t . ,(num t))
-      (clock . ,(num (current-second)))
+      (clock . ,(num (utc-seconds)))
       (aspaces . ,(list->vector (map (lambda (a) (aspace-json a state)) answers)))
       (boxes . ,(vector-map (lambda (b) b) boxes))
       (tasks . ,(task-table->json (view-state-table state) 12)))))
@@ -369,7 +369,7 @@
           ;; The trace counts wall-clock seconds from its start; the
           ;; next look is due by the monotonic clock, as every deadline.
           (let ((t0 (monotonic-seconds))
-                (at (- (current-second) start)))
+                (at (- (utc-seconds) start)))
             (feed-add! feed (json-text
                              (view-snapshot lab at
                                             (parameterize ((remote-timeout 1))
@@ -412,17 +412,33 @@
         (flush-output-port out)
         out)))
 
+;;> runs/LAB-SECONDS.jsonl, or LAB-SECONDS-2.jsonl and on when a view
+;;> started in the same second has that: a name is claimed by making the
+;;> file, which only one process can.
 (define (default-trace lab)
-  (let ((dir "runs"))
+  (let ((dir "runs")
+        (stem (string-append "runs/" (symbol->string (lab-name lab)) "-"
+                             (number->string (exact (floor (utc-seconds)))))))
     (if (not (file-exists? dir)) (create-directory* dir))
-    (string-append dir "/" (symbol->string (lab-name lab)) "-"
-                   (number->string (exact (floor (current-second)))) ".jsonl")))
+    (let claim ((n 1))
+      (let* ((name (string-append stem
+                                  (if (= n 1) "" (string-append "-" (number->string n)))
+                                  ".jsonl"))
+             (fd (open name (bitwise-ior open/write open/create open/exclusive) #o644)))
+        (cond (fd (close-port (open-output-file-descriptor fd)) name)
+              ((file-exists? name) (claim (+ n 1)))
+              (else (error "cannot make the trace" name)))))))
 
 ;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
-;;> (default 7248) to play the run that \var{trace} holds.
+;;> (default: port-base + 148, MURDOCH_PORT_BASE's or else 7100's, as the
+;;> view's) to play the run that \var{trace} holds.
 (define (run-replay web trace port)
   (if (not (file-exists? trace)) (error "no such trace" trace))
-  (let* ((port (or port 7248))
+  (let ((header (trace-header trace)))
+    (if (not (and (list? header) (equal? (assq 'kind header) '(kind . "lab"))))
+        (error (string-append "not a trace of the view: " trace " (a trace's first"
+                              " line is the view's header of the room)"))))
+  (let* ((port (or port (+ (unread-lab-port-base) 148)))
          (listener (listen-on port)))
     (say "view: http://127.0.0.1:" port "/ (replaying " trace ")")
     (serve! listener

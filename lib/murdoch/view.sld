@@ -5,19 +5,22 @@
 (define-library (murdoch view)
   (export run-view run-replay
           ;; the parts, for tests
-          lab-header view-snapshot new-view-state make-task-table task-table-update!
+          lab-header default-trace view-snapshot new-view-state make-task-table
+          task-table-update!
           task-table->json reservation-task json-text box-seen)
   (import (scheme base) (scheme write) (scheme file) (scheme eval)
-          (scheme time) (scheme inexact) (scheme char)
+          (scheme inexact) (scheme char)
           (srfi 1) (srfi 18)
           (chibi net) (chibi net http-server) (chibi net servlet)
           (only (chibi config) make-conf)
           (only (chibi process) current-process-id)
           (only (chibi filesystem) create-directory* open open/write open/append
+                open/create open/exclusive
                 open-output-file-descriptor)
           (only (srfi 151) bitwise-ior)
           (chibi json)
           (only (murdoch scheduler) monotonic-seconds)
+          (only (murdoch log) utc-seconds)
           (only (murdoch wait) with-lock seconds-until)
           (murdoch process-name) (murdoch lab) (murdoch command) (murdoch remote))
   (include "view.scm" "view-tasks.scm"))

@@ -52,6 +52,93 @@
           (loop rest lab as (cons (cons line (car steps)) (cdr steps))
                 shell))))))))
 
+;;> The REPL sessions a document shows, as one transcript: every code
+;;> block whose first line starts with a prompt ("guest-1234> ") is a step
+;;> of it, its prompt lines input and the lines after each what that
+;;> prints, in the order of the document, at one REPL of one lab: the lab
+;;> that the line "<!-- transcript lab: FILE -->" names.  The document
+;;> shows what a run printed, so a number in it stands for any number
+;;> ({number}) and "..." for any text ({any}).
+(define (read-doc-transcript file)
+  (let ((lines (read-lines file)))
+    (make-transcript
+     (or (any (lambda (l) (and (prefixed? "<!-- transcript lab: " l)
+                               (string-trim (substring l 21 (- (string-length l) 4)))))
+              lines)
+         (error "a document to replay names its lab" file))
+     #f
+     (append-map block-steps (code-blocks lines))
+     '())))
+
+;; The code blocks of a markdown text's lines, each a list of its lines:
+;; fenced by ``` or indented by four spaces.
+(define (code-blocks lines)
+  (let loop ((lines lines) (blocks '()))
+    (cond
+     ((null? lines) (reverse blocks))
+     ((prefixed? "```" (car lines))
+      (let ((end (or (list-index (lambda (l) (prefixed? "```" l)) (cdr lines))
+                     (length (cdr lines)))))
+        (loop (drop (cdr lines) (min (+ end 1) (length (cdr lines))))
+              (cons (take (cdr lines) end) blocks))))
+     ((prefixed? "    " (car lines))
+      (let-values (((block rest) (span (lambda (l) (prefixed? "    " l)) lines)))
+        (loop rest (cons (map (lambda (l) (substring l 4 (string-length l))) block)
+                         blocks))))
+     (else (loop (cdr lines) blocks)))))
+
+(define (prompt-end line)
+  (let loop ((i 0))
+    (cond ((>= (+ i 1) (string-length line)) #f)
+          ((and (char=? (string-ref line i) #\>) (char=? (string-ref line (+ i 1)) #\space))
+           (and (> i 0) i))
+          ((or (char-alphabetic? (string-ref line i)) (char-numeric? (string-ref line i))
+               (char=? (string-ref line i) #\-))
+           (loop (+ i 1)))
+          (else #f))))
+
+(define (block-steps block)
+  (if (and (pair? block) (prompt-end (car block)))
+      (let loop ((lines block) (steps '()))
+        (cond ((null? lines) (reverse (map reverse steps)))
+              ((prompt-end (car lines))
+               => (lambda (i)
+                    (loop (cdr lines)
+                          (cons (list (substring (car lines) (+ i 2)
+                                                 (string-length (car lines))))
+                                steps))))
+              (else (loop (cdr lines)
+                          (cons (cons (loosen (car lines)) (car steps)) (cdr steps))))))
+      '()))
+
+;; A line a run printed as a pattern for any run: numbers as {number},
+;; "..." as {any}.
+(define (loosen line)
+  (let loop ((i 0) (acc '()))
+    (cond
+     ((= i (string-length line)) (apply string-append (reverse acc)))
+     ((and (<= (+ i 3) (string-length line)) (string=? "..." (substring line i (+ i 3))))
+      (loop (+ i 3) (cons "{any}" acc)))
+     ((number-start? line i)
+      (let ((end (number-end line i)))
+        (loop end (cons "{number}" acc))))
+     (else (loop (+ i 1) (cons (string (string-ref line i)) acc))))))
+
+(define (digit-at? line i)
+  (and (< i (string-length line)) (char-numeric? (string-ref line i))))
+
+(define (number-start? line i)
+  (or (digit-at? line i)
+      (and (char=? (string-ref line i) #\-) (digit-at? line (+ i 1)))))
+
+(define (number-end line i)
+  (let loop ((j (+ i 1)))
+    (if (and (< j (string-length line))
+             (or (char-numeric? (string-ref line j))
+                 (and (char=? (string-ref line j) #\.) (digit-at? line (+ j 1)))))
+        (loop (+ j 1))
+        j)))
+
 ;;> What to do, in order: each input line as a string, typed at the REPL,
 ;;> and each shell command as (shell COMMAND K), to run once the REPL has
 ;;> answered its first K inputs.
@@ -142,3 +229,111 @@
   (filter (lambda (e)
             (string->number (substring line l e)))
           (iota (- (string-length line) l) (+ l 1))))
+
+;;; Replaying: bin/murdoch lab on a free port base, then bin/murdoch repl
+;;; with the transcript's input typed through a pipe.
+
+;; The lab of transcript t, started in dir on a free port base without the
+;; address space the REPL will be, if it is one of the lab's; answers
+;; (pid . port-base) once it is ready.
+(define (start-lab! t dir)
+  (let ((base (free-port-base dir)))
+    (cons (start-murdoch-lab!
+           (cons* (tool-path (transcript-lab t)) "--logs" (string-append dir "/logs")
+                  (if (transcript-as t)
+                      (list "--except" (symbol->string (transcript-as t)))
+                      '()))
+           (string-append dir "/lab.out")
+           base)
+          (number->string base))))
+
+;; The REPL's whole output for t's input, stdout and stderr together.
+;; Its input is typed through a pipe, a line at a time, so that a shell
+;; command runs only once the REPL has answered every input before it.
+(define (replay t dir base lab-pid)
+  (let ((out (string-append dir "/output")))
+    (call-with-process-io
+     (list "sh" "-c"
+           "MURDOCH_PORT_BASE=$1 exec timeout -s KILL 90 \"$2\" repl \"$3\" $4 >\"$5\" 2>&1"
+           "replay" base (tool-path "bin/murdoch") (tool-path (transcript-lab t))
+           (if (transcript-as t) (symbol->string (transcript-as t)) "")
+           out)
+     (lambda (pid in . _)
+       (for-each (lambda (item) (perform! item t in out base lab-pid))
+                 (transcript-script t))
+       (close-output-port in)
+       (waitpid pid 0)))
+    (file-text out)))
+
+;; An input line is typed; a shell command waits for the REPL's answers
+;; (at most 60 s), then runs with LAB_PID and MURDOCH_PORT_BASE set.
+(define (perform! item t in out base lab-pid)
+  (cond
+   ((string? item)
+    (write-string (string-append item "\n") in)
+    (flush-output-port in))
+   (else
+    (let ((k (car (cddr item))))
+      (wait-until 60 (lambda ()
+                       (let ((output (file-text out)))
+                         (> (prompt-count (prompt-of t output) output) k))))
+      (system? "env" (string-append "LAB_PID=" (number->string lab-pid))
+               (string-append "MURDOCH_PORT_BASE=" base)
+               "sh" "-c" (cadr item))))))
+
+;; The REPL's prompt: its uid, which for a guest holds its process id.
+(define (prompt-of t output)
+  (if (transcript-as t)
+      (string-append (symbol->string (transcript-as t)) "> ")
+      (guest-prompt output)))
+
+(define (guest-prompt output)
+  (let loop ((i 0))
+    (cond ((> (+ i 6) (string-length output)) "guest-?> ")
+          ((string=? "guest-" (substring output i (+ i 6)))
+           (let digits ((j (+ i 6)))
+             (if (and (< j (string-length output))
+                      (char-numeric? (string-ref output j)))
+                 (digits (+ j 1))
+                 (string-append (substring output i j) "> "))))
+          (else (loop (+ i 1))))))
+
+;; A diff of each mismatch: the input, "-" before the lines expected and
+;; "+" before those the REPL printed.
+(define (report file mismatches output)
+  (if (pair? mismatches)
+      (begin
+        (display (string-append "transcript " file " differs:\n"))
+        (for-each report-mismatch mismatches)
+        (display "the REPL's whole output:\n")
+        (display output)
+        (newline))))
+
+(define (report-mismatch m)
+  (let ((field (lambda (key) (cadr (memq key m)))))
+    (if (memq 'input m)
+        (begin
+          (display (string-append "> " (field 'input) "\n"))
+          (for-each (lambda (l) (display (string-append "- " l "\n"))) (field 'expected))
+          (for-each (lambda (l) (display (string-append "+ " l "\n"))) (field 'actual)))
+        (begin (write m) (newline)))))
+
+;;> Replays transcript \var{t}, read from \var{file}, against a fresh lab
+;;> of its own, as one test named \var{file}: a mismatch is shown as a
+;;> diff.  A transcript whose lab does not start fails as a test (chibi
+;;> test reports the error) rather than ending the run.
+(define (check-transcript file t)
+  (let ((dir (temporary-directory)))
+    (test file '() (mismatches-of file t dir))
+    (delete-file-hierarchy dir)))
+
+(define (mismatches-of file t dir)
+  (let ((lab (start-lab! t dir)))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       (let* ((output (replay t dir (cdr lab) (car lab)))
+              (mismatches (transcript-mismatches t (prompt-of t output) output)))
+         (report file mismatches output)
+         mismatches))
+     (lambda () (stop-process! (car lab))))))
