@@ -109,7 +109,7 @@
     (system "sh" "-c" (string-append "mkdir -p \"$1/bin\" \"$1/tools\" \"$1/lib/murdoch\""
                                      " && cp bin/murdoch bin/murdoch.scm \"$1/bin\""
                                      " && cp tools/chibi \"$1/tools\""
-                                     " && touch \"$1/lib/murdoch/glue.c\"")
+                                     " && echo \"(include-shared \\\"glue\\\")\" >\"$1/lib/murdoch/glue.sld\"")
             (tool-path ".") fresh)
     (let ((status (system "sh" "-c" "PATH=/usr/bin:/bin \"$1/bin/murdoch\" --help >\"$0\" 2>&1"
                           out fresh)))
