@@ -43,7 +43,9 @@
   (done task-done)                      ; a mailbox: the results, once done
   (state task-state task-state-set!)    ; negotiating running done failed cancelled
   (team task-team task-team-set!)       ; its robots, in component order
-  (steps task-steps task-steps-set!))   ; of a task of steps, those started
+  (steps task-steps task-steps-set!)    ; of a task of steps, those started
+  (turn task-turn task-turn-set!)       ; how it waits its turn: a turn record
+  (waiter task-waiter task-waiter-set!)) ; while it waits, its waiter record
 
 (define-record-type component
   (make-component index capabilities metric proc restartable?)
@@ -53,8 +55,9 @@
   (metric component-metric)
   (proc component-proc)
   (restartable? component-restartable?)
-  ;; (negotiating), (running UID SINCE), (done VALUE), (failed WHY) or
-  ;; (reassigned FROM TO); SINCE is a (current-second).
+  ;; (negotiating), (waiting POSITION WHY), (running UID SINCE), (done
+  ;; VALUE), (failed WHY) or (reassigned FROM TO); SINCE is a
+  ;; (current-second).
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
@@ -68,26 +71,34 @@
 ;;> component: #t when a component whose robot is lost may be given to
 ;;> another robot (see the header of lib/murdoch/task.scm); by default
 ;;> none may, and a lost robot's component fails, as in the thesis.
+;;> After them, or instead, come keywords and their values: \scheme{wait}
+;;> #t or #f, whether the task waits when too few capable robots are free
+;;> (default: the lab's when-robots-busy); \scheme{priority}, the task's
+;;> priority (default (pose-task-priority)); \scheme{deadline}, seconds
+;;> after which a task not yet started fails with \scheme{deadline}.
 (define (start-task task-name num-robots capability-list metrics procs . options)
-  (let ((priorities (if (pair? options) (car options) (iota num-robots num-robots -1)))
-        (restartable (if (and (pair? options) (pair? (cdr options)))
-                         (cadr options)
-                         (make-list num-robots #f))))
+  (let* ((lists (take-while list? options))
+         (priorities (if (pair? lists) (car lists) (iota num-robots num-robots -1)))
+         (restartable (if (and (pair? lists) (pair? (cdr lists)))
+                          (cadr lists)
+                          (make-list num-robots #f))))
     (check-task task-name num-robots capability-list metrics procs priorities)
     (if (not (and (list? restartable) (= (length restartable) num-robots)
                   (every boolean? restartable)))
         (error "start-task: restartable is a list of a boolean for each component"
                restartable))
-    (let ((t (new-task task-name capability-list metrics procs restartable)))
+    (let* ((turn (read-turn "start-task" (drop options (length lists))))
+           (t (new-task task-name capability-list metrics procs restartable turn)))
       (thread-start!
        (make-thread (inheriting
                      (lambda () (run-task t priorities)))
                     (task-id t)))
       t)))
 
-(define (new-task task-name capability-list metrics procs restartable)
+(define (new-task task-name capability-list metrics procs restartable turn)
   (with-lock *tasks-lock*
     (lambda ()
+      (check-waiting-room turn)
       (set! *started* (+ *started* 1))
       (let ((t (make-task
                 (string->symbol (string-append (symbol->string task-name) "@"
@@ -105,6 +116,8 @@
         (task-state-set! t 'negotiating)
         (task-team-set! t '())
         (task-steps-set! t #f)
+        (task-turn-set! t turn)
+        (task-waiter-set! t #f)
         (set! *posed* (cons t *posed*))
         t))))
 
@@ -122,14 +135,24 @@
 ;; its own, and puts their results in t's mailbox.
 (define (run-task t priorities)
   (let* ((cs (task-components t))
-         (team (negotiate (task-name t) (length cs)
-                          (map component-capabilities cs)
-                          (map component-metric cs) (map component-proc cs)
-                          priorities)))
+         (team (negotiate-turn
+                t cs
+                (lambda ()
+                  (negotiate (task-name t) (length cs)
+                             (map component-capabilities cs)
+                             (map component-metric cs) (map component-proc cs)
+                             priorities)))))
     (cond
-     ((symbol? team)
-      (for-each (lambda (c) (component-state-set! c (list 'failed team))) cs)
+     ((and (symbol? team) (not (eq? team 'cancelled)))
+      (if (memq (task-state t) '(negotiating waiting)) (task-state-set! t 'failed))
+      (for-each (lambda (c)
+                  (if (not (eq? (car (component-state c)) 'failed))
+                      (component-state-set! c (list 'failed team))))
+                cs)
       (finish! t team))
+     ((symbol? team)
+      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
+      (finish! t (map component-result cs)))
      ((eq? (task-state t) 'cancelled)
       (for-each (lambda (winner type) (free-winner! winner type)) (car team) (cadr team))
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
@@ -148,7 +171,7 @@
       (finish! t (map component-result cs))))))
 
 (define (finish! t results)
-  (if (memq (task-state t) '(negotiating running)) (task-state-set! t 'done))
+  (if (memq (task-state t) '(negotiating waiting running)) (task-state-set! t 'done))
   (progress (task-id t) ": " (task-state t))
   (mailbox-put! (task-done t) results))
 
@@ -215,8 +238,12 @@
                                         (and (eq? (car (component-state other)) 'running)
                                              (cadr (component-state other))))
                                       (task-components t)))))
-    (let ((team (negotiate (task-name t) 1 (list (component-capabilities c))
-                           (list (component-metric c)) (list (component-proc c)))))
+    (let ((team (negotiate-turn
+                 t (list c)
+                 (lambda ()
+                   (negotiate (task-name t) 1 (list (component-capabilities c))
+                              (list (component-metric c))
+                              (list (component-proc c)))))))
       (and (pair? team)
            (cons (car (caar team)) (work-for (caar team) (caadr team) c))))))
 
@@ -280,8 +307,8 @@
   (let ((state (component-state c)))
     (if (eq? (car state) 'done)
         (cadr state)
-        (list 'error (let ((last (last-pair (component-attempts c))))
-                       (and (pair? last) (caar last)))
+        (list 'error (let ((attempts (component-attempts c)))
+                       (and (pair? attempts) (car (last attempts))))
               (cadr state)))))
 
 ;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS):
@@ -291,6 +318,7 @@
 ;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
 (define (task-status task)
   (check-task-record "task-status" task)
+  (if (task-waiter task) (move-up! (task-waiter task)))
   (if (task-steps task)
       (map (lambda (i sub) (list 'step i (task-status sub)))
            (iota (length (task-steps task)) 1) (task-steps task))
@@ -324,6 +352,7 @@
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
   (task-state-set! task 'cancelled)
+  (if (task-waiter task) (tell-waiter! (task-waiter task) '(cancel)))
   (if (task-steps task) (for-each cancel-task (task-steps task)))
   (for-each (lambda (c)
               (let ((state (component-state c)))
@@ -344,7 +373,12 @@
 ;;> The tasks of this address space: (posed ID STATE) for each it started,
 ;;> newest first, and (running ID INDEX POSER) for each component it runs.
 (define (tasks)
-  (append (map (lambda (t) (list 'posed (task-id t) (task-state t)))
+  (append (map (lambda (t)
+                 (let ((w (task-waiter t)))
+                   (if (and w (eq? (task-state t) 'waiting))
+                       (list 'posed (task-id t) 'waiting (waiter-position w)
+                             (waiter-why w))
+                       (list 'posed (task-id t) (task-state t)))))
                (with-lock *tasks-lock* (lambda () *posed*)))
           (map (lambda (r) (cons 'running r)) (components-running))))
 
@@ -380,18 +414,22 @@
   (make-step capability-list metrics procs options))
 
 ;;> Starts a task of \var{steps} (made by task-step) and answers its task
-;;> record at once.  task-status gives (step I STATUS) for each step
+;;> record at once; start-task's keywords may follow the steps, and each
+;;> step is started with them.  task-status gives (step I STATUS) for each step
 ;;> started, task-wait the list of each step's results, and cancel-task
 ;;> stops the step running and those after it.
-(define (start-steps task-name . steps)
-  (if (not (and (symbol? task-name) (pair? steps) (every step? steps)))
-      (error "start-steps: a task name, then one or more steps made by task-step"))
-  (for-each check-same steps (iota (length steps) 1))
-  (let ((t (new-task task-name '() '() '() '())))
-    (task-steps-set! t '())
-    (thread-start! (make-thread (inheriting (lambda () (run-steps t steps)))
-                                (task-id t)))
-    t))
+(define (start-steps task-name . steps+options)
+  (let ((steps (take-while step? steps+options))
+        (options (drop-while step? steps+options)))
+    (if (not (and (symbol? task-name) (pair? steps)))
+        (error "start-steps: a task name, then one or more steps made by task-step"))
+    (read-turn "start-steps" options)
+    (for-each check-same steps (iota (length steps) 1))
+    (let ((t (new-task task-name '() '() '() '() #f)))
+      (task-steps-set! t '())
+      (thread-start! (make-thread (inheriting (lambda () (run-steps t steps options)))
+                                  (task-id t)))
+      t)))
 
 ;;> Runs a task of steps and answers, as task-wait, each step's results.
 (define (pose-steps task-name . steps)
@@ -410,7 +448,7 @@
                          c)))
             (step-capabilities s)))
 
-(define (run-steps t steps)
+(define (run-steps t steps options)
   (let loop ((i 1) (steps steps) (previous '()) (results '()))
     (cond
      ((or (null? steps) (eq? (task-state t) 'cancelled))
@@ -420,7 +458,7 @@
              (coordinator (make-coordinator (lambda () (if sub (task-team sub) '()))))
              (step-results
               (begin
-                (set! sub (start-step t (car steps) i previous coordinator))
+                (set! sub (start-step t (car steps) i previous coordinator options))
                 (task-steps-set! t (append (task-steps t) (list sub)))
                 (task-wait sub))))
         (release-proxy! coordinator)
@@ -435,7 +473,7 @@
       (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
 
 ;; Starts step number i of t as a task of its own.
-(define (start-step t s i previous coordinator)
+(define (start-step t s i previous coordinator options)
   (apply start-task (task-name t) (length (step-procs s))
          (map (lambda (c) (if (same? c) (same-robot t c) c)) (step-capabilities s))
          (map (lambda (c m) (if (same? c) #f m))
@@ -444,7 +482,7 @@
                 (sendable-lambda ()
                   (with-coordinator coordinator (lambda () (p previous)))))
               (step-procs s))
-         (step-options s)))
+         (append (step-options s) options)))
 
 ;; The capabilities of the robot that (same J K) names: its uid, to
 ;; itself.
@@ -453,3 +491,315 @@
     (if (> (car (cddr c)) (length team))
         (error "task-step: no such component" c))
     (list (list (list-ref team (- (car (cddr c)) 1))) '())))
+
+;;; Tasks that wait their turn (thesis ch. 6; docs/tasks.md)
+;;
+;; A task started with wait #t that finds too few capable robots free
+;; waits for them, holding nothing and asking nothing, while its poser
+;; subscribes to waiting-tasks.  When a robot's exclusive subjects are
+;; freed (pubsub's on-free!), the robot asks waiting-tasks who waits for
+;; it, and offers itself to each in rank order, its subjects kept for
+;; that one's poser while it tries, until one starts or none can.  A rank
+;; is (KEY POSED ID), KEY being the task's priority less aging times the
+;; second it was posed: the higher KEY goes first, then the earlier
+;; POSED, then the smaller ID.  That is a total order, the same in every
+;; address space, and aging does not reorder the tasks that wait: it
+;; raises all their priorities alike, and only a task posed later starts
+;; from lower down.  A task no live robot of the lab is capable of fails
+;; at once; one whose capable robots all die while it waits fails when
+;; its poser next looks, every (* 10 heartbeat) seconds.
+
+(define-record-type turn
+  (make-turn wait? priority deadline posed)
+  turn?
+  (wait? turn-wait?)
+  (priority turn-priority)
+  (deadline turn-deadline)              ; monotonic-seconds, or #f
+  (posed turn-posed))                   ; current-second
+
+;; A turn from start-task's keywords and their values.
+(define (read-turn who options)
+  (let loop ((kv options)
+             (wait (eq? (lab-setting (current-lab) 'when-robots-busy) 'wait))
+             (priority (pose-task-priority))
+             (deadline #f))
+    (define (bad what)
+      (error (string-append who ": " what) kv))
+    (cond
+     ((null? kv)
+      (make-turn wait priority (and deadline (+ (monotonic-seconds) deadline))
+                 (current-second)))
+     ((not (and (symbol? (car kv)) (pair? (cdr kv))))
+      (bad "after the lists come keywords, each with its value: wait, priority, deadline"))
+     ((eq? (car kv) 'wait)
+      (if (not (boolean? (cadr kv))) (bad "wait is #t or #f"))
+      (loop (cddr kv) (cadr kv) priority deadline))
+     ((eq? (car kv) 'priority)
+      (if (not (and (real? (cadr kv)) (>= (cadr kv) 0)))
+          (bad "priority is a number, 0 or more"))
+      (loop (cddr kv) wait (cadr kv) deadline))
+     ((eq? (car kv) 'deadline)
+      (if (not (and (real? (cadr kv)) (>= (cadr kv) 0)))
+          (bad "deadline is a number of seconds, 0 or more"))
+      (loop (cddr kv) wait priority (cadr kv)))
+     (else (bad "no such option; the options are wait, priority and deadline")))))
+
+;; Refuses a task that would wait when this address space has
+;; max-waiting tasks waiting or about to.  Under *tasks-lock*.
+(define (check-waiting-room turn)
+  (if (and turn (turn-wait? turn)
+           (>= (count (lambda (t) (and (task-turn t) (turn-wait? (task-turn t))
+                                       (memq (task-state t) '(negotiating waiting))))
+                      *posed*)
+               (lab-setting (current-lab) 'max-waiting)))
+      (error "start-task: this address space has max-waiting tasks waiting already"
+             (lab-setting (current-lab) 'max-waiting))))
+
+(define (turn-rank turn id)
+  (list (- (turn-priority turn) (* (lab-setting (current-lab) 'aging) (turn-posed turn)))
+        (turn-posed turn) (symbol->string id)))
+
+;; Whether rank a goes before rank b.
+(define (rank<? a b)
+  (or (> (car a) (car b))
+      (and (= (car a) (car b))
+           (or (< (cadr a) (cadr b))
+               (and (= (cadr a) (cadr b)) (string<? (car (cddr a)) (car (cddr b))))))))
+
+;; A task waiting here: news is what came for it, offers and cancels, and
+;; bell rings when news comes.
+(define-record-type waiter
+  (make-waiter task components rank)
+  waiter?
+  (task waiter-task)
+  (components waiter-components)
+  (rank waiter-rank)
+  (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots
+  (position waiter-position waiter-position-set!)
+  (why waiter-why waiter-why-set!)               ; a line a component
+  (news waiter-news waiter-news-set!)
+  (bell waiter-bell waiter-bell-set!))
+
+(define *waiters* '())
+
+(define (enlist! w)
+  (waiter-capable-set! w '())
+  (waiter-position-set! w #f)
+  (waiter-why-set! w '())
+  (waiter-news-set! w '())
+  (waiter-bell-set! w (make-mailbox))
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-waiter-set! (waiter-task w) w)
+      (set! *waiters* (cons w *waiters*))
+      (subscribe 'waiting-tasks))))
+
+(define (delist! w)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-waiter-set! (waiter-task w) #f)
+      (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*))
+      (if (null? *waiters*) (unsubscribe 'waiting-tasks)))))
+
+(define (tell-waiter! w news)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (waiter-news-set! w (cons news (waiter-news w)))
+      (mailbox-put! (waiter-bell w) #t))))
+
+;; The news that came for w, oldest first, once some has come or the
+;; monotonic second until has passed.
+(define (take-news! w until)
+  (mailbox-take (waiter-bell w) until (lambda () #f))
+  (with-lock *tasks-lock*
+    (lambda ()
+      (let ((news (reverse (waiter-news w))))
+        (waiter-news-set! w '())
+        (waiter-bell-set! w (make-mailbox))
+        news))))
+
+;; What try, a thunk that negotiates cs of t, answers; for a task that
+;; waits, tried again whenever a robot it may use is offered, until it
+;; wins its robots or cannot: (winners type-list), or a symbol,
+;; not-enough-takers, deadline or cancelled.
+(define (negotiate-turn t cs try)
+  (if (not (turn-wait? (task-turn t)))
+      (try)
+      (let ((w (make-waiter t cs (turn-rank (task-turn t) (task-id t)))))
+        (dynamic-wind
+         (lambda () (enlist! w))
+         (lambda () (wait-turn w try '()))
+         (lambda () (delist! w))))))
+
+;; Tries, answers the offers that woke it, and waits for the next.
+(define (wait-turn w try offers)
+  (let ((t (waiter-task w)))
+    (cond
+     ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
+     ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
+     (else
+      (let ((team (quiet-try try)))
+        (answer-offers! offers (pair? team))
+        (cond
+         ((pair? team) team)
+         ((look! w) => (lambda (never)
+                         (for-each (lambda (c) (component-state-set! c (list 'failed never)))
+                                   (waiter-components w))
+                         'not-enough-takers))
+         (else
+          (let ((news (take-news! w (next-look (turn-deadline (task-turn t))))))
+            (wait-turn w try (filter (lambda (n) (eq? (car n) 'offer)) news))))))))))
+
+(define (past? deadline) (and deadline (>= (monotonic-seconds) deadline)))
+
+(define (next-look deadline)
+  (let ((look (+ (monotonic-seconds) (* 10 (lab-setting (current-lab) 'heartbeat)))))
+    (if deadline (min deadline look) look)))
+
+;; A try that answers at once and writes no explanation: the waiter
+;; gives its own.
+(define (quiet-try try)
+  (parameterize ((pose-task-retries 0) (current-error-port (open-output-string)))
+    (try)))
+
+(define (answer-offers! offers took?)
+  (for-each (lambda (offer) (mailbox-put! (cadr offer) took?)) offers))
+
+;; Looks at the lab for w after a try that failed: why it waits, and its
+;; place in line, in its components' states; answers why it never can be
+;; served, or #f.
+(define (look! w)
+  (let* ((cs (waiter-components w))
+         (lines (explain-components
+                 (map (lambda (c) (capability-layout (component-capabilities c))) cs)))
+         (capable (map (lambda (line)
+                         (remove (lambda (uid) (memq uid (pose-task-excluded)))
+                                 (car (cddr line))))
+                       lines))
+         (exclusive (filter-map (lambda (c caps)
+                                  (and (pair? (car (capability-layout
+                                                    (component-capabilities c))))
+                                       caps))
+                                cs capable)))
+    (cond
+     ((any null? capable)
+      (string-append "no live robot of the lab is capable of it:"
+                     (apply string-append (map car lines))))
+     ((< (length (delete-duplicates (apply append exclusive))) (length exclusive))
+      "fewer live robots of the lab are capable of it than it has components")
+     (else
+      (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
+      (waiter-position-set! w (place-in-line w))
+      (with-lock *tasks-lock*
+        (lambda ()
+          (if (eq? (task-state (waiter-task w)) 'negotiating)
+              (task-state-set! (waiter-task w) 'waiting))))
+      (for-each (lambda (c why)
+                  (component-state-set! c (list 'waiting (waiter-position w) why)))
+                cs (waiter-why w))
+      (progress (task-id (waiter-task w)) ": waiting, " (waiter-position w)
+                " in line")
+      #f))))
+
+(define (trimmed line)
+  (let loop ((s line))
+    (cond ((and (> (string-length s) 0) (char-whitespace? (string-ref s 0)))
+           (loop (substring s 1 (string-length s))))
+          ((and (> (string-length s) 0)
+                (char-whitespace? (string-ref s (- (string-length s) 1))))
+           (loop (substring s 0 (- (string-length s) 1))))
+          (else s))))
+
+;; Brings w's place in line, in its components' states, up to date.
+(define (move-up! w)
+  (let ((place (guard (e (#t (waiter-position w))) (place-in-line w))))
+    (waiter-position-set! w place)
+    (for-each (lambda (c)
+                (let ((state (component-state c)))
+                  (if (eq? (car state) 'waiting)
+                      (component-state-set! c (list 'waiting place (car (cddr state)))))))
+              (waiter-components w))))
+
+;; w's place among the tasks of the lab that wait for a robot it may use:
+;; 1 + how many of them rank before it.
+(define (place-in-line w)
+  (+ 1 (count (lambda (other)
+                (and (rank<? (car other) (waiter-rank w))
+                     (any (lambda (uid) (memq uid (waiter-capable w))) (cadr other))))
+              (append-map cadr (request 'waiting-tasks waiting-ranks)))))
+
+;;> The (RANK CAPABLE) of each task waiting here: its rank and the uids
+;;> of the robots it may use.
+(define (waiting-ranks)
+  (map (lambda (w) (list (waiter-rank w) (waiter-capable w)))
+       (with-lock *tasks-lock* (lambda () *waiters*))))
+
+;;> The (RANK POSER ID) of each task waiting here that may use robot
+;;> \var{uid}.
+(define (waiting-for uid)
+  (filter-map (lambda (w)
+                (and (memq uid (waiter-capable w))
+                     (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
+              (with-lock *tasks-lock* (lambda () *waiters*))))
+
+;;> What a freed robot \var{uid} calls where task \var{id} waits: the
+;;> task tries again at once; answers whether it started, #f when it is
+;;> no longer waiting here or did not answer within a second.
+(define (receive-offer id uid)
+  (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
+                 (with-lock *tasks-lock* (lambda () *waiters*))))
+        (reply (make-mailbox)))
+    (and w
+         (begin (tell-waiter! w (list 'offer reply uid))
+                (mailbox-take reply (+ (monotonic-seconds) 1) (lambda () #f))))))
+
+;;; The robot's side: offers when its subjects are freed
+
+(define *offering* #f)                  ; an offer round runs here
+(define *offer-again* #f)               ; and another was asked for meanwhile
+(define *offer-lock* (make-mutex 'offers))
+
+;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
+;; starts an offer round, or asks the one running for another.
+(define (robot-freed!)
+  (if (with-lock *offer-lock*
+        (lambda ()
+          (if *offering*
+              (begin (set! *offer-again* #t) #f)
+              (begin (set! *offering* #t) #t))))
+      (thread-start! (make-thread offer-rounds 'offers))))
+
+(define (offer-rounds)
+  (guard (e (#t (log-warn "offering this robot: " (error-message e))))
+    (offer-round))
+  (if (with-lock *offer-lock*
+        (lambda ()
+          (let ((again *offer-again*))
+            (set! *offer-again* #f)
+            (if (not again) (set! *offering* #f))
+            again)))
+      (offer-rounds)))
+
+;; Offers this robot, while it is free, to the tasks that wait for it,
+;; best rank first.  While one tries, only its poser may reserve here.
+(define (offer-round)
+  (let ((me (local-aspace-uid)))
+    (let loop ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
+                                   (append-map cadr
+                                               (request 'waiting-tasks waiting-for me)))))
+      (when (and (pair? waiting) (free-here?))
+        (let ((poser (cadr (car waiting))))
+          (offer-subjects! poser 1.5)
+          (guard (e (#t #f))
+            (parameterize ((remote-timeout 1.5))
+              (remote-apply (uid->aspace poser) receive-offer
+                            (car (cddr (car waiting))) me)))
+          (offer-subjects! #f)
+          (loop (cdr waiting)))))))
+
+;; Whether no subject here is held exclusively.
+(define (free-here?)
+  (every (lambda (s) (memq (cadr s) '(() shared))) (subscription-statuses '>)))
+
+(on-free! robot-freed!)

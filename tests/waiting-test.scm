@@ -1,0 +1,242 @@
+;;; Tasks that wait their turn, between real address spaces: a task
+;;; posed while every capable robot is busy waits, says why and where it
+;;; stands, and starts when a robot frees, best rank first and, within a
+;;; priority, first posed first, across posers; one no robot could ever
+;;; take fails at once; cancel, deadline, the per-poser limit, bad
+;;; options, and a robot killed while tasks wait.  Workstations stand in
+;;; for robots; a component "holds" its robot until the test opens its
+;;; gate there.
+(import (except (scheme base) lambda define) (scheme write) (scheme eval)
+        (srfi 1) (srfi 18) (chibi test)
+        (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
+
+(define lab-code "
+;; Each component counts, on its robot, how many run there at once, and
+;; notes its label and a ticket from p1, whose numbers give the order the
+;; components started in.
+(define ticket 0)
+(define (next-ticket!) (set! ticket (+ ticket 1)) ticket)
+(define inside 0)
+(define most-inside 0)
+(define starts '())
+(define open-gates '())
+(define (open-gate! gate) (set! open-gates (cons gate open-gates)))
+(define (job label gate)
+  (lambda ()
+    (set! inside (+ inside 1))
+    (set! most-inside (max most-inside inside))
+    (set! starts (cons (list label (remote-apply (uid->aspace 'p1) next-ticket!))
+                       starts))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       (let loop ()
+         (if (and gate (not (memq gate open-gates)))
+             (begin (thread-sleep! 0.05) (loop))))
+       (thread-sleep! 0.1)
+       label)
+     (lambda () (set! inside (- inside 1))))))
+;; What the posers p1 and p2 run: a one-robot task that waits.
+(define posed-here '())
+(define (pose-job label)
+  (set! posed-here
+        (cons (start-task 'job 1 (list '((arm) ())) (list #f) (list (job label #f))
+                          'wait #t)
+              posed-here))
+  #t)
+")
+
+(define lab
+  (make-test-lab
+   '((code "code.scm") (heartbeat 0.2) (max-waiting 5)
+     (aspace tester)
+     (aspace p1)
+     (aspace p2)
+     (aspace r1 (capabilities arm))
+     (aspace r2 (capabilities arm))
+     (aspace r3 (capabilities arm lift)))
+   `(("code.scm" . ,lab-code))))
+
+(define pids
+  (map (lambda (uid) (cons uid (start-lab-aspace! lab uid)))
+       '(p1 p2 r1 r2 r3)))
+(join-lab (test-lab-file lab) 'tester)
+(wait-until 10 (lambda () (= 5 (length (filter (lambda (u) (memq u '(p1 p2 r1 r2 r3)))
+                                                (live-uids))))))
+
+(define (lab-proc name) (eval name (lab-environment)))
+(define (job label gate) ((lab-proc 'job) label gate))
+(define (robot-value uid name)
+  (remote-apply (uid->aspace uid) (eval `(lambda () ,name) (lab-environment))))
+(define (open-gate! uid gate) (remote-apply (uid->aspace uid) (lab-proc 'open-gate!) gate))
+(define (state-of task k) (cadr (list-ref (task-status task) (- k 1))))
+(define (all-free?)
+  (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
+         (request-status 'arm)))
+
+;; Holds robot uid with a task until gate is opened there.
+(define (block! uid gate)
+  (let ((t (start-task 'block 1 (list `((arm ,uid) ())) (list #f) (list (job gate gate)))))
+    (wait-until 10 (lambda () (eq? (car (state-of t 1)) 'running)))
+    t))
+
+(define (waiting? t) (eq? (car (state-of t 1)) 'waiting))
+
+(define (wait-job label . options)
+  (apply start-task 'job 1 (list '((arm) ())) (list #f) (list (job label #f))
+         'wait #t options))
+
+;; The labels that started on the robots, first started first.
+(define (start-order labels)
+  (map car
+       (sort (filter (lambda (s) (memq (car s) labels))
+                     (append-map (lambda (uid) (robot-value uid 'starts)) '(r1 r2 r3)))
+             (lambda (a b) (< (cadr a) (cadr b))))))
+
+(define (sort ls less?)
+  (if (null? ls)
+      '()
+      (let ((pivot (car ls)))
+        (append (sort (filter (lambda (x) (less? x pivot)) (cdr ls)) less?)
+                (list pivot)
+                (sort (remove (lambda (x) (less? x pivot)) (cdr ls)) less?)))))
+
+(define (waiting-count)
+  (length (append-map cadr (request 'waiting-tasks waiting-ranks))))
+
+(test-begin "tasks that wait their turn")
+
+(test-group "the thesis's answer stays the default"
+  (let ((blocks (map block! '(r1 r2 r3) '(d1 d2 d3))))
+    (test "a task that does not wait answers not-enough-takers at once"
+        'not-enough-takers
+      (task-wait (start-task 'job 1 (list '((arm) ())) (list #f) (list (job 'x #f))) 10))
+    (for-each open-gate! '(r1 r2 r3) '(d1 d2 d3))
+    (for-each (lambda (t) (task-wait t 10)) blocks)))
+
+(test-group "a task posed while every robot is busy waits, then runs"
+  (let* ((blocks (map block! '(r1 r2 r3) '(g1 g2 g3)))
+         (w (wait-job 'w)))
+    (test "it waits" #t (wait-until 10 (lambda () (waiting? w))))
+    (test "first in line" 1 (cadr (state-of w 1)))
+    (test-assert "it says which robots are busy, and with which task"
+      (let ((why (car (cddr (state-of w 1)))))
+        (and (text-contains? why "r1 held by block@")
+             (text-contains? why "r3 held by block@"))))
+    (test "(tasks) shows it waiting, with its place" (list 'waiting 1)
+      (let ((entry (find (lambda (e) (eq? (cadr e) (task-id w))) (tasks))))
+        (list (car (cddr entry)) (cadr (cddr entry)))))
+    (test-assert "it holds nothing: every arm is held by a blocker"
+      (every (lambda (r) (every (lambda (s) (or (null? (cadr s))
+                                                 (text-contains? (symbol->string (cadr s))
+                                                                 "block@")))
+                                (cadr r)))
+             (request-status 'arm)))
+    (open-gate! 'r2 'g2)
+    (test "it runs on the robot that freed" '(w) (task-wait w 10))
+    (test "on r2" 'r2 (car (car (car (cddr (list-ref (task-status w) 0))))))
+    (for-each open-gate! '(r1 r3) '(g1 g3))
+    (for-each (lambda (t) (task-wait t 10)) blocks)
+    (test "every subject is free" #t (wait-until 5 all-free?))))
+
+(test-group "a task no robot of the lab can take fails at once"
+  (let ((t (start-task 'fly 1 (list '((wings) ())) (list #f) (list (job 'f #f))
+                       'wait #t)))
+    (test "not-enough-takers" 'not-enough-takers (task-wait t 10))
+    (test-assert "and says so"
+      (text-contains? (cadr (state-of t 1)) "no live robot of the lab is capable"))))
+
+(test-group "best rank first, then first posed"
+  (let* ((blocks (map block! '(r1 r2 r3) '(h1 h2 h3)))
+         (a (wait-job 'a))
+         (b (wait-job 'b 'priority 5))
+         (c (wait-job 'c)))
+    (test "all three wait" #t (wait-until 10 (lambda () (every waiting? (list a b c)))))
+    (test "their places: b, then a, then c" '(2 1 3)
+      (begin (task-status a)
+             (map (lambda (t) (cadr (state-of t 1))) (list a b c))))
+    (open-gate! 'r1 'h1)
+    (for-each (lambda (t) (task-wait t 20)) (list a b c))
+    (test "they started in rank order" '(b a c) (start-order '(a b c)))
+    (for-each open-gate! '(r2 r3) '(h2 h3))
+    (for-each (lambda (t) (task-wait t 10)) blocks)))
+
+(test-group "first posed, first served, across three posers"
+  (let ((blocks (map block! '(r1 r2 r3) '(k1 k2 k3)))
+        (mine '()))
+    (define (pose! where label)
+      (if (eq? where 'tester)
+          (set! mine (cons (wait-job label) mine))
+          (remote-apply (uid->aspace where) (lab-proc 'pose-job) label))
+      (wait-until 10 (lambda () (>= (waiting-count) (length (memq label '(f5 f4 f3 f2 f1)))))))
+    (for-each pose! '(p1 tester p2 p1 tester) '(f1 f2 f3 f4 f5))
+    (test "five wait, lab-wide" 5 (waiting-count))
+    (open-gate! 'r3 'k3)
+    (test "all ran" #t
+      (wait-until 20 (lambda () (= 5 (length (start-order '(f1 f2 f3 f4 f5)))))))
+    (test "in the order they were posed" '(f1 f2 f3 f4 f5)
+      (start-order '(f1 f2 f3 f4 f5)))
+    (for-each open-gate! '(r1 r2) '(k1 k2))
+    (for-each (lambda (t) (task-wait t 10)) (append mine blocks))))
+
+(test-group "cancel and deadline while waiting"
+  (let* ((blocks (map block! '(r1 r2 r3) '(m1 m2 m3)))
+         (cancelled (wait-job 'cancelled))
+         (late (wait-job 'late 'deadline 0.5)))
+    (test "both wait" #t (wait-until 10 (lambda () (waiting? cancelled))))
+    (cancel-task cancelled)
+    (test "a cancelled one ends, cancelled" '(failed "cancelled")
+      (begin (task-wait cancelled 5) (state-of cancelled 1)))
+    (test "one past its deadline fails with deadline" 'deadline (task-wait late 5))
+    (test "deadline, in its state" '(failed deadline) (state-of late 1))
+    (for-each open-gate! '(r1 r2 r3) '(m1 m2 m3))
+    (for-each (lambda (t) (task-wait t 10)) blocks)
+    (test "neither ever started" '() (start-order '(cancelled late)))
+    (test "no task waits" 0 (waiting-count))))
+
+(test-group "at most max-waiting tasks wait per poser"
+  (let* ((blocks (map block! '(r1 r2 r3) '(n1 n2 n3)))
+         (ws (map (lambda (i) (wait-job 'limited)) (iota 5)))
+         (before (length (tasks))))
+    (test-assert "the sixth is refused, saying why"
+      (text-contains? (error-text (lambda () (wait-job 'limited))) "max-waiting"))
+    (test "and nothing is added" before (length (tasks)))
+    (for-each cancel-task ws)
+    (for-each (lambda (t) (task-wait t 5)) ws)
+    (for-each open-gate! '(r1 r2 r3) '(n1 n2 n3))
+    (for-each (lambda (t) (task-wait t 10)) blocks)))
+
+(test-group "bad options get one clear error"
+  (for-each
+   (lambda (options word)
+     (test-assert word
+       (text-contains? (error-text (lambda () (apply wait-job 'bad options))) word)))
+   '((priority -1) (priority high) (deadline -2) (wait maybe) (soon 3) (priority))
+   '("priority" "priority" "deadline" "wait" "no such option" "keywords")))
+
+(test-group "a robot killed while tasks wait"
+  (let* ((blocks (map block! '(r1 r2 r3) '(q1 q2 q3)))
+         (lifter (start-task 'lift 1 (list '((arm lift) ())) (list #f) (list (job 'lift #f))
+                             'wait #t))
+         (armer (wait-job 'armer)))
+    (test "both wait" #t (wait-until 10 (lambda () (and (waiting? lifter) (waiting? armer)))))
+    (kill-process! (cdr (assq 'r3 pids)))
+    (test "the one only r3 could take fails, saying so" 'not-enough-takers
+      (task-wait lifter 10))
+    (test "the other waits on for the others" #t (waiting? armer))
+    (open-gate! 'r1 'q1)
+    (test "and runs when one frees" '(armer) (task-wait armer 10))
+    (open-gate! 'r2 'q2)
+    (for-each (lambda (t) (task-wait t 10)) (take blocks 2))))
+
+(test-group "at the end"
+  (test "no robot ever ran two exclusive components at once, seen from inside"
+      '(1 1)
+    (map (lambda (uid) (robot-value uid 'most-inside)) '(r1 r2)))
+  (test "no reservation is held" #t (wait-until 5 all-free?))
+  (test "no task waits" 0 (waiting-count)))
+
+(test-end)
+(stop-all-processes!)
+(remove-test-lab! lab)
+(test-exit)
