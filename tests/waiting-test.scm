@@ -214,6 +214,34 @@
    '((priority -1) (priority high) (deadline -2) (wait maybe) (soon 3) (priority))
    '("priority" "priority" "deadline" "wait" "no such option" "keywords")))
 
+(define (holder-of uid)
+  (cadr (find (lambda (s) (eq? (car s) 'arm)) (cadr (assq uid (request-status 'arm))))))
+
+(define (pair-job label)
+  (lambda options
+    (apply start-task 'pair 2 (list '((arm) ()) '((arm) ())) (list #f #f)
+           (list (job label #f) (job label #f)) 'wait #t 'hold #t options)))
+
+(test-group "the classic deadlock: two tasks of two robots, each holding one"
+  ;; r3 stays busy, so that two robots serve the two tasks.  low holds r2
+  ;; while r1 is busy; high, better-ranked, then wins r1 as it frees, and
+  ;; needs r2: each holds one robot and waits for the other.
+  (let* ((x3 (block! 'r3 'x3))
+         (x1 (block! 'r1 'x1))
+         (low ((pair-job 'low) 'priority 0)))
+    (test "the lower-ranked one waits, holding the free robot" #t
+      (wait-until 10 (lambda () (and (waiting? low) (symbol? (holder-of 'r2))
+                                     (text-contains? (symbol->string (holder-of 'r2))
+                                                     "pair@")))))
+    (let ((high ((pair-job 'high) 'priority 5)))
+      (test "the better-ranked one waits" #t (wait-until 10 (lambda () (waiting? high))))
+      (open-gate! 'r1 'x1)
+      (test "both complete" '((high high) (low low))
+        (list (task-wait high 20) (task-wait low 20)))
+      (test "in rank order" '(high high low low) (start-order '(high low)))
+      (open-gate! 'r3 'x3)
+      (for-each (lambda (t) (task-wait t 10)) (list x1 x3)))))
+
 (test-group "a robot killed while tasks wait"
   (let* ((blocks (map block! '(r1 r2 r3) '(q1 q2 q3)))
          (lifter (start-task 'lift 1 (list '((arm lift) ())) (list #f) (list (job 'lift #f))
@@ -233,6 +261,7 @@
   (test "no robot ever ran two exclusive components at once, seen from inside"
       '(1 1)
     (map (lambda (uid) (robot-value uid 'most-inside)) '(r1 r2)))
+  (test-assert "nothing is held" (every null? (map holder-of '(r1 r2))))
   (test "no reservation is held" #t (wait-until 5 all-free?))
   (test "no task waits" 0 (waiting-count)))
 

@@ -211,7 +211,8 @@
 ;;> \var{task-name}), reserves the exclusive ones for \var{task-name} and
 ;;> answers a promise.  Answers ((uid promise) ...).  A promise applied to
 ;;> #t applies \var{proc} to \var{args} there, frees the subjects and
-;;> returns the result; applied to #f it only frees them.  A promise never
+;;> returns the result; applied to #f it only frees them; applied to
+;;> \scheme{keep}, it holds them for another lease.  A promise never
 ;;> applied is freed after the lab's lease.
 (define (request-exclusive topic task-name proc . args)
   (let ((layout (capability-layout topic)))
@@ -341,7 +342,7 @@
   (task reservation-task)
   (exclusive reservation-exclusive)     ; subjects held exclusively
   (shared reservation-shared)           ; subjects held for sharing
-  (deadline reservation-deadline)
+  (deadline reservation-deadline reservation-deadline-set!)
   (state reservation-state reservation-state-set!)) ; reserved running done
 
 (define *reservations* '())             ; those not yet promised away
@@ -477,15 +478,28 @@
             (letrec ((promise
                       (encap
                        (lambda (commit?)
-                         (if (not (claim! r))
-                             (error "this promise's reservation has ended"
-                                    (reservation-task r)))
-                         (release-proxy! promise)
-                         (dynamic-wind
-                          (lambda () #f)
-                          (lambda () (and commit? (apply proc args)))
-                          (lambda () (release! r)))))))
+                         (cond
+                          ((eq? commit? 'keep) (renew! r))
+                          ((not (claim! r))
+                           (error "this promise's reservation has ended"
+                                  (reservation-task r)))
+                          (else
+                           (release-proxy! promise)
+                           (dynamic-wind
+                            (lambda () #f)
+                            (lambda () (and commit? (apply proc args)))
+                            (lambda () (release! r)))))))))
               promise))))
+
+;; A promise applied to keep holds its subjects for another lease: a task
+;; that holds what it has while it waits for the rest (task.scm).
+;; Answers whether it still holds them.
+(define (renew! r)
+  (with-subscriptions
+    (lambda ()
+      (and (eq? (reservation-state r) 'reserved)
+           (begin (reservation-deadline-set! r (+ (monotonic-seconds) *lease*))
+                  #t)))))
 
 ;; Frees the reservations whose promise was never applied: the sender
 ;; died, or the network broke.  No subject is held for ever.

@@ -137,11 +137,13 @@
   (let* ((cs (task-components t))
          (team (negotiate-turn
                 t cs
-                (lambda ()
-                  (negotiate (task-name t) (length cs)
-                             (map component-capabilities cs)
-                             (map component-metric cs) (map component-proc cs)
-                             priorities)))))
+                (if (and (turn-hold? (task-turn t)) (> (length cs) 1))
+                    (lambda (w) (hold-try w priorities))
+                    (lambda (w)
+                      (negotiate (task-name t) (length cs)
+                                 (map component-capabilities cs)
+                                 (map component-metric cs) (map component-proc cs)
+                                 priorities))))))
     (cond
      ((and (symbol? team) (not (eq? team 'cancelled)))
       (if (memq (task-state t) '(negotiating waiting)) (task-state-set! t 'failed))
@@ -240,7 +242,7 @@
                                       (task-components t)))))
     (let ((team (negotiate-turn
                  t (list c)
-                 (lambda ()
+                 (lambda (w)
                    (negotiate (task-name t) 1 (list (component-capabilities c))
                               (list (component-metric c))
                               (list (component-proc c)))))))
@@ -510,9 +512,10 @@
 ;; its poser next looks, every (* 10 heartbeat) seconds.
 
 (define-record-type turn
-  (make-turn wait? priority deadline posed)
+  (make-turn wait? hold? priority deadline posed)
   turn?
   (wait? turn-wait?)
+  (hold? turn-hold?)
   (priority turn-priority)
   (deadline turn-deadline)              ; monotonic-seconds, or #f
   (posed turn-posed))                   ; current-second
@@ -521,28 +524,33 @@
 (define (read-turn who options)
   (let loop ((kv options)
              (wait (eq? (lab-setting (current-lab) 'when-robots-busy) 'wait))
+             (hold #f)
              (priority (pose-task-priority))
              (deadline #f))
     (define (bad what)
       (error (string-append who ": " what) kv))
+    (define (value ok? what)
+      (if (not (ok? (cadr kv))) (bad what))
+      (cadr kv))
+    (define (at-least-0? x) (and (real? x) (>= x 0)))
     (cond
      ((null? kv)
-      (make-turn wait priority (and deadline (+ (monotonic-seconds) deadline))
-                 (current-second)))
+      (make-turn (or wait hold) hold priority
+                 (and deadline (+ (monotonic-seconds) deadline)) (current-second)))
      ((not (and (symbol? (car kv)) (pair? (cdr kv))))
-      (bad "after the lists come keywords, each with its value: wait, priority, deadline"))
+      (bad (string-append "after the lists come keywords, each with its value: "
+                          "wait, hold, priority, deadline")))
      ((eq? (car kv) 'wait)
-      (if (not (boolean? (cadr kv))) (bad "wait is #t or #f"))
-      (loop (cddr kv) (cadr kv) priority deadline))
+      (loop (cddr kv) (value boolean? "wait is #t or #f") hold priority deadline))
+     ((eq? (car kv) 'hold)
+      (loop (cddr kv) wait (value boolean? "hold is #t or #f") priority deadline))
      ((eq? (car kv) 'priority)
-      (if (not (and (real? (cadr kv)) (>= (cadr kv) 0)))
-          (bad "priority is a number, 0 or more"))
-      (loop (cddr kv) wait (cadr kv) deadline))
+      (loop (cddr kv) wait hold (value at-least-0? "priority is a number, 0 or more")
+            deadline))
      ((eq? (car kv) 'deadline)
-      (if (not (and (real? (cadr kv)) (>= (cadr kv) 0)))
-          (bad "deadline is a number of seconds, 0 or more"))
-      (loop (cddr kv) wait priority (cadr kv)))
-     (else (bad "no such option; the options are wait, priority and deadline")))))
+      (loop (cddr kv) wait hold priority
+            (value at-least-0? "deadline is a number of seconds, 0 or more")))
+     (else (bad "no such option; the options are wait, hold, priority and deadline")))))
 
 ;; Refuses a task that would wait when this address space has
 ;; max-waiting tasks waiting or about to.  Under *tasks-lock*.
@@ -574,6 +582,8 @@
   (task waiter-task)
   (components waiter-components)
   (rank waiter-rank)
+  (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
+  (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots
   (position waiter-position waiter-position-set!)
   (why waiter-why waiter-why-set!)               ; a line a component
@@ -583,6 +593,8 @@
 (define *waiters* '())
 
 (define (enlist! w)
+  (waiter-held-set! w '())
+  (waiter-yielded-set! w '())
   (waiter-capable-set! w '())
   (waiter-position-set! w #f)
   (waiter-why-set! w '())
@@ -618,27 +630,29 @@
         (waiter-bell-set! w (make-mailbox))
         news))))
 
-;; What try, a thunk that negotiates cs of t, answers; for a task that
-;; waits, tried again whenever a robot it may use is offered, until it
-;; wins its robots or cannot: (winners type-list), or a symbol,
-;; not-enough-takers, deadline or cancelled.
+;; What try, a procedure of the task's waiter that negotiates cs of t,
+;; answers; for a task that waits, tried again whenever a robot it may
+;; use is offered, until it wins its robots or cannot: (winners
+;; type-list), or a symbol, not-enough-takers, deadline or cancelled.
 (define (negotiate-turn t cs try)
-  (if (not (turn-wait? (task-turn t)))
-      (try)
-      (let ((w (make-waiter t cs (turn-rank (task-turn t) (task-id t)))))
+  (let ((w (make-waiter t cs (turn-rank (task-turn t) (task-id t)))))
+    (if (not (turn-wait? (task-turn t)))
+        (try w)
         (dynamic-wind
          (lambda () (enlist! w))
          (lambda () (wait-turn w try '()))
-         (lambda () (delist! w))))))
+         (lambda () (let-go-held! w) (delist! w))))))
 
 ;; Tries, answers the offers that woke it, and waits for the next.
-(define (wait-turn w try offers)
-  (let ((t (waiter-task w)))
+(define (wait-turn w try news)
+  (let ((t (waiter-task w))
+        (offers (filter (lambda (n) (eq? (car n) 'offer)) news)))
+    (give-way! w news)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (quiet-try try)))
+      (let ((team (quiet-try (lambda () (try w)))))
         (answer-offers! offers (pair? team))
         (cond
          ((pair? team) team)
@@ -647,13 +661,118 @@
                                    (waiter-components w))
                          'not-enough-takers))
          (else
-          (let ((news (take-news! w (next-look (turn-deadline (task-turn t))))))
-            (wait-turn w try (filter (lambda (n) (eq? (car n) 'offer)) news))))))))))
+          (keep-held! w)
+          (wait-turn w try (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+
+;;; Holding what it has (the thesis's chapter 6 wish)
+;;
+;; A task started with hold #t keeps, while it waits, the robots it won
+;; for some of its components, and waits for the others.  No deadlock:
+;; a waiting task gives up what it holds when a better-ranked waiting
+;; task could start with it (give-way!), and ranks are totally ordered,
+;; so the best-ranked waiting task never waits on one that holds; a
+;; running component is never taken away.  docs/allocation.md gives the
+;; argument.
+
+;; A try that keeps what it wins: each component of w not yet held is
+;; negotiated alone, in priority order, without the robots held or given
+;; way on.  Answers (winners type-list) once every component has a robot.
+(define (hold-try w priorities)
+  (let ((t (waiter-task w)) (cs (waiter-components w)))
+    (for-each
+     (lambda (c)
+       (if (not (assv (component-index c) (waiter-held w)))
+           (let ((team (parameterize ((pose-task-excluded
+                                       (append (map (lambda (h) (car (cadr h))) (waiter-held w))
+                                               (waiter-yielded w) (pose-task-excluded))))
+                         (negotiate (task-name t) 1 (list (component-capabilities c))
+                                    (list (component-metric c)) (list (component-proc c))))))
+             (if (pair? team)
+                 (waiter-held-set! w (cons (list (component-index c) (caar team)
+                                                 (caadr team))
+                                           (waiter-held w)))))))
+     (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
+    (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
+      (cond ((every pair? held)
+             (waiter-held-set! w '())
+             (list (map cadr held) (map (lambda (h) (car (cddr h))) held)))
+            (else 'not-enough-takers)))))
+
+(define (held-uids w) (map (lambda (h) (car (cadr h))) (waiter-held w)))
+
+;; Frees what w holds on robot uid, or on every robot.
+(define (let-go-held! w . uid)
+  (let ((out (filter (lambda (h) (or (null? uid) (eq? (car (cadr h)) (car uid))))
+                     (waiter-held w))))
+    (for-each (lambda (h) (free-winner! (cadr h) (car (cddr h)))) out)
+    (waiter-held-set! w (remove (lambda (h) (memq h out)) (waiter-held w)))))
+
+;; Holds what w holds for another lease.
+(define (keep-held! w)
+  (for-each (lambda (h)
+              (if (eq? (car (cddr h)) 'exclusive)
+                  (if (not (guard (e (#t #f)) ((cadr (cadr h)) 'keep)))
+                      (let-go-held! w (car (cadr h))))))
+            (waiter-held w)))
+
+;; Acts on the news: gives way on each robot a better-ranked task asked
+;; for, and takes robots offered to it again.
+(define (give-way! w news)
+  (for-each
+   (lambda (n)
+     (case (car n)
+       ((give-way)
+        (when (memq (cadr n) (held-uids w))
+          (progress (task-id (waiter-task w)) ": gives way on " (cadr n))
+          (let-go-held! w (cadr n))
+          (waiter-yielded-set! w (cons (cadr n) (waiter-yielded w)))))
+       ((offer)
+        (waiter-yielded-set! w (remove (lambda (u) (eq? u (car (cddr n))))
+                                       (waiter-yielded w))))))
+   news))
+
+;;> What a waiting task of rank \var{rank} calls where the task that holds
+;;> robot \var{uid} waits: that task gives way on it if \var{rank} goes
+;;> before its own.  Answers #t.
+(define (receive-give-way uid rank)
+  (for-each (lambda (w)
+              (if (and (memq uid (held-uids w)) (rank<? rank (waiter-rank w)))
+                  (tell-waiter! w (list 'give-way uid))))
+            (with-lock *tasks-lock* (lambda () *waiters*)))
+  #t)
+
+;; Asks the waiting tasks that rank after w, and hold robots w could
+;; start with, to give way, when with those robots and the free ones each
+;; of w's components not held would have one.
+(define (ask-way! w lines others)
+  (let* ((worse (filter (lambda (o) (rank<? (waiter-rank w) (car (cadr o)))) others))
+         (yieldable (append-map (lambda (o) (car (cddr (cadr o)))) worse))
+         (held (map car (waiter-held w)))
+         (open (filter-map (lambda (c line)
+                             (and (not (memv (component-index c) held))
+                                  (filter (lambda (uid) (or (memq uid (cadr line))
+                                                            (memq uid yieldable)))
+                                          (remove (lambda (u) (memq u (held-uids w)))
+                                                  (car (cddr line))))))
+                           (waiter-components w) lines))
+         (wanted (filter (lambda (uid) (memq uid yieldable)) (apply append open))))
+    (when (and (pair? wanted) (every pair? open)
+               (>= (length (delete-duplicates (apply append open))) (length open)))
+      (for-each (lambda (o)
+                  (for-each (lambda (uid)
+                              (if (memq uid wanted)
+                                  (guard (e (#t #f))
+                                    (remote-apply (uid->aspace (car o)) receive-give-way
+                                                  uid (waiter-rank w)))))
+                            (car (cddr (cadr o)))))
+                worse))))
 
 (define (past? deadline) (and deadline (>= (monotonic-seconds) deadline)))
 
 (define (next-look deadline)
-  (let ((look (+ (monotonic-seconds) (* 10 (lab-setting (current-lab) 'heartbeat)))))
+  (let ((look (+ (monotonic-seconds)
+                 (min (* 10 (lab-setting (current-lab) 'heartbeat))
+                      (/ (lab-setting (current-lab) 'lease) 3)))))
     (if deadline (min deadline look) look)))
 
 ;; A try that answers at once and writes no explanation: the waiter
@@ -676,6 +795,10 @@
                          (remove (lambda (uid) (memq uid (pose-task-excluded)))
                                  (car (cddr line))))
                        lines))
+         (others (guard (e (#t '()))
+                   (append-map (lambda (poser)
+                                 (map (lambda (o) (list (car poser) o)) (cadr poser)))
+                               (request 'waiting-tasks waiting-ranks))))
          (exclusive (filter-map (lambda (c caps)
                                   (and (pair? (car (capability-layout
                                                     (component-capabilities c))))
@@ -690,7 +813,8 @@
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
       (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
-      (waiter-position-set! w (place-in-line w))
+      (waiter-position-set! w (place-in-line w (map cadr others)))
+      (ask-way! w lines others)
       (with-lock *tasks-lock*
         (lambda ()
           (if (eq? (task-state (waiter-task w)) 'negotiating)
@@ -713,7 +837,9 @@
 
 ;; Brings w's place in line, in its components' states, up to date.
 (define (move-up! w)
-  (let ((place (guard (e (#t (waiter-position w))) (place-in-line w))))
+  (let ((place (guard (e (#t (waiter-position w)))
+                 (place-in-line w (append-map cadr (request 'waiting-tasks
+                                                            waiting-ranks))))))
     (waiter-position-set! w place)
     (for-each (lambda (c)
                 (let ((state (component-state c)))
@@ -723,16 +849,16 @@
 
 ;; w's place among the tasks of the lab that wait for a robot it may use:
 ;; 1 + how many of them rank before it.
-(define (place-in-line w)
+(define (place-in-line w others)
   (+ 1 (count (lambda (other)
                 (and (rank<? (car other) (waiter-rank w))
                      (any (lambda (uid) (memq uid (waiter-capable w))) (cadr other))))
-              (append-map cadr (request 'waiting-tasks waiting-ranks)))))
+              others)))
 
-;;> The (RANK CAPABLE) of each task waiting here: its rank and the uids
-;;> of the robots it may use.
+;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
+;;> of the robots it may use, and of those it holds.
 (define (waiting-ranks)
-  (map (lambda (w) (list (waiter-rank w) (waiter-capable w)))
+  (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
        (with-lock *tasks-lock* (lambda () *waiters*))))
 
 ;;> The (RANK POSER ID) of each task waiting here that may use robot

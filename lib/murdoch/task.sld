@@ -6,7 +6,7 @@
 (define-library (murdoch task)
   (export start-task task? task-id task-name task-status task-wait cancel-task
           tasks task-step start-steps pose-steps
-          waiting-ranks waiting-for receive-offer)
+          waiting-ranks waiting-for receive-offer receive-give-way)
   (import (scheme base) (scheme char) (scheme cxr) (scheme time)
           (srfi 1) (srfi 18) (srfi 132)
           (only (chibi ast) thread-interrupt!)
