@@ -6,7 +6,7 @@
 ;;; options, and a robot killed while tasks wait.  Workstations stand in
 ;;; for robots; a component "holds" its robot until the test opens its
 ;;; gate there.
-(import (except (scheme base) lambda define) (scheme write) (scheme eval)
+(import (except (scheme base) lambda define) (scheme write) (scheme eval) (scheme time)
         (srfi 1) (srfi 18) (chibi test)
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
@@ -36,6 +36,9 @@
        (thread-sleep! 0.1)
        label)
      (lambda () (set! inside (- inside 1))))))
+;; A component that keeps its robot for seconds.
+(define (slow-job label seconds)
+  (lambda () ((job label #f)) (thread-sleep! seconds) label))
 ;; What the posers p1 and p2 run: a one-robot task that waits.
 (define posed-here '())
 (define (pose-job label)
@@ -48,7 +51,7 @@
 
 (define lab
   (make-test-lab
-   '((code "code.scm") (heartbeat 0.2) (max-waiting 5)
+   '((code "code.scm") (heartbeat 0.2) (max-waiting 20) (aging 1)
      (aspace tester)
      (aspace p1)
      (aspace p2)
@@ -196,9 +199,9 @@
 
 (test-group "at most max-waiting tasks wait per poser"
   (let* ((blocks (map block! '(r1 r2 r3) '(n1 n2 n3)))
-         (ws (map (lambda (i) (wait-job 'limited)) (iota 5)))
+         (ws (map (lambda (i) (wait-job 'limited)) (iota 20)))
          (before (length (tasks))))
-    (test-assert "the sixth is refused, saying why"
+    (test-assert "one more is refused, saying why"
       (text-contains? (error-text (lambda () (wait-job 'limited))) "max-waiting"))
     (test "and nothing is added" before (length (tasks)))
     (for-each cancel-task ws)
@@ -213,6 +216,42 @@
        (text-contains? (error-text (lambda () (apply wait-job 'bad options))) word)))
    '((priority -1) (priority high) (deadline -2) (wait maybe) (soon 3) (priority))
    '("priority" "priority" "deadline" "wait" "no such option" "keywords")))
+
+(define (list-head ls n)
+  (if (or (zero? n) (null? ls)) '() (cons (car ls) (list-head (cdr ls) (- n 1)))))
+
+(test-group "no starvation: aging bounds a low-priority task's wait"
+  ;; Aging is 1 a second here: a task of priority 1 posed more than 1 s
+  ;; after one of priority 0 ranks after it.  r1 alone serves a stream of
+  ;; such tasks, posed faster than it runs them.
+  (let* ((blocks (map block! '(r2 r3) '(s2 s3)))
+         (x1 (block! 'r1 's1))
+         (low (wait-job 'patient))
+         (low-posed (current-second))
+         (highs (map (lambda (i)
+                       (thread-sleep! 0.15)
+                       (let ((posed (current-second)))
+                         (open-gate! 'r1 's1)
+                         (cons posed
+                               (start-task 'high 1 (list '((arm) ())) (list #f)
+                                           (list ((lab-proc 'slow-job)
+                                                  (string->symbol
+                                                   (string-append "high" (number->string i)))
+                                                  0.3))
+                                           'wait #t 'priority 1))))
+                     (iota 16)))
+         (later (filter-map (lambda (h) (and (> (car h) (+ low-posed 1))
+                                             (car (task-wait (cdr h) 30))))
+                            highs)))
+    (task-wait low 30)
+    (test-assert "some high-priority tasks were posed past the bound" (pair? later))
+    (test "the low-priority task starts before every one of them" '(patient)
+      (let ((order (start-order (cons 'patient later))))
+        (list-head order 1)))
+    (for-each (lambda (h) (task-wait (cdr h) 30)) highs)
+    (open-gate! 'r2 's2)
+    (open-gate! 'r3 's3)
+    (for-each (lambda (t) (task-wait t 10)) (cons x1 blocks))))
 
 (define (holder-of uid)
   (cadr (find (lambda (s) (eq? (car s) 'arm)) (cadr (assq uid (request-status 'arm))))))
