@@ -129,6 +129,13 @@
     (test "(tasks) shows it waiting, with its place" (list 'waiting 1)
       (let ((entry (find (lambda (e) (eq? (cadr e) (task-id w))) (tasks))))
         (list (car (cddr entry)) (cadr (cddr entry)))))
+    (test-assert "the lab's status shows it, with its place and why"
+      (let ((out (open-output-string)))
+        (show-status out)
+        (let ((text (get-output-string out)))
+          (and (text-contains? text (string-append (symbol->string (task-id w))
+                                                   " waiting, 1 in line: "))
+               (text-contains? text "r1 held by block@")))))
     (test-assert "it holds nothing: every arm is held by a blocker"
       (every (lambda (r) (every (lambda (s) (or (null? (cadr s))
                                                  (text-contains? (symbol->string (cadr s))
