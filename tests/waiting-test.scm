@@ -93,7 +93,9 @@
 (define (start-order labels)
   (map car
        (sort (filter (lambda (s) (memq (car s) labels))
-                     (append-map (lambda (uid) (robot-value uid 'starts)) '(r1 r2 r3)))
+                     (append-map (lambda (uid)
+                                   (guard (e (#t '())) (robot-value uid 'starts)))
+                                 '(r1 r2 r3)))
              (lambda (a b) (< (cadr a) (cadr b))))))
 
 (define (sort ls less?)
@@ -289,19 +291,32 @@
       (for-each (lambda (t) (task-wait t 10)) (list x1 x3)))))
 
 (test-group "a robot killed while tasks wait"
-  (let* ((blocks (map block! '(r1 r2 r3) '(q1 q2 q3)))
+  ;; mover, restartable, runs on r3 while r1 and r2 are busy; lifter can
+  ;; only have r3, armer any robot.
+  (let* ((blocks (map block! '(r1 r2) '(q1 q2)))
+         (mover (start-task 'mover 1 (list '((arm) ())) (list #f) (list (job 'mover 'q3))
+                            '(1) '(#t) 'wait #t))
+         (running (wait-until 10 (lambda () (eq? (car (state-of mover 1)) 'running))))
          (lifter (start-task 'lift 1 (list '((arm lift) ())) (list #f) (list (job 'lift #f))
                              'wait #t))
          (armer (wait-job 'armer)))
+    (for-each (lambda (uid) (open-gate! uid 'q3)) '(r1 r2))
     (test "both wait" #t (wait-until 10 (lambda () (and (waiting? lifter) (waiting? armer)))))
     (kill-process! (cdr (assq 'r3 pids)))
     (test "the one only r3 could take fails, saying so" 'not-enough-takers
       (task-wait lifter 10))
+    (test "a restartable component that was lost waits for another robot" #t
+      (wait-until 10 (lambda () (waiting? mover))))
     (test "the other waits on for the others" #t (waiting? armer))
     (open-gate! 'r1 'q1)
-    (test "and runs when one frees" '(armer) (task-wait armer 10))
+    (test "the lost component runs when a robot frees" '(mover) (task-wait mover 10))
+    (test "its attempts: lost on r3, done on r1" '((r3 lost) (r1 done))
+      (map (lambda (a) (list (car a) (cadr a))) (car (cddr (car (task-status mover))))))
+    (test "and the other after it: it ranks first, posed first" '(armer) (task-wait armer 10))
+    (test "in that order (r3's notes died with it)" '(mover armer)
+      (start-order '(mover armer)))
     (open-gate! 'r2 'q2)
-    (for-each (lambda (t) (task-wait t 10)) (take blocks 2))))
+    (for-each (lambda (t) (task-wait t 10)) blocks)))
 
 (test-group "at the end"
   (test "no robot ever ran two exclusive components at once, seen from inside"
