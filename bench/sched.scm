@@ -180,6 +180,7 @@
          tasks))
 
 (define makespan (apply max 0 (map car ends)))
+(define (one-robot-start? s) (= 1 (task-robots (list-ref tasks (list-ref s 2)))))
 
 ;; Stalls: 2 s or more with a task posed and not started, and no
 ;; component running.
@@ -195,19 +196,23 @@
                (quiet (if (and waiting (not running)) (+ quiet 0.1) 0)))
           (loop (+ t 0.1) quiet (if (and (>= quiet 2) (< quiet 2.1)) (+ n 1) n))))))
 
-;; From each end on a robot to the next start there, while a task waited.
-(define latencies
+;; From each end on a robot to the next start there, while a task waited;
+;; and the same where that start is of a one-robot task, which no task
+;; could have held for a while before it started.
+(define (latencies-where ok?)
   (filter-map
    (lambda (e)
      (let ((next (find (lambda (s) (and (eq? (list-ref s 4) (list-ref e 4)) (>= (car s) (car e))))
                        starts)))
-       (and next
+       (and next (ok? next)
             (any (lambda (x) (and (< (vector-ref posed-at (car x)) (car e))
                                   (let ((s (span-of (car x))))
                                     (and s (>= (cadr s) (car e))))))
                  tasks)
             (* 1000 (- (car next) (car e))))))
    ends))
+(define latencies (latencies-where (lambda (s) #t)))
+(define one-robot-latencies (latencies-where one-robot-start?))
 
 ;;; The ideal schedule: the same arrivals and rank rule, the measured
 ;;; work, no messages.  At each moment the waiting tasks, best rank
@@ -281,6 +286,10 @@
 (bench "sched-makespan-over-bound" (round-to (/ makespan bound) 3) "x")
 (bench "sched-start-latency-p50" (round-to (percentile latencies 0.5) 1) "ms")
 (bench "sched-start-latency-p95" (round-to (percentile latencies 0.95) 1) "ms")
+(bench "sched-start-latency-one-robot-p50"
+       (round-to (percentile one-robot-latencies 0.5) 1) "ms")
+(bench "sched-start-latency-one-robot-p95"
+       (round-to (percentile one-robot-latencies 0.95) 1) "ms")
 (bench "sched-utilization" (round-to (* 100 (/ robot-seconds (* (length robots) makespan))) 1) "%")
 (for-each (lambda (k)
             (bench (string-append "sched-wait-p95-priority-" (number->string k))

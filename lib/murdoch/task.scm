@@ -584,7 +584,7 @@
   (rank waiter-rank)
   (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
-  (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots
+  (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
   (position waiter-position waiter-position-set!)
   (why waiter-why waiter-why-set!)               ; a line a component
   (news waiter-news waiter-news-set!)
@@ -595,7 +595,7 @@
 (define (enlist! w)
   (waiter-held-set! w '())
   (waiter-yielded-set! w '())
-  (waiter-capable-set! w '())
+  (waiter-capable-set! w #t)            ; any robot, until it has looked
   (waiter-position-set! w #f)
   (waiter-why-set! w '())
   (waiter-news-set! w '())
@@ -657,12 +657,14 @@
         (cond
          ((pair? team) team)
          ((look! w) => (lambda (never)
-                         (for-each (lambda (c) (component-state-set! c (list 'failed never)))
+                         (for-each (lambda (c)
+                                     (component-state-set! c (list 'failed never)))
                                    (waiter-components w))
                          'not-enough-takers))
          (else
           (keep-held! w)
-          (wait-turn w try (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+          (wait-turn w try
+                     (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
 ;;; Holding what it has (the thesis's chapter 6 wish)
 ;;
@@ -683,10 +685,11 @@
      (lambda (c)
        (if (not (assv (component-index c) (waiter-held w)))
            (let ((team (parameterize ((pose-task-excluded
-                                       (append (map (lambda (h) (car (cadr h))) (waiter-held w))
-                                               (waiter-yielded w) (pose-task-excluded))))
+                                       (append (held-uids w) (waiter-yielded w)
+                                               (pose-task-excluded))))
                          (negotiate (task-name t) 1 (list (component-capabilities c))
-                                    (list (component-metric c)) (list (component-proc c))))))
+                                    (list (component-metric c))
+                                    (list (component-proc c))))))
              (if (pair? team)
                  (waiter-held-set! w (cons (list (component-index c) (caar team)
                                                  (caadr team))
@@ -852,11 +855,17 @@
 (define (place-in-line w others)
   (+ 1 (count (lambda (other)
                 (and (rank<? (car other) (waiter-rank w))
-                     (any (lambda (uid) (memq uid (waiter-capable w))) (cadr other))))
+                     (may-use? other (waiter-capable w))))
               others)))
 
+;; Whether the waiting task (RANK CAPABLE HELD) may use one of uids.
+(define (may-use? other uids)
+  (or (eq? (cadr other) #t) (eq? uids #t)
+      (any (lambda (uid) (memq uid (cadr other))) uids)))
+
 ;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
-;;> of the robots it may use, and of those it holds.
+;;> of the robots it may use (#t before it has looked), and of those it
+;;> holds.
 (define (waiting-ranks)
   (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
        (with-lock *tasks-lock* (lambda () *waiters*))))
@@ -865,7 +874,7 @@
 ;;> \var{uid}.
 (define (waiting-for uid)
   (filter-map (lambda (w)
-                (and (memq uid (waiter-capable w))
+                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w)))
                      (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
               (with-lock *tasks-lock* (lambda () *waiters*))))
 
