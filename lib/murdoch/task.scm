@@ -583,6 +583,8 @@
   (components waiter-components)
   (rank waiter-rank)
   (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
+  (looked waiter-looked waiter-looked-set!)      ; monotonic-seconds
+  (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
   (position waiter-position waiter-position-set!)
@@ -594,6 +596,8 @@
 
 (define (enlist! w)
   (waiter-held-set! w '())
+  (waiter-looked-set! w #f)
+  (waiter-kept-set! w (monotonic-seconds))
   (waiter-yielded-set! w '())
   (waiter-capable-set! w #t)            ; any robot, until it has looked
   (waiter-position-set! w #f)
@@ -643,26 +647,35 @@
          (lambda () (wait-turn w try '()))
          (lambda () (let-go-held! w) (delist! w))))))
 
-;; Tries, answers the offers that woke it, and waits for the next.
+;; Tries, answers the offers that woke it, and waits for the next.  It
+;; looks at the lab again when what it holds changed, or a second after
+;; its last look: an offer is answered at once, not after a look.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
-        (offers (filter (lambda (n) (eq? (car n) 'offer)) news)))
+        (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
+        (held (held-uids w)))
     (give-way! w news)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (quiet-try (lambda () (try w)))))
+      (let ((team (quiet-try (lambda ()
+                               (parameterize ((pose-task-excluded
+                                               (append (offered-to-others w)
+                                                       (pose-task-excluded))))
+                                 (try w))))))
         (answer-offers! offers (pair? team))
         (cond
          ((pair? team) team)
-         ((look! w) => (lambda (never)
-                         (for-each (lambda (c)
-                                     (component-state-set! c (list 'failed never)))
-                                   (waiter-components w))
-                         'not-enough-takers))
+         ((and (or (not (equal? held (held-uids w))) (look-due? w)) (look! w))
+          => (lambda (never)
+               (for-each (lambda (c) (component-state-set! c (list 'failed never)))
+                         (waiter-components w))
+               'not-enough-takers))
          (else
-          (keep-held! w)
+          (if (> (- (monotonic-seconds) (waiter-kept w))
+                 (/ (lab-setting (current-lab) 'lease) 4))
+              (keep-held! w))
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
@@ -712,6 +725,7 @@
 
 ;; Holds what w holds for another lease.
 (define (keep-held! w)
+  (waiter-kept-set! w (monotonic-seconds))
   (for-each (lambda (h)
               (if (eq? (car (cddr h)) 'exclusive)
                   (if (not (guard (e (#t #f)) ((cadr (cadr h)) 'keep)))
@@ -770,6 +784,9 @@
                             (car (cddr (cadr o)))))
                 worse))))
 
+(define (look-due? w)
+  (or (not (waiter-looked w)) (> (- (monotonic-seconds) (waiter-looked w)) 1)))
+
 (define (past? deadline) (and deadline (>= (monotonic-seconds) deadline)))
 
 (define (next-look deadline)
@@ -791,6 +808,7 @@
 ;; place in line, in its components' states; answers why it never can be
 ;; served, or #f.
 (define (look! w)
+  (waiter-looked-set! w (monotonic-seconds))
   (let* ((cs (waiter-components w))
          (lines (explain-components
                  (map (lambda (c) (capability-layout (component-capabilities c))) cs)))
@@ -884,10 +902,29 @@
 (define (receive-offer id uid)
   (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
                  (with-lock *tasks-lock* (lambda () *waiters*))))
-        (reply (make-mailbox)))
+        (reply (make-mailbox))
+        (offer (cons uid id)))
     (and w
-         (begin (tell-waiter! w (list 'offer reply uid))
-                (mailbox-take reply (+ (monotonic-seconds) 1) (lambda () #f))))))
+         (dynamic-wind
+          (lambda ()
+            (with-lock *tasks-lock* (lambda () (set! *offers* (cons offer *offers*)))))
+          (lambda ()
+            (tell-waiter! w (list 'offer reply uid))
+            (mailbox-take reply (+ (monotonic-seconds) 1) (lambda () #f)))
+          (lambda ()
+            (with-lock *tasks-lock*
+              (lambda ()
+                (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+
+;; The offers being answered here, (UID . ID): the robot UID keeps itself
+;; for this poser while task ID tries, and the poser's other waiting
+;; tasks leave it alone meanwhile.
+(define *offers* '())
+
+(define (offered-to-others w)
+  (let ((id (task-id (waiter-task w))))
+    (filter-map (lambda (o) (and (not (eq? (cdr o) id)) (car o)))
+                (with-lock *tasks-lock* (lambda () *offers*)))))
 
 ;;; The robot's side: offers when its subjects are freed
 
@@ -917,12 +954,16 @@
       (offer-rounds)))
 
 ;; Offers this robot, while it is free, to the tasks that wait for it,
-;; best rank first.  While one tries, only its poser may reserve here.
+;; best rank first.  While one tries, only its poser may reserve here;
+;; while it asks who waits, nobody may, so that no task takes it before
+;; the best-ranked has been offered it.
 (define (offer-round)
   (let ((me (local-aspace-uid)))
+    (offer-subjects! 'nobody 1.5)
     (let loop ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                                    (append-map cadr
-                                               (request 'waiting-tasks waiting-for me)))))
+                                               (guard (e (#t (offer-subjects! #f) '()))
+                                                 (request 'waiting-tasks waiting-for me))))))
       (when (and (pair? waiting) (free-here?))
         (let ((poser (cadr (car waiting))))
           (offer-subjects! poser 1.5)
@@ -931,7 +972,8 @@
               (remote-apply (uid->aspace poser) receive-offer
                             (car (cddr (car waiting))) me)))
           (offer-subjects! #f)
-          (loop (cdr waiting)))))))
+          (loop (cdr waiting))))
+      (offer-subjects! #f))))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
