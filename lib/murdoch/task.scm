@@ -584,6 +584,7 @@
   (rank waiter-rank)
   (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
   (looked waiter-looked waiter-looked-set!)      ; monotonic-seconds
+  (free-seen? waiter-free-seen? waiter-free-seen?-set!) ; at its last look
   (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
@@ -597,6 +598,7 @@
 (define (enlist! w)
   (waiter-held-set! w '())
   (waiter-looked-set! w #f)
+  (waiter-free-seen?-set! w #f)
   (waiter-kept-set! w (monotonic-seconds))
   (waiter-yielded-set! w '())
   (waiter-capable-set! w #t)            ; any robot, until it has looked
@@ -644,12 +646,13 @@
         (try w)
         (dynamic-wind
          (lambda () (enlist! w))
-         (lambda () (wait-turn w try '()))
+         (lambda () (wait-turn w try '((posed))))
          (lambda () (let-go-held! w) (delist! w))))))
 
 ;; Tries, answers the offers that woke it, and waits for the next.  It
-;; looks at the lab again when what it holds changed, or a second after
-;; its last look: an offer is answered at once, not after a look.
+;; tries only when news came (it was posed, offered a robot, asked to give
+;; way), and looks at the lab again when what it holds changed, or a
+;; second after its last look: an offer is answered by one try.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
         (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
@@ -659,11 +662,13 @@
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (quiet-try (lambda ()
-                               (parameterize ((pose-task-excluded
-                                               (append (offered-to-others w)
-                                                       (pose-task-excluded))))
-                                 (try w))))))
+      (let ((team (if (null? news)
+                      'not-enough-takers
+                      (quiet-try (lambda ()
+                                   (parameterize ((pose-task-excluded
+                                                   (append (offered-to-others w)
+                                                           (pose-task-excluded))))
+                                     (try w)))))))
         (answer-offers! offers (pair? team))
         (cond
          ((pair? team) team)
@@ -677,7 +682,9 @@
                  (/ (lab-setting (current-lab) 'lease) 4))
               (keep-held! w))
           (wait-turn w try
-                     (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+                     (if (and (null? news) (waiter-free-seen? w))
+                         '((free))     ; an offer it missed: a robot is free
+                         (take-news! w (next-look (turn-deadline (task-turn t)))))))))))))
 
 ;;; Holding what it has (the thesis's chapter 6 wish)
 ;;
@@ -833,6 +840,7 @@
       "fewer live robots of the lab are capable of it than it has components")
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (waiter-free-seen?-set! w (any pair? (map cadr lines)))
       (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
       (waiter-position-set! w (place-in-line w (map cadr others)))
       (ask-way! w lines others)
@@ -961,9 +969,9 @@
   (let ((me (local-aspace-uid)))
     (offer-subjects! 'nobody 1.5)
     (let loop ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
-                                   (append-map cadr
-                                               (guard (e (#t (offer-subjects! #f) '()))
-                                                 (request 'waiting-tasks waiting-for me))))))
+                                   (guard (e (#t '()))
+                                     (append-map cadr (request 'waiting-tasks
+                                                               waiting-for me))))))
       (when (and (pair? waiting) (free-here?))
         (let ((poser (cadr (car waiting))))
           (offer-subjects! poser 1.5)
