@@ -963,25 +963,31 @@
 
 ;; Offers this robot, while it is free, to the tasks that wait for it,
 ;; best rank first.  While one tries, only its poser may reserve here;
-;; while it asks who waits, nobody may, so that no task takes it before
-;; the best-ranked has been offered it.
+;; while it asks who waits, if tasks waited at its last round, nobody may,
+;; so that no task takes it before the best-ranked has been offered it.
+;; In a lab where no task waits it refuses nobody, as in the thesis.
+(define *waiters-seen* #f)
+
 (define (offer-round)
   (let ((me (local-aspace-uid)))
-    (offer-subjects! 'nobody 1.5)
-    (let loop ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
-                                   (guard (e (#t '()))
-                                     (append-map cadr (request 'waiting-tasks
-                                                               waiting-for me))))))
-      (when (and (pair? waiting) (free-here?))
-        (let ((poser (cadr (car waiting))))
-          (offer-subjects! poser 1.5)
-          (guard (e (#t #f))
-            (parameterize ((remote-timeout 1.5))
-              (remote-apply (uid->aspace poser) receive-offer
-                            (car (cddr (car waiting))) me)))
-          (offer-subjects! #f)
-          (loop (cdr waiting))))
-      (offer-subjects! #f))))
+    (if *waiters-seen* (offer-subjects! 'nobody 1.5))
+    (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
+                              (guard (e (#t '()))
+                                (append-map cadr (request 'waiting-tasks
+                                                          waiting-for me))))))
+      (set! *waiters-seen* (pair? waiting))
+      (offer-to me waiting))))
+
+(define (offer-to me waiting)
+  (when (and (pair? waiting) (free-here?))
+    (let ((poser (cadr (car waiting))))
+      (offer-subjects! poser 1.5)
+      (guard (e (#t #f))
+        (parameterize ((remote-timeout 1.5))
+          (remote-apply (uid->aspace poser) receive-offer
+                        (car (cddr (car waiting))) me)))
+      (offer-to me (cdr waiting))))
+  (offer-subjects! #f))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
