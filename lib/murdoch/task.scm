@@ -906,7 +906,7 @@
 
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
 ;;> task tries again at once; answers whether it started, #f when it is
-;;> no longer waiting here or did not answer within a second.
+;;> no longer waiting here or did not answer within two seconds.
 (define (receive-offer id uid)
   (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
                  (with-lock *tasks-lock* (lambda () *waiters*))))
@@ -918,7 +918,7 @@
             (with-lock *tasks-lock* (lambda () (set! *offers* (cons offer *offers*)))))
           (lambda ()
             (tell-waiter! w (list 'offer reply uid))
-            (mailbox-take reply (+ (monotonic-seconds) 1) (lambda () #f)))
+            (mailbox-take reply (+ (monotonic-seconds) 2) (lambda () #f)))
           (lambda ()
             (with-lock *tasks-lock*
               (lambda ()
@@ -970,7 +970,7 @@
 
 (define (offer-round)
   (let ((me (local-aspace-uid)))
-    (if *waiters-seen* (offer-subjects! 'nobody 1.5))
+    (if *waiters-seen* (offer-subjects! 'nobody 3))
     (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                               (guard (e (#t '()))
                                 (append-map cadr (request 'waiting-tasks
@@ -981,9 +981,9 @@
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
     (let ((poser (cadr (car waiting))))
-      (offer-subjects! poser 1.5)
+      (offer-subjects! poser 3)
       (guard (e (#t #f))
-        (parameterize ((remote-timeout 1.5))
+        (parameterize ((remote-timeout 3))
           (remote-apply (uid->aspace poser) receive-offer
                         (car (cddr (car waiting))) me)))
       (offer-to me (cdr waiting))))
