@@ -612,18 +612,24 @@
       (set! *waiters* (cons w *waiters*))
       (subscribe 'waiting-tasks))))
 
+;; The offers w had not answered are declined: a robot waits for no task
+;; that no longer waits.
 (define (delist! w)
   (with-lock *tasks-lock*
     (lambda ()
       (task-waiter-set! (waiter-task w) #f)
       (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*))
+      (answer-offers! (filter (lambda (n) (eq? (car n) 'offer)) (waiter-news w)) #f)
+      (waiter-news-set! w '())
       (if (null? *waiters*) (unsubscribe 'waiting-tasks)))))
 
 (define (tell-waiter! w news)
   (with-lock *tasks-lock*
     (lambda ()
-      (waiter-news-set! w (cons news (waiter-news w)))
-      (mailbox-put! (waiter-bell w) #t))))
+      (cond ((memq w *waiters*)
+             (waiter-news-set! w (cons news (waiter-news w)))
+             (mailbox-put! (waiter-bell w) #t))
+            ((eq? (car news) 'offer) (answer-offers! (list news) #f))))))
 
 ;; The news that came for w, oldest first, once some has come or the
 ;; monotonic second until has passed.
