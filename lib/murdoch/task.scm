@@ -497,8 +497,8 @@
 ;;; Tasks that wait their turn (thesis ch. 6; docs/tasks.md)
 ;;
 ;; A task started with wait #t that finds too few capable robots free
-;; waits for them, holding nothing and asking nothing, while its poser
-;; subscribes to waiting-tasks.  When a robot's exclusive subjects are
+;; waits for them, holding nothing and trying only when a robot offers
+;; itself, while its poser subscribes to waiting-tasks.  When a robot's exclusive subjects are
 ;; freed (pubsub's on-free!), the robot asks waiting-tasks who waits for
 ;; it, and offers itself to each in rank order, its subjects kept for
 ;; that one's poser while it tries, until one starts or none can.  A rank
@@ -509,7 +509,8 @@
 ;; raises all their priorities alike, and only a task posed later starts
 ;; from lower down.  A task no live robot of the lab is capable of fails
 ;; at once; one whose capable robots all die while it waits fails when
-;; its poser next looks, every (* 10 heartbeat) seconds.
+;; it next looks at the lab, every ten heartbeats or a third of the
+;; lease, whichever is sooner.
 
 (define-record-type turn
   (make-turn wait? hold? priority deadline posed)
