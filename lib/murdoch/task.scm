@@ -611,7 +611,9 @@
     (lambda ()
       (task-waiter-set! (waiter-task w) w)
       (set! *waiters* (cons w *waiters*))
-      (subscribe 'waiting-tasks))))
+      (subscribe 'waiting-tasks)))
+  (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
+    (publish 'all note-waiters!)))
 
 ;; The offers w had not answered are declined: a robot waits for no task
 ;; that no longer waits.
@@ -947,14 +949,24 @@
 (define *offer-again* #f)               ; and another was asked for meanwhile
 (define *offer-lock* (make-mutex 'offers))
 
+;; Whether a task may wait for this robot: set when a task starts to
+;; wait anywhere, cleared by an offer round that finds none, so that a lab
+;; where no task waits sends nothing more when a robot is freed.
+(define *waiters-here?* #f)
+
+;;> What a poser publishes to the lab when one of its tasks starts to
+;;> wait: the robots offer themselves when freed.
+(define (note-waiters!) (set! *waiters-here?* #t))
+
 ;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
 ;; starts an offer round, or asks the one running for another.
 (define (robot-freed!)
-  (if (with-lock *offer-lock*
-        (lambda ()
-          (if *offering*
-              (begin (set! *offer-again* #t) #f)
-              (begin (set! *offering* #t) #t))))
+  (if (and *waiters-here?*
+           (with-lock *offer-lock*
+             (lambda ()
+               (if *offering*
+                   (begin (set! *offer-again* #t) #f)
+                   (begin (set! *offering* #t) #t)))))
       (thread-start! (make-thread offer-rounds 'offers))))
 
 (define (offer-rounds)
@@ -977,12 +989,14 @@
 
 (define (offer-round)
   (let ((me (local-aspace-uid)))
+    (set! *waiters-here?* #f)       ; before asking: a note after it stands
     (if *waiters-seen* (offer-subjects! 'nobody 3))
     (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                               (guard (e (#t '()))
                                 (append-map cadr (request 'waiting-tasks
                                                           waiting-for me))))))
       (set! *waiters-seen* (pair? waiting))
+      (if (pair? waiting) (set! *waiters-here?* #t))
       (offer-to me waiting))))
 
 (define (offer-to me waiting)

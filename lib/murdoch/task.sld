@@ -6,7 +6,7 @@
 (define-library (murdoch task)
   (export start-task task? task-id task-name task-status task-wait cancel-task
           tasks task-step start-steps pose-steps
-          waiting-ranks waiting-for receive-offer receive-give-way)
+          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
   (import (scheme base) (scheme char) (scheme cxr) (scheme time)
           (srfi 1) (srfi 18) (srfi 132)
           (only (chibi ast) thread-interrupt!)
@@ -14,7 +14,7 @@
           (murdoch remote-error) (murdoch sendable) (murdoch lab)
           (murdoch remote) (murdoch progress)
           (murdoch team) (murdoch pose-task) (murdoch component)
-          (only (murdoch pubsub) subscribe unsubscribe request capability-layout
+          (only (murdoch pubsub) subscribe unsubscribe publish request capability-layout
                 subscription-statuses on-free! offer-subjects!)
           (only (murdoch takers) explain-components))
   (include "task.scm"))
