@@ -498,9 +498,10 @@
 ;;
 ;; A task started with wait #t that finds too few capable robots free
 ;; waits for them, holding nothing and trying only when a robot offers
-;; itself, while its poser subscribes to waiting-tasks.  When a robot's exclusive subjects are
-;; freed (pubsub's on-free!), the robot asks waiting-tasks who waits for
-;; it, and offers itself to each in rank order, its subjects kept for
+;; itself, while its poser subscribes to waiting-tasks and tells the lab
+;; that a task waits (note-waiters!).  When a robot's exclusive subjects
+;; are freed (pubsub's on-free!), the robot asks waiting-tasks who waits
+;; for it, and offers itself to each in rank order, its subjects kept for
 ;; that one's poser while it tries, until one starts or none can.  A rank
 ;; is (KEY POSED ID), KEY being the task's priority less aging times the
 ;; second it was posed: the higher KEY goes first, then the earlier
