@@ -962,6 +962,8 @@
 ;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
 ;; starts an offer round, or asks the one running for another.
 (define (robot-freed!)
+  ;; At once, not in the round's thread, which may start late.
+  (if (and *waiters-here?* *waiters-seen*) (offer-subjects! 'nobody 3))
   (if (and *waiters-here?*
            (with-lock *offer-lock*
              (lambda ()
