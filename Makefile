@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-sim bench-alloc bench-chaos demo demo-box clean
+.PHONY: all deps native sim test bench bench-sim bench-alloc bench-chaos bench-sched demo demo-box clean
 
 all: deps
 	$(MAKE) native
@@ -31,6 +31,9 @@ bench-alloc: all
 # (docs/tasks.md); MURDOCH_CHAOS_SECONDS, default 90.
 bench-chaos: all
 	tools/chibi bench/chaos.scm
+
+bench-sched: all
+	tools/chibi bench/sched.scm
 
 demo: all
 	bin/murdoch demo examples/tulane-lab.scm

@@ -36,6 +36,7 @@
           ;; the task life cycle (lib/murdoch/task.scm)
           start-task task? task-id task-name task-status task-wait cancel-task
           tasks run-component component-heartbeat! stop-component!
+          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
           team-send! team-receive step-team
           ;; what the lab is doing (lib/murdoch/status.scm)

@@ -58,6 +58,8 @@
 (define (text what) (cons (lambda (x) (and (string? x) x)) what))
 
 (define seconds (number-over 0 "a positive number of seconds"))
+(define rate
+  (cons (lambda (x) (and (real? x) (>= x 0) x)) "a number, 0 or more, per second"))
 (define positive-count (whole-from 1 1000000000 "a positive whole number"))
 
 ;; A size: bytes, or a string of a number and K, M or G.
@@ -100,6 +102,13 @@
     ;; every heartbeat seconds (task.scm).
     (heartbeat 0.5 ,seconds)
     (max-attempts 3 ,positive-count)
+    ;; A started task that finds too few capable robots free waits for
+    ;; them or fails with not-enough-takers; its priority rises by aging
+    ;; a second while it waits; a poser keeps at most max-waiting such
+    ;; tasks (task.scm, docs/tasks.md).
+    (when-robots-busy fail (,(lambda (x) (and (memq x '(fail wait)) x)) . "fail or wait"))
+    (aging 0.1 ,rate)
+    (max-waiting 100 ,positive-count)
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" (,size-bytes . "bytes, or a size in quotes such as \"512M\""))

@@ -7,6 +7,7 @@
   (export pose-task negotiate check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
           pose-task-backoff pose-task-excluded receive-rival pose-negotiations
+          reservation-aspace-uid
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between sort-response resolve-conflicts

@@ -211,7 +211,8 @@
 ;;> \var{task-name}), reserves the exclusive ones for \var{task-name} and
 ;;> answers a promise.  Answers ((uid promise) ...).  A promise applied to
 ;;> #t applies \var{proc} to \var{args} there, frees the subjects and
-;;> returns the result; applied to #f it only frees them.  A promise never
+;;> returns the result; applied to #f it only frees them; applied to
+;;> \scheme{keep}, it holds them for another lease.  A promise never
 ;;> applied is freed after the lab's lease.
 (define (request-exclusive topic task-name proc . args)
   (let ((layout (capability-layout topic)))
@@ -305,7 +306,7 @@
 ;;> Reserves and promises, if addressed here and free: (#t uid promise)
 ;;> or (#f uid).
 (define (receive-request-exclusive topiclist task-name uid proc args)
-  (promise-for (reserve! (car topiclist) (cadr topiclist) task-name)
+  (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
                proc args))
 
 ;;> The shared counterpart of receive-request-exclusive.
@@ -341,7 +342,7 @@
   (task reservation-task)
   (exclusive reservation-exclusive)     ; subjects held exclusively
   (shared reservation-shared)           ; subjects held for sharing
-  (deadline reservation-deadline)
+  (deadline reservation-deadline reservation-deadline-set!)
   (state reservation-state reservation-state-set!)) ; reserved running done
 
 (define *reservations* '())             ; those not yet promised away
@@ -376,10 +377,11 @@
   (let ((subs (map find-subscription topics)))
     (and (every (lambda (s) (and s (ok? s))) subs) subs)))
 
-(define (reserve! exclusive non-exclusive task)
+(define (reserve! exclusive non-exclusive task uid)
   (with-subscriptions
     (lambda ()
-      (let ((ex (subscriptions-if exclusive (lambda (s) (free-for? s task))))
+      (let ((ex (and (not (and (pair? exclusive) (offered-elsewhere? uid)))
+                     (subscriptions-if exclusive (lambda (s) (free-for? s task)))))
             (non (subscriptions-if non-exclusive
                                    (lambda (s) (not-held-by-another? s task)))))
         (and ex non
@@ -413,16 +415,43 @@
 ;; Frees a reservation's subjects, once.  A subject is free again when no
 ;; reservation holds it any more.
 (define (release! r)
+  (if (with-subscriptions
+        (lambda ()
+          (and (not (eq? (reservation-state r) 'done))
+               (begin
+                 (reservation-state-set! r 'done)
+                 (set! *reservations* (remove (lambda (x) (eq? x r)) *reservations*))
+                 (for-each (lambda (topic) (let-go! topic #t))
+                           (reservation-exclusive r))
+                 (for-each (lambda (topic) (let-go! topic #f))
+                           (reservation-shared r))
+                 (pair? (reservation-exclusive r))))))
+      (*on-free*)))
+
+;; What runs when a reservation of exclusive subjects here ends: tasks
+;; that wait for robots hear of it (task.scm).
+(define *on-free* (lambda () #f))
+
+;;> Sets the thunk that runs, outside any lock, each time exclusive
+;;> subjects here are freed.
+(define (on-free! thunk) (set! *on-free* thunk))
+
+;; While a freed robot is offered to a waiting task's poser, exclusive
+;; subjects here are reserved for that poser's requests only: (uid
+;; . until), until a monotonic-seconds, or #f.
+(define *offered* #f)
+
+;;> For \var{seconds}, reserves exclusive subjects here only at the
+;;> request of address space \var{uid}; #f for \var{uid} ends that.
+(define (offer-subjects! uid . seconds)
   (with-subscriptions
     (lambda ()
-      (if (not (eq? (reservation-state r) 'done))
-          (begin
-            (reservation-state-set! r 'done)
-            (set! *reservations* (remove (lambda (x) (eq? x r)) *reservations*))
-            (for-each (lambda (topic) (let-go! topic #t))
-                      (reservation-exclusive r))
-            (for-each (lambda (topic) (let-go! topic #f))
-                      (reservation-shared r)))))))
+      (set! *offered* (and uid (cons uid (+ (monotonic-seconds) (car seconds))))))))
+
+;; Caller holds the lock.
+(define (offered-elsewhere? uid)
+  (and *offered* (not (eq? (car *offered*) uid))
+       (< (monotonic-seconds) (cdr *offered*))))
 
 (define (let-go! topic exclusive?)
   (let ((s (find-subscription topic)))
@@ -449,15 +478,28 @@
             (letrec ((promise
                       (encap
                        (lambda (commit?)
-                         (if (not (claim! r))
-                             (error "this promise's reservation has ended"
-                                    (reservation-task r)))
-                         (release-proxy! promise)
-                         (dynamic-wind
-                          (lambda () #f)
-                          (lambda () (and commit? (apply proc args)))
-                          (lambda () (release! r)))))))
+                         (cond
+                          ((eq? commit? 'keep) (renew! r))
+                          ((not (claim! r))
+                           (error "this promise's reservation has ended"
+                                  (reservation-task r)))
+                          (else
+                           (release-proxy! promise)
+                           (dynamic-wind
+                            (lambda () #f)
+                            (lambda () (and commit? (apply proc args)))
+                            (lambda () (release! r)))))))))
               promise))))
+
+;; A promise applied to keep holds its subjects for another lease: a task
+;; that holds what it has while it waits for the rest (task.scm).
+;; Answers whether it still holds them.
+(define (renew! r)
+  (with-subscriptions
+    (lambda ()
+      (and (eq? (reservation-state r) 'reserved)
+           (begin (reservation-deadline-set! r (+ (monotonic-seconds) *lease*))
+                  #t)))))
 
 ;; Frees the reservations whose promise was never applied: the sender
 ;; died, or the network broke.  No subject is held for ever.

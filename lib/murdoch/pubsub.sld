@@ -6,7 +6,8 @@
           capability-layout check-subjects
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive receive-components set-lease! start-leases!)
+          receive-request-non-exclusive receive-components set-lease! start-leases!
+          on-free! offer-subjects!)
   (import (scheme base) (only (murdoch scheduler) monotonic-seconds)
           (srfi 1) (srfi 18)
           (murdoch log) (murdoch lab) (murdoch remote)

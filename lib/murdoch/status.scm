@@ -61,12 +61,23 @@
       (for-each (lambda (t) (write-line out "    " (task-text t)))
                 (list-ref r 5))))))
 
-;; (posed ID STATE) or (running ID INDEX POSER), as a line.
+;; (posed ID STATE), (posed ID waiting POSITION WHY) or (running ID INDEX
+;; POSER), as a line.
 (define (task-text t)
   (if (eq? (car t) 'posed)
-      (string-append "task " (held-text (cadr t)) " " (held-text (car (cddr t))))
+      (string-append "task " (held-text (cadr t)) " " (held-text (car (cddr t)))
+                     (if (= (length t) 5)
+                         (string-append ", " (held-text (list-ref t 3)) " in line: "
+                                        (join-text (list-ref t 4)))
+                         ""))
       (string-append "runs component " (held-text (car (cddr t))) " of "
                      (held-text (cadr t)) " for " (held-text (cadr (cddr t))))))
+
+;; Strings, joined by "; ".
+(define (join-text strings)
+  (if (null? strings)
+      ""
+      (fold (lambda (s acc) (string-append acc "; " s)) (car strings) (cdr strings))))
 
 (define (write-line out . parts)
   (for-each (lambda (p) (write-string p out)) parts)

@@ -12,17 +12,24 @@
 ;;> address spaces capable of it, each free, held (and by which
 ;;> reservation, TASK@POSER#N) or away.
 (define (explain-no-takers task-name layouts port)
-  (let* ((live (map car (request 'all (sendable-lambda () #t))))
-         (lines (map (lambda (i layout) (explain-component i layout live))
-                     (iota (length layouts) 1) layouts)))
+  (let ((lines (explain-components layouts)))
     (write-string (string-append "pose-task: not enough takers for "
                                  (name task-name) ":\n"
                                  (apply string-append (map car lines))
-                                 (too-few-line layouts (map cdr lines)))
+                                 (too-few-line layouts (map cadr lines)))
                   port)
     (flush-output-port port)))
 
-;; A line on component i, and the robots free for it.
+;;> For each of \var{layouts}, in order, (LINE FREE CAPABLE): LINE says
+;;> who could take the component and why none did, as explain-no-takers
+;;> writes it; FREE and CAPABLE are the uids of the live address spaces
+;;> capable of it that are free, and all of them.
+(define (explain-components layouts)
+  (let ((live (map car (request 'all (sendable-lambda () #t)))))
+    (map (lambda (i layout) (explain-component i layout live))
+         (iota (length layouts) 1) layouts)))
+
+;; A line on component i, the robots free for it, and those capable.
 (define (explain-component i layout live)
   (let* ((exclusive (car layout))
          (answers (in-lab-order
@@ -30,14 +37,15 @@
                             (sendable-lambda () (map topic-status exclusive)))))
          (silent (remove (lambda (uid) (assq uid answers))
                          (file-capable (apply append layout)))))
-    (cons (string-append
+    (list (string-append
            "  component " (number->string i) " needs " (name layout) ": "
            (if (and (null? answers) (null? silent))
                "no address space of the lab is capable of it"
                (join (append (map robot-state answers)
                              (map (lambda (uid) (silent-state uid live)) silent))))
            "\n")
-          (filter-map (lambda (a) (and (free? a) (car a))) answers))))
+          (filter-map (lambda (a) (and (free? a) (car a))) answers)
+          (map car answers))))
 
 ;; When each component that needs a robot to itself has a free one, but
 ;; there are fewer free robots than such components, a line that says so.

@@ -2,7 +2,7 @@
 ;;> lab is capable of it and what each was doing.
 
 (define-library (murdoch takers)
-  (export explain-no-takers)
+  (export explain-no-takers explain-components)
   (import (scheme base) (scheme write) (srfi 1)
           (only (chibi) call-with-output-string)
           (murdoch lab) (murdoch sendable) (murdoch remote) (murdoch pubsub))

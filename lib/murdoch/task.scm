@@ -44,7 +44,9 @@
   (done task-done)                      ; a mailbox: the results, once done
   (state task-state task-state-set!)    ; negotiating running done failed cancelled
   (team task-team task-team-set!)       ; its robots, in component order
-  (steps task-steps task-steps-set!))   ; of a task of steps, those started
+  (steps task-steps task-steps-set!)    ; of a task of steps, those started
+  (turn task-turn task-turn-set!)       ; how it waits its turn: a turn record
+  (waiter task-waiter task-waiter-set!)) ; while it waits, its waiter record
 
 (define-record-type component
   (make-component index capabilities metric proc restartable?)
@@ -54,8 +56,9 @@
   (metric component-metric)
   (proc component-proc)
   (restartable? component-restartable?)
-  ;; (negotiating), (running UID SINCE), (done VALUE), (failed WHY) or
-  ;; (reassigned FROM TO); SINCE is a (utc-seconds).
+  ;; (negotiating), (waiting POSITION WHY), (running UID SINCE), (done
+  ;; VALUE), (failed WHY) or (reassigned FROM TO); SINCE is a
+  ;; (utc-seconds).
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
@@ -69,26 +72,34 @@
 ;;> component: #t when a component whose robot is lost may be given to
 ;;> another robot (see the header of lib/murdoch/task.scm); by default
 ;;> none may, and a lost robot's component fails, as in the thesis.
+;;> After them, or instead, come keywords and their values: \scheme{wait}
+;;> #t or #f, whether the task waits when too few capable robots are free
+;;> (default: the lab's when-robots-busy); \scheme{priority}, the task's
+;;> priority (default (pose-task-priority)); \scheme{deadline}, seconds
+;;> after which a task not yet started fails with \scheme{deadline}.
 (define (start-task task-name num-robots capability-list metrics procs . options)
-  (let ((priorities (if (pair? options) (car options) (iota num-robots num-robots -1)))
-        (restartable (if (and (pair? options) (pair? (cdr options)))
-                         (cadr options)
-                         (make-list num-robots #f))))
+  (let* ((lists (take-while list? options))
+         (priorities (if (pair? lists) (car lists) (iota num-robots num-robots -1)))
+         (restartable (if (and (pair? lists) (pair? (cdr lists)))
+                          (cadr lists)
+                          (make-list num-robots #f))))
     (check-task task-name num-robots capability-list metrics procs priorities)
     (if (not (and (list? restartable) (= (length restartable) num-robots)
                   (every boolean? restartable)))
         (error "start-task: restartable is a list of a boolean for each component"
                restartable))
-    (let ((t (new-task task-name capability-list metrics procs restartable)))
+    (let* ((turn (read-turn "start-task" (drop options (length lists))))
+           (t (new-task task-name capability-list metrics procs restartable turn)))
       (thread-start!
        (make-thread (inheriting
                      (lambda () (run-task t priorities)))
                     (task-id t)))
       t)))
 
-(define (new-task task-name capability-list metrics procs restartable)
+(define (new-task task-name capability-list metrics procs restartable turn)
   (with-lock *tasks-lock*
     (lambda ()
+      (check-waiting-room turn)
       (set! *started* (+ *started* 1))
       (let ((t (make-task
                 (string->symbol (string-append (symbol->string task-name) "@"
@@ -106,6 +117,8 @@
         (task-state-set! t 'negotiating)
         (task-team-set! t '())
         (task-steps-set! t #f)
+        (task-turn-set! t turn)
+        (task-waiter-set! t #f)
         (set! *posed* (cons t *posed*))
         t))))
 
@@ -123,14 +136,26 @@
 ;; its own, and puts their results in t's mailbox.
 (define (run-task t priorities)
   (let* ((cs (task-components t))
-         (team (negotiate (task-name t) (length cs)
-                          (map component-capabilities cs)
-                          (map component-metric cs) (map component-proc cs)
-                          priorities)))
+         (team (negotiate-turn
+                t cs
+                (if (and (turn-hold? (task-turn t)) (> (length cs) 1))
+                    (lambda (w) (hold-try w priorities))
+                    (lambda (w)
+                      (negotiate (task-name t) (length cs)
+                                 (map component-capabilities cs)
+                                 (map component-metric cs) (map component-proc cs)
+                                 priorities))))))
     (cond
-     ((symbol? team)
-      (for-each (lambda (c) (component-state-set! c (list 'failed team))) cs)
+     ((and (symbol? team) (not (eq? team 'cancelled)))
+      (if (memq (task-state t) '(negotiating waiting)) (task-state-set! t 'failed))
+      (for-each (lambda (c)
+                  (if (not (eq? (car (component-state c)) 'failed))
+                      (component-state-set! c (list 'failed team))))
+                cs)
       (finish! t team))
+     ((symbol? team)
+      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
+      (finish! t (map component-result cs)))
      ((eq? (task-state t) 'cancelled)
       (for-each (lambda (winner type) (free-winner! winner type)) (car team) (cadr team))
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
@@ -149,7 +174,7 @@
       (finish! t (map component-result cs))))))
 
 (define (finish! t results)
-  (if (memq (task-state t) '(negotiating running)) (task-state-set! t 'done))
+  (if (memq (task-state t) '(negotiating waiting running)) (task-state-set! t 'done))
   (progress (task-id t) ": " (task-state t))
   (mailbox-put! (task-done t) results))
 
@@ -216,8 +241,12 @@
                                         (and (eq? (car (component-state other)) 'running)
                                              (cadr (component-state other))))
                                       (task-components t)))))
-    (let ((team (negotiate (task-name t) 1 (list (component-capabilities c))
-                           (list (component-metric c)) (list (component-proc c)))))
+    (let ((team (negotiate-turn
+                 t (list c)
+                 (lambda (w)
+                   (negotiate (task-name t) 1 (list (component-capabilities c))
+                              (list (component-metric c))
+                              (list (component-proc c)))))))
       (and (pair? team)
            (cons (car (caar team)) (work-for (caar team) (caadr team) c))))))
 
@@ -281,8 +310,8 @@
   (let ((state (component-state c)))
     (if (eq? (car state) 'done)
         (cadr state)
-        (list 'error (let ((last (last-pair (component-attempts c))))
-                       (and (pair? last) (caar last)))
+        (list 'error (let ((attempts (component-attempts c)))
+                       (and (pair? attempts) (car (last attempts))))
               (cadr state)))))
 
 ;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS):
@@ -292,6 +321,7 @@
 ;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
 (define (task-status task)
   (check-task-record "task-status" task)
+  (if (task-waiter task) (move-up! (task-waiter task)))
   (if (task-steps task)
       (map (lambda (i sub) (list 'step i (task-status sub)))
            (iota (length (task-steps task)) 1) (task-steps task))
@@ -325,6 +355,7 @@
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
   (task-state-set! task 'cancelled)
+  (if (task-waiter task) (tell-waiter! (task-waiter task) '(cancel)))
   (if (task-steps task) (for-each cancel-task (task-steps task)))
   (for-each (lambda (c)
               (let ((state (component-state c)))
@@ -345,7 +376,12 @@
 ;;> The tasks of this address space: (posed ID STATE) for each it started,
 ;;> newest first, and (running ID INDEX POSER) for each component it runs.
 (define (tasks)
-  (append (map (lambda (t) (list 'posed (task-id t) (task-state t)))
+  (append (map (lambda (t)
+                 (let ((w (task-waiter t)))
+                   (if (and w (eq? (task-state t) 'waiting))
+                       (list 'posed (task-id t) 'waiting (waiter-position w)
+                             (waiter-why w))
+                       (list 'posed (task-id t) (task-state t)))))
                (with-lock *tasks-lock* (lambda () *posed*)))
           (map (lambda (r) (cons 'running r)) (components-running))))
 
@@ -381,18 +417,22 @@
   (make-step capability-list metrics procs options))
 
 ;;> Starts a task of \var{steps} (made by task-step) and answers its task
-;;> record at once.  task-status gives (step I STATUS) for each step
+;;> record at once; start-task's keywords may follow the steps, and each
+;;> step is started with them.  task-status gives (step I STATUS) for each step
 ;;> started, task-wait the list of each step's results, and cancel-task
 ;;> stops the step running and those after it.
-(define (start-steps task-name . steps)
-  (if (not (and (symbol? task-name) (pair? steps) (every step? steps)))
-      (error "start-steps: a task name, then one or more steps made by task-step"))
-  (for-each check-same steps (iota (length steps) 1))
-  (let ((t (new-task task-name '() '() '() '())))
-    (task-steps-set! t '())
-    (thread-start! (make-thread (inheriting (lambda () (run-steps t steps)))
-                                (task-id t)))
-    t))
+(define (start-steps task-name . steps+options)
+  (let ((steps (take-while step? steps+options))
+        (options (drop-while step? steps+options)))
+    (if (not (and (symbol? task-name) (pair? steps)))
+        (error "start-steps: a task name, then one or more steps made by task-step"))
+    (read-turn "start-steps" options)
+    (for-each check-same steps (iota (length steps) 1))
+    (let ((t (new-task task-name '() '() '() '() #f)))
+      (task-steps-set! t '())
+      (thread-start! (make-thread (inheriting (lambda () (run-steps t steps options)))
+                                  (task-id t)))
+      t)))
 
 ;;> Runs a task of steps and answers, as task-wait, each step's results.
 (define (pose-steps task-name . steps)
@@ -411,7 +451,7 @@
                          c)))
             (step-capabilities s)))
 
-(define (run-steps t steps)
+(define (run-steps t steps options)
   (let loop ((i 1) (steps steps) (previous '()) (results '()))
     (cond
      ((or (null? steps) (eq? (task-state t) 'cancelled))
@@ -421,7 +461,7 @@
              (coordinator (make-coordinator (lambda () (if sub (task-team sub) '()))))
              (step-results
               (begin
-                (set! sub (start-step t (car steps) i previous coordinator))
+                (set! sub (start-step t (car steps) i previous coordinator options))
                 (task-steps-set! t (append (task-steps t) (list sub)))
                 (task-wait sub))))
         (release-proxy! coordinator)
@@ -436,7 +476,7 @@
       (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
 
 ;; Starts step number i of t as a task of its own.
-(define (start-step t s i previous coordinator)
+(define (start-step t s i previous coordinator options)
   (apply start-task (task-name t) (length (step-procs s))
          (map (lambda (c) (if (same? c) (same-robot t c) c)) (step-capabilities s))
          (map (lambda (c m) (if (same? c) #f m))
@@ -445,7 +485,7 @@
                 (sendable-lambda ()
                   (with-coordinator coordinator (lambda () (p previous)))))
               (step-procs s))
-         (step-options s)))
+         (append (step-options s) options)))
 
 ;; The capabilities of the robot that (same J K) names: its uid, to
 ;; itself.
@@ -454,3 +494,528 @@
     (if (> (car (cddr c)) (length team))
         (error "task-step: no such component" c))
     (list (list (list-ref team (- (car (cddr c)) 1))) '())))
+
+;;; Tasks that wait their turn (thesis ch. 6; docs/tasks.md)
+;;
+;; A task started with wait #t that finds too few capable robots free
+;; waits for them, holding nothing and trying only when a robot offers
+;; itself, while its poser subscribes to waiting-tasks and tells the lab
+;; that a task waits (note-waiters!).  When a robot's exclusive subjects
+;; are freed (pubsub's on-free!), the robot asks waiting-tasks who waits
+;; for it, and offers itself to each in rank order, its subjects kept for
+;; that one's poser while it tries, until one starts or none can.  A rank
+;; is (KEY POSED ID), KEY being the task's priority less aging times the
+;; second it was posed: the higher KEY goes first, then the earlier
+;; POSED, then the smaller ID.  That is a total order, the same in every
+;; address space, and aging does not reorder the tasks that wait: it
+;; raises all their priorities alike, and only a task posed later starts
+;; from lower down.  A task no live robot of the lab is capable of fails
+;; at once; one whose capable robots all die while it waits fails when
+;; it next looks at the lab, every ten heartbeats or a third of the
+;; lease, whichever is sooner.
+
+(define-record-type turn
+  (make-turn wait? hold? priority deadline posed)
+  turn?
+  (wait? turn-wait?)
+  (hold? turn-hold?)
+  (priority turn-priority)
+  (deadline turn-deadline)              ; monotonic-seconds, or #f
+  (posed turn-posed))                   ; current-second
+
+;; A turn from start-task's keywords and their values.
+(define (read-turn who options)
+  (let loop ((kv options)
+             (wait (eq? (lab-setting (current-lab) 'when-robots-busy) 'wait))
+             (hold #f)
+             (priority (pose-task-priority))
+             (deadline #f))
+    (define (bad what)
+      (error (string-append who ": " what) kv))
+    (define (value ok? what)
+      (if (not (ok? (cadr kv))) (bad what))
+      (cadr kv))
+    (define (at-least-0? x) (and (real? x) (>= x 0)))
+    (cond
+     ((null? kv)
+      (make-turn (or wait hold) hold priority
+                 (and deadline (+ (monotonic-seconds) deadline)) (current-second)))
+     ((not (and (symbol? (car kv)) (pair? (cdr kv))))
+      (bad (string-append "after the lists come keywords, each with its value: "
+                          "wait, hold, priority, deadline")))
+     ((eq? (car kv) 'wait)
+      (loop (cddr kv) (value boolean? "wait is #t or #f") hold priority deadline))
+     ((eq? (car kv) 'hold)
+      (loop (cddr kv) wait (value boolean? "hold is #t or #f") priority deadline))
+     ((eq? (car kv) 'priority)
+      (loop (cddr kv) wait hold (value at-least-0? "priority is a number, 0 or more")
+            deadline))
+     ((eq? (car kv) 'deadline)
+      (loop (cddr kv) wait hold priority
+            (value at-least-0? "deadline is a number of seconds, 0 or more")))
+     (else (bad "no such option; the options are wait, hold, priority and deadline")))))
+
+;; Refuses a task that would wait when this address space has
+;; max-waiting tasks waiting or about to.  Under *tasks-lock*.
+(define (check-waiting-room turn)
+  (if (and turn (turn-wait? turn)
+           (>= (count (lambda (t) (and (task-turn t) (turn-wait? (task-turn t))
+                                       (memq (task-state t) '(negotiating waiting))))
+                      *posed*)
+               (lab-setting (current-lab) 'max-waiting)))
+      (error "start-task: this address space has max-waiting tasks waiting already"
+             (lab-setting (current-lab) 'max-waiting))))
+
+(define (turn-rank turn id)
+  (list (- (turn-priority turn) (* (lab-setting (current-lab) 'aging) (turn-posed turn)))
+        (turn-posed turn) (symbol->string id)))
+
+;; Whether rank a goes before rank b.
+(define (rank<? a b)
+  (or (> (car a) (car b))
+      (and (= (car a) (car b))
+           (or (< (cadr a) (cadr b))
+               (and (= (cadr a) (cadr b)) (string<? (car (cddr a)) (car (cddr b))))))))
+
+;; A task waiting here: news is what came for it, offers and cancels, and
+;; bell rings when news comes.
+(define-record-type waiter
+  (make-waiter task components rank)
+  waiter?
+  (task waiter-task)
+  (components waiter-components)
+  (rank waiter-rank)
+  (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
+  (looked waiter-looked waiter-looked-set!)      ; monotonic-seconds
+  (free-seen? waiter-free-seen? waiter-free-seen?-set!) ; at its last look
+  (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
+  (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
+  (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
+  (position waiter-position waiter-position-set!)
+  (why waiter-why waiter-why-set!)               ; a line a component
+  (news waiter-news waiter-news-set!)
+  (bell waiter-bell waiter-bell-set!))
+
+(define *waiters* '())
+
+(define (enlist! w)
+  (waiter-held-set! w '())
+  (waiter-looked-set! w #f)
+  (waiter-free-seen?-set! w #f)
+  (waiter-kept-set! w (monotonic-seconds))
+  (waiter-yielded-set! w '())
+  (waiter-capable-set! w #t)            ; any robot, until it has looked
+  (waiter-position-set! w #f)
+  (waiter-why-set! w '())
+  (waiter-news-set! w '())
+  (waiter-bell-set! w (make-mailbox))
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-waiter-set! (waiter-task w) w)
+      (set! *waiters* (cons w *waiters*))
+      (subscribe 'waiting-tasks)))
+  (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
+    (publish 'all note-waiters!)))
+
+;; The offers w had not answered are declined: a robot waits for no task
+;; that no longer waits.
+(define (delist! w)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-waiter-set! (waiter-task w) #f)
+      (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*))
+      (answer-offers! (filter (lambda (n) (eq? (car n) 'offer)) (waiter-news w)) #f)
+      (waiter-news-set! w '())
+      (if (null? *waiters*) (unsubscribe 'waiting-tasks)))))
+
+(define (tell-waiter! w news)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (cond ((memq w *waiters*)
+             (waiter-news-set! w (cons news (waiter-news w)))
+             (mailbox-put! (waiter-bell w) #t))
+            ((eq? (car news) 'offer) (answer-offers! (list news) #f))))))
+
+;; The news that came for w, oldest first, once some has come or the
+;; monotonic second until has passed.
+(define (take-news! w until)
+  (mailbox-take (waiter-bell w) until (lambda () #f))
+  (with-lock *tasks-lock*
+    (lambda ()
+      (let ((news (reverse (waiter-news w))))
+        (waiter-news-set! w '())
+        (waiter-bell-set! w (make-mailbox))
+        news))))
+
+;; What try, a procedure of the task's waiter that negotiates cs of t,
+;; answers; for a task that waits, tried again whenever a robot it may
+;; use is offered, until it wins its robots or cannot: (winners
+;; type-list), or a symbol, not-enough-takers, deadline or cancelled.
+(define (negotiate-turn t cs try)
+  (let ((w (make-waiter t cs (turn-rank (task-turn t) (task-id t)))))
+    (if (not (turn-wait? (task-turn t)))
+        (try w)
+        (dynamic-wind
+         (lambda () (enlist! w))
+         (lambda () (wait-turn w try '((posed))))
+         (lambda () (let-go-held! w) (delist! w))))))
+
+;; Tries, answers the offers that woke it, and waits for the next.  It
+;; tries only when news came (it was posed, offered a robot, asked to give
+;; way), and looks at the lab again when what it holds changed, or a
+;; second after its last look: an offer is answered by one try.
+(define (wait-turn w try news)
+  (let ((t (waiter-task w))
+        (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
+        (held (held-uids w)))
+    (give-way! w news)
+    (cond
+     ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
+     ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
+     (else
+      (let ((team (if (null? news)
+                      'not-enough-takers
+                      (quiet-try (lambda ()
+                                   (parameterize ((pose-task-excluded
+                                                   (append (offered-to-others w)
+                                                           (pose-task-excluded))))
+                                     (try w)))))))
+        (answer-offers! offers (pair? team))
+        (cond
+         ((pair? team) team)
+         ((and (or (not (equal? held (held-uids w))) (look-due? w)) (look! w))
+          => (lambda (never)
+               (for-each (lambda (c) (component-state-set! c (list 'failed never)))
+                         (waiter-components w))
+               'not-enough-takers))
+         (else
+          (if (> (- (monotonic-seconds) (waiter-kept w))
+                 (/ (lab-setting (current-lab) 'lease) 4))
+              (keep-held! w))
+          (wait-turn w try
+                     (if (and (null? news) (waiter-free-seen? w))
+                         '((free))     ; an offer it missed: a robot is free
+                         (take-news! w (next-look (turn-deadline (task-turn t)))))))))))))
+
+;;; Holding what it has (the thesis's chapter 6 wish)
+;;
+;; A task started with hold #t keeps, while it waits, the robots it won
+;; for some of its components, and waits for the others.  No deadlock:
+;; a waiting task gives up what it holds when a better-ranked waiting
+;; task could start with it (give-way!), and ranks are totally ordered,
+;; so the best-ranked waiting task never waits on one that holds; a
+;; running component is never taken away.  docs/allocation.md gives the
+;; argument.
+
+;; A try that keeps what it wins: each component of w not yet held is
+;; negotiated alone, in priority order, without the robots held or given
+;; way on.  Answers (winners type-list) once every component has a robot.
+(define (hold-try w priorities)
+  (let ((t (waiter-task w)) (cs (waiter-components w)))
+    (for-each
+     (lambda (c)
+       (if (not (assv (component-index c) (waiter-held w)))
+           (let ((team (parameterize ((pose-task-excluded
+                                       (append (held-uids w) (waiter-yielded w)
+                                               (pose-task-excluded))))
+                         (negotiate (task-name t) 1 (list (component-capabilities c))
+                                    (list (component-metric c))
+                                    (list (component-proc c))))))
+             (if (pair? team)
+                 (waiter-held-set! w (cons (list (component-index c) (caar team)
+                                                 (caadr team))
+                                           (waiter-held w)))))))
+     (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
+    (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
+      (cond ((every pair? held)
+             (waiter-held-set! w '())
+             (list (map cadr held) (map (lambda (h) (car (cddr h))) held)))
+            (else 'not-enough-takers)))))
+
+(define (held-uids w) (map (lambda (h) (car (cadr h))) (waiter-held w)))
+
+;; Frees what w holds on robot uid, or on every robot.
+(define (let-go-held! w . uid)
+  (let ((out (filter (lambda (h) (or (null? uid) (eq? (car (cadr h)) (car uid))))
+                     (waiter-held w))))
+    (for-each (lambda (h) (free-winner! (cadr h) (car (cddr h)))) out)
+    (waiter-held-set! w (remove (lambda (h) (memq h out)) (waiter-held w)))))
+
+;; Holds what w holds for another lease.
+(define (keep-held! w)
+  (waiter-kept-set! w (monotonic-seconds))
+  (for-each (lambda (h)
+              (if (eq? (car (cddr h)) 'exclusive)
+                  (if (not (guard (e (#t #f)) ((cadr (cadr h)) 'keep)))
+                      (let-go-held! w (car (cadr h))))))
+            (waiter-held w)))
+
+;; Acts on the news: gives way on each robot a better-ranked task asked
+;; for, and takes robots offered to it again.
+(define (give-way! w news)
+  (for-each
+   (lambda (n)
+     (case (car n)
+       ((give-way)
+        (when (memq (cadr n) (held-uids w))
+          (progress (task-id (waiter-task w)) ": gives way on " (cadr n))
+          (let-go-held! w (cadr n))
+          (waiter-yielded-set! w (cons (cadr n) (waiter-yielded w)))))
+       ((offer)
+        (waiter-yielded-set! w (remove (lambda (u) (eq? u (car (cddr n))))
+                                       (waiter-yielded w))))))
+   news))
+
+;;> What a waiting task of rank \var{rank} calls where the task that holds
+;;> robot \var{uid} waits: that task gives way on it if \var{rank} goes
+;;> before its own.  Answers #t.
+(define (receive-give-way uid rank)
+  (for-each (lambda (w)
+              (if (and (memq uid (held-uids w)) (rank<? rank (waiter-rank w)))
+                  (tell-waiter! w (list 'give-way uid))))
+            (with-lock *tasks-lock* (lambda () *waiters*)))
+  #t)
+
+;; Asks the waiting tasks that rank after w, and hold robots w could
+;; start with, to give way, when with those robots and the free ones each
+;; of w's components not held would have one.
+(define (ask-way! w lines others)
+  (let* ((worse (filter (lambda (o) (rank<? (waiter-rank w) (car (cadr o)))) others))
+         (yieldable (append-map (lambda (o) (car (cddr (cadr o)))) worse))
+         (held (map car (waiter-held w)))
+         (open (filter-map (lambda (c line)
+                             (and (not (memv (component-index c) held))
+                                  (filter (lambda (uid) (or (memq uid (cadr line))
+                                                            (memq uid yieldable)))
+                                          (remove (lambda (u) (memq u (held-uids w)))
+                                                  (car (cddr line))))))
+                           (waiter-components w) lines))
+         (wanted (filter (lambda (uid) (memq uid yieldable)) (apply append open))))
+    (when (and (pair? wanted) (every pair? open)
+               (>= (length (delete-duplicates (apply append open))) (length open)))
+      (for-each (lambda (o)
+                  (for-each (lambda (uid)
+                              (if (memq uid wanted)
+                                  (guard (e (#t #f))
+                                    (remote-apply (uid->aspace (car o)) receive-give-way
+                                                  uid (waiter-rank w)))))
+                            (car (cddr (cadr o)))))
+                worse))))
+
+(define (look-due? w)
+  (or (not (waiter-looked w)) (> (- (monotonic-seconds) (waiter-looked w)) 1)))
+
+(define (past? deadline) (and deadline (>= (monotonic-seconds) deadline)))
+
+(define (next-look deadline)
+  (let ((look (+ (monotonic-seconds)
+                 (min (* 10 (lab-setting (current-lab) 'heartbeat))
+                      (/ (lab-setting (current-lab) 'lease) 3)))))
+    (if deadline (min deadline look) look)))
+
+;; A try that answers at once and writes no explanation: the waiter
+;; gives its own.
+(define (quiet-try try)
+  (parameterize ((pose-task-retries 0) (current-error-port (open-output-string)))
+    (try)))
+
+(define (answer-offers! offers took?)
+  (for-each (lambda (offer) (mailbox-put! (cadr offer) took?)) offers))
+
+;; Looks at the lab for w after a try that failed: why it waits, and its
+;; place in line, in its components' states; answers why it never can be
+;; served, or #f.
+(define (look! w)
+  (waiter-looked-set! w (monotonic-seconds))
+  (let* ((cs (waiter-components w))
+         (lines (explain-components
+                 (map (lambda (c) (capability-layout (component-capabilities c))) cs)))
+         (capable (map (lambda (line)
+                         (remove (lambda (uid) (memq uid (pose-task-excluded)))
+                                 (car (cddr line))))
+                       lines))
+         (others (guard (e (#t '()))
+                   (append-map (lambda (poser)
+                                 (map (lambda (o) (list (car poser) o)) (cadr poser)))
+                               (request 'waiting-tasks waiting-ranks))))
+         (exclusive (filter-map (lambda (c caps)
+                                  (and (pair? (car (capability-layout
+                                                    (component-capabilities c))))
+                                       caps))
+                                cs capable)))
+    (cond
+     ((any null? capable)
+      (string-append "no live robot of the lab is capable of it:"
+                     (apply string-append (map car lines))))
+     ((< (length (delete-duplicates (apply append exclusive))) (length exclusive))
+      "fewer live robots of the lab are capable of it than it has components")
+     (else
+      (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (waiter-free-seen?-set! w (any pair? (map cadr lines)))
+      (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
+      (waiter-position-set! w (place-in-line w (map cadr others)))
+      (ask-way! w lines others)
+      (with-lock *tasks-lock*
+        (lambda ()
+          (if (eq? (task-state (waiter-task w)) 'negotiating)
+              (task-state-set! (waiter-task w) 'waiting))))
+      (for-each (lambda (c why)
+                  (component-state-set! c (list 'waiting (waiter-position w) why)))
+                cs (waiter-why w))
+      (progress (task-id (waiter-task w)) ": waiting, " (waiter-position w)
+                " in line")
+      #f))))
+
+(define (trimmed line)
+  (let loop ((s line))
+    (cond ((and (> (string-length s) 0) (char-whitespace? (string-ref s 0)))
+           (loop (substring s 1 (string-length s))))
+          ((and (> (string-length s) 0)
+                (char-whitespace? (string-ref s (- (string-length s) 1))))
+           (loop (substring s 0 (- (string-length s) 1))))
+          (else s))))
+
+;; Brings w's place in line, in its components' states, up to date.
+(define (move-up! w)
+  (let ((place (guard (e (#t (waiter-position w)))
+                 (place-in-line w (append-map cadr (request 'waiting-tasks
+                                                            waiting-ranks))))))
+    (waiter-position-set! w place)
+    (for-each (lambda (c)
+                (let ((state (component-state c)))
+                  (if (eq? (car state) 'waiting)
+                      (component-state-set! c (list 'waiting place (car (cddr state)))))))
+              (waiter-components w))))
+
+;; w's place among the tasks of the lab that wait for a robot it may use:
+;; 1 + how many of them rank before it.
+(define (place-in-line w others)
+  (+ 1 (count (lambda (other)
+                (and (rank<? (car other) (waiter-rank w))
+                     (may-use? other (waiter-capable w))))
+              others)))
+
+;; Whether the waiting task (RANK CAPABLE HELD) may use one of uids.
+(define (may-use? other uids)
+  (or (eq? (cadr other) #t) (eq? uids #t)
+      (any (lambda (uid) (memq uid (cadr other))) uids)))
+
+;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
+;;> of the robots it may use (#t before it has looked), and of those it
+;;> holds.
+(define (waiting-ranks)
+  (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
+       (with-lock *tasks-lock* (lambda () *waiters*))))
+
+;;> The (RANK POSER ID) of each task waiting here that may use robot
+;;> \var{uid}.
+(define (waiting-for uid)
+  (filter-map (lambda (w)
+                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w)))
+                     (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
+              (with-lock *tasks-lock* (lambda () *waiters*))))
+
+;;> What a freed robot \var{uid} calls where task \var{id} waits: the
+;;> task tries again at once; answers whether it started, #f when it is
+;;> no longer waiting here or did not answer within two seconds.
+(define (receive-offer id uid)
+  (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
+                 (with-lock *tasks-lock* (lambda () *waiters*))))
+        (reply (make-mailbox))
+        (offer (cons uid id)))
+    (and w
+         (dynamic-wind
+          (lambda ()
+            (with-lock *tasks-lock* (lambda () (set! *offers* (cons offer *offers*)))))
+          (lambda ()
+            (tell-waiter! w (list 'offer reply uid))
+            (mailbox-take reply (+ (monotonic-seconds) 2) (lambda () #f)))
+          (lambda ()
+            (with-lock *tasks-lock*
+              (lambda ()
+                (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+
+;; The offers being answered here, (UID . ID): the robot UID keeps itself
+;; for this poser while task ID tries, and the poser's other waiting
+;; tasks leave it alone meanwhile.
+(define *offers* '())
+
+(define (offered-to-others w)
+  (let ((id (task-id (waiter-task w))))
+    (filter-map (lambda (o) (and (not (eq? (cdr o) id)) (car o)))
+                (with-lock *tasks-lock* (lambda () *offers*)))))
+
+;;; The robot's side: offers when its subjects are freed
+
+(define *offering* #f)                  ; an offer round runs here
+(define *offer-again* #f)               ; and another was asked for meanwhile
+(define *offer-lock* (make-mutex 'offers))
+
+;; Whether a task may wait for this robot: set when a task starts to
+;; wait anywhere, cleared by an offer round that finds none, so that a lab
+;; where no task waits sends nothing more when a robot is freed.
+(define *waiters-here?* #f)
+
+;;> What a poser publishes to the lab when one of its tasks starts to
+;;> wait: the robots offer themselves when freed.
+(define (note-waiters!) (set! *waiters-here?* #t))
+
+;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
+;; starts an offer round, or asks the one running for another.
+(define (robot-freed!)
+  ;; At once, not in the round's thread, which may start late.
+  (if (and *waiters-here?* *waiters-seen*) (offer-subjects! 'nobody 3))
+  (if (and *waiters-here?*
+           (with-lock *offer-lock*
+             (lambda ()
+               (if *offering*
+                   (begin (set! *offer-again* #t) #f)
+                   (begin (set! *offering* #t) #t)))))
+      (thread-start! (make-thread offer-rounds 'offers))))
+
+(define (offer-rounds)
+  (guard (e (#t (log-warn "offering this robot: " (error-message e))))
+    (offer-round))
+  (if (with-lock *offer-lock*
+        (lambda ()
+          (let ((again *offer-again*))
+            (set! *offer-again* #f)
+            (if (not again) (set! *offering* #f))
+            again)))
+      (offer-rounds)))
+
+;; Offers this robot, while it is free, to the tasks that wait for it,
+;; best rank first.  While one tries, only its poser may reserve here;
+;; while it asks who waits, if tasks waited at its last round, nobody may,
+;; so that no task takes it before the best-ranked has been offered it.
+;; In a lab where no task waits it refuses nobody, as in the thesis.
+(define *waiters-seen* #f)
+
+(define (offer-round)
+  (let ((me (local-aspace-uid)))
+    (set! *waiters-here?* #f)       ; before asking: a note after it stands
+    (if *waiters-seen* (offer-subjects! 'nobody 3))
+    (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
+                              (guard (e (#t '()))
+                                (append-map cadr (request 'waiting-tasks
+                                                          waiting-for me))))))
+      (set! *waiters-seen* (pair? waiting))
+      (if (pair? waiting) (set! *waiters-here?* #t))
+      (offer-to me waiting))))
+
+(define (offer-to me waiting)
+  (when (and (pair? waiting) (free-here?))
+    (let ((poser (cadr (car waiting))))
+      (offer-subjects! poser 3)
+      (guard (e (#t #f))
+        (parameterize ((remote-timeout 3))
+          (remote-apply (uid->aspace poser) receive-offer
+                        (car (cddr (car waiting))) me)))
+      (offer-to me (cdr waiting))))
+  (offer-subjects! #f))
+
+;; Whether no subject here is held exclusively.
+(define (free-here?)
+  (every (lambda (s) (memq (cadr s) '(() shared))) (subscription-statuses '>)))
+
+(on-free! robot-freed!)

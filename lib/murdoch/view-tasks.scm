@@ -97,8 +97,12 @@
 ;; (KEY STATE) for each task the report says this address space posed.
 (define (report-posed report)
   (filter-map (lambda (t)
-                (and (pair? t) (eq? (car t) 'posed) (= (length t) 3)
-                     (list (text (cadr t)) (text (car (cddr t))))))
+                (and (pair? t) (eq? (car t) 'posed) (memv (length t) '(3 5))
+                     (list (text (cadr t))
+                           (if (= (length t) 5)
+                               (string-append "waiting, " (text (list-ref t 3))
+                                              " in line")
+                               (text (car (cddr t)))))))
               (list-ref report 5)))
 
 (define (task-named table key)
