@@ -7,6 +7,10 @@
 
 (define box-path '((-1500 0) (300 0) (1800 900)))
 
+;; The box's side, mm: the fiducial finder tells where the box is, not how
+;; big it is.
+(define box-side 600)
+
 (define degrees (/ (acos -1) 180))
 
 (define (goal) (list-ref box-path (- (length box-path) 1)))
