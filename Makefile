@@ -41,7 +41,7 @@ demo-box: all
 	MURDOCH_DEMO_TASK=examples/pose-box-move.scm \
 	MURDOCH_DEMO_JUDGE=examples/box-judge.scm \
 	MURDOCH_DEMO_FAULT=$(if $(filter 1,$(FAULT)),inside,$(if $(filter 2,$(FAULT)),outside)) \
-	bin/murdoch demo examples/box-lab.scm
+	bin/murdoch demo $(or $(BOX_LAB),examples/box-lab.scm)
 
 clean: native-clean
 	$(MAKE) -C sim clean

@@ -16,6 +16,26 @@
 ;;; a spare robot, which finds its way to the lost pusher's place at the box
 ;;; as the box is then, while the other pushes alone.
 
+;;; Geometry
+
+(define degrees (/ (acos -1) 180))
+
+(define (goal) (list-ref box-path (- (length box-path) 1)))
+
+;; The heading the box should end with: its last leg's.
+(define (goal-heading)
+  (heading-to (list-ref box-path (- (length box-path) 2)) (goal)))
+
+(define (distance p q)
+  (sqrt (+ (square (- (car p) (car q))) (square (- (cadr p) (cadr q))))))
+
+;; The heading from p to q, degrees.
+(define (heading-to p q) (/ (atan (- (cadr q) (cadr p)) (- (car q) (car p))) degrees))
+
+;; An angle in (-180, 180]; a square box's heading in (-45, 45].
+(define (wrap a) (- a (* 360 (round (/ a 360)))))
+(define (square-wrap a) (- a (* 90 (round (/ a 90)))))
+
 (define box-half (/ box-side 2))
 (define body-radius 180)                ; a B14's
 (define pusher-offset 170)              ; each pusher's offset from the centre line
@@ -59,7 +79,19 @@
     (list (- (+ (car box) (* offset (- (sin a)))) (* back (cos a)))
           (- (+ (cadr box) (* offset (cos a))) (* back (sin a))))))
 
-(define (place-axis box) (box-axis box (heading-to box (aim-point box))))
+;; The axis the box is pushed along: the one of its four nearest the
+;; heading of the path's leg nearest it, so that a box turned or off the
+;; path keeps its rear face.
+(define (place-axis box) (box-axis box (apply heading-to (nearest-leg box))))
+
+(define (nearest-leg box)
+  (let loop ((legs box-path) (best #f) (best-d #f))
+    (if (null? (cdr legs))
+        (list (car best) (cadr best))
+        (let ((d (leg-distance box (car legs) (cadr legs))))
+          (if (or (not best-d) (< d best-d))
+              (loop (cdr legs) legs d)
+              (loop (cdr legs) best best-d))))))
 
 ;; Where the pusher on side (+1 left, -1 right) stands behind the box.
 (define (place-of box side) (behind-at box (place-axis box) (* side pusher-offset)))
@@ -122,6 +154,7 @@
   (team-barrier 'push 120)
   (let loop ((last #f) (where '()) (done 0) (n 0))
     (let ((box (see-box)) (bodies (lost-bodies where)))
+      (if (= 0 (modulo n 10)) (begin (write (list 'DBG n (reckon) box last where done)) (newline)))
       (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
@@ -232,6 +265,7 @@
             (team-send! watcher (list 'at (car me) (cadr me)))))
       (thread-sleep! 0.05)
       (let ((box (and view (car view))))
+        (if (= 0 (modulo n 10)) (begin (write (list 'DBG (local-aspace-uid) n at-face? (reckon) view partner-here partner-coming partner-coming-mm waypoint)) (newline)))
         (cond
          ((and box (arrived? box))
           (stop-base)
@@ -242,35 +276,55 @@
           (team-send! watcher 'done)
           (error "push: the box did not reach the goal" box))
          ((not box) (stop-base) (loop (latest view) at-face? (+ n 1)))
-         ((or at-face? (at-place? box side))
+         ((or (and at-face? (< (distance (reckon) (place-of box side)) 600))
+              (at-place? box side))
           (team-send! (partner) 'here)
-          (steer! box side)
+          (steer! view side)
           (loop (latest view) #t (+ n 1)))
          (else
-          (team-send! (partner) (list 'coming (distance (reckon) (place-of box side))))
+          (team-send! (partner) (list 'coming (if waypoint
+                                                  (distance (reckon) (place-of box side))
+                                                  1e9)))
           (approach! view side n)
           (loop (latest view) #f (+ n 1))))))))
 
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
-;; pushes harder.  A pusher alone turns the box by where it pushes: at the
-;; middle of the face to go straight, to the right of it to turn left.
-;; When a spare is near it keeps to its own place, slowly, to leave the
-;; spare's free.
-(define (steer! box side)
-  (let* ((d (heading-to box (aim-point box)))
-         (axis (box-axis box d))
+;; pushes harder.  A pusher alone (its partner has not said it is at the
+;; face for three rounds) turns the box by where it pushes on its own half
+;; (lone-offset), and holds when only a push on the other half would turn
+;; it back.  When a spare is within 800 mm of its place it holds at its
+;; own place, leaving the spare's free.
+(define (steer! view side)
+  (let* ((box (car view)) (bodies (cadr view))
+         (d (heading-to box (aim-point box)))
+         (axis (place-axis box))
          (err (wrap (- d axis))))               ; > 0: the box must turn left
     (cond ((< (- tick partner-here) 4)
            (push-at! box axis (* side pusher-offset) (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
-          ((and (< (- tick partner-coming) 10) (< partner-coming-mm 1500))
-           (push-at! box axis (* side pusher-offset) 0.3))
-          (else (push-at! box axis (lone-offset err) 0.5)))))
+          ((and (< (- tick partner-coming) 10) (< partner-coming-mm 800))
+           (push-at! box axis (* side pusher-offset) 0))
+          ((> (* side err) 40)       ; only a push on the other half would turn it
+           (push-at! box axis (lone-offset box axis side err bodies) 0))
+          (else (push-at! box axis (lone-offset box axis side err bodies) 0.5)))))
 
-;; Where a pusher alone pushes, mm left of the middle, for a box that
-;; must turn err degrees left: the middle, within 4 degrees.
-(define (lone-offset err)
-  (if (< (abs err) 4) 0 (clip (* -8 err) pusher-offset)))
+;; Where a pusher alone on side pushes, mm left of the middle, for a box
+;; that must turn err degrees left: the middle, within 4 degrees, else to
+;; the side that turns it, as far as its own half of the face goes: it
+;; never crosses the middle, and it keeps its distance from a lost
+;; pusher's body, which would stop it.
+(define (lone-offset box axis side err bodies)
+  (let loop ((offset (* side (max 0 (* side (if (< (abs err) 4) 0 (clip (* -8 err) pusher-offset)))))))
+    (if (or (>= (* side offset) pusher-offset) (clear-of? bodies (list (behind-at box axis offset))))
+        offset
+        (loop (+ offset (* side 20))))))
+
+;; Whether every point is a robot's width and a margin from every body.
+(define (clear-of? bodies points)
+  (every (lambda (b)
+           (every (lambda (p) (> (distance b p) (+ body-radius body-radius 20)))
+                  points))
+         bodies))
 
 ;; Pushes at share of push-speed at the place offset mm left of the middle
 ;; of the box's rear face, hurrying when it has fallen behind it.  A pusher
@@ -278,10 +332,13 @@
 ;; sliding across a face while it pushes turns the box the wrong way.
 (define (push-at! box axis offset share)
   (let* ((off (offsets-to box axis offset)) (ahead (car off)) (left (cadr off)))
-    (if (> (abs left) 100)
-        (drive-to! (behind-at box axis offset (+ box-half body-radius face-gap 250)))
-        (drive-along! axis ahead left
-                      (* push-speed (slowing box) (+ share (clip (/ ahead 100) 0 1)))))))
+    (cond ((<= (abs left) 100)
+           (drive-along! axis ahead left
+                         (* push-speed (slowing box) (+ share (clip (/ ahead 100) 0 1)))))
+          ((< ahead 190)                        ; back off straight
+           (set-velocity -150 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
+          (else (drive-to! (behind-at box axis offset (+ box-half body-radius face-gap 250)))))))
+
 
 ;; Sets the velocities that bring the robot, heading along axis, to a
 ;; point ahead and left of it (mm, in the axis's frame): forward at speed,
@@ -290,33 +347,45 @@
   (let ((turn (wrap (- (+ axis (clip (* 0.15 left) 25)) (list-ref (reckon) 2)))))
     (set-velocity (if (< ahead -80) (max -200 (* 2 ahead)) speed) (clip (* 2 turn) 40))))
 
-;; Sets the velocities that bring the robot to point p, forward or back,
-;; whichever needs the smaller turn; it turns in place first.
+;; Sets the velocities that bring the robot to point p; it turns in place
+;; first.
 (define (drive-to! p)
-  (let* ((me (reckon)) (d (distance me p))
-         (turn (wrap (- (heading-to me p) (list-ref me 2))))
-         (back? (> (abs turn) 100))
-         (turn (if back? (wrap (+ turn 180)) turn))
-         (speed (* (min 300 (* 2 d)) (max 0 (- (* 2 (cos (* turn degrees))) 1)))))
-    (set-velocity (if back? (- (min speed 200)) speed) (clip (* 2 turn) 60))))
+  (let* ((me (reckon)) (turn (wrap (- (heading-to me p) (list-ref me 2)))))
+    (set-velocity (* (min 300 (* 2 (distance me p))) (max 0 (- (* 2 (cos (* turn degrees))) 1)))
+                  (clip (* 2 turn) 60))))
 
 ;;; Finding a way to the place
 
 ;; Comes to the place on side at the box of view, (BOX BODIES): along a
-;; planned way (plan-way) to a point stage-back mm behind the place, then
+;; planned way (plan-way) to a point behind the place (staging), then
 ;; along the box's axis into it.
 (define stage-back 450)
+
+;; The point stage-back mm behind the place offset mm left of the middle,
+;; or, when a body is in the way, nearer it or out to its side, with room
+;; to come in; #f when there is none yet: a body right at the place.
+(define (staging box axis offset bodies)
+  (and (clear-of? bodies (list (behind-at box axis offset)))
+       (any (lambda (p) (and (clear-of? bodies (list p)) p))
+            (append-map (lambda (out)
+                          (map (lambda (back)
+                                 (behind-at box axis (+ offset (* out (if (< offset 0) -1 1)))
+                                            (+ box-half body-radius face-gap back)))
+                               '(450 350 250)))
+                        '(0 150 300)))))
 (define waypoint #f)
+(define docking? #f)
 (define (approach! view side n)
   (let* ((box (car view)) (axis (place-axis box)) (offset (* side pusher-offset))
-         (off (offsets-to box axis offset)))
-    (if (and (< (abs (cadr off)) 100) (< -120 (car off) (+ stage-back 150)))
-        (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300))
+         (off (offsets-to box axis offset)) (stage (staging box axis offset (cadr view))))
+    (if (or (and stage (< (distance (reckon) stage) 150))
+            (and docking? (< -150 (car off) (+ stage-back 200)) (< (abs (cadr off)) 400)))
+        (begin (set! docking? #t)
+               (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
         (begin
+          (set! docking? #f)
           (if (or (not waypoint) (= 0 (modulo n 5)))
-              (set! waypoint (plan-way (behind-at box axis offset
-                                                  (+ box-half body-radius face-gap stage-back))
-                                       box (cadr view))))
+              (set! waypoint (and stage (plan-way stage box (cadr view)))))
           (if waypoint (drive-to! waypoint) (stop-base))))))
 
 ;; A point some 400 mm along a shortest way from here to goal, on a grid of
