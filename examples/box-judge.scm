@@ -13,7 +13,9 @@
 ;;; rear face); exits 0 when all is well, 1 when not, 2 when the log has no
 ;;; such line.
 (import (scheme base) (scheme write) (scheme read) (scheme file) (scheme inexact)
-        (scheme process-context) (scheme eval) (srfi 1) (only (meta) mutable-environment))
+        (scheme process-context) (scheme eval) (srfi 1) (only (meta) mutable-environment)
+        (only (chibi string) string-contains string-cursor->index string-split)
+        (only (chibi io) port->string))
 
 (define (folder-of path)
   (let loop ((i (- (string-length path) 1)))
@@ -47,12 +49,9 @@
 (define (string-prefix? p s)
   (and (>= (string-length s) (string-length p)) (string=? p (substring s 0 (string-length p)))))
 
+;; read-line stops at 8191 characters, and the trace's lines are longer.
 (define (read-lines file)
-  (call-with-input-file file
-    (lambda (in)
-      (let loop ((lines '()))
-        (let ((line (read-line in)))
-          (if (eof-object? line) (reverse lines) (loop (cons line lines))))))))
+  (string-split (call-with-input-file file port->string) #\newline))
 
 (define (read-after prefix line)
   (read (open-input-string (substring line (string-length prefix) (string-length line)))))
@@ -88,44 +87,30 @@
                                     (if (eq? w 'to) (read in) (skip (read in)))))))
           (else (loop (cdr lines) step-2? found)))))
 
-(define (string-contains s part)
-  (let loop ((i 0))
-    (and (<= (+ i (string-length part)) (string-length s))
-         (or (string=? part (substring s i (+ i (string-length part)))) (loop (+ i 1))))))
 
 ;; The trace's columns of samples, boxes first, then robots: each a vector
-;; of (X Y HEADING).
+;; of (X Y HEADING).  Each body's line has its translations, then its
+;; rotations.
 (define (trace-columns svg)
-  (let ((text (call-with-input-file svg (lambda (in) (read-string 100000000 in)))))
-    (let loop ((from 0) (columns '()))
-      (let ((at (string-search text "type=\"translate\"" from)))
-        (if (not at)
-            (reverse columns)
-            (let* ((xy (values-after text at))
-                   (turn (values-after text (string-search text "type=\"rotate\"" at))))
-              (loop (+ at 1)
-                    (cons (vector-map (lambda (p h) (list (car p) (cadr p) (car h)))
-                                      (list->vector xy) (list->vector turn))
-                          columns))))))))
+  (filter-map (lambda (line)
+                (and (string-contains line "type=\"translate\"")
+                     (let* ((xy (after-values line))
+                            (turn (after-values (cdr xy))))
+                       (list->vector
+                        (map (lambda (p h) (append p h)) (car xy) (car turn))))))
+              (read-lines svg)))
 
-(define (string-search s part from)
-  (let loop ((i from))
-    (and (<= (+ i (string-length part)) (string-length s))
-         (if (string=? part (substring s i (+ i (string-length part)))) i (loop (+ i 1))))))
+;; The samples of the first values="..." in text, each a list of numbers,
+;; and the text after it.
+(define (after-values text)
+  (let* ((rest (after text "values=\"")) (end (index-of rest "\"")))
+    (cons (map (lambda (sample) (map string->number (string-split sample #\,)))
+               (string-split (substring rest 0 end) #\;))
+          (substring rest end (string-length rest)))))
 
-;; The numbers of the values="..." after position at, each sample a list.
-(define (values-after text at)
-  (let* ((start (+ (string-search text "values=\"" at) 8))
-         (end (string-search text "\"" start)))
-    (map (lambda (sample)
-           (map string->number (split sample #\,)))
-         (split (substring text start end) #\;))))
-
-(define (split s c)
-  (let loop ((i 0) (from 0) (out '()))
-    (cond ((= i (string-length s)) (reverse (cons (substring s from i) out)))
-          ((char=? c (string-ref s i)) (loop (+ i 1) (+ i 1) (cons (substring s from i) out)))
-          (else (loop (+ i 1) from out)))))
+(define (index-of s part) (string-cursor->index s (string-contains s part)))
+(define (after s part)
+  (substring s (+ (index-of s part) (string-length part)) (string-length s)))
 
 (define pi (acos -1))
 
@@ -183,9 +168,10 @@
           ok?))))
 
 (define (radius svg)
-  (let* ((text (call-with-input-file svg (lambda (in) (read-string 100000000 in))))
-         (at (+ (string-search text "<circle r=\"" 0) 11)))
-    (string->number (substring text at (string-search text "\"" at)))))
+  (let ((rest (after (find (lambda (line) (string-contains line "<circle r=\""))
+                           (read-lines svg))
+                     "<circle r=\"")))
+    (string->number (substring rest 0 (index-of rest "\"")))))
 
 (define (judge log name lab svg pose-out)
   (let* ((end (box-end log)) (env (path-env lab))

@@ -154,7 +154,6 @@
   (team-barrier 'push 120)
   (let loop ((last #f) (where '()) (done 0) (n 0))
     (let ((box (see-box)) (bodies (lost-bodies where)))
-      (if (= 0 (modulo n 10)) (begin (write (list 'DBG n (reckon) box last where done)) (newline)))
       (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
@@ -225,7 +224,8 @@
 ;; Whether this robot stands at its place, against the box's face.
 (define (at-place? box side)
   (let ((off (offsets-to box (place-axis box) (* side pusher-offset))))
-    (and (< -120 (car off) 30) (< (abs (cadr off)) 70))))
+    (and (< -120 (car off) 30) (< (abs (cadr off)) 70)
+         (< (abs (wrap (- (place-axis box) (list-ref (reckon) 2)))) 20))))
 
 ;; What the pusher hears: the round its partner last said it was at the
 ;; face ('here), and the last round it said how far it still had to come
@@ -265,7 +265,6 @@
             (team-send! watcher (list 'at (car me) (cadr me)))))
       (thread-sleep! 0.05)
       (let ((box (and view (car view))))
-        (if (= 0 (modulo n 10)) (begin (write (list 'DBG (local-aspace-uid) n at-face? (reckon) view partner-here partner-coming partner-coming-mm waypoint)) (newline)))
         (cond
          ((and box (arrived? box))
           (stop-base)
@@ -319,12 +318,12 @@
         offset
         (loop (+ offset (* side 20))))))
 
-;; Whether every point is a robot's width and a margin from every body.
-(define (clear-of? bodies points)
-  (every (lambda (b)
-           (every (lambda (p) (> (distance b p) (+ body-radius body-radius 20)))
-                  points))
-         bodies))
+;; Whether every point is a robot's width and a margin (20 mm, or the one
+;; given: a spare may nudge a body at its place) from every body.
+(define (clear-of? bodies points . margin)
+  (let ((room (+ body-radius body-radius (if (pair? margin) (car margin) 20))))
+    (every (lambda (b) (every (lambda (p) (> (distance b p) room)) points))
+           bodies)))
 
 ;; Pushes at share of push-speed at the place offset mm left of the middle
 ;; of the box's rear face, hurrying when it has fallen behind it.  A pusher
@@ -357,36 +356,46 @@
 ;;; Finding a way to the place
 
 ;; Comes to the place on side at the box of view, (BOX BODIES): along a
-;; planned way (plan-way) to a point behind the place (staging), then
-;; along the box's axis into it.
+;; planned way (plan-way) to a staging point, then into the place: along
+;; the box's axis from a point behind it, or, when a body lies right behind
+;; the place, along the face from a point beside it, turning in place there.
 (define stage-back 450)
-
-;; The point stage-back mm behind the place offset mm left of the middle,
-;; or, when a body is in the way, nearer it or out to its side, with room
-;; to come in; #f when there is none yet: a body right at the place.
-(define (staging box axis offset bodies)
-  (and (clear-of? bodies (list (behind-at box axis offset)))
-       (any (lambda (p) (and (clear-of? bodies (list p)) p))
-            (append-map (lambda (out)
-                          (map (lambda (back)
-                                 (behind-at box axis (+ offset (* out (if (< offset 0) -1 1)))
-                                            (+ box-half body-radius face-gap back)))
-                               '(450 350 250)))
-                        '(0 150 300)))))
+(define docking #f)             ; the staging point reached, while docking
 (define waypoint #f)
-(define docking? #f)
+
 (define (approach! view side n)
   (let* ((box (car view)) (axis (place-axis box)) (offset (* side pusher-offset))
-         (off (offsets-to box axis offset)) (stage (staging box axis offset (cadr view))))
-    (if (or (and stage (< (distance (reckon) stage) 150))
-            (and docking? (< -150 (car off) (+ stage-back 200)) (< (abs (cadr off)) 400)))
-        (begin (set! docking? #t)
-               (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
-        (begin
-          (set! docking? #f)
-          (if (or (not waypoint) (= 0 (modulo n 5)))
-              (set! waypoint (and stage (plan-way stage box (cadr view)))))
-          (if waypoint (drive-to! waypoint) (stop-base))))))
+         (off (offsets-to box axis offset)) (place (behind-at box axis offset))
+         (stage (staging box axis offset (cadr view))))
+    (if (and stage (< (distance (reckon) (car stage)) 150))
+        (set! docking (cdr stage)))
+    (cond ((and (eq? docking 'behind) (< -150 (car off) (+ stage-back 200))
+                (< (abs (cadr off)) 400))
+           (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
+          ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
+           (if (> (distance (reckon) place) 40)
+               (drive-to! place)
+               (set-velocity 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
+          (else
+           (set! docking #f)
+           (if (or (not waypoint) (= 0 (modulo n 5)))
+               (set! waypoint (and stage (plan-way (car stage) box (cadr view)))))
+           (if waypoint (drive-to! waypoint) (stop-base))))))
+
+;; Where to come up to the place offset mm left of the middle from, as
+;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
+;; nearer, or out to its side, whichever first is clear of the bodies;
+;; beside it, 450 mm out, when a body lies right behind it.  #f when the
+;; place itself is not clear.
+(define (staging box axis offset bodies)
+  (let ((out (if (< offset 0) -1 1)))
+    (define (clear p kind) (and (clear-of? bodies (list p)) (cons p kind)))
+    (and (clear-of? bodies (list (behind-at box axis offset)) -40)
+         (or (any (lambda (back)
+                    (clear (behind-at box axis offset (+ box-half body-radius face-gap back))
+                           'behind))
+                  '(450 350 250))
+             (clear (behind-at box axis (+ offset (* out 450))) 'beside)))))
 
 ;; A point some 400 mm along a shortest way from here to goal, on a grid of
 ;; cells 100 mm square, that keeps clear of the box, of the bodies (X Y)
