@@ -82,12 +82,15 @@
 ;; The axis the box is pushed along: the one of its four nearest the
 ;; heading of the path's leg nearest it, so that a box turned or off the
 ;; path keeps its rear face.
-(define (place-axis box) (box-axis box (apply heading-to (nearest-leg box))))
+(define (place-axis box)
+  (let ((legs (nearest-legs box)))
+    (box-axis box (heading-to (car legs) (cadr legs)))))
 
-(define (nearest-leg box)
+;; The path from the start of the leg nearest the box on.
+(define (nearest-legs box)
   (let loop ((legs box-path) (best #f) (best-d #f))
     (if (null? (cdr legs))
-        (list (car best) (cadr best))
+        best
         (let ((d (leg-distance box (car legs) (cadr legs))))
           (if (or (not best-d) (< d best-d))
               (loop (cdr legs) legs d)
@@ -137,7 +140,9 @@
   (distance (reckon) (along-path box-path (/ (path-length box-path) 2))))
 
 (define (path-length legs)
-  (if (null? (cdr legs)) 0 (+ (distance (car legs) (cadr legs)) (path-length (cdr legs)))))
+  (if (null? (cdr legs))
+      0
+      (+ (distance (car legs) (cadr legs)) (path-length (cdr legs)))))
 
 (define (asking proc) (metric-by-asking proc (lambda (mm) mm)))
 
@@ -176,7 +181,8 @@
 (define (fold-at heard where)
   (fold (lambda (h where)
           (if (and (pair? (cdr h)) (eq? (car (cdr h)) 'at))
-              (cons (cons (car h) (cdr (cdr h))) (remove (lambda (w) (eq? (car w) (car h))) where))
+              (cons (cons (car h) (cdr (cdr h)))
+                    (remove (lambda (w) (eq? (car w) (car h))) where))
               where))
         where heard))
 
@@ -300,12 +306,17 @@
          (axis (place-axis box))
          (err (wrap (- d axis))))               ; > 0: the box must turn left
     (cond ((< (- tick partner-here) 4)
-           (push-at! box axis (* side pusher-offset) (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
+           (push-at! box axis (* side pusher-offset)
+                     (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
           ((and (< (- tick partner-coming) 10) (< partner-coming-mm 800))
            (push-at! box axis (* side pusher-offset) 0))
-          ((> (* side err) 40)       ; only a push on the other half would turn it
+          ((and (> (* side err) 40) (spare-on-its-way?))
+           ;; only a push on the other half would turn it
            (push-at! box axis (lone-offset box axis side err bodies) 0))
           (else (push-at! box axis (lone-offset box axis side err bodies) 0.5)))))
+
+;; Whether a spare said lately that it has a way to its place.
+(define (spare-on-its-way?) (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
 
 ;; Where a pusher alone on side pushes, mm left of the middle, for a box
 ;; that must turn err degrees left: the middle, within 4 degrees, else to
@@ -313,8 +324,11 @@
 ;; never crosses the middle, and it keeps its distance from a lost
 ;; pusher's body, which would stop it.
 (define (lone-offset box axis side err bodies)
-  (let loop ((offset (* side (max 0 (* side (if (< (abs err) 4) 0 (clip (* -8 err) pusher-offset)))))))
-    (if (or (>= (* side offset) pusher-offset) (clear-of? bodies (list (behind-at box axis offset))))
+  (let loop ((offset (* side (max 0 (* side (if (< (abs err) 4)
+                                                 0
+                                                 (clip (* -8 err) pusher-offset)))))))
+    (if (or (>= (* side offset) pusher-offset)
+            (clear-of? bodies (list (behind-at box axis offset))))
         offset
         (loop (+ offset (* side 20))))))
 
@@ -336,7 +350,8 @@
                          (* push-speed (slowing box) (+ share (clip (/ ahead 100) 0 1)))))
           ((< ahead 190)                        ; back off straight
            (set-velocity -150 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
-          (else (drive-to! (behind-at box axis offset (+ box-half body-radius face-gap 250)))))))
+          (else (drive-to! (behind-at box axis offset
+                                      (+ box-half body-radius face-gap 250)))))))
 
 
 ;; Sets the velocities that bring the robot, heading along axis, to a
@@ -350,7 +365,8 @@
 ;; first.
 (define (drive-to! p)
   (let* ((me (reckon)) (turn (wrap (- (heading-to me p) (list-ref me 2)))))
-    (set-velocity (* (min 300 (* 2 (distance me p))) (max 0 (- (* 2 (cos (* turn degrees))) 1)))
+    (set-velocity (* (min 300 (* 2 (distance me p)))
+                     (max 0 (- (* 2 (cos (* turn degrees))) 1)))
                   (clip (* 2 turn) 60))))
 
 ;;; Finding a way to the place
@@ -392,42 +408,49 @@
     (define (clear p kind) (and (clear-of? bodies (list p)) (cons p kind)))
     (and (clear-of? bodies (list (behind-at box axis offset)) -40)
          (or (any (lambda (back)
-                    (clear (behind-at box axis offset (+ box-half body-radius face-gap back))
+                    (clear (behind-at box axis offset
+                                      (+ box-half body-radius face-gap back))
                            'behind))
                   '(450 350 250))
              (clear (behind-at box axis (+ offset (* out 450))) 'beside)))))
 
 ;; A point some 400 mm along a shortest way from here to goal, on a grid of
 ;; cells 100 mm square, that keeps clear of the box, of the bodies (X Y)
-;; and of what the sonar echoes; #f when there is none.
+;; and of what the sonar echoes; #f when there is none.  goal has been
+;; found clear (staging): its own cell, as start's, may be marked.
 (define cell 100)
 (define (plan-way goal box bodies)
   (let* ((me (reckon)) (margin 1500)
-         (x0 (- (min (car me) (car goal)) margin)) (y0 (- (min (cadr me) (cadr goal)) margin))
-         (nx (+ 1 (exact (ceiling (/ (+ (abs (- (car me) (car goal))) margin margin) cell)))))
-         (ny (+ 1 (exact (ceiling (/ (+ (abs (- (cadr me) (cadr goal))) margin margin) cell)))))
+         (x0 (- (min (car me) (car goal)) margin))
+         (y0 (- (min (cadr me) (cadr goal)) margin))
+         (nx (cells-across (car me) (car goal) margin))
+         (ny (cells-across (cadr me) (cadr goal) margin))
          (blocked (make-vector (* nx ny) #f))
          (cell-of (lambda (p) (+ (exact (round (/ (- (car p) x0) cell)))
                                  (* nx (exact (round (/ (- (cadr p) y0) cell))))))))
     (define (paint! p r)
-      (let ((i0 (exact (round (/ (- (car p) x0) cell)))) (j0 (exact (round (/ (- (cadr p) y0) cell))))
+      (let ((i0 (exact (round (/ (- (car p) x0) cell))))
+            (j0 (exact (round (/ (- (cadr p) y0) cell))))
             (k (exact (ceiling (/ r cell)))))
         (do ((i (- i0 k) (+ i 1))) ((> i (+ i0 k)))
           (do ((j (- j0 k) (+ j 1))) ((> j (+ j0 k)))
-            (if (and (< -1 i nx) (< -1 j ny) (<= (* cell cell (+ (square (- i i0)) (square (- j j0))))
-                                                 (* r r)))
+            (if (and (< -1 i nx) (< -1 j ny)
+                     (<= (* cell cell (+ (square (- i i0)) (square (- j j0)))) (* r r)))
                 (vector-set! blocked (+ i (* nx j)) #t))))))
     (paint-box! paint! box)
-    (for-each (lambda (b) (paint! b (+ body-radius body-radius 80))) bodies)
+    (for-each (lambda (b) (paint! b (+ body-radius body-radius))) bodies)
     (for-each (lambda (e) (paint! e (+ body-radius 80))) (echoes me box))
     (let ((start (cell-of me)) (end (cell-of goal)))
-      (and (not (vector-ref blocked end))
-           (let ((from (breadth-first blocked nx ny end start)))
-             (and from
-                  (let follow ((c start) (k 4))
-                    (if (or (= k 0) (= c end))
-                        (list (+ x0 (* cell (modulo c nx))) (+ y0 (* cell (quotient c nx))))
-                        (follow (vector-ref from c) (- k 1))))))))))
+      (let ((from (breadth-first blocked nx ny end start)))
+        (and from
+             (let follow ((c start) (k 4))
+               (if (or (= k 0) (= c end))
+                   (list (+ x0 (* cell (modulo c nx))) (+ y0 (* cell (quotient c nx))))
+                   (follow (vector-ref from c) (- k 1)))))))))
+
+;; The cells from a to b and margin beyond each.
+(define (cells-across a b margin)
+  (+ 1 (exact (ceiling (/ (+ (abs (- a b)) margin margin) cell)))))
 
 ;; Marks the box, grown by a body's radius and a margin, with paint!.
 (define (paint-box! paint! box)
@@ -450,12 +473,14 @@
                  (p (list (+ (car me) (* r (cos t))) (+ (cadr me) (* r (sin t)))))
                  (dx (- (car p) (car box))) (dy (- (cadr p) (cadr box)))
                  (in-box? (and (< (abs (+ (* dx (cos a)) (* dy (sin a)))) (+ box-half 150))
-                               (< (abs (- (* dy (cos a)) (* dx (sin a)))) (+ box-half 150)))))
-            (loop (+ i 1) (cdr ranges) (if (or (> (car ranges) 2500) in-box?) out (cons p out))))))))
+                               (< (abs (- (* dy (cos a)) (* dx (sin a))))
+                                  (+ box-half 150)))))
+            (loop (+ i 1) (cdr ranges)
+                  (if (or (> (car ranges) 2500) in-box?) out (cons p out))))))))
 
 ;; Each cell's next cell on a shortest way to end, by a breadth-first
 ;; search from end over free cells and their eight neighbours, until it
-;; reaches start; #f when it does not.  start's own cell may be marked.
+;; reaches start; #f when it does not.
 (define (breadth-first blocked nx ny end start)
   (let ((from (make-vector (* nx ny) #f)) (queue (make-vector (* nx ny) 0)))
     (vector-set! from end end)
@@ -492,13 +517,8 @@
 ;; past the point of it nearest the box, or the goal.
 (define lookahead 700)
 (define (aim-point box)
-  (let loop ((legs box-path) (best #f) (best-d #f))
-    (if (or (null? legs) (null? (cdr legs)))
-        (along-path best (+ (leg-position box (car best) (cadr best)) lookahead))
-        (let ((d (leg-distance box (car legs) (cadr legs))))
-          (if (or (not best-d) (< d best-d))
-              (loop (cdr legs) legs d)
-              (loop (cdr legs) best best-d))))))
+  (let ((legs (nearest-legs box)))
+    (along-path legs (+ (leg-position box (car legs) (cadr legs)) lookahead))))
 
 ;; How far along the leg from a to b the point of it nearest p is, mm.
 (define (leg-position p a b)
