@@ -81,10 +81,15 @@
 
 ;; The axis the box is pushed along: the one of its four nearest the
 ;; heading of the path's leg nearest it, so that a box turned or off the
-;; path keeps its rear face.
+;; path keeps its rear face; at a bend, the one it was, while that is
+;; within 60 degrees of the new leg.
+(define last-axis #f)
 (define (place-axis box)
-  (let ((legs (nearest-legs box)))
-    (box-axis box (heading-to (car legs) (cadr legs)))))
+  (let* ((legs (nearest-legs box)) (leg (heading-to (car legs) (cadr legs)))
+         (kept (and last-axis (box-axis box last-axis)))
+         (axis (if (and kept (< (abs (wrap (- kept leg))) 60)) kept (box-axis box leg))))
+    (set! last-axis axis)
+    axis))
 
 ;; The path from the start of the leg nearest the box on.
 (define (nearest-legs box)
@@ -297,9 +302,9 @@
 ;; box turns toward the path when the one on the far side of the turn
 ;; pushes harder.  A pusher alone (its partner has not said it is at the
 ;; face for three rounds) turns the box by where it pushes on its own half
-;; (lone-offset), and holds when only a push on the other half would turn
-;; it back.  When a spare is within 800 mm of its place it holds at its
-;; own place, leaving the spare's free.
+;; (lone-offset).  A spare coming turns the box the most: once the spare
+;; has a way to its place, the lone pusher holds at its own, leaving the
+;; spare's free.
 (define (steer! view side)
   (let* ((box (car view)) (bodies (cadr view))
          (d (heading-to box (aim-point box)))
@@ -308,15 +313,12 @@
     (cond ((< (- tick partner-here) 4)
            (push-at! box axis (* side pusher-offset)
                      (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
-          ((and (< (- tick partner-coming) 10) (< partner-coming-mm 800))
-           (push-at! box axis (* side pusher-offset) 0))
-          ((and (> (* side err) 40) (spare-on-its-way?))
-           ;; only a push on the other half would turn it
-           (push-at! box axis (lone-offset box axis side err bodies) 0))
+          ((spare-on-its-way?) (push-at! box axis (* side pusher-offset) 0))
           (else (push-at! box axis (lone-offset box axis side err bodies) 0.5)))))
 
 ;; Whether a spare said lately that it has a way to its place.
-(define (spare-on-its-way?) (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
+(define (spare-on-its-way?)
+  (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
 
 ;; Where a pusher alone on side pushes, mm left of the middle, for a box
 ;; that must turn err degrees left: the middle, within 4 degrees, else to
@@ -472,7 +474,8 @@
                  (t (* degrees (+ (list-ref me 2) (* i 22.5))))
                  (p (list (+ (car me) (* r (cos t))) (+ (cadr me) (* r (sin t)))))
                  (dx (- (car p) (car box))) (dy (- (cadr p) (cadr box)))
-                 (in-box? (and (< (abs (+ (* dx (cos a)) (* dy (sin a)))) (+ box-half 150))
+                 (in-box? (and (< (abs (+ (* dx (cos a)) (* dy (sin a))))
+                                  (+ box-half 150))
                                (< (abs (- (* dy (cos a)) (* dx (sin a))))
                                   (+ box-half 150)))))
             (loop (+ i 1) (cdr ranges)
