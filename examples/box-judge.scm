@@ -47,7 +47,8 @@
     env))
 
 (define (string-prefix? p s)
-  (and (>= (string-length s) (string-length p)) (string=? p (substring s 0 (string-length p)))))
+  (and (>= (string-length s) (string-length p))
+       (string=? p (substring s 0 (string-length p)))))
 
 ;; read-line stops at 8191 characters, and the trace's lines are longer.
 (define (read-lines file)
@@ -136,7 +137,8 @@
                               (dx (- (car b) (car a))) (dy (- (cadr b) (cadr a)))
                               (d (sqrt (+ (* dx dx) (* dy dy)))))
                          (cons d (and (> d 0.5)
-                                      (at-rear? (vector-ref robot s) a side radius dx dy)))))
+                                      (at-rear? (vector-ref robot s) a side radius
+                                                dx dy)))))
                      (iota (- n 1))))
          (travel (fold + 0 (map car steps))))
     (let loop ((steps steps) (gone 0) (pushed 0) (last 0))

@@ -23,7 +23,8 @@
                     " MURDOCH_DEMO_TASK=\"$2/examples/pose-box-move.scm\""
                     " MURDOCH_DEMO_JUDGE=\"$2/examples/box-judge.scm\""
                     " timeout -s KILL 280 \"$2/bin/murdoch\" demo \"$2/$5\" >\"$3\" 2>&1")
-                   dir (number->string (free-port-base dir)) (tool-path ".") out fault lab))
+                   dir (number->string (free-port-base dir)) (tool-path ".") out
+                   fault lab))
          (text (file-text out)))
     (delete-file-hierarchy dir)
     (cons status text)))
@@ -46,8 +47,9 @@
 (define (box-case lab fault)
   (let* ((run (run-demo lab fault)) (status (car run)) (text (cdr run))
          (name (if (string=? fault "") "box-move" "box-move-fault")))
-    (test-group (string-append lab (if (string=? fault "") "" (string-append ", " fault
-                                                                             " pusher killed")))
+    (test-group (string-append lab (if (string=? fault "")
+                                       ""
+                                       (string-append ", " fault " pusher killed")))
       (test "the box arrives: within 300 mm of the goal and 20 degrees of its heading" #t
         (text-contains? text "within 300 mm and 20 degrees"))
       (test-assert "its goal error, a bench line, is at most 300 mm"
@@ -57,11 +59,14 @@
         (text-contains? text ": step 2 done: ("))
       (if (not (string=? fault ""))
           (begin
-            (test-assert "a pusher was killed" (text-contains? text "demo: FAULT: killing "))
-            (test-assert "its component went to a spare" (text-contains? text " reassigned from "))
+            (test-assert "a pusher was killed"
+              (text-contains? text "demo: FAULT: killing "))
+            (test-assert "its component went to a spare"
+              (text-contains? text " reassigned from "))
             (test "the spare pushed for the last third of the way" #t
               (text-contains? text ": it pushed"))
             (test-assert "box-move-spare-push-mm, a bench line, is above nought"
-              (let ((mm (bench text "box-move-spare-push-mm"))) (and (real? mm) (> mm 0))))))
+              (let ((mm (bench text "box-move-spare-push-mm")))
+                (and (real? mm) (> mm 0))))))
       (test "the demo says so by its exit status" #t status))
     (if (not status) (display text))))
