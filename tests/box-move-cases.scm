@@ -1,16 +1,13 @@
 ;;; The cases of the box team (examples/box-move.scm, docs/box-move.md),
-;;; included by box-move-test.scm, box-move-fault-test.scm and
-;;; box-move-right-test.scm, which tests/run runs one by one: each case is
+;;; included by tests/box-move*-test.scm, one case each, which tests/run
+;;; runs one by one: each case is
 ;;; `make demo-box`'s run, in the lab's fast-forward simulator, on a port
 ;;; base of its own, judged by examples/box-judge.scm from the simulator's
 ;;; own word: the box must end within 300 mm of the path's goal and 20
 ;;; degrees of its heading, and with a fault the spare, the robot the lost
 ;;; pusher's component went to, must have been at the box's rear face for
-;;; the last third of the distance the box moved.
-(import (scheme base) (scheme write) (scheme read) (srfi 1) (chibi test)
-        (only (chibi process) system?)
-        (only (chibi filesystem) delete-file-hierarchy)
-        (murdoch testing))
+;;; the last third of the distance the box moved.  The including file
+;;; imports what it needs.
 
 ;; The demo's output, and whether it exited 0, for LAB with FAULT ("" for
 ;; none, or a role: inside, outside).
