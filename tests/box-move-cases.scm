@@ -34,11 +34,7 @@
                 (string=? prefix (substring line 0 (string-length prefix)))
                 (read (open-input-string (substring line (string-length prefix)
                                                     (string-length line))))))
-         (read-lines (open-input-string text)))))
-
-(define (read-lines in)
-  (let ((line (read-line in)))
-    (if (eof-object? line) '() (cons line (read-lines in)))))
+         (text-lines text))))
 
 ;; One case: LAB's demo with FAULT, its assertions in a group of their own.
 (define (box-case lab fault)
