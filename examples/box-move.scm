@@ -413,7 +413,7 @@
                     (clear (behind-at box axis offset
                                       (+ box-half body-radius face-gap back))
                            'behind))
-                  '(450 350 250))
+                  (list stage-back (- stage-back 100) (- stage-back 200)))
              (clear (behind-at box axis (+ offset (* out 450))) 'beside)))))
 
 ;; A point some 400 mm along a shortest way from here to goal, on a grid of
