@@ -38,13 +38,13 @@ bench-sched: all
 demo: all
 	bin/murdoch demo examples/tulane-lab.scm
 
-# A team moves a box along a path (docs/box-move.md); FAULT=1 kills one
-# pusher midway, and a spare takes its place.
+# A team moves a box along a path (docs/box-move.md); FAULT=1 kills the
+# inside pusher midway, FAULT=2 the other, and a spare takes its place.
 demo-box: all
 	MURDOCH_DEMO_TASK=examples/pose-box-move.scm \
 	MURDOCH_DEMO_JUDGE=examples/box-judge.scm \
-	MURDOCH_DEMO_FAULT=$(if $(filter-out 0,$(FAULT)),moseley) \
-	bin/murdoch demo examples/box-lab.scm
+	MURDOCH_DEMO_FAULT=$(if $(filter 1,$(FAULT)),inside,$(if $(filter 2,$(FAULT)),outside)) \
+	bin/murdoch demo $(or $(BOX_LAB),examples/box-lab.scm)
 
 clean: native-clean
 	$(MAKE) -C sim clean

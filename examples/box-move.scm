@@ -2,20 +2,44 @@
 ;;; pushers push it from behind, and a watcher watches it with its
 ;;; fiducial finder and tells the pushers where it is.  No one reads where
 ;;; the box is in the simulator: the watcher sees it as a sensor would.
+;;; Every place comes from the path (box-path.scm: box-path, box-side) and
+;;; from what the robots see; nothing here knows the lab.
 ;;;
 ;;; (box-move-task) is the task: two steps, run by start-steps.
-;;;   1. Take places: each pusher drives to its side behind the box, the
-;;;      watcher turns to face the path.
+;;;   1. Take places: each pusher finds its way to its side behind the box,
+;;;      the watcher turns to face the path's start.
 ;;;   2. Move the box: at the barrier push, the pushers start; the watcher
 ;;;      sends each its sighting of the box every 0.2 s; each pusher keeps
 ;;;      the box's heading on the path by pushing harder or softer on its
 ;;;      side; they stop when the box reaches the goal.
 ;;; The pushers' components may restart: a pusher that fails is replaced by
-;;; a spare robot, which takes its side behind the box wherever the box is.
+;;; a spare robot, which finds its way to the lost pusher's place at the box
+;;; as the box is then, while the other pushes alone.
 
-(define box-half 300)                   ; half the box's side, mm
+;;; Geometry
+
+(define degrees (/ (acos -1) 180))
+
+(define (goal) (list-ref box-path (- (length box-path) 1)))
+
+;; The heading the box should end with: its last leg's.
+(define (goal-heading)
+  (heading-to (list-ref box-path (- (length box-path) 2)) (goal)))
+
+(define (distance p q)
+  (sqrt (+ (square (- (car p) (car q))) (square (- (cadr p) (cadr q))))))
+
+;; The heading from p to q, degrees.
+(define (heading-to p q) (/ (atan (- (cadr q) (cadr p)) (- (car q) (car p))) degrees))
+
+;; An angle in (-180, 180]; a square box's heading in (-45, 45].
+(define (wrap a) (- a (* 360 (round (/ a 360)))))
+(define (square-wrap a) (- a (* 90 (round (/ a 90)))))
+
+(define box-half (/ box-side 2))
 (define body-radius 180)                ; a B14's
 (define pusher-offset 170)              ; each pusher's offset from the centre line
+(define face-gap 40)                    ; between a place and the box's face
 (define push-speed 220)                 ; mm/s
 
 ;; The box as this robot sees it, (X Y HEADING) in the room, or #f.
@@ -27,7 +51,6 @@
            (list (+ (car me) (* (list-ref f 1) (cos a)))
                  (+ (cadr me) (* (list-ref f 1) (sin a)))
                  (+ (list-ref me 2) (list-ref f 3)))))))
-
 
 ;; The distance from point p to the leg from a to b.
 (define (leg-distance p a b)
@@ -47,127 +70,441 @@
         (>= (+ (* (- (car box) (car g)) (cos d)) (* (- (cadr box) (cadr g)) (sin d)))
             -60))))
 
-;; Where a pusher stands behind the box on its side (+1 left, -1 right),
-;; pushing toward d degrees.
-(define (behind box d side) (behind-at box d (* side pusher-offset)))
-
 ;; The place behind the box, pushing toward d degrees, offset mm to the
-;; left of its centre line.
-(define (behind-at box d offset)
-  (let ((back (+ box-half body-radius 40)) (a (* d degrees)))
+;; left of its centre line and back mm behind its centre (by default a
+;; pusher's place, face-gap from the face).
+(define (behind-at box d offset . back)
+  (let ((back (if (pair? back) (car back) (+ box-half body-radius face-gap)))
+        (a (* d degrees)))
     (list (- (+ (car box) (* offset (- (sin a)))) (* back (cos a)))
           (- (+ (cadr box) (* offset (cos a))) (* back (sin a))))))
 
+;; The axis the box is pushed along: the one of its four nearest the
+;; heading of the path's leg nearest it, so that a box turned or off the
+;; path keeps its rear face; at a bend, the one it was, while that is
+;; within 60 degrees of the new leg.
+(define last-axis #f)
+(define (place-axis box)
+  (let* ((legs (nearest-legs box)) (leg (heading-to (car legs) (cadr legs)))
+         (kept (and last-axis (box-axis box last-axis)))
+         (axis (if (and kept (< (abs (wrap (- kept leg))) 60)) kept (box-axis box leg))))
+    (set! last-axis axis)
+    axis))
+
+;; The path from the start of the leg nearest the box on.
+(define (nearest-legs box)
+  (let loop ((legs box-path) (best #f) (best-d #f))
+    (if (null? (cdr legs))
+        best
+        (let ((d (leg-distance box (car legs) (cadr legs))))
+          (if (or (not best-d) (< d best-d))
+              (loop (cdr legs) legs d)
+              (loop (cdr legs) best best-d))))))
+
+;; Where the pusher on side (+1 left, -1 right) stands behind the box.
+(define (place-of box side) (behind-at box (place-axis box) (* side pusher-offset)))
+
+;; How far the point offset mm left of the box's middle, back mm behind it,
+;; lies ahead of this robot along axis and to its left: (AHEAD LEFT).
+(define (offsets-to box axis offset . back)
+  (let* ((p (apply behind-at box axis offset back)) (me (reckon)) (a (* axis degrees))
+         (dx (- (car p) (car me))) (dy (- (cadr p) (cadr me))))
+    (list (+ (* dx (cos a)) (* dy (sin a))) (- (* dy (cos a)) (* dx (sin a))))))
+
+;;; Roles and their metrics, from the path and the box's sighting
+
+;; The path's first point, as a box heading along its first leg.
+(define (path-start-box)
+  (let ((p (car box-path)))
+    (list (car p) (cadr p) (heading-to p (cadr box-path)))))
+
+;; The side the path first turns to (+1 left, -1 right): the inside
+;; pusher's.  Left for a straight path.
+(define (inside-side)
+  (let loop ((p box-path))
+    (if (or (null? (cdr p)) (null? (cddr p)))
+        1
+        (let* ((a (car p)) (b (cadr p)) (c (car (cddr p)))
+               (cross (- (* (- (car b) (car a)) (- (cadr c) (cadr b)))
+                         (* (- (cadr b) (cadr a)) (- (car c) (car b))))))
+          (cond ((> cross 1) 1) ((< cross -1) -1) (else (loop (cdr p))))))))
+
+(define (role side) (if (= side (inside-side)) 'inside 'outside))
+
+;; How far this robot is from the place of the pusher on side: at the box as
+;; its fiducial finder sees it, or, seeing none, at the path's start.  The
+;; pushers' metrics ask each candidate this, so that in step 2 the robots
+;; at the places win them, and a spare is measured to the box as it is now.
+(define (place-distance side)
+  (distance (reckon) (place-of (or (see-box) (path-start-box)) side)))
+(define (left-place-distance) (place-distance 1))
+(define (right-place-distance) (place-distance -1))
+
+;; How far this robot is from the middle of the path: the watcher's metric.
+(define (path-middle-distance)
+  (distance (reckon) (along-path box-path (/ (path-length box-path) 2))))
+
+(define (path-length legs)
+  (if (null? (cdr legs))
+      0
+      (+ (distance (car legs) (cadr legs)) (path-length (cdr legs)))))
+
+(define (asking proc) (metric-by-asking proc (lambda (mm) mm)))
+
 ;;; The watcher
 
-(define (watch-place previous) (rotate 'to -90) (local-aspace-uid))
+(define (watch-place previous)
+  (rotate 'to (heading-to (reckon) (car box-path)))
+  (local-aspace-uid))
 
-;; Tells the pushers where the box is until both say they are done.
+;; Tells the pushers where the box is, and where the bodies of lost pushers
+;; lie (their last word of where they were), until the box has arrived;
+;; keeps the box in view.
 (define (watch previous)
   (team-barrier 'push 120)
-  (let loop ((done 0) (n 0))
-    (let ((box (see-box)))
+  (let loop ((last #f) (where '()) (done 0) (n 0))
+    (let ((box (see-box)) (bodies (lost-bodies where)))
+      (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
-                                      (team-send! uid box)))
+                                      (team-send! uid (list 'box box bodies))))
                     (step-team)))
-      (let ((heard (guard (e (#t #f)) (team-receive 0.2))))
-        (cond ((and heard (eq? (cdr heard) 'done) (= done 1)) (or box 'lost-sight))
-              ((> n 900) 'gave-up)
-              (else (loop (+ done (if (and heard (eq? (cdr heard) 'done)) 1 0))
-                          (+ n 1))))))))
+      (thread-sleep! 0.15)
+      (let* ((heard (all-heard)) (box (or box last))
+             (where (fold-at heard where))
+             (done (+ done (count (lambda (h) (eq? (cdr h) 'done)) heard))))
+        (cond ((or (>= done 2) (and (>= done 1) box (arrived? box))) (or box 'lost-sight))
+              ((> n 3000) (error "watch: the pushers did not finish" done))
+              (else (loop box where done (+ n 1))))))))
+
+;; Every message waiting, (FROM . VALUE) each.
+(define (all-heard)
+  (let ((heard (guard (e (#t #f)) (team-receive 0.01))))
+    (if heard (cons heard (all-heard)) '())))
+
+;; where, a list of (UID X Y), with each pusher's newest (at X Y).
+(define (fold-at heard where)
+  (fold (lambda (h where)
+          (if (and (pair? (cdr h)) (eq? (car (cdr h)) 'at))
+              (cons (cons (car h) (cdr (cdr h)))
+                    (remove (lambda (w) (eq? (car w) (car h))) where))
+              where))
+        where heard))
+
+;; Where the pushers that left the team were last.
+(define (lost-bodies where)
+  (let ((team (step-team)))
+    (map cdr (remove (lambda (w) (memq (car w) team)) where))))
+
+;; Turns toward the box when it nears the edge of the finder's view.
+(define (keep-in-view box)
+  (if box
+      (let* ((me (reckon)) (bearing (wrap (- (heading-to me box) (list-ref me 2)))))
+        (set-velocity 0 (if (< (abs bearing) 30) 0 (clip bearing 30))))))
 
 ;;; The pushers
 
 ;; The team as it is now: a spare may have replaced a pusher.
 (define (my-side) (if (eq? (local-aspace-uid) (car (step-team))) 1 -1))
 
+;; The other pusher, as the team was at the last look.
+(define team '())
+(define (partner) (list-ref team (if (eq? (local-aspace-uid) (car team)) 1 0)))
+
+;; Finds its way to its place behind the box, as it sees the box (which
+;; stays put meanwhile); fails when it has never seen it.
 (define (take-place previous)
-  (let ((box (or (see-box) '(-1500 0 0))))
-    (go-to-place box)
-    (local-aspace-uid)))
+  (let ((side (my-side)) (first (see-box)))
+    (if (not first)
+        (error "take-place: this robot's fiducial finder does not see the box"
+               (local-aspace-uid) (reckon)))
+    (sonar-start)
+    (let loop ((box first) (n 0))
+      (cond ((at-place? box side)
+             (stop-base)
+             (rotate 'to (place-axis box))
+             (list (local-aspace-uid) (role side)))
+            ((> n 1500)
+             (stop-base)
+             (error "take-place: found no way to its place behind the box"
+                    (local-aspace-uid) (place-of box side)))
+            (else (approach! (list box '()) side n)
+                  (thread-sleep! 0.1)
+                  (loop (or (see-box) box) (+ n 1)))))))
 
-;; Drives to this pusher's place behind the box, facing along it.
-(define (go-to-place box)
-  (let ((axis (place-axis box)))
-    (goto-xy (behind box axis (my-side)))
-    (rotate 'to axis)))
+;; Whether this robot stands at its place, against the box's face.
+(define (at-place? box side)
+  (let ((off (offsets-to box (place-axis box) (* side pusher-offset))))
+    (and (< -120 (car off) 30) (< (abs (cadr off)) 70)
+         (< (abs (wrap (- (place-axis box) (list-ref (reckon) 2)))) 20))))
 
-(define (place-axis box) (box-axis box (heading-to box (aim-point box))))
+;; What the pusher hears: the round its partner last said it was at the
+;; face ('here), and the last round it said how far it still had to come
+;; ((coming MM)).
+(define tick 0)
+(define partner-here -100)
+(define partner-coming -100)
+(define partner-coming-mm #f)
 
-;; A spare comes up to its place from well behind it and out to its side,
-;; so as not to cross the other pusher's way.
-(define (come-up-to-place box)
-  (let* ((axis (place-axis box)) (a (* axis degrees)) (side (my-side))
-         (place (behind box axis side)))
-    (goto-xy (list (- (car place) (* 700 (cos a)) (* side 300 (sin a)))
-                   (+ (- (cadr place) (* 700 (sin a))) (* side 300 (cos a)))))
-    (go-to-place box)))
-
-;; The other pusher, and the rounds since it last said it was there.
-(define (partner) (list-ref (step-team) (if (= (my-side) 1) 1 0)))
-(define partner-silent 0)
-
-;; The newest sighting the watcher sent, or last when none came; the
-;; partner's word that it is there is counted.
+;; The newest view the watcher sent, (BOX BODIES), or last when none came.
 (define (latest last)
-  (let ((heard (guard (e (#t #f)) (team-receive 0.05))))
-    (cond ((not heard) last)
-          ((eq? (cdr heard) 'here) (set! partner-silent 0) (latest last))
-          ((pair? (cdr heard)) (latest (cdr heard)))
-          (else (latest last)))))
+  (let ((heard (guard (e (#t #f)) (team-receive 0.03))))
+    (if (not heard)
+        last
+        (let ((m (cdr heard)))
+          (cond ((and (pair? m) (eq? (car m) 'box)) (latest (cdr m)))
+                ((eq? m 'here) (set! partner-here tick) (latest last))
+                ((and (pair? m) (eq? (car m) 'coming))
+                 (set! partner-coming tick)
+                 (set! partner-coming-mm (cadr m))
+                 (latest last))
+                (else (latest last)))))))
 
-;; Each round a pusher tells its partner it is there.  A pusher lost is
-;; replaced by a spare, which comes up to its place wherever the box is;
-;; meanwhile the other pushes alone (steer!).
+;; Each round a pusher at the box tells its partner it is there, and a
+;; spare on its way how far it has to come.  A spare pushes only once it
+;; is at the face; until then the other pushes alone (steer!).
 (define (push previous)
   (team-barrier 'push 120)
-  ;; A spare that took over midway is not yet behind the box.
-  (let ((box (latest (see-box))))
-    (if (and box (> (distance (reckon) (behind box (place-axis box) (my-side))) 300))
-        (come-up-to-place box)))
-  (set! partner-silent 0)
-  (let ((watcher (list-ref (step-team) 2)))
-    (let loop ((box (latest (see-box))) (n 0))
-      (team-send! (partner) 'here)
-      (set! partner-silent (+ partner-silent 1))
-      (cond
-       ((and box (arrived? box))
-        (set-velocity 0 0)
-        (team-send! watcher 'done)
-        (local-aspace-uid))
-       ((> n 1500) (set-velocity 0 0) (team-send! watcher 'done) 'gave-up)
-       (else
-        (if box (steer! box (<= partner-silent 3)))
-        (thread-sleep! 0.1)
-        (loop (latest box) (+ n 1)))))))
+  (sonar-start)
+  (let ((watcher (list-ref (step-team) 2)) (side (my-side))
+        (own (see-box)))
+    (let loop ((view (latest (and own (list own '())))) (at-face? #f) (n 0))
+      (set! tick n)
+      (if (= 0 (modulo n 5))
+          (let ((me (reckon)))
+            (set! team (step-team))
+            (team-send! watcher (list 'at (car me) (cadr me)))))
+      (thread-sleep! 0.05)
+      (let ((box (and view (car view))))
+        (cond
+         ((and box (arrived? box))
+          (stop-base)
+          (team-send! watcher 'done)
+          (list (local-aspace-uid) (role side)))
+         ((> n 6000)
+          (stop-base)
+          (team-send! watcher 'done)
+          (error "push: the box did not reach the goal" box))
+         ((not box) (stop-base) (loop (latest view) at-face? (+ n 1)))
+         ((or (and at-face? (< (distance (reckon) (place-of box side)) 600))
+              (at-place? box side))
+          (team-send! (partner) 'here)
+          (steer! view side)
+          (loop (latest view) #t (+ n 1)))
+         (else
+          (team-send! (partner) (list 'coming (if waypoint
+                                                  (distance (reckon) (place-of box side))
+                                                  1e9)))
+          (approach! view side n)
+          (loop (latest view) #f (+ n 1))))))))
 
-;; Each pusher keeps to its place at the box's rear face and drives along
-;; the box's axis, hurrying when it has fallen behind its place.  Two
-;; pushers stand pusher-offset to either side of the middle, and the box
-;; turns toward the path when the one on the far side of the turn pushes
-;; harder.  A pusher alone (its partner silent for three rounds) turns the
-;; box by where it pushes: at the middle of the face to go straight, to
-;; the right of it to turn left; at one corner, at full speed, it would
-;; drag the box off its path.
-(define (steer! box paired?)
-  (let* ((side (my-side))
+;; Two pushers stand pusher-offset to either side of the middle, and the
+;; box turns toward the path when the one on the far side of the turn
+;; pushes harder.  A pusher alone (its partner has not said it is at the
+;; face for three rounds) turns the box by where it pushes on its own half
+;; (lone-offset).  A spare coming turns the box the most: once the spare
+;; has a way to its place, the lone pusher holds at its own, leaving the
+;; spare's free.
+(define (steer! view side)
+  (let* ((box (car view)) (bodies (cadr view))
          (d (heading-to box (aim-point box)))
-         (axis (box-axis box d))
-         (err (wrap (- d axis)))                ; > 0: the box must turn left
-         (a (* axis degrees))
-         (slot (behind-at box axis (if paired?
-                                       (* side pusher-offset)
-                                       (clip (* -8 err) pusher-offset))))
-         (me (reckon))
-         (dx (- (car me) (car slot))) (dy (- (cadr me) (cadr slot)))
-         (lag (- (+ (* dx (cos a)) (* dy (sin a)))))      ; behind the place
-         (across (- (* dy (cos a)) (* dx (sin a))))       ; left of it
-         (turn (wrap (- (- axis (clip (* 0.15 across) 25)) (list-ref me 2))))
-         (speed (* push-speed (slowing box)
-                   (+ (if paired? (clip (- 1 (* 0.05 side err)) 0.3 1.7) 0.5)
-                      (clip (/ lag 100) 0 1)))))
-    (set-velocity speed (clip (* 2 turn) 40))))
+         (axis (place-axis box))
+         (err (wrap (- d axis))))               ; > 0: the box must turn left
+    (cond ((< (- tick partner-here) 4)
+           (push-at! box axis (* side pusher-offset)
+                     (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
+          ((spare-on-its-way?) (push-at! box axis (* side pusher-offset) 0))
+          (else (push-at! box axis (lone-offset box axis side err bodies) 0.5)))))
+
+;; Whether a spare said lately that it has a way to its place.
+(define (spare-on-its-way?)
+  (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
+
+;; Where a pusher alone on side pushes, mm left of the middle, for a box
+;; that must turn err degrees left: the middle, within 4 degrees, else to
+;; the side that turns it, as far as its own half of the face goes: it
+;; never crosses the middle, and it keeps its distance from a lost
+;; pusher's body, which would stop it.
+(define (lone-offset box axis side err bodies)
+  (let loop ((offset (* side (max 0 (* side (if (< (abs err) 4)
+                                                 0
+                                                 (clip (* -8 err) pusher-offset)))))))
+    (if (or (>= (* side offset) pusher-offset)
+            (clear-of? bodies (list (behind-at box axis offset))))
+        offset
+        (loop (+ offset (* side 20))))))
+
+;; Whether every point is a robot's width and a margin (20 mm, or the one
+;; given: a spare may nudge a body at its place) from every body.
+(define (clear-of? bodies points . margin)
+  (let ((room (+ body-radius body-radius (if (pair? margin) (car margin) 20))))
+    (every (lambda (b) (every (lambda (p) (> (distance b p) room)) points))
+           bodies)))
+
+;; Pushes at share of push-speed at the place offset mm left of the middle
+;; of the box's rear face, hurrying when it has fallen behind it.  A pusher
+;; far to the side of that place backs off the face to cross it: one
+;; sliding across a face while it pushes turns the box the wrong way.
+(define (push-at! box axis offset share)
+  (let* ((off (offsets-to box axis offset)) (ahead (car off)) (left (cadr off)))
+    (cond ((<= (abs left) 100)
+           (drive-along! axis ahead left
+                         (* push-speed (slowing box) (+ share (clip (/ ahead 100) 0 1)))))
+          ((< ahead 190)                        ; back off straight
+           (set-velocity -150 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
+          (else (drive-to! (behind-at box axis offset
+                                      (+ box-half body-radius face-gap 250)))))))
+
+
+;; Sets the velocities that bring the robot, heading along axis, to a
+;; point ahead and left of it (mm, in the axis's frame): forward at speed,
+;; turning toward the point, or back when it is well behind.
+(define (drive-along! axis ahead left speed)
+  (let ((turn (wrap (- (+ axis (clip (* 0.15 left) 25)) (list-ref (reckon) 2)))))
+    (set-velocity (if (< ahead -80) (max -200 (* 2 ahead)) speed) (clip (* 2 turn) 40))))
+
+;; Sets the velocities that bring the robot to point p; it turns in place
+;; first.
+(define (drive-to! p)
+  (let* ((me (reckon)) (turn (wrap (- (heading-to me p) (list-ref me 2)))))
+    (set-velocity (* (min 300 (* 2 (distance me p)))
+                     (max 0 (- (* 2 (cos (* turn degrees))) 1)))
+                  (clip (* 2 turn) 60))))
+
+;;; Finding a way to the place
+
+;; Comes to the place on side at the box of view, (BOX BODIES): along a
+;; planned way (plan-way) to a staging point, then into the place: along
+;; the box's axis from a point behind it, or, when a body lies right behind
+;; the place, along the face from a point beside it, turning in place there.
+(define stage-back 450)
+(define docking #f)             ; the staging point reached, while docking
+(define waypoint #f)
+
+(define (approach! view side n)
+  (let* ((box (car view)) (axis (place-axis box)) (offset (* side pusher-offset))
+         (off (offsets-to box axis offset)) (place (behind-at box axis offset))
+         (stage (staging box axis offset (cadr view))))
+    (if (and stage (< (distance (reckon) (car stage)) 150))
+        (set! docking (cdr stage)))
+    (cond ((and (eq? docking 'behind) (< -150 (car off) (+ stage-back 200))
+                (< (abs (cadr off)) 400))
+           (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
+          ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
+           (if (> (distance (reckon) place) 40)
+               (drive-to! place)
+               (set-velocity 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
+          (else
+           (set! docking #f)
+           (if (or (not waypoint) (= 0 (modulo n 5)))
+               (set! waypoint (and stage (plan-way (car stage) box (cadr view)))))
+           (if waypoint (drive-to! waypoint) (stop-base))))))
+
+;; Where to come up to the place offset mm left of the middle from, as
+;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
+;; nearer, or out to its side, whichever first is clear of the bodies;
+;; beside it, 450 mm out, when a body lies right behind it.  #f when the
+;; place itself is not clear.
+(define (staging box axis offset bodies)
+  (let ((out (if (< offset 0) -1 1)))
+    (define (clear p kind) (and (clear-of? bodies (list p)) (cons p kind)))
+    (and (clear-of? bodies (list (behind-at box axis offset)) -40)
+         (or (any (lambda (back)
+                    (clear (behind-at box axis offset
+                                      (+ box-half body-radius face-gap back))
+                           'behind))
+                  (list stage-back (- stage-back 100) (- stage-back 200)))
+             (clear (behind-at box axis (+ offset (* out 450))) 'beside)))))
+
+;; A point some 400 mm along a shortest way from here to goal, on a grid of
+;; cells 100 mm square, that keeps clear of the box, of the bodies (X Y)
+;; and of what the sonar echoes; #f when there is none.  goal has been
+;; found clear (staging): its own cell, as start's, may be marked.
+(define cell 100)
+(define (plan-way goal box bodies)
+  (let* ((me (reckon)) (margin 1500)
+         (x0 (- (min (car me) (car goal)) margin))
+         (y0 (- (min (cadr me) (cadr goal)) margin))
+         (nx (cells-across (car me) (car goal) margin))
+         (ny (cells-across (cadr me) (cadr goal) margin))
+         (blocked (make-vector (* nx ny) #f))
+         (cell-of (lambda (p) (+ (exact (round (/ (- (car p) x0) cell)))
+                                 (* nx (exact (round (/ (- (cadr p) y0) cell))))))))
+    (define (paint! p r)
+      (let ((i0 (exact (round (/ (- (car p) x0) cell))))
+            (j0 (exact (round (/ (- (cadr p) y0) cell))))
+            (k (exact (ceiling (/ r cell)))))
+        (do ((i (- i0 k) (+ i 1))) ((> i (+ i0 k)))
+          (do ((j (- j0 k) (+ j 1))) ((> j (+ j0 k)))
+            (if (and (< -1 i nx) (< -1 j ny)
+                     (<= (* cell cell (+ (square (- i i0)) (square (- j j0)))) (* r r)))
+                (vector-set! blocked (+ i (* nx j)) #t))))))
+    (paint-box! paint! box)
+    (for-each (lambda (b) (paint! b (+ body-radius body-radius))) bodies)
+    (for-each (lambda (e) (paint! e (+ body-radius 80))) (echoes me box))
+    (let ((start (cell-of me)) (end (cell-of goal)))
+      (let ((from (breadth-first blocked nx ny end start)))
+        (and from
+             (let follow ((c start) (k 4))
+               (if (or (= k 0) (= c end))
+                   (list (+ x0 (* cell (modulo c nx))) (+ y0 (* cell (quotient c nx))))
+                   (follow (vector-ref from c) (- k 1)))))))))
+
+;; The cells from a to b and margin beyond each.
+(define (cells-across a b margin)
+  (+ 1 (exact (ceiling (/ (+ (abs (- a b)) margin margin) cell)))))
+
+;; Marks the box, grown by a body's radius and a margin, with paint!.
+(define (paint-box! paint! box)
+  (let* ((a (* (list-ref box 2) degrees)) (reach (+ box-half body-radius 60)))
+    (do ((u (- reach) (+ u (/ cell 2)))) ((> u reach))
+      (do ((v (- reach) (+ v (/ cell 2)))) ((> v reach))
+        (paint! (list (+ (car box) (* u (cos a)) (* v (- (sin a))))
+                      (+ (cadr box) (* u (sin a)) (* v (cos a))))
+                0)))))
+
+;; The sonar's echoes within 2.5 m of the ring, as points in the room, less those of
+;; the box itself.
+(define (echoes me box)
+  (let ((a (* (list-ref box 2) degrees)))
+    (let loop ((i 0) (ranges (sonar-read)) (out '()))
+      (if (null? ranges)
+          out
+          (let* ((r (+ (car ranges) body-radius))   ; the ring is at the body's edge
+                 (t (* degrees (+ (list-ref me 2) (* i 22.5))))
+                 (p (list (+ (car me) (* r (cos t))) (+ (cadr me) (* r (sin t)))))
+                 (dx (- (car p) (car box))) (dy (- (cadr p) (cadr box)))
+                 (in-box? (and (< (abs (+ (* dx (cos a)) (* dy (sin a))))
+                                  (+ box-half 150))
+                               (< (abs (- (* dy (cos a)) (* dx (sin a))))
+                                  (+ box-half 150)))))
+            (loop (+ i 1) (cdr ranges)
+                  (if (or (> (car ranges) 2500) in-box?) out (cons p out))))))))
+
+;; Each cell's next cell on a shortest way to end, by a breadth-first
+;; search from end over free cells and their eight neighbours, until it
+;; reaches start; #f when it does not.
+(define (breadth-first blocked nx ny end start)
+  (let ((from (make-vector (* nx ny) #f)) (queue (make-vector (* nx ny) 0)))
+    (vector-set! from end end)
+    (vector-set! queue 0 end)
+    (let loop ((head 0) (tail 1))
+      (cond ((vector-ref from start) from)
+            ((= head tail) #f)
+            (else
+             (let* ((c (vector-ref queue head)) (i (modulo c nx)) (j (quotient c nx)))
+               (let next ((ds '((1 0) (-1 0) (0 1) (0 -1) (1 1) (1 -1) (-1 1) (-1 -1)))
+                          (tail tail))
+                 (if (null? ds)
+                     (loop (+ head 1) tail)
+                     (let* ((i2 (+ i (car (car ds)))) (j2 (+ j (cadr (car ds))))
+                            (c2 (+ i2 (* nx j2))))
+                       (if (and (< -1 i2 nx) (< -1 j2 ny) (not (vector-ref from c2))
+                                (or (= c2 start) (not (vector-ref blocked c2))))
+                           (begin (vector-set! from c2 c)
+                                  (vector-set! queue tail c2)
+                                  (next (cdr ds) (+ tail 1)))
+                           (next (cdr ds) tail)))))))))))
 
 (define (clip x lo . hi)
   (if (pair? hi) (max lo (min (car hi) x)) (max (- lo) (min lo x))))
@@ -183,13 +520,8 @@
 ;; past the point of it nearest the box, or the goal.
 (define lookahead 700)
 (define (aim-point box)
-  (let loop ((legs box-path) (best #f) (best-d #f))
-    (if (or (null? legs) (null? (cdr legs)))
-        (along-path best (+ (leg-position box (car best) (cadr best)) lookahead))
-        (let ((d (leg-distance box (car legs) (cadr legs))))
-          (if (or (not best-d) (< d best-d))
-              (loop (cdr legs) legs d)
-              (loop (cdr legs) best best-d))))))
+  (let ((legs (nearest-legs box)))
+    (along-path legs (+ (leg-position box (car legs) (cadr legs)) lookahead))))
 
 ;; How far along the leg from a to b the point of it nearest p is, mm.
 (define (leg-position p a b)
@@ -217,18 +549,16 @@
   (start-steps 'box-move
                (task-step (list '((mobile fiducial) ()) '((mobile fiducial) ())
                                 '((fiducial) ()))
-                          (list (location-metric-maker '(-2000 400 0 0))
-                                (location-metric-maker '(-2000 -400 0 0))
-                                (location-metric-maker '(0 2500 0 0)))
+                          (list (asking left-place-distance) (asking right-place-distance)
+                                (asking path-middle-distance))
                           (list take-place take-place watch-place)
                           '(3 2 1) '(#t #t #f))
-               ;; Negotiated again, by the places taken: the robots behind
-               ;; the box win, and a pusher lost is replaced by the nearest
-               ;; capable robot left.
+               ;; Negotiated again by the same metrics: the robots at the
+               ;; places just taken win, and a pusher lost is replaced by the
+               ;; capable robot left nearest its place at the box as it is.
                (task-step (list '((mobile fiducial) ()) '((mobile fiducial) ())
                                 '(same 1 3))
-                          (list (location-metric-maker '(-2040 170 0 0))
-                                (location-metric-maker '(-2040 -170 0 0))
+                          (list (asking left-place-distance) (asking right-place-distance)
                                 #f)
                           (list push push watch)
                           '(2 1 3) '(#t #t #f))))

@@ -1,0 +1,65 @@
+;;; The cases of the box team (examples/box-move.scm, docs/box-move.md),
+;;; included by tests/box-move*-test.scm, one case each, which tests/run
+;;; runs one by one: each case is
+;;; `make demo-box`'s run, in the lab's fast-forward simulator, on a port
+;;; base of its own, judged by examples/box-judge.scm from the simulator's
+;;; own word: the box must end within 300 mm of the path's goal and 20
+;;; degrees of its heading, and with a fault the spare, the robot the lost
+;;; pusher's component went to, must have been at the box's rear face for
+;;; the last third of the distance the box moved.  The including file
+;;; imports what it needs.
+
+;; The demo's output, and whether it exited 0, for LAB with FAULT ("" for
+;; none, or a role: inside, outside).
+(define (run-demo lab fault)
+  (let* ((dir (temporary-directory)) (out (string-append dir "/demo.out"))
+         (status
+          (system? "sh" "-c"
+                   (string-append
+                    "cd \"$0\" && MURDOCH_PORT_BASE=$1 MURDOCH_DEMO_FAULT=$4"
+                    " MURDOCH_DEMO_TASK=\"$2/examples/pose-box-move.scm\""
+                    " MURDOCH_DEMO_JUDGE=\"$2/examples/box-judge.scm\""
+                    " timeout -s KILL 280 \"$2/bin/murdoch\" demo \"$2/$5\" >\"$3\" 2>&1")
+                   dir (number->string (free-port-base dir)) (tool-path ".") out
+                   fault lab))
+         (text (file-text out)))
+    (delete-file-hierarchy dir)
+    (cons status text)))
+
+;; The number after "bench: NAME " in text, or #f.
+(define (bench text name)
+  (let ((prefix (string-append "bench: " name " ")))
+    (any (lambda (line)
+           (and (>= (string-length line) (string-length prefix))
+                (string=? prefix (substring line 0 (string-length prefix)))
+                (read (open-input-string (substring line (string-length prefix)
+                                                    (string-length line))))))
+         (text-lines text))))
+
+;; One case: LAB's demo with FAULT, its assertions in a group of their own.
+(define (box-case lab fault)
+  (let* ((run (run-demo lab fault)) (status (car run)) (text (cdr run))
+         (name (if (string=? fault "") "box-move" "box-move-fault")))
+    (test-group (string-append lab (if (string=? fault "")
+                                       ""
+                                       (string-append ", " fault " pusher killed")))
+      (test "the box arrives: within 300 mm of the goal and 20 degrees of its heading" #t
+        (text-contains? text "within 300 mm and 20 degrees"))
+      (test-assert "its goal error, a bench line, is at most 300 mm"
+        (let ((mm (bench text (string-append name "-goal-error-mm"))))
+          (and (real? mm) (<= mm 300))))
+      (test-assert "both steps ran, the second to its end"
+        (text-contains? text ": step 2 done: ("))
+      (if (not (string=? fault ""))
+          (begin
+            (test-assert "a pusher was killed"
+              (text-contains? text "demo: FAULT: killing "))
+            (test-assert "its component went to a spare"
+              (text-contains? text " reassigned from "))
+            (test "the spare pushed for the last third of the way" #t
+              (text-contains? text ": it pushed"))
+            (test-assert "box-move-spare-push-mm, a bench line, is above nought"
+              (let ((mm (bench text "box-move-spare-push-mm")))
+                (and (real? mm) (> mm 0))))))
+      (test "the demo says so by its exit status" #t status))
+    (if (not status) (display text))))

@@ -1,0 +1,11 @@
+;;; The box team on the example lab, the inside pusher killed midway (FAULT=1).
+;;; One case a file: tests/run gives each file 300 s.  tests/box-move-cases.scm.
+(import (scheme base) (scheme write) (scheme read) (srfi 1) (chibi test)
+        (only (chibi process) system?)
+        (only (chibi filesystem) delete-file-hierarchy)
+        (murdoch testing))
+(include "tests/box-move-cases.scm")   ; tests/run runs from the top
+(test-begin "box move, the inside pusher lost")
+(box-case "examples/box-lab.scm" "inside")
+(test-end)
+(test-exit)
