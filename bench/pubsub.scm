@@ -173,6 +173,11 @@
 (define (measure-lab n)
   (let ((task (eval '(dual-sonar-task) (lab-environment))))
     (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
+    ;; A lab of hundreds connects one address space after another within
+    ;; a request's timeout; on a loaded machine it takes a few requests.
+    (let warm ((tries 30))
+      (if (and (> tries 0) (< (length (request 'all (lambda () #t))) n))
+          (warm (- tries 1))))
     (report "request-latency" n
             (median-ms 50 (lambda ()
                             (let ((answers (request 'all (lambda () #t))))
