@@ -1,7 +1,8 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-sim bench-alloc bench-chaos bench-sched demo demo-box clean
+.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
+	demo demo-box clean
 
 all: deps
 	$(MAKE) native
@@ -19,6 +20,10 @@ test: all
 
 bench: all
 	bench/run
+
+# Labs of 64, 128 and 256 address spaces (about ten minutes, 10 GB).
+bench-scale: all
+	bench/scale
 
 bench-sim: all
 	$(MAKE) -C sim bench

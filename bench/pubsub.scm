@@ -17,6 +17,9 @@
 ;; Medians over many runs.  Usage: tools/chibi bench/pubsub.scm N [multicast]
 ;; (one lab a process: an address space joins one lab); bench/run runs 4, 16
 ;; and 64, by simulated broadcast and by multicast (NAME-mcast-NN).
+;; With "scale" after N (bench/scale) it also prints lab-start-seconds-NN,
+;; from the first address space's start to the last's port open, and
+;; aspace-rss-mb-NN, the median address space's resident memory.
 ;; With "busy SECONDS" after N it measures nothing: it prints "busy" and the
 ;; lab's pids, sends requests to all back to back for that long, then prints
 ;; "requests K in SECONDS s", for bench/profile to sample the lab meanwhile.
@@ -27,7 +30,8 @@
         (only (chibi time) get-resource-usage resource-usage/self
               resource-usage-time resource-usage-system-time
               timeval-seconds timeval-microseconds)
-        (only (murdoch trip-client) split-words)
+        (only (murdoch trip-client) split-words) (scheme read)
+        (only (chibi string) string-prefix?)
         (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
 
 (define (aspace-clause i)
@@ -42,8 +46,11 @@
 (define (start-lab n delivery)
   (let ((lab (make-test-lab
               `((code ,(tool-path "examples/dual-sonar.scm")) ,@delivery
+                ,@(if scale? (scale-settings n) '())
                 (aspace bencher)
-                ,@(map aspace-clause (iota n 1))))))
+                ,@(map aspace-clause (iota n 1)))))
+        (started (current-second)))
+    (if scale? (move-lab! lab scale-port-base))
     (set! lab-pids
           (map (lambda (i)
                  (start-process!
@@ -55,12 +62,60 @@
     (for-each (lambda (i)
                 ;; Sixty-four address spaces starting at once take a
                 ;; minute of two cores, more while others' tests run.
-                (if (not (wait-for-port (+ (test-lab-port-base lab) i) 300))
+                (if (not (wait-for-port (+ (if scale? scale-port-base
+                                                 (test-lab-port-base lab))
+                                             i)
+                                          900))
                     (begin (stop-all-processes!)
                            (error "an address space did not start; see its log"
                                   (test-lab-directory lab) i))))
               (iota n 1))
+    (if scale? (report "lab-start-seconds" n (- (current-second) started) "s"))
     lab))
+
+;;; bench-scale: labs of 64 to 256 (bench/scale)
+
+;; A lab past 64 on one host needs more connections than the lab's
+;; defaults allow from one host: the requester's to each, and each one's
+;; back to the requester.
+(define (scale-settings n)
+  `((max-connections ,(* 2 (+ n 8))) (max-connections-per-host ,(* 2 (+ n 8)))))
+
+;; Ports past 200 from a base would run into the next base that
+;; tools/free-port-base hands out, so a lab of more is put below its
+;; range, at MURDOCH_SCALE_PORT_BASE (default 7000): one bench-scale at
+;; a time on a machine.
+(define scale-port-base
+  (string->number (or (get-environment-variable "MURDOCH_SCALE_PORT_BASE")
+                      "7000")))
+
+(define (move-lab! lab base)
+  (let* ((file (test-lab-file lab))
+         (form (call-with-input-file file read)))
+    (call-with-output-file file
+      (lambda (out)
+        (write-simple (map (lambda (clause)
+                             (if (and (pair? clause) (eq? (car clause) 'port-base))
+                                 (list 'port-base base)
+                                 clause))
+                           form)
+                      out)))))
+
+;; Median resident memory of the lab's address spaces, in MB (Linux's
+;; /proc/PID/status).
+(define (resident-mb pid)
+  (call-with-input-file (string-append "/proc/" (number->string pid) "/status")
+    (lambda (in)
+      (let loop ()
+        (let ((line (read-line in)))
+          (cond ((eof-object? line) 0)
+                ((string-prefix? "VmRSS:" line)
+                 (/ (string->number (cadr (split-words line))) 1024.))
+                (else (loop))))))))
+
+(define (report-resident n)
+  (let ((mbs (list-sort < (map resident-mb lab-pids))))
+    (report "aspace-rss-mb" n (list-ref mbs (quotient (length mbs) 2)) "MB")))
 
 (define (median-ms runs thunk) (* 1000 (median-seconds runs thunk)))
 
@@ -118,6 +173,11 @@
 (define (measure-lab n)
   (let ((task (eval '(dual-sonar-task) (lab-environment))))
     (median-ms 5 (lambda () (request 'all (lambda () #t))))    ; warm-up
+    ;; A lab of hundreds connects one address space after another within
+    ;; a request's timeout; on a loaded machine it takes a few requests.
+    (let warm ((tries 30))
+      (if (and (> tries 0) (< (length (request 'all (lambda () #t))) n))
+          (warm (- tries 1))))
     (report "request-latency" n
             (median-ms 50 (lambda ()
                             (let ((answers (request 'all (lambda () #t))))
@@ -151,11 +211,13 @@
          (done (lambda () (stop-all-processes!) (remove-test-lab! lab))))
     (guard (e (#t (done) (raise e)))
       (join-lab (test-lab-file lab) 'bencher)
-      (if busy-seconds (keep-busy busy-seconds) (measure-lab n)))
+      (if busy-seconds (keep-busy busy-seconds) (measure-lab n))
+      (if scale? (report-resident n)))
     (done)))
 
 (define options (cddr (command-line)))
 (define multicast? (member "multicast" options))
+(define scale? (member "scale" options))
 (define suffix (if multicast? "-mcast-N" "-N"))
 (bench-lab (string->number (cadr (command-line)))
            (if multicast? '((delivery multicast "239.255.77.7")) '())

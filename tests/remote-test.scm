@@ -6,7 +6,9 @@
               open-output-file-descriptor)
         (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
         (murdoch netstring) (murdoch hmac) (murdoch connect) (murdoch testing)
-        (murdoch raw))
+        (murdoch raw)
+        (only (murdoch wait) make-mailbox mailbox-put! mailbox-take)
+        (only (murdoch scheduler) monotonic-seconds))
 
 (define shared-code "
 (define *counter* 0)
@@ -339,6 +341,76 @@
                                   (remote-apply (uid->aspace 'tester)
                                                 (lambda () 'too-late))))))))
       (wait-until 10 (lambda () (var-ref 'troy *last-abandoned*))))))
+
+;; A callee played by hand, as uid, at the lab's port base plus offset,
+;; where no address space is (so that no prober calls it): it welcomes
+;; one caller, reads its call, hands (answer! conn caller-nonce id) the
+;; rest, and closes.
+(define (hand-address offset)
+  (get-address-info "127.0.0.1" (+ (test-lab-port-base lab) offset)))
+
+(define (hand-played-callee uid offset answer!)
+  (let* ((address (hand-address offset))
+         (listener (make-listener-socket address 5)))
+    (thread-start!
+     (make-thread
+      (lambda ()
+        (let* ((fd (accept listener (address-info-address address)
+                           (address-info-address-length address)))
+               (conn (cons (open-input-file-descriptor fd #t)
+                           (open-output-file-descriptor fd #t)))
+               (caller-nonce (list-ref (raw-answer conn) 4)))
+          (close-port (open-input-file-descriptor listener))
+          (raw-send! conn (counted key caller-nonce 0 `(welcome ,uid "h1")))
+          (answer! conn caller-nonce (cadr (raw-answer conn)))
+          (raw-close! conn)))))))
+
+(define (call-hand uid offset)
+  (thread-start!
+   (make-thread
+    (lambda ()
+      (parameterize ((remote-timeout 10))
+        (error-text
+         (lambda ()
+           (remote-apply (make-aspace uid "127.0.0.1"
+                                      (+ (test-lab-port-base lab) offset))
+                         (lambda () 1)))))))))
+
+(test-group "one poller reads every connection"
+  ;; The answer comes in two writes; between them, another address space
+  ;; is called and answers: the half frame holds up no other connection.
+  (let* ((half-sent (make-mailbox))
+         (go-on (make-mailbox))
+         (hand (hand-played-callee
+               'hand 50
+                 (lambda (conn nonce id)
+                   (let* ((bytes (counted key nonce 1 `(error ,id "in pieces")))
+                          (n (bytevector-length bytes)))
+                     (raw-send! conn (bytevector-copy bytes 0 (- n 7)))
+                     (mailbox-put! half-sent #t)
+                     (mailbox-take go-on (+ (monotonic-seconds) 10) (lambda () #f))
+                     (raw-send! conn (bytevector-copy bytes (- n 7) n))))))
+         (caller (call-hand 'hand 50)))
+    (mailbox-take half-sent (+ (monotonic-seconds) 10) (lambda () #f))
+    (test "another address space answers while a frame is half read" 5
+      (remote-apply (troy) (lambda () 5)))
+    (mailbox-put! go-on #t)
+    (test "and the frame, once whole, answers its call" "in pieces"
+      (thread-join! caller))
+    (thread-join! hand))
+  ;; A frame that is not a netstring: its connection closes, its call
+  ;; hears so, and the others carry on.
+  (let* ((hand (hand-played-callee
+               'breaker 51
+                 (lambda (conn nonce id)
+                   (raw-send! conn (string->utf8 "12x:not a netstring,")))))
+         (caller (call-hand 'breaker 51)))
+    (test "a callee that breaks the wire fails only its own calls"
+        "connection lost"
+      (thread-join! caller))
+    (test "and the others carry on" 6
+      (remote-apply (troy) (lambda () 6)))
+    (thread-join! hand)))
 
 (test-end)
 (stop-all-processes!)

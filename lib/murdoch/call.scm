@@ -10,46 +10,44 @@
          (proc-code (encode proc (lab-environment) "the procedure"))
          (args-code (encode-arguments args))
          (deadline (+ (monotonic-seconds) seconds)))
-    (finish-call (start-call a kind proc-code args-code deadline)
-                 deadline seconds proc)))
+    (let ((g (make-gathering)))
+      (finish-call (start-call a kind proc-code args-code deadline g)
+                   g deadline seconds proc))))
 
-;; A call on its way: where it went, and the mailbox its answer will reach.
-(define-record-type pending-call
-  (make-pending-call uid connection id mailbox)
-  pending-call?
-  (uid pending-call-uid)
-  (connection pending-call-connection)
-  (id pending-call-id)
-  (mailbox pending-call-mailbox))
-
-(define (start-call a kind proc-code args-code deadline)
+;; A call sent, its answer to come to gathering g.
+(define (start-call a kind proc-code args-code deadline g)
   (undo-on-raise
    (lambda () (note-unreachable! (aspace-uid a)))
    (lambda ()
-     (let* ((c (connection-to a deadline))
-            (sent (send-call! c kind proc-code args-code)))
-       (make-pending-call (aspace-uid a) c (car sent) (cdr sent))))))
+     (send-call! (connection-to a deadline) kind proc-code args-code g))))
 
 ;; The answer to a pending call, by the deadline (on the monotonic
 ;; clock), which is \var{seconds} after the call began: the value, or a
 ;; remote-error.
-(define (finish-call p deadline seconds proc)
-  (await-answer (pending-call-uid p) (pending-call-mailbox p) deadline seconds
-                proc
-                (lambda ()
-                  (give-up-call! (pending-call-connection p) (pending-call-id p)))))
+(define (finish-call p g deadline seconds proc)
+  (await-answers g (list p) deadline)
+  (answer-value p seconds proc))
 
-;; The answer that uid puts in mailbox mb to a call of proc, by the
-;; deadline: the value, or a remote-error.  (forget) runs when none came,
-;; by the deadline or because the wait was interrupted (Ctrl-C).
+;; Waits until each pending call of ps has its answer, or the deadline
+;; has passed.  A wait interrupted (Ctrl-C) gives up every call that has
+;; none.
+(define (await-answers g ps deadline)
+  (undo-on-raise
+   (lambda () (for-each give-up! ps))
+   (lambda () (gathering-wait g (length ps) deadline))))
+
+;; Forgets p, unless its answer came, and tells its callee.
+(define (give-up! p)
+  (if (and (not (pending-call-answer p)) (pending-call-connection p))
+      (give-up-call! (pending-call-connection p) (pending-call-id p))))
+
+;; What the answer of pending call p to a call of proc says: the value, or
+;; a remote-error; none came within seconds, and p is given up.
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
-(define (await-answer uid mb deadline seconds proc forget)
-  (let ((answer (undo-on-raise
-                 forget
-                 (lambda ()
-                   (mailbox-take mb deadline
-                                 (lambda () (timed-out uid proc seconds)))))))
-    (match answer
+(define (answer-value p seconds proc)
+  (let ((uid (pending-call-uid p)))
+    (match (pending-call-answer p)
+      (#f (give-up! p) (timed-out uid proc seconds))
       (('ack . _) #t)
       (('value id value) (decode-value value))
       (('error id message)
@@ -89,6 +87,7 @@
 
 (define (send-all aspaces kind proc args proc-code args-code seconds)
   (let* ((deadline (+ (monotonic-seconds) seconds))
+         (g (make-gathering))
          (started
           (capture-each aspace-uid
                         (lambda (a)
@@ -96,15 +95,18 @@
                                 (if (local? a)
                                     (local-call kind proc args)
                                     (start-call a kind proc-code args-code
-                                                deadline))))
+                                                deadline g))))
                         aspaces)))
+    (await-answers g (filter-map started-call started) deadline)
     (capture-each car
                   (lambda (s)
-                    (if (and (cadr s) (pending-call? (car (cddr s))))
-                        (list (car s) #t
-                              (finish-call (car (cddr s)) deadline seconds proc))
-                        s))
+                    (let ((p (started-call s)))
+                      (if p (list (car s) #t (answer-value p seconds proc)) s)))
                   started)))
+
+;; The pending call of an entry of send-all's, if it started one.
+(define (started-call s)
+  (and (cadr s) (pending-call? (car (cddr s))) (car (cddr s))))
 
 ;; A call to this address space is a remote call too: an abandoned thread
 ;; stops at it (abandon.scm), as a component cut off from its poser whose
@@ -192,18 +194,20 @@
 ;; is answered by each address space over its own connection, with an
 ;; answer frame, which that connection's reader hands here.
 
-(define *datagram-calls* (make-hash-table eqv?)) ; id -> ((uid . mailbox) ...)
+(define *datagram-calls* (make-hash-table eqv?)) ; id -> (pending-call ...)
 (define *datagram-calls-lock* (make-mutex 'datagram-calls))
 (define *next-datagram-id* 0)
 
-;; A new datagram call's id, whose answers from each of uids will reach
-;; their mailboxes in waiting, ((uid . mailbox) ...).
-(define (expect-answers! waiting)
+;; A new datagram call's id, whose answers from each of uids will come to
+;; gathering g; answers it and their pending calls, in the order of uids.
+(define (expect-answers! uids g)
   (with-lock *datagram-calls-lock*
     (lambda ()
       (set! *next-datagram-id* (+ *next-datagram-id* 1))
-      (hash-table-set! *datagram-calls* *next-datagram-id* waiting)
-      *next-datagram-id*)))
+      (let* ((id *next-datagram-id*)
+             (ps (map (lambda (uid) (make-pending-call uid #f id g #f)) uids)))
+        (hash-table-set! *datagram-calls* id ps)
+        (cons id ps)))))
 
 ;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
@@ -218,8 +222,8 @@
      (let ((waiting (with-lock *datagram-calls-lock*
                       (lambda ()
                         (hash-table-ref/default *datagram-calls* id '())))))
-       (cond ((assq uid waiting)
-              => (lambda (w) (mailbox-put! (cdr w) (list kind id value)))))))))
+       (cond ((find (lambda (p) (eq? (pending-call-uid p) uid)) waiting)
+              => (lambda (p) (answer-call! p (list kind id value)))))))))
 
 ;;; The prober
 

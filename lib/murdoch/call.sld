@@ -4,7 +4,7 @@
 (define-library (murdoch call)
   (export remote-run! remote-apply remote-apply-all remote-run-all!
           encode-arguments send-all local-call capture
-          capture-each await-answer expect-answers! forget-answers!
+          capture-each await-answers answer-value expect-answers! forget-answers!
           take-datagram-answer! prober)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 69)
           (chibi match)

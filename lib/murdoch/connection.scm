@@ -2,22 +2,47 @@
 ;;
 ;; A call goes out on the one connection this address space keeps to its
 ;; target, made and greeted (steps 1 and 2 of frame.scm's protocol) when
-;; there is none.  The connection's reader thread hands each answer to the
-;; mailbox of the call that waits for it.
+;; there is none.  One thread, the poller, reads every connection: it
+;; waits on the scheduler's one epoll descriptor, takes each connection's
+;; frames as their bytes come, and hands each answer to the call that
+;; waits for it, found by id.  No thread waits on a connection of its own.
 
 (define-record-type connection
-  (make-connection uid in out text write-lock pending)
+  (make-connection uid in out text write-lock pending own-nonce welcome)
   connection?
   (uid connection-uid)
   (in connection-in)
   (out connection-out)
   (text connection-text)                       ; see write-frame!
   (write-lock connection-write-lock)
-  (pending connection-pending)                 ; id -> mailbox
+  (pending connection-pending)                 ; id -> pending-call
+  (own-nonce connection-own-nonce)             ; the callee MACs with it
+  (welcome connection-welcome)                 ; a mailbox: #t, or the fault
+  (fd connection-fd connection-fd-set!)        ; while the poller watches it
+  (received connection-received connection-received-set!)
   (nonce connection-nonce connection-nonce-set!) ; the callee's
   (sent connection-sent connection-sent-set!)
   (next-id connection-next-id connection-next-id-set!)
   (open? connection-open? connection-open?-set!))
+
+;;> A call on its way to uid, or, with no connection, the answer of uid to
+;;> a datagram call.  Its answer, #f until it comes, is handed in through
+;;> its gathering, which a caller shares among all the calls it awaits.
+(define-record-type pending-call
+  (make-pending-call uid connection id gathering answer)
+  pending-call?
+  (uid pending-call-uid)
+  (connection pending-call-connection)
+  (id pending-call-id)
+  (gathering pending-call-gathering)
+  (answer pending-call-answer pending-call-answer-set!))
+
+;;> Gives pending call p its answer, unless it has one.
+(define (answer-call! p answer)
+  (gathering-put! (pending-call-gathering p)
+                  (lambda ()
+                    (and (not (pending-call-answer p))
+                         (begin (pending-call-answer-set! p answer) #t)))))
 
 ;; The open connections, and a lock for each uid that one thread holds
 ;; while it connects to that uid: a peer that does not answer holds up the
@@ -65,11 +90,12 @@
                       (aspace-uid a) 'connect
                       (string-append "cannot connect to " (aspace-host a) ":"
                                      (number->string (aspace-port a)) ": " io)))
-    (let ((c (make-connection (aspace-uid a) (car io) (cadr io)
-                              (open-output-string)
-                              (make-mutex) (make-hash-table eqv?)))
-          (nonce (random-hex 16))
-          (welcome (make-mailbox)))
+    (let* ((nonce (random-hex 16))
+           (c (make-connection (aspace-uid a) (car io) (cadr io)
+                               (open-output-string) (make-mutex)
+                               (make-hash-table eqv?) nonce (make-mailbox))))
+      (connection-fd-set! c #f)
+      (connection-received-set! c 0)
       (connection-nonce-set! c #f)
       (connection-sent-set! c 0)
       (connection-next-id-set! c 0)
@@ -78,10 +104,9 @@
                    (let ((me (local-aspace)))
                      (make-message 'hello (aspace-uid me) (aspace-host me)
                                    (aspace-port me) nonce)))
-      (thread-start! (make-thread (lambda () (read-answers c nonce welcome))
-                                  'answers))
+      (watch! c)
       (let ((greeted (mailbox-take
-                      welcome deadline
+                      (connection-welcome c) deadline
                       (lambda ()
                         (close-connection! c)
                         (remote-error 'timed-out (aspace-uid a) 'connect
@@ -91,21 +116,85 @@
                           (aspace-uid a) 'connect (fault-message greeted))))
       c)))
 
-;; The reader of one outgoing connection: the welcome, then answers, each
-;; handed to the mailbox of the call that waits for it.  The welcome
-;; mailbox gets #t, or what was wrong with the welcome, which the call
-;; reports: only faults after the welcome are logged, so that the prober,
-;; trying a gone peer every second, does not fill the log.
-(define (read-answers c nonce welcome)
-  (guard (e (#t (mailbox-put! welcome e)
-                (if (connection-nonce c) (log-fault (connection-uid c) e))))
-    (let ((w (read-frame (connection-in c) nonce 0)))
-      (connection-nonce-set! c (welcome-nonce w (connection-uid c)))
-      (mailbox-put! welcome #t)
-      (let loop ((count 1))
-        (let ((answer (read-frame (connection-in c) nonce count)))
-          (if (not (eof-object? answer))
-              (begin (deliver-answer! c answer) (loop (+ count 1))))))))
+;;; The poller
+
+;; The watched connections by descriptor: a vector, which the poller reads
+;; without a lock (a vector-set! is whole), replaced by a larger one under
+;; *connections-lock* when a descriptor is past its end.
+(define *watched* (make-vector 64 #f))
+(define *poller-port* #f)               ; on the epoll descriptor
+
+(define (watch! c)
+  (with-lock *connections-lock*
+    (lambda ()
+      (if (not *poller-port*) (start-poller!))
+      (let ((fd (poller-watch! (connection-in c))))
+        (if (>= fd (vector-length *watched*))
+            (set! *watched* (vector-grow *watched* (* 2 (+ fd 1)))))
+        (connection-fd-set! c fd)
+        (vector-set! *watched* fd c)))))
+
+(define (vector-grow v n)
+  (let ((grown (make-vector n #f)))
+    (vector-copy! grown 0 v)
+    grown))
+
+(define (start-poller!)
+  (set! *poller-port* (poller-port))
+  (thread-start! (make-thread poll-connections 'poller)))
+
+;; Reads each connection as its bytes come.  A frame that breaks the
+;; protocol closes its connection; the others carry on.  One handler for
+;; the thread's life, entered again after each fault: one per frame would
+;; cost a continuation each (see undo-on-raise).
+(define (poll-connections)
+  (let ((current #f))
+    (define (take! fd)
+      (let ((c (and (< fd (vector-length *watched*)) (vector-ref *watched* fd))))
+        (set! current c)
+        (if c
+            (take-frames! c (poller-frames! fd (max-frame)))
+            (poller-unwatch! fd))))
+    (let again ()
+      (guard (e (#t (if current (connection-fault! current e))
+                    (again)))
+        (let loop ()
+          (let ((fds (poller-ready)))
+            (if (null? fds)
+                (port-wait! *poller-port* 3600)
+                (for-each take! fds)))
+          (loop))))))
+
+;; The frames, eof or fault that poller-frames! read from c.
+(define (take-frames! c taken)
+  (when (pair? taken)
+    (take-frame! c (car taken))
+    (take-frames! c (cdr taken))))
+
+;; The welcome, then answers, each handed to the call that waits for it.
+(define (take-frame! c x)
+  (cond ((bytevector? x)
+         (let ((count (connection-received c)))
+           (connection-received-set! c (+ count 1))
+           (let ((message (open-frame x (connection-own-nonce c) count)))
+             (if (connection-nonce c)
+                 (deliver-answer! c message)
+                 (greeted! c message)))))
+        ((not (eof-object? x)) (protocol-fail "netstring" x))
+        ((connection-nonce c) (close-connection! c))
+        (else (greeted! c x))))
+
+(define (greeted! c w)
+  (connection-nonce-set! c (welcome-nonce w (connection-uid c)))
+  (mailbox-put! (connection-welcome c) #t))
+
+;; The welcome mailbox gets what was wrong with the welcome, which the
+;; call reports: only faults after the welcome are logged, so that the
+;; prober, trying a gone peer every second, does not fill the log.
+(define (connection-fault! c e)
+  (if (connection-nonce c)
+      (log-fault (connection-uid c) e)
+      (mailbox-put! (connection-welcome c) e))
   (close-connection! c))
 
 ;; The nonce of w, the welcome from uid.  A welcome from another address
@@ -120,53 +209,68 @@
          (error (string-append "found " (symbol->string found) " at its address")))
      nonce)))
 
+;; Hands an answer to its call; the lock without a dynamic-wind, since
+;; nothing under it raises.
 (define (deliver-answer! c answer)
-  (let* ((id (match (check-message answer '(ack value error) "an answer")
-               ((kind id . value) id)))
-         (mb (with-lock (connection-write-lock c)
-               (lambda () (take-mailbox! (connection-pending c) id)))))
-    (if mb (mailbox-put! mb answer))))   ; else the caller gave up
+  (let ((id (match (check-message answer '(ack value error) "an answer")
+              ((kind id . value) id)))
+        (lock (connection-write-lock c)))
+    (mutex-lock! lock)
+    (let ((p (take-mailbox! (connection-pending c) id)))
+      (mutex-unlock! lock)
+      (if p (answer-call! p answer)))))   ; else the caller gave up
 
 ;; Close once; every call still waiting hears that the connection is lost.
+;; The poller stops watching it before its descriptor closes.
 (define (close-connection! c)
-  (let ((waiting
-         (with-lock (connection-write-lock c)
-           (lambda ()
-             (and (connection-open? c)
-                  (begin
-                    (connection-open?-set! c #f)
-                    (take-all-mailboxes! (connection-pending c))))))))
-    (when waiting
+  (let* ((fd #f)
+         (waiting
+          (with-lock (connection-write-lock c)
+            (lambda ()
+              (set! fd (connection-fd c))
+              (connection-fd-set! c #f)
+              (connection-open?-set! c #f)
+              (take-all-mailboxes! (connection-pending c))))))
+    (when fd
+      (with-lock *connections-lock*
+        (lambda ()
+          (vector-set! *watched* fd #f)
+          (poller-unwatch! fd)))
       ;; Closing both ports closes the socket; closing it again could close
       ;; another connection's socket that has taken its number.
       (guard (e (#t #f)) (close-input-port (connection-in c)))
-      (guard (e (#t #f)) (close-output-port (connection-out c)))
-      (for-each (lambda (mb) (mailbox-put! mb '(lost))) waiting))))
+      (guard (e (#t #f)) (close-output-port (connection-out c))))
+    (for-each (lambda (p) (answer-call! p '(lost))) waiting)))
 
-;; Send one call; answers a mailbox that will hold its answer.
-(define (send-call! c kind proc-code args-code)
+;;> Sends one call, whose answer its gathering g will be handed; answers
+;;> the pending call.
+(define (send-call! c kind proc-code args-code g)
   (with-lock (connection-write-lock c)
     (lambda ()
-      (let ((id (+ 1 (connection-next-id c)))
-            (mb (make-mailbox)))
+      (let* ((id (+ 1 (connection-next-id c)))
+             (p (make-pending-call (connection-uid c) c id g #f)))
         (connection-next-id-set! c id)
-        (hash-table-set! (connection-pending c) id mb)
-        (send-counted! c (make-message kind id proc-code args-code))
-        (cons id mb)))))
+        (hash-table-set! (connection-pending c) id p)
+        (send-counted! c (make-message kind id proc-code args-code)
+                       (lambda () (hash-table-delete! (connection-pending c) id)))
+        p))))
 
 ;; Sends message as the connection's next frame; the caller holds its
-;; write lock.  A frame that fails to go out leaves the connection closed.
-(define (send-counted! c message)
+;; write lock.  A frame that fails to go out leaves the connection closed
+;; to calls, and (forget) is called.
+(define (send-counted! c message forget)
   (if (not (connection-open? c))
       (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
   (let ((text (frame-text (connection-text c) message))
         (count (+ 1 (connection-sent c))))
     (connection-sent-set! c count)
     (undo-on-raise
-     (lambda () (connection-open?-set! c #f))
+     (lambda () (connection-open?-set! c #f) (forget))
      (lambda ()
        (write-frame! (connection-out c) text (connection-nonce c) count)
        (flush-output-port (connection-out c))))))
+
+(define (nothing) #f)
 
 ;;> Sends the answer to call id of a multicast datagram that a, its sender,
 ;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
@@ -174,7 +278,8 @@
 (define (send-datagram-answer! a id kind value)
   (let ((c (connection-to a (+ (monotonic-seconds) (current-timeout)))))
     (with-lock (connection-write-lock c)
-      (lambda () (send-counted! c (make-message 'answer id kind value))))))
+      (lambda ()
+        (send-counted! c (make-message 'answer id kind value) nothing)))))
 
 ;; Forgets call id, and tells the callee, if the connection still stands,
 ;; that nobody waits for it (see abandon.scm).
@@ -184,4 +289,4 @@
       (lambda ()
         (hash-table-delete! (connection-pending c) id)
         (when (connection-open? c)
-          (send-counted! c (make-message 'abandon id)))))))
+          (send-counted! c (make-message 'abandon id) nothing))))))

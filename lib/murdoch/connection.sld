@@ -1,8 +1,12 @@
 ;;> The caller's side of the wire: one greeted connection to each address
-;;> space called, whose reader hands each answer to the call awaiting it.
+;;> space called, and the poller that reads them all and hands each
+;;> answer to the call awaiting it.
 
 (define-library (murdoch connection)
-  (export connection-to send-call! give-up-call! send-datagram-answer!)
+  (export connection-to send-call! give-up-call! send-datagram-answer!
+          make-pending-call pending-call? pending-call-uid
+          pending-call-connection pending-call-id pending-call-answer
+          answer-call!)
   (import (scheme base) (srfi 18) (srfi 69)
           (only (chibi string) string-prefix?)
           (chibi match)

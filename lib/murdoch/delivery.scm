@@ -36,22 +36,24 @@
   (and (eq? (delivery-mode) 'multicast)
        (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                               (live-uids)))
-              (waiting (map (lambda (uid) (cons uid (make-mailbox))) others))
-              (id (expect-answers! waiting)))
+              (g (make-gathering))
+              (expected (expect-answers! others g))
+              (id (car expected))
+              (waiting (cdr expected)))
          (define (forget!) (forget-answers! id))
          (if (send-datagram! (make-message 'call id kind proc-code args-code))
              (let* ((here (capture (local-aspace-uid)
                                    (lambda () (local-call kind proc args))))
-                    (deadline (+ (monotonic-seconds) seconds))
-                    (there (capture-each
-                            car
-                            (lambda (w)
-                              (list (car w) #t
-                                    (await-answer (car w) (cdr w) deadline
-                                                  seconds proc (lambda () #f))))
-                            waiting)))
+                    (deadline (+ (monotonic-seconds) seconds)))
+               (undo-on-raise forget!
+                              (lambda () (await-answers g waiting deadline)))
                (forget!)
-               (cons here there))
+               (cons here
+                     (capture-each pending-call-uid
+                                   (lambda (p)
+                                     (list (pending-call-uid p) #t
+                                           (answer-value p seconds proc)))
+                                   waiting)))
              (begin (forget!) #f)))))
 
 ;;; Serving the group's calls

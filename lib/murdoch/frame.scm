@@ -142,9 +142,17 @@
   (let ((payload (read-netstring in *max-frame*)))
     (if (eof-object? payload)
         payload
-        (parse-message
-         (authentic-text payload (bytevector-length payload)
-                         (list nonce ":" count ":"))))))
+        (open-frame payload nonce count))))
+
+;;> The message of a frame whose netstring's payload is \var{payload}, the
+;;> count'th from the side whose nonce is given; raises as read-frame.
+(define (open-frame payload nonce count)
+  (parse-message
+   (authentic-text payload (bytevector-length payload)
+                  (list nonce ":" count ":"))))
+
+;;> The lab's max-frame: the most bytes a netstring's payload may hold.
+(define (max-frame) *max-frame*)
 
 ;; The text after the MAC in the first end bytes of bytes, once the MAC is
 ;; that of the list parts followed by the text.

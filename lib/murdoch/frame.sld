@@ -5,6 +5,7 @@
 (define-library (murdoch frame)
   (export message-kinds make-message check-message check-datagram
           configure-wire! frame-text write-frame! send-frame! read-frame
+          open-frame max-frame
           frame-fail parse-message protocol-fault? fault-message log-fault
           datagram-bytes open-datagram-text)
   (import (scheme base) (scheme write)

@@ -27,7 +27,11 @@
 #include <errno.h>
 #include <poll.h>
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/epoll.h>
+#include <sys/socket.h>
 #include <sys/time.h>
 #include <time.h>
 
@@ -619,6 +623,227 @@ static sexp port_wait (sexp ctx, sexp self, sexp_sint_t n, sexp port,
   return SEXP_VOID;
 }
 
+
+/* The poller.  One epoll descriptor holds every connection this process
+ * has called out on; one green thread waits on it (through an input port
+ * on it, which Chibi's blocker and the wrapper's ppoll know), so a process
+ * with 64 connections waits on one descriptor, not 64, and no thread
+ * waits per connection.  Each connection's bytes are gathered here, in a
+ * buffer of its own, as they come, and handed to Scheme a whole netstring
+ * at a time: a peer that stalls mid-frame holds up no other.  The checks
+ * are read-netstring's (netstring.scm), with its words for each fault. */
+struct inbox {
+  unsigned char *bytes;
+  size_t length, size;
+};
+
+static int poller_fd = -1;
+static struct inbox *inboxes;           /* by descriptor */
+static size_t inbox_count;
+
+#define POLLER_READ 65536
+#define POLLER_EVENTS 256
+
+/* (poller-port): an input port on the epoll descriptor, made once, for
+ * the poller's thread to wait on as on any port; never read. */
+static sexp poller_port (sexp ctx, sexp self, sexp_sint_t n) {
+  sexp_gc_var2(fileno, port);
+  if (poller_fd >= 0)
+    return sexp_user_exception(ctx, self, "the poller has its port", SEXP_NULL);
+  poller_fd = epoll_create1(EPOLL_CLOEXEC);
+  if (poller_fd < 0)
+    return sexp_user_exception(ctx, self, strerror(errno), SEXP_NULL);
+  sexp_gc_preserve2(ctx, fileno, port);
+  fileno = sexp_make_fileno(ctx, sexp_make_fixnum(poller_fd), SEXP_FALSE);
+  port = sexp_exceptionp(fileno) ? fileno
+    : sexp_open_input_file_descriptor(ctx, self, 2, fileno, SEXP_FALSE);
+  sexp_gc_release2(ctx);
+  return port;
+}
+
+static struct inbox *inbox_of (int fd) {
+  struct inbox *grown;
+  size_t count = inbox_count ? inbox_count : 64;
+  if ((size_t)fd >= inbox_count) {
+    while (count <= (size_t)fd) count *= 2;
+    grown = realloc(inboxes, count * sizeof(*grown));
+    if (!grown) return NULL;
+    memset(grown + inbox_count, 0, (count - inbox_count) * sizeof(*grown));
+    inboxes = grown;
+    inbox_count = count;
+  }
+  return &inboxes[fd];
+}
+
+static void empty_inbox (int fd) {
+  if (fd >= 0 && (size_t)fd < inbox_count) {
+    free(inboxes[fd].bytes);
+    memset(&inboxes[fd], 0, sizeof(inboxes[fd]));
+  }
+}
+
+/* (poller-watch! port): the poller watches port's descriptor, with an
+ * empty buffer; answers the descriptor. */
+static sexp poller_watch (sexp ctx, sexp self, sexp_sint_t n, sexp port) {
+  struct epoll_event e;
+  int fd;
+  if (!sexp_iportp(port))
+    return sexp_type_exception(ctx, self, SEXP_IPORT, port);
+  fd = sexp_port_fileno(port);
+  if (fd < 0 || poller_fd < 0 || !inbox_of(fd))
+    return sexp_user_exception(ctx, self, "cannot watch", port);
+  empty_inbox(fd);
+  memset(&e, 0, sizeof(e));
+  e.events = EPOLLIN;
+  e.data.fd = fd;
+  if (epoll_ctl(poller_fd, EPOLL_CTL_ADD, fd, &e) != 0)
+    return sexp_user_exception(ctx, self, strerror(errno), port);
+  return sexp_make_fixnum(fd);
+}
+
+/* (poller-unwatch! fd), before its port is closed: a closed number may be
+ * another connection's next. */
+static sexp poller_unwatch (sexp ctx, sexp self, sexp_sint_t n, sexp fd) {
+  if (!sexp_fixnump(fd))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, fd);
+  if (poller_fd >= 0)
+    epoll_ctl(poller_fd, EPOLL_CTL_DEL, sexp_unbox_fixnum(fd), NULL);
+  empty_inbox(sexp_unbox_fixnum(fd));
+  return SEXP_VOID;
+}
+
+/* (poller-ready): the descriptors with something to read, or that ended;
+ * never waits. */
+static sexp poller_ready (sexp ctx, sexp self, sexp_sint_t n) {
+  struct epoll_event events[POLLER_EVENTS];
+  int i, k = poller_fd < 0 ? 0
+    : epoll_wait(poller_fd, events, POLLER_EVENTS, 0);
+  sexp_gc_var1(ls);
+  sexp_gc_preserve1(ctx, ls);
+  ls = SEXP_NULL;
+  for (i = k - 1; i >= 0; i--)
+    ls = sexp_cons(ctx, sexp_make_fixnum(events[i].data.fd), ls);
+  sexp_gc_release1(ctx);
+  return ls;
+}
+
+/* The next netstring of the length bytes at p: its payload's start and
+ * length, and where the next begins; NULL with *fault unset when more
+ * must come, or with *fault saying what is wrong. */
+static const unsigned char *next_netstring (const unsigned char *p,
+                                            size_t length, size_t most,
+                                            size_t *start, size_t *size,
+                                            const char **fault) {
+  static char words[64];
+  size_t i, len = 0;
+  *fault = NULL;
+  for (i = 0; i < length && p[i] != ':'; i++) {
+    if (p[i] < '0' || p[i] > '9') {
+      snprintf(words, sizeof words, "non-digit byte %d in length", p[i]);
+      *fault = words;
+      return NULL;
+    }
+    if (i == 1 && p[0] == '0') {
+      *fault = "leading zero in length";
+      return NULL;
+    }
+    len = len * 10 + (p[i] - '0');
+    if (len > most) {
+      snprintf(words, sizeof words, "length over %lu bytes",
+               (unsigned long)most);
+      *fault = words;
+      return NULL;
+    }
+  }
+  if (i == length) return NULL;
+  if (i == 0) {
+    *fault = "empty length";
+    return NULL;
+  }
+  if (length - (i + 1) < len + 1) return NULL;
+  if (p[i + 1 + len] != ',') {
+    *fault = "missing comma after payload";
+    return NULL;
+  }
+  *start = i + 1;
+  *size = len;
+  return p + i + 2 + len;
+}
+
+/* Reads once what descriptor fd holds, without waiting, after what its
+ * buffer kept. */
+static int fill_inbox (struct inbox *box, int fd) {
+  unsigned char *grown;
+  ssize_t got;
+  if (box->size - box->length < POLLER_READ) {
+    grown = realloc(box->bytes, box->length + POLLER_READ);
+    if (!grown) return -1;
+    box->bytes = grown;
+    box->size = box->length + POLLER_READ;
+  }
+  got = recv(fd, box->bytes + box->length, box->size - box->length,
+             MSG_DONTWAIT);
+  if (got > 0) box->length += got;
+  if (got < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR))
+    return 1;
+  return got > 0;
+}
+
+/* (poller-frames! fd max): reads what fd holds and answers the payloads,
+ * as bytevectors, of the netstrings now whole, in order; the list ends in
+ * an eof object when the peer has closed between frames, or in a string
+ * saying what is wrong with the next frame.  What is left of a frame
+ * waits in fd's buffer for the rest. */
+static sexp poller_frames (sexp ctx, sexp self, sexp_sint_t n, sexp fd,
+                           sexp max) {
+  struct inbox *box;
+  const unsigned char *p, *next;
+  const char *fault = NULL;
+  size_t start, size, left;
+  int open;
+  sexp_gc_var3(ls, tail, item);
+  if (!sexp_fixnump(fd) || !sexp_fixnump(max))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM,
+                               sexp_fixnump(fd) ? max : fd);
+  box = inbox_of(sexp_unbox_fixnum(fd));
+  if (!box) return sexp_user_exception(ctx, self, "out of memory", fd);
+  open = fill_inbox(box, sexp_unbox_fixnum(fd));
+  sexp_gc_preserve3(ctx, ls, tail, item);
+  ls = tail = SEXP_NULL;
+  p = box->bytes;
+  left = box->length;
+  for (;;) {
+    next = next_netstring(p, left, sexp_unbox_fixnum(max), &start, &size,
+                          &fault);
+    if (!next) {
+      if (fault)
+        item = sexp_c_string(ctx, fault, -1);
+      else if (open)
+        break;
+      else if (left == 0)
+        item = SEXP_EOF;
+      else
+        item = sexp_c_string(ctx, left && memchr(p, ':', left)
+                             ? "truncated payload" : "truncated length", -1);
+    } else {
+      item = sexp_make_bytes(ctx, sexp_make_fixnum(size), SEXP_ZERO);
+      if (!sexp_exceptionp(item))
+        memcpy(sexp_bytes_data(item), p + start, size);
+    }
+    if (sexp_exceptionp(item)) { ls = item; break; }
+    item = sexp_cons(ctx, item, SEXP_NULL);
+    if (sexp_pairp(tail)) sexp_cdr(tail) = item; else ls = item;
+    tail = item;
+    if (!next) break;
+    left -= next - p;
+    p = next;
+  }
+  if (box->bytes && p != box->bytes) memmove(box->bytes, p, left);
+  box->length = left;
+  sexp_gc_release3(ctx);
+  return ls;
+}
+
 sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
                         const char *version, const sexp_abi_identifier_t abi) {
   if (!(sexp_version_compatible(ctx, version, sexp_version)
@@ -630,5 +855,10 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "wall-microseconds", 0, wall_microseconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);
   sexp_define_foreign(ctx, env, "%port-wait!", 2, port_wait);
+  sexp_define_foreign(ctx, env, "poller-port", 0, poller_port);
+  sexp_define_foreign(ctx, env, "poller-watch!", 1, poller_watch);
+  sexp_define_foreign(ctx, env, "poller-unwatch!", 1, poller_unwatch);
+  sexp_define_foreign(ctx, env, "poller-ready", 0, poller_ready);
+  sexp_define_foreign(ctx, env, "poller-frames!", 2, poller_frames);
   return install(ctx);
 }

@@ -31,11 +31,36 @@
 ;;> is ready (to read, for an input port; to write, for an output port)
 ;;> or \var{seconds} have passed, whichever is first.  The caller then
 ;;> looks again at what it waits for: readiness is a hint.
+;;>
+;;> \procedure{(poller-port)}
+;;> An input port on the process's one epoll descriptor, made at the first
+;;> call: it is ready when a watched descriptor is.  Only one thread, the
+;;> poller's, waits on it, with port-wait!.
+;;>
+;;> \procedure{(poller-watch! port)}
+;;> Watches the descriptor of the input port \var{port}, with an empty
+;;> buffer of its own; answers the descriptor.
+;;>
+;;> \procedure{(poller-unwatch! fd)}
+;;> Stops watching \var{fd} and drops its buffer; call it before the
+;;> descriptor is closed.
+;;>
+;;> \procedure{(poller-ready)}
+;;> The watched descriptors with bytes to read or an end, without waiting.
+;;>
+;;> \procedure{(poller-frames! fd max)}
+;;> Reads once what \var{fd} holds, without waiting, and answers the
+;;> payloads of the netstrings now whole, in order, as bytevectors; the
+;;> list ends in an eof object when the peer closed between frames, or in a
+;;> string saying what is wrong with the next frame (as read-netstring's
+;;> errors say it).  Part of a frame waits in the buffer for the rest.
 
 (define-library (murdoch scheduler)
   (export poll-scheduler-installed? monotonic-seconds wall-microseconds
           stack-guard-tripped?
-          port-wait!)
+          port-wait!
+          poller-port poller-watch! poller-unwatch! poller-ready
+          poller-frames!)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
   (import (scheme base) (srfi 18))
   (include-shared "scheduler")

@@ -86,3 +86,47 @@
     (for-each (lambda (id) (hash-table-delete! table id))
               (hash-table-keys table))
     mbs))
+
+;;; Gatherings: one wake for the answers to many calls
+
+;;> A gathering: the poller hands in the answers to a caller's calls one
+;;> at a time, and the caller, waiting for n of them, wakes once, when the
+;;> nth has come or at its deadline; a mailbox each would wake it n times.
+(define-record-type gathering
+  (%make-gathering mutex condvar got wanted)
+  gathering?
+  (mutex gathering-mutex)
+  (condvar gathering-condvar)
+  (got gathering-got gathering-got-set!)
+  (wanted gathering-wanted gathering-wanted-set!))
+
+(define (make-gathering)
+  (%make-gathering (make-mutex) (make-condition-variable) 0 #f))
+
+;;> Calls \scheme{(put!)} under the gathering's lock, which records an
+;;> answer and answers whether it is a new one; counts it if so.  No
+;;> dynamic-wind: put! only sets a field.
+(define (gathering-put! g put!)
+  (let ((m (gathering-mutex g)))
+    (mutex-lock! m)
+    (when (put!)
+      (let ((got (+ 1 (gathering-got g))))
+        (gathering-got-set! g got)
+        (if (and (gathering-wanted g) (>= got (gathering-wanted g)))
+            (condition-variable-signal! (gathering-condvar g)))))
+    (mutex-unlock! m)))
+
+;;> Waits until \var{n} answers have come, answering #t, or until the
+;;> deadline, answering #f.
+(define (gathering-wait g n deadline)
+  (let ((m (gathering-mutex g)))
+    (let loop ()
+      (mutex-lock! m)
+      (gathering-wanted-set! g n)
+      (if (>= (gathering-got g) n)
+          (begin (mutex-unlock! m) #t)
+          (let ((left (seconds-until deadline)))
+            (if (and (positive? left)
+                     (mutex-unlock! m (gathering-condvar g) left))
+                (loop)
+                (begin (mutex-unlock! m) (>= (gathering-got g) n))))))))
