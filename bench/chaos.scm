@@ -18,8 +18,8 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme process-context) (scheme inexact)
         (srfi 1) (srfi 18) (srfi 27) (srfi 132)
-        (murdoch) (murdoch remote) (murdoch command) (murdoch testing)
-        (only (murdoch scheduler) monotonic-seconds))
+        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
+        (only (murdoch sys scheduler) monotonic-seconds))
 
 (define seconds
   (cond ((get-environment-variable "MURDOCH_CHAOS_SECONDS") => string->number)

@@ -4,7 +4,7 @@
 ;;
 ;; Listens on 127.0.0.1:PORT, serves the first connection: reads a
 ;; netstring and writes it back until the peer closes.  "poll" waits in
-;; ppoll through (murdoch scheduler), as an address space waits; "block"
+;; ppoll through (murdoch sys scheduler), as an address space waits; "block"
 ;; reads in the kernel.  A file of its own, importing only what it uses:
 ;; started from bench/scheme-pingpong.scm, which imports (murdoch
 ;; testing), each server took 1.3 s of CPU to start instead of 0.3 s, 85 s
@@ -20,6 +20,6 @@
 
 (let* ((args (cdr (command-line)))
        (poll? (equal? (cadr args) "poll")))
-  ;; Loading (murdoch scheduler) installs it.
-  (if poll? (environment '(murdoch scheduler)))
+  ;; Loading (murdoch sys scheduler) installs it.
+  (if poll? (environment '(murdoch sys scheduler)))
   (serve (string->number (car args)) poll?))

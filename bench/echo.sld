@@ -5,5 +5,5 @@
 (define-library (bench echo)
   (export echo-connection)
   (import (scheme base) (srfi 151) (chibi net) (chibi filesystem)
-          (murdoch netstring))
+          (murdoch wire netstring))
   (include "echo.scm"))

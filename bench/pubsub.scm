@@ -30,9 +30,9 @@
         (only (chibi time) get-resource-usage resource-usage/self
               resource-usage-time resource-usage-system-time
               timeval-seconds timeval-microseconds)
-        (only (murdoch trip-client) split-words) (scheme read)
+        (only (murdoch robot trip) split-words) (scheme read)
         (only (chibi string) string-prefix?)
-        (murdoch) (murdoch remote) (murdoch command) (murdoch testing))
+        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
 
 (define (aspace-clause i)
   (let ((name (string->symbol (string-append "w" (number->string i)))))

@@ -15,7 +15,7 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme time)
         (scheme process-context)
         (srfi 1) (srfi 18) (srfi 132)
-        (murdoch) (murdoch command) (murdoch testing))
+        (murdoch) (murdoch cli command) (murdoch testing harness))
 
 (define lab (make-test-lab '((aspace bencher) (aspace troy))))
 

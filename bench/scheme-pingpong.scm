@@ -5,7 +5,7 @@
 ;; For each mode (default: both, nap first) the process forks an echo
 ;; server, connects to it, and times round trips of a 4-byte netstring
 ;; after a warm-up.  "nap" runs Chibi's own scheduler, which naps 10 ms
-;; whenever every thread is blocked; "poll" first loads (murdoch scheduler),
+;; whenever every thread is blocked; "poll" first loads (murdoch sys scheduler),
 ;; which the forked server inherits, so both ends wait in ppoll instead.
 ;; The module cannot be taken out again, so nap must come before poll.
 ;; Prints, per mode, the MEDIAN round trip in microseconds:
@@ -26,7 +26,7 @@
 ;; turn, then each echo is read; prints the MEDIAN round in microseconds:
 ;;   bench: chibi-fanout-NN VALUE us       the servers block in read(2)
 ;;   bench: chibi-fanout-poll-NN VALUE us  they wait in ppoll through
-;;                                         (murdoch scheduler), as an
+;;                                         (murdoch sys scheduler), as an
 ;;                                         address space waits
 ;; The sender waits in ppoll in both.  bench/c-pingpong N is the same in C.
 
@@ -34,8 +34,8 @@
         (srfi 1) (srfi 18) (srfi 132)
         (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
-        (murdoch netstring) (bench echo)
-        (only (murdoch testing) listen-on-free-port free-port-base tool-path
+        (murdoch wire netstring) (bench echo)
+        (only (murdoch testing harness) listen-on-free-port free-port-base tool-path
               start-process! stop-all-processes!))
 
 (define payload (bytevector 112 105 110 103))   ; "ping"
@@ -127,11 +127,11 @@
      (if poll-loaded? (error "nap must be measured before poll"))
      (report "chibi-pingpong-rtt-nap" (measure mode)))
     ((poll)
-     (environment '(murdoch scheduler))   ; loading it installs it
+     (environment '(murdoch sys scheduler))   ; loading it installs it
      (set! poll-loaded? #t)
      (report "chibi-pingpong-rtt" (measure mode)))
     ((pipelined)
-     (environment '(murdoch scheduler))
+     (environment '(murdoch sys scheduler))
      (set! poll-loaded? #t)
      (report "chibi-pipelined-throughput" (measure mode) "per-s"))
     (else (error "unknown mode; expected nap or poll" mode))))
@@ -149,7 +149,7 @@
 ;; The fan-out to n echo servers started as processes of their own
 ;; (bench/echo-server.scm).
 (define (measure-fan-out n wait)
-  (environment '(murdoch scheduler))
+  (environment '(murdoch sys scheduler))
   (let ((base (free-port-base)))
     (for-each (lambda (i)
                 (start-process! (list (tool-path "tools/chibi")

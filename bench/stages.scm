@@ -36,11 +36,11 @@
         (only (chibi time) get-resource-usage resource-usage/self
               resource-usage-time resource-usage-system-time
               timeval-seconds timeval-microseconds)
-        (only (murdoch trip-client) split-words)
-        (murdoch) (murdoch command) (murdoch testing)
-        (murdoch netstring) (murdoch hmac) (murdoch frame) (murdoch sendable)
-        (murdoch aspace) (murdoch sandbox) (murdoch lab) (murdoch scheduler)
-        (only (murdoch call) encode-arguments)
+        (only (murdoch robot trip) split-words)
+        (murdoch) (murdoch cli command) (murdoch testing harness)
+        (murdoch wire netstring) (murdoch wire hmac) (murdoch wire frame) (murdoch code sendable)
+        (murdoch remote aspace) (murdoch code sandbox) (murdoch lab) (murdoch sys scheduler)
+        (only (murdoch remote call) encode-arguments)
         (bench echo))
 
 (define lab (make-test-lab '((aspace bencher) (aspace troy))))

@@ -8,7 +8,7 @@
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
         (only (chibi ast) setenv unsetenv)
-        (murdoch lab) (murdoch command) (murdoch launch))
+        (murdoch lab) (murdoch cli command) (murdoch cli launch))
 
 (define version "0.3")
 

@@ -1,9 +1,8 @@
 # Murdoch's C outside the simulator, for the top Makefile to include; paths
 # are from the top of the repository.
-#   make native         builds lib/murdoch/scheduler.so, multicast.so,
-#                       hmac.so, netstring.so, connect.so, guard.so,
-#                       process-name.so and sendable.so, the C of the
-#                       libraries of those names, and bench/c-pingpong
+#   make native         builds the .so of each library with C (its .stub,
+#                       or the scheduler's .c), beside its .sld in its
+#                       family's folder, and bench/c-pingpong
 #   make native-clean   removes them, and the C that chibi-ffi wrote
 
 # tools/chibi-cflags names the directory of Chibi's headers, which in the
@@ -15,10 +14,10 @@ NATIVE_CHIBI_CFLAGS = $(addprefix -idirafter ,$(NATIVE_CHIBI_INCLUDE))
 NATIVE_CHIBI_HEADERS = $(wildcard $(addsuffix /chibi/*.h,$(NATIVE_CHIBI_INCLUDE)))
 NATIVE_CFLAGS ?= -O2 -g -Wall
 
-NATIVE_MODULES := lib/murdoch/scheduler.so lib/murdoch/multicast.so \
-                  lib/murdoch/hmac.so lib/murdoch/netstring.so lib/murdoch/connect.so \
-                  lib/murdoch/guard.so lib/murdoch/process-name.so \
-                  lib/murdoch/sendable.so
+# Every stub's library, beside its .sld in its family's folder, and the
+# scheduler's.
+NATIVE_STUBS := $(wildcard lib/murdoch/*/*.stub)
+NATIVE_MODULES := $(NATIVE_STUBS:.stub=.so) lib/murdoch/sys/scheduler.so
 
 native: $(NATIVE_MODULES) bench/c-pingpong
 
@@ -27,21 +26,19 @@ native: $(NATIVE_MODULES) bench/c-pingpong
 # checks, their type errors and sexp_init_library.  The C they bind is in
 # a file of plain C that the stub includes.  Only the scheduler is C
 # written by hand through and through (scheduler.c says why).
-NATIVE_STUBS := $(wildcard lib/murdoch/*.stub)
-
 lib/murdoch/%.c: lib/murdoch/%.stub
 	tools/chibi-ffi $< $@
 
 lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
-	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< $(NATIVE_LIBS_$*)
+	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< $(NATIVE_LIBS_$(notdir $*))
 
 # The plain C that a stub includes.
-lib/murdoch/guard.so: lib/murdoch/heap-watch.c
-lib/murdoch/hmac.so: lib/murdoch/hmac-sha256.c
-lib/murdoch/netstring.so: lib/murdoch/netstring-scan.c
-lib/murdoch/sendable.so: lib/murdoch/plain.c
-lib/murdoch/connect.so: lib/murdoch/nonblocking-connect.c
-lib/murdoch/multicast.so: lib/murdoch/multicast-socket.c
+lib/murdoch/sys/guard.so: lib/murdoch/sys/heap-watch.c
+lib/murdoch/wire/hmac.so: lib/murdoch/wire/hmac-sha256.c
+lib/murdoch/wire/netstring.so: lib/murdoch/wire/netstring-scan.c
+lib/murdoch/code/sendable.so: lib/murdoch/code/plain.c
+lib/murdoch/wire/connect.so: lib/murdoch/wire/nonblocking-connect.c
+lib/murdoch/wire/multicast.so: lib/murdoch/wire/multicast-socket.c
 
 # Kept, so that a look at what chibi-ffi wrote needs no rebuild.
 .SECONDARY: $(NATIVE_STUBS:.stub=.c)

@@ -1,7 +1,7 @@
-;;; (murdoch assign): the Hungarian method against every permutation, on
+;;; (murdoch task assign): the Hungarian method against every permutation, on
 ;;; square and rectangular problems, with pairs that may not be made; and
 ;;; the thesis's greedy rule where it pays more.
-(import (scheme base) (srfi 1) (srfi 27) (chibi test) (murdoch assign))
+(import (scheme base) (srfi 1) (srfi 27) (chibi test) (murdoch task assign))
 
 ;; The least total cost over every way to give the rows distinct columns,
 ;; by trying them all: the answer the method must match.

@@ -4,7 +4,7 @@
 (import (scheme base) (scheme write) (scheme read) (srfi 1) (chibi test)
         (only (chibi process) system?)
         (only (chibi filesystem) delete-file-hierarchy)
-        (murdoch testing))
+        (murdoch testing harness))
 (include "tests/box-move-cases.scm")   ; tests/run runs from the top
 (test-begin "box move, bending right")
 (box-case "examples/box-lab-right.scm" "")

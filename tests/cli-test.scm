@@ -3,7 +3,7 @@
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
         (only (chibi process) system)
         (only (chibi filesystem) delete-file-hierarchy)
-        (murdoch testing))
+        (murdoch testing harness))
 
 (define dir (temporary-directory))
 (define out (string-append dir "/out"))

@@ -1,4 +1,4 @@
-;;; (murdoch connect): a connect that answers ports, says why it failed, and
+;;; (murdoch wire connect): a connect that answers ports, says why it failed, and
 ;;; gives up at its timeout while the process's other threads run; and
 ;;; sockets of failed connects that the collector never closes twice.
 ;;; Values and order only: durations are not asserted.
@@ -8,8 +8,8 @@
         (only (chibi filesystem) open-input-file-descriptor
               open-output-file-descriptor directory-files)
         (only (chibi ast) gc) (only (chibi process) alarm)
-        (murdoch connect)
-        (only (murdoch testing) listen-on-free-port))
+        (murdoch wire connect)
+        (only (murdoch testing harness) listen-on-free-port))
 
 ;; A connect that never gives up fails the run instead of stalling it.
 (alarm 120)

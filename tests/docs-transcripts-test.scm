@@ -2,7 +2,7 @@
 ;;; are written there (read-doc-transcript, docs/transcripts.md), so that
 ;;; neither drifts from the code.  Apart from transcripts-test, whose
 ;;; files fill its time.
-(import (scheme base) (chibi test) (murdoch testing) (murdoch transcript))
+(import (scheme base) (chibi test) (murdoch testing harness) (murdoch testing transcript))
 
 (test-begin "docs-transcripts")
 (for-each (lambda (doc)

@@ -1,6 +1,6 @@
 ;;; A test program that fails on purpose, for lab-test: a lab removed after
 ;;; a failure shows the last lines of its logs first.
-(import (scheme base) (scheme file) (chibi test) (murdoch testing))
+(import (scheme base) (scheme file) (chibi test) (murdoch testing harness))
 
 (define lab (make-test-lab '((aspace a))))
 (call-with-output-file (string-append (test-lab-directory lab) "/a.log")

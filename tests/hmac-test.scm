@@ -1,5 +1,5 @@
 ;;; HMAC-SHA256 against the test vectors of RFC 4231, section 4.
-(import (scheme base) (chibi test) (murdoch hmac))
+(import (scheme base) (chibi test) (murdoch wire hmac))
 
 (define (repeat byte n) (make-bytevector n byte))
 (define (hex->bytevector hex)

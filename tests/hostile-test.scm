@@ -8,8 +8,8 @@
         (srfi 1) (srfi 18) (srfi 132) (chibi test) (chibi net)
         (only (chibi process) kill current-process-id)
         (only (chibi filesystem) directory-files)
-        (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
-        (murdoch multicast) (murdoch testing) (murdoch raw))
+        (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
+        (murdoch wire multicast) (murdoch testing harness) (murdoch testing raw))
 
 (define shared-code "
 (define *counter* 0)

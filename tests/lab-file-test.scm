@@ -2,7 +2,7 @@
 ;;; (lib/murdoch/lab.scm), read once, every mistake named with its clause.
 (import (scheme base) (scheme write) (scheme file) (chibi test)
         (only (chibi filesystem) delete-file-hierarchy)
-        (murdoch lab) (murdoch testing))
+        (murdoch lab) (murdoch testing harness))
 
 (define dir (temporary-directory))
 (define file (string-append dir "/lab.scm"))

@@ -5,7 +5,7 @@
         (only (chibi process) system system? kill signal/kill)
         (chibi io) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor)
-        (murdoch testing))
+        (murdoch testing harness))
 
 ;; Workstations only, so that no simulator is needed: the launcher starts
 ;; one only for labs with robots.

@@ -1,38 +1,46 @@
 ;;; The libraries as layers: each imports only from its own layer and
 ;;; those below, and no import goes round in a cycle.  The order of the
-;;; layers is written here, once; README's "The shape" follows it.
-(import (scheme base) (scheme read) (scheme file) (scheme write)
+;;; layers is written here, once, by folder; README's "The shape" follows
+;;; it, and names every library.
+(import (scheme base) (scheme read) (scheme file) (scheme write) (scheme cxr)
         (srfi 1) (chibi test)
-        (only (chibi filesystem) directory-files)
-        (murdoch testing))
+        (only (chibi filesystem) directory-files file-directory?)
+        (only (chibi string) string-split)
+        (murdoch testing harness))
 
-;; Bottom to top.
+;; Bottom to top: each family's folder under lib/murdoch/, or a library
+;; of its own there, and `murdoch` for (murdoch) itself.  Inside a folder
+;; any order will do, but where one is given, (FOLDER SUBLAYER ...), bottom
+;; to top; a family's umbrella, (murdoch FOLDER), is above all its members.
 (define layers
-  '((process (murdoch scheduler) (murdoch guard) (murdoch process-name) (murdoch log)
-             (murdoch wait))
-    (wire (murdoch remote-error) (murdoch netstring) (murdoch hmac)
-          (murdoch multicast) (murdoch connect) (murdoch frame))
-    (lab (murdoch lab))
-    (values (murdoch sendable) (murdoch abandon) (murdoch sandbox))
-    (robot (murdoch trip-client))
-    (aspace (murdoch aspace))
-    (call (murdoch connection) (murdoch worker) (murdoch call))
-    (group (murdoch group))
-    (serve (murdoch serve))
-    (proxy (murdoch proxy))
-    (delivery (murdoch delivery))
-    (remote (murdoch remote))
-    (messaging (murdoch pubsub))
-    (monitors (murdoch monitor))
-    (task-parts (murdoch assign) (murdoch progress) (murdoch metric) (murdoch takers))
-    (team (murdoch team))
-    (tasks (murdoch pose-task) (murdoch component))
-    (life-cycle (murdoch task) (murdoch status))
-    (interface (murdoch))
-    (commands (murdoch hints) (murdoch command) (murdoch launch) (murdoch view))))
+  '(sys wire lab code robot
+    (remote aspace (connection worker call) group serve proxy delivery)
+    (pubsub messaging monitor)
+    (task (assign progress metric takers) team (pose-task component) life-cycle)
+    status murdoch cli view testing))
 
-(define (layer-of name)
-  (list-index (lambda (layer) (member name (cdr layer))) layers))
+(define (layer-folder layer) (if (pair? layer) (car layer) layer))
+
+;; (FOLDER-INDEX . SUBLAYER-INDEX) of a library name, or #f: the sublayer
+;; is 0 where its folder gives no order, and past them all for the umbrella.
+(define (place-of name)
+  (let* ((parts (cdr name))
+         (folder (if (null? parts) 'murdoch (car parts)))
+         (i (list-index (lambda (layer) (eq? (layer-folder layer) folder)) layers)))
+    (and i
+         (let ((layer (list-ref layers i)))
+           (cond ((or (null? parts) (null? (cdr parts))) (cons i 1000))
+                 ((not (pair? layer)) (cons i 0))
+                 (else
+                  (let ((j (list-index (lambda (sub)
+                                         (if (pair? sub)
+                                             (memq (cadr parts) sub)
+                                             (eq? sub (cadr parts))))
+                                       (cdr layer))))
+                    (and j (cons i j)))))))))
+
+(define (below? a b)
+  (or (< (car a) (car b)) (and (= (car a) (car b)) (<= (cdr a) (cdr b)))))
 
 ;; The define-library form of file.
 (define (library-form file)
@@ -54,11 +62,18 @@
 
 (define (ours? name) (and (pair? name) (eq? (car name) 'murdoch)))
 
+;; Every .sld under dir, in its folders too.
+(define (sld-files dir)
+  (append-map (lambda (f)
+                (let ((path (string-append dir "/" f)))
+                  (cond ((member f '("." "..")) '())
+                        ((file-directory? path) (sld-files path))
+                        ((text-contains? f ".sld") (list path))
+                        (else '()))))
+              (directory-files dir)))
+
 (define library-files
-  (cons (tool-path "murdoch.sld")
-        (map (lambda (f) (tool-path (string-append "lib/murdoch/" f)))
-             (filter (lambda (f) (text-contains? f ".sld"))
-                     (directory-files (tool-path "lib/murdoch"))))))
+  (cons (tool-path "lib/murdoch.sld") (sld-files (tool-path "lib/murdoch"))))
 
 ;; (name . imports of ours), for every library.
 (define graph
@@ -75,16 +90,44 @@
           (else (any (lambda (next) (walk next (cons here path)))
                      (cond ((assoc here graph) => cdr) (else '())))))))
 
+;; How README's shape table names a library: its path under lib/murdoch/,
+;; `wire/frame`, or `(murdoch)`.
+(define (table-name name)
+  (if (null? (cdr name))
+      "(murdoch)"
+      (let loop ((parts (cddr name)) (path (symbol->string (cadr name))))
+        (if (null? parts)
+            path
+            (loop (cdr parts) (string-append path "/" (symbol->string (car parts))))))))
+
+;; The second cells of the rows of README's "The shape" table.
+(define shape-library-cells
+  (let loop ((lines (read-lines (tool-path "README.md"))) (in? #f) (cells '()))
+    (cond ((null? lines) cells)
+          ((string=? (car lines) "## The shape") (loop (cdr lines) #t cells))
+          ((and in? (text-contains? (car lines) "## ")) cells)
+          ((and in? (> (string-length (car lines)) 0)
+                (char=? (string-ref (car lines) 0) #\|))
+           (loop (cdr lines) in?
+                 (cons (caddr (string-split (car lines) #\|)) cells)))
+          (else (loop (cdr lines) in? cells)))))
+
 (test-begin "layers")
 
+(test "README's shape table names every library" '()
+  (remove (lambda (name)
+            (let ((quoted (string-append "`" (table-name name) "`")))
+              (any (lambda (cell) (text-contains? cell quoted)) shape-library-cells)))
+          (map car graph)))
+
 (test "every library has a layer" '()
-  (remove layer-of (map car graph)))
+  (remove place-of (map car graph)))
 
 (test "no library imports from a layer above its own" '()
   (append-map (lambda (entry)
                 (filter-map (lambda (import)
-                              (and (layer-of import) (layer-of (car entry))
-                                   (> (layer-of import) (layer-of (car entry)))
+                              (and (place-of import) (place-of (car entry))
+                                   (not (below? (place-of import) (place-of (car entry))))
                                    (list (car entry) 'imports import)))
                             (cdr entry)))
               graph))

@@ -1,5 +1,5 @@
 ;;; The strict netstring reader: good frames, and each kind of bad one.
-(import (scheme base) (chibi test) (chibi io) (murdoch netstring))
+(import (scheme base) (chibi test) (chibi io) (murdoch wire netstring))
 
 (define (bytes s) (string->utf8 s))
 (define (read-all s max)

@@ -3,7 +3,7 @@
 ;;; without one fails here.
 (import (scheme base) (scheme write) (scheme read) (scheme file) (srfi 1) (chibi test)
         (only (chibi process) system?)
-        (murdoch testing))
+        (murdoch testing harness))
 
 (define dir (temporary-directory))
 (define generated (string-append dir "/reference.md"))
@@ -42,11 +42,11 @@
 (test "every export has a ;;> comment" '()
   (undocumented (file-text generated)))
 
-(test "each export of murdoch.sld has its row" '()
+(test "each export of lib/murdoch.sld has its row" '()
   (let ((rows (row-names (file-text generated))))
     (remove (lambda (name) (memq name rows))
             (map (lambda (e) (if (pair? e) (car (cddr e)) e))
-                 (cdr (assq 'export (cddr (call-with-input-file (tool-path "murdoch.sld")
+                 (cdr (assq 'export (cddr (call-with-input-file (tool-path "lib/murdoch.sld")
                                             read))))))))
 
 (test-end)

@@ -4,11 +4,11 @@
         (srfi 18) (chibi test) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor
               open-output-file-descriptor)
-        (murdoch) (murdoch remote) (murdoch command) (murdoch lab)
-        (murdoch netstring) (murdoch hmac) (murdoch connect) (murdoch testing)
-        (murdoch raw)
-        (only (murdoch wait) make-mailbox mailbox-put! mailbox-take)
-        (only (murdoch scheduler) monotonic-seconds))
+        (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
+        (murdoch wire netstring) (murdoch wire hmac) (murdoch wire connect) (murdoch testing harness)
+        (murdoch testing raw)
+        (only (murdoch sys wait) make-mailbox mailbox-put! mailbox-take)
+        (only (murdoch sys scheduler) monotonic-seconds))
 
 (define shared-code "
 (define *counter* 0)
@@ -238,7 +238,7 @@
                     (remote-apply (troy) (lambda () (eval '(exit 1) #f))))))))
 
 ;;; Raw connections, for what a well-behaved peer never sends
-;;; (tests/murdoch/raw.scm)
+;;; (lib/murdoch/testing/raw.scm)
 
 (define key (lab-key (read-lab (test-lab-file lab))))
 (define (troy-raw-connect) (raw-connect (aspace-port (troy))))

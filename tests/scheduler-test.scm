@@ -1,4 +1,4 @@
-;;; (murdoch scheduler): with the wrapper installed, threads blocked on
+;;; (murdoch sys scheduler): with the wrapper installed, threads blocked on
 ;;; descriptors wake when data comes, sleepers and timeouts wake in order,
 ;;; and runnable threads run.  Values and order only: durations are not
 ;;; asserted, a loaded machine stretches them.
@@ -10,8 +10,8 @@
         (chibi test) (chibi net) (chibi filesystem) (chibi process)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
         (only (chibi ast) thread-interrupt!)
-        (murdoch scheduler)
-        (only (murdoch testing) listen-on-free-port))
+        (murdoch sys scheduler)
+        (only (murdoch testing harness) listen-on-free-port))
 
 ;; A scheduler that never wakes fails the run instead of stalling it.
 (alarm 120)

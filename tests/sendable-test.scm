@@ -2,7 +2,7 @@
 (import (except (scheme base) lambda define) (scheme eval) (scheme read)
         (scheme write) (scheme cxr) (srfi 1) (chibi test)
         (only (meta) mutable-environment)
-        (rename (murdoch sendable) (sendable-lambda lambda)
+        (rename (murdoch code sendable) (sendable-lambda lambda)
                 (sendable-define define)))
 
 (define env (environment '(scheme base)))

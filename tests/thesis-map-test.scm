@@ -1,7 +1,7 @@
 ;;; docs/thesis-map.md: each name of the thesis's appendix that the map
 ;;; gives a file is defined in that file, and each it gives none says why.
 (import (scheme base) (scheme write) (scheme char) (scheme cxr) (srfi 1) (chibi test)
-        (murdoch testing))
+        (murdoch testing harness))
 
 ;; The cells of a table row "| a | b | ... |", trimmed.
 (define (row-cells line)

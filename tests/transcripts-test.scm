@@ -3,7 +3,7 @@
 ;;; `bin/murdoch repl` with the transcript's input piped in.
 (import (scheme base) (srfi 1) (chibi test)
         (only (chibi filesystem) directory-files)
-        (murdoch testing) (murdoch transcript))
+        (murdoch testing harness) (murdoch testing transcript))
 
 (define (transcript-files)
   (let ((dir (tool-path "tests/transcripts")))

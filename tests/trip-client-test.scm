@@ -4,7 +4,7 @@
         (scheme process-context)
         (only (chibi process) system? kill signal/term current-process-id)
         (chibi net) (only (chibi filesystem) open-input-file-descriptor)
-        (murdoch abandon) (murdoch trip-client))
+        (murdoch code abandon) (murdoch robot trip))
 
 ;; Start b14 in the background on free ports in a fresh folder, wait
 ;; (boundedly) for its ready line, and leave "(DIR PORT-BASE PID)" in a file.

@@ -9,7 +9,7 @@
         (only (chibi filesystem) delete-file-hierarchy file-size directory-files
               current-directory change-directory)
         (chibi json)
-        (murdoch lab) (murdoch view) (murdoch connect) (murdoch testing))
+        (murdoch lab) (murdoch view) (murdoch wire connect) (murdoch testing harness))
 
 (define (assq-ref key alist) (cdr (assq key alist)))
 

@@ -12,7 +12,7 @@
 ;;; this writes, and when an export has no comment.
 (import (scheme base) (scheme write) (scheme read) (scheme file) (scheme char)
         (scheme process-context)
-        (srfi 1))
+        (srfi 1) (only (chibi string) string-join) (only (chibi pathname) path-directory))
 
 (define top (or (get-environment-variable "MURDOCH_TOP") "."))
 
@@ -38,10 +38,13 @@
 
 (define (ours? name) (and (pair? name) (eq? (car name) 'murdoch) (pair? (cdr name))))
 
-(define (library-file name)
-  (string-append top "/lib/murdoch/" (symbol->string (cadr name)) ".sld"))
+(define (library-path name)
+  (string-join (map symbol->string name) "/"))
 
-(define murdoch-form (read-form (string-append top "/murdoch.sld")))
+(define (library-file name)
+  (string-append top "/lib/" (library-path name) ".sld"))
+
+(define murdoch-form (read-form (string-append top "/lib/murdoch.sld")))
 
 ;; The ;;> comments of library name: (NAME SIGNATURE TEXT) for each
 ;; definition a comment stands right above (other ; lines may come
@@ -55,7 +58,7 @@
    ((assoc name docs-cache) => cdr)
    (else
     (let* ((sld (library-file name))
-           (files (cons sld (map (lambda (f) (string-append top "/lib/murdoch/" f))
+           (files (cons sld (map (lambda (f) (string-append (path-directory sld) "/" f))
                                  (declarations (read-form sld) 'include))))
            (docs (append-map file-docs files)))
       (set! docs-cache (cons (cons name docs) docs-cache))
@@ -291,7 +294,7 @@
           ((string=? sig (string-append "(" old ")")) (string-append "(" new ")"))
           (else sig))))
 
-(define (lib-text lib) (string-append "lib/murdoch/" (symbol->string (cadr lib)) ".scm"))
+(define (lib-text lib) (string-append "lib/" (library-path lib) ".scm"))
 
 (define (main)
   (let* ((entries

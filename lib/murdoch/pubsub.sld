@@ -1,15 +1,15 @@
+;;> Publish/subscribe messaging (appendix A.8): subjects, requests and
+;;> their promises, and the monitors (A.6, A.2).
+;;> Its members are each a library of their own in pubsub/.
+
 (define-library (murdoch pubsub)
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
-          subscribe-remote unsubscribe-remote
-          publish request request-exclusive request-non-exclusive
-          request-components
-          capability-layout check-subjects
-          request-status subscription-statuses
-          receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive receive-components set-lease! start-leases!
-          on-free! offer-subjects!)
-  (import (scheme base) (only (murdoch scheduler) monotonic-seconds)
-          (srfi 1) (srfi 18)
-          (murdoch log) (murdoch lab) (murdoch remote)
-          (only (murdoch remote-error) error-message))
-  (include "pubsub.scm"))
+          subscribe-remote unsubscribe-remote publish request request-exclusive
+          request-non-exclusive request-components capability-layout check-subjects
+          request-status subscription-statuses receive-publication receive-request
+          receive-request-exclusive receive-request-non-exclusive receive-components
+          set-lease! start-leases! on-free! offer-subjects! get-system-load load-monitor
+          battery-monitor *battery-charging* *battery-low* *load-threshold*
+          set-battery-charging! set-battery-low! set-load-threshold!
+          initialize-subscriptions!)
+  (import (murdoch pubsub messaging) (murdoch pubsub monitor)))

@@ -15,9 +15,8 @@
           remote-protocol-error?
           encap release-proxy! start-aspace!
           var-ref var-set! display-remote undo-on-raise with-lock)
-  (import (scheme base) (scheme write)
-          (murdoch log) (murdoch wait) (murdoch remote-error) (murdoch frame)
-          (murdoch lab) (murdoch sendable) (murdoch sandbox)
-          (murdoch aspace) (murdoch worker) (murdoch call) (murdoch serve)
-          (murdoch group) (murdoch proxy) (murdoch delivery))
+  (import (scheme base) (scheme write) (murdoch sys) (murdoch wire) (murdoch lab)
+          (murdoch code) (murdoch remote aspace) (murdoch remote worker)
+          (murdoch remote call) (murdoch remote serve) (murdoch remote group)
+          (murdoch remote proxy) (murdoch remote delivery))
   (include "remote.scm"))

@@ -2,7 +2,6 @@
 ;;> command and REPL procedure.
 (define-library (murdoch status)
   (export aspace-report lab-status show-status write-lab-status)
-  (import (scheme base) (scheme write) (srfi 1) (only (murdoch log) utc-seconds)
-          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch trip-client)
-          (murdoch task))
+  (import (scheme base) (scheme write) (srfi 1) (only (murdoch sys) utc-seconds)
+          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot) (murdoch task))
   (include "status.scm"))

@@ -1,20 +1,22 @@
-;;> The task life cycle: start-task answers a task record at once;
-;;> task-status, task-wait, cancel-task and tasks read and act on it; the
-;;> components are watched by heartbeats, and a lost robot's restartable
-;;> component is given to another.  See lib/murdoch/task.scm's header.
+;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
+;;> pose-task and a task's life cycle.
+;;> Its members are each a library of their own in task/.
 
 (define-library (murdoch task)
-  (export start-task task? task-id task-name task-status task-wait cancel-task
-          tasks task-step start-steps pose-steps
-          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
-  (import (scheme base) (scheme char) (scheme cxr) (scheme time)
-          (srfi 1) (srfi 18) (srfi 132)
-          (only (chibi ast) thread-interrupt!)
-          (murdoch scheduler) (murdoch log) (murdoch wait) (murdoch abandon)
-          (murdoch remote-error) (murdoch sendable) (murdoch lab)
-          (murdoch remote) (murdoch progress)
-          (murdoch team) (murdoch pose-task) (murdoch component)
-          (only (murdoch pubsub) subscribe unsubscribe publish request capability-layout
-                subscription-statuses on-free! offer-subjects!)
-          (only (murdoch takers) explain-components))
-  (include "task.scm"))
+  (export assign-optimal assign-greedy assignment-cost dominant-cost run-component
+          component-heartbeat! stop-component! components-running lost-periods
+          start-task task? task-id task-name task-status task-wait cancel-task tasks
+          task-step start-steps pose-steps waiting-ranks waiting-for receive-offer
+          receive-give-way note-waiters! location-metric-maker load-metric-maker
+          load-metric reverse-metric metric-by metric-by-asking metric-within
+          compose-metrics reckon-distance-between sort-response metric-keys measure-key?
+          measured-response asking-procs sort-measured shuffle pose-task negotiate
+          check-task pose-task-progress task-timeout pose-task-assignment
+          pose-task-priority pose-task-retries pose-task-backoff pose-task-excluded
+          receive-rival pose-negotiations reservation-aspace-uid resolve-conflicts
+          with-team-proc-maker with-team on-list current-team exec-on t sort-list
+          make-maxrandom progress explain-no-takers explain-components with-coordinator
+          team-barrier team-send! team-receive step-team make-coordinator)
+  (import (murdoch task assign) (murdoch task component) (murdoch task life-cycle)
+          (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
+          (murdoch task takers) (murdoch task team)))

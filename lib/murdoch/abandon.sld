@@ -1,9 +1,0 @@
-;;> Abandoned calls: a thread whose caller gave up stops at its next robot
-;;> command or remote call, or is woken in its wait for a robot's motion.
-(define-library (murdoch abandon)
-  (export abandon-thread! forget-abandoned! abandoned? check-not-abandoned
-          abandoned-error? despite-abandonment with-wake-on-abandon)
-  (import (scheme base) (only (srfi 1) delete) (srfi 18)
-          (only (murdoch wait) with-lock)
-          (only (chibi) make-exception exception? exception-kind))
-  (include "abandon.scm"))

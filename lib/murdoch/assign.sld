@@ -1,4 +1,0 @@
-(define-library (murdoch assign)
-  (export assign-optimal assign-greedy assignment-cost dominant-cost)
-  (import (scheme base) (scheme inexact))
-  (include "assign.scm"))

@@ -1,0 +1,13 @@
+;;> What the REPL adds to an error that a person's own mistake caused: the
+;;> error as the person's, not as the library's line where it surfaced,
+;;> and a hint for the mistakes a newcomer meets first.
+
+(define-library (murdoch cli hints)
+  (export eval-with-hints)
+  (import (scheme base) (scheme eval)
+          (only (chibi) make-exception exception? exception-kind env-parent env-exports identifier? identifier->symbol)
+          (only (chibi edit-distance) find-nearest-edits edit-distance)
+          (only (murdoch remote) known-uids)
+          (only (chibi ast) exception-source procedure-arity procedure-variadic? procedure-name)
+          (murdoch wire) (only (murdoch code) send-error?))
+  (include "hints.scm"))

@@ -1,0 +1,315 @@
+;;;; The sandbox: where received code runs.
+;;
+;; It is the safety boundary of an address space: a peer that holds the
+;; lab's key can run anything this sandbox allows, and nothing more.
+;;
+;; 1. The environment has R7RS's computing libraries and Murdoch's
+;;    interface, and none of (scheme file), (scheme process-context),
+;;    (scheme load), (scheme eval) or (scheme repl).  The lab's code files
+;;    are loaded into it, so that their procedures are there to be called
+;;    by name.
+;; 2. Its imported bindings cannot be assigned.  Chibi shares an imported
+;;    binding's cell with the library it comes from, so (set! car cdr)
+;;    there would change car for the whole process, the person's REPL
+;;    included; R7RS makes such an assignment an error, and here it is
+;;    one, found when the code is compiled.  What the lab's code files
+;;    define is the lab's own, and var-set! changes it as before.  A
+;;    define inside received code is local to that code.
+;; 3. A thread that serves calls cannot be ended by the code it serves
+;;    (see make-guarded-thread): its caller would never be answered.
+;; 4. Each received call runs with ports of its own, writing through to
+;;    the process's standard output and error: code that closes or rebinds
+;;    them harms no other call and not the process's log.  Its parameter
+;;    bindings are its own too, Murdoch's among them (see
+;;    sandbox-parameter!): (remote-timeout 0) in one call sets nothing for
+;;    the next.
+;; 5. A constructor told a size (make-vector, make-string, iota, expt ...)
+;;    refuses one whose result would take more than the lab's max-alloc
+;;    bytes, with an error answered to the call: Chibi would grow the heap
+;;    by twice that at once, past heap-max, and the heap guard would end
+;;    the address space with every call it runs.
+;; 6. A thread that received code makes, and one that serves calls, says
+;;    in one line of the log that it died, and of what (make-logged-thread),
+;;    where Chibi writes its own objects and a backtrace.
+
+(define sandbox-libraries
+  '((except (scheme base) lambda define set! make-vector make-string
+            make-bytevector make-list read-bytevector expt)
+    (scheme char) (scheme cxr)
+    (scheme inexact) (scheme complex) (scheme lazy) (scheme case-lambda)
+    (scheme write) (except (srfi 1) make-list list-tabulate iota)
+    (except (srfi 18) thread-terminate! make-thread) (murdoch)
+    (rename (only (murdoch code sandbox) guarded-set! guarded-thread-terminate!
+                  make-logged-thread sized-make-vector sized-make-string
+                  sized-make-bytevector sized-make-list sized-list-tabulate
+                  sized-iota sized-read-bytevector sized-expt)
+            (guarded-set! set!)
+            (guarded-thread-terminate! thread-terminate!)
+            (make-logged-thread make-thread)
+            (sized-make-vector make-vector) (sized-make-string make-string)
+            (sized-make-bytevector make-bytevector) (sized-make-list make-list)
+            (sized-list-tabulate list-tabulate) (sized-iota iota)
+            (sized-read-bytevector read-bytevector) (sized-expt expt))))
+
+;;; Assignment
+
+;; The environments whose imports are guarded: their parents hold the
+;; imported cells (a mutable environment's own frame holds what is
+;; defined in it).
+(define *guarded* '())
+
+;;> Murdoch's set! inside the sandbox: an ordinary set! of a local
+;;> variable or of something the lab's code defined; an error, raised when
+;;> the code is compiled, for a binding imported from a library.
+(define-syntax guarded-set!
+  (lambda (expr use-env mac-env)
+    (let ((target (and (pair? (cdr expr)) (cadr expr))))
+      (if (and (identifier? target) (imported? use-env target))
+          (error (string-append "set!: " (symbol->string (identifier->symbol target))
+                                " is imported, and cannot be assigned here")))
+      (cons (make-syntactic-closure mac-env '() 'set!) (cdr expr)))))
+
+(define (imported? use-env id)
+  (let ((cell (env-cell use-env id)))
+    (and cell
+         (any (lambda (env)
+                (eq? cell (env-cell (env-parent env) (identifier->symbol id))))
+              *guarded*))))
+
+;;; Threads
+
+;; The threads that serve calls: a reader, a worker, the multicast
+;; listener, the janitor.
+(define *protected* (make-hash-table eq?))
+(define *protected-lock* (make-mutex 'protected))
+
+(define (protect! thread on?)
+  (mutex-lock! *protected-lock*)
+  (if on?
+      (hash-table-set! *protected* thread #t)
+      (hash-table-delete! *protected* thread))
+  (mutex-unlock! *protected-lock*))
+
+;;> A thread, as make-thread makes, that received code cannot end.
+(define (make-guarded-thread thunk name)
+  (make-logged-thread (lambda ()
+                        (protect! (current-thread) #t)
+                        (dynamic-wind (lambda () #f)
+                                      thunk
+                                      (lambda () (protect! (current-thread) #f))))
+                      name))
+
+;;> make-thread inside the sandbox: a thread that ends by raising says so
+;;> in one line of the log, naming the address space, the thread and the
+;;> error, and thread-join! raises the error as before.
+(define (make-logged-thread thunk . name)
+  (apply make-thread
+         (lambda ()
+           (guard (e (#t (log-thread-death e) (raise e)))
+             (thunk)))
+         name))
+
+;; Chibi writes a thread's uncaught error to the thread's current error
+;; port, as "ERROR in child thread: #<Context ...>" and a backtrace; the
+;; thread's last binding of that port is made a sink, so that the line
+;; logged here is the only one.
+(define (log-thread-death e)
+  (parameterize ((current-error-port (or *err* (current-error-port))))
+    (log-warn "thread " (thread-label (current-thread)) " died: " (error-message e)))
+  (thread-parameters-set! (cons (cons current-error-port (open-output-string))
+                                (thread-parameters))))
+
+(define (thread-label thread)
+  (let ((name (thread-name thread)))
+    (if name
+        (call-with-output-string (lambda (out) (write name out)))
+        "without a name")))
+
+;;; Allocation
+
+(define *max-alloc* #f)                 ; the lab's max-alloc, in bytes
+
+;; Refuses count items of unit bytes each, past the lab's max-alloc.
+(define (check-alloc! who count unit)
+  (if (and *max-alloc* (real? count) (> (* count unit) *max-alloc*))
+      (error (string-append who ": " (number->string count)
+                            " would take more than the lab's max-alloc, "
+                            (number->string *max-alloc*) " bytes"))))
+
+;; A constructor whose first argument is a count of unit bytes each.
+(define (sized who unit make)
+  (lambda (count . rest)
+    (check-alloc! who count unit)
+    (apply make count rest)))
+
+;; In Chibi a vector's slot and a pair each take a word or more.
+(define sized-make-vector (sized "make-vector" 8 make-vector))
+(define sized-make-bytevector (sized "make-bytevector" 1 make-bytevector))
+(define sized-make-list (sized "make-list" 32 make-list))
+(define sized-list-tabulate (sized "list-tabulate" 32 list-tabulate))
+(define sized-iota (sized "iota" 32 iota))
+(define sized-read-bytevector (sized "read-bytevector" 1 read-bytevector))
+
+(define (sized-make-string count . fill)
+  (check-alloc! "make-string" count
+                (if (and (pair? fill) (char? (car fill)))
+                    (bytevector-length (string->utf8 (string (car fill))))
+                    1))
+  (apply make-string count fill))
+
+;; An exact power takes as many bits as its exponent times its base's.
+(define (sized-expt base power)
+  (if (and (number? base) (number? power) (exact? base) (exact? power)
+           (rational? base) (integer? power) (> (abs power) 1))
+      (let ((digits (max (abs (numerator base)) (denominator base))))
+        (if (> digits 1)
+            (check-alloc! "expt" (abs power) (/ (log digits 2) 8)))))
+  (expt base power))
+
+;;> thread-terminate! inside the sandbox: for the threads received code
+;;> made, not for those that serve calls.
+(define (guarded-thread-terminate! thread)
+  (if (hash-table-ref/default *protected* thread #f)
+      (error "thread-terminate!: this thread serves calls, and a call cannot end it"))
+  (thread-terminate! thread))
+
+;;; Each call's own ports and parameters
+
+(define *out* #f)                       ; the process's output ports
+(define *err* #f)
+
+;;> Gives the ports that received code writes through to: the process's
+;;> standard output and error, taken at start-up.
+(define (set-sandbox-ports! out err)
+  (set! *out* out)
+  (set! *err* err))
+
+;; A port that writes through to port, and can be closed without closing
+;; it.  It holds what is written until it is flushed, as any port, and at
+;; the end of each call.
+(define (through-port port)
+  (make-custom-output-port
+   (lambda (str start end)
+     (write-string str port start end)
+     (flush-output-port port)
+     (- end start))))
+
+;; The ports of the calls a thread runs, made again when a call closed
+;; one.  Kept as the thread's specific, in a record that received code
+;; cannot make, so that a worker's next call, from anyone, never writes
+;; to ports that a call before it chose.
+(define-record-type call-ports
+  (make-call-ports in out err)
+  call-ports?
+  (in call-ports-in)
+  (out call-ports-out)
+  (err call-ports-err))
+
+(define (thread-call-ports)
+  (let ((p (thread-specific (current-thread))))
+    (if (and (call-ports? p) (port-open? (call-ports-in p))
+             (port-open? (call-ports-out p)) (port-open? (call-ports-err p)))
+        p
+        (let ((new (make-call-ports (make-null-input-port)
+                                    (through-port (or *out* (current-output-port)))
+                                    (through-port (or *err* (current-error-port))))))
+          (thread-specific-set! (current-thread) new)
+          new))))
+
+(define (flush-if-open port)
+  (if (port-open? port) (flush-output-port port)))
+
+(define *parameters* '())
+
+;;> Gives each received call a binding of \var{parameter} of its own, so
+;;> that the call setting it sets nothing for the process: for a layer's
+;;> settings made as parameters, such as remote-timeout.
+(define (sandbox-parameter! parameter)
+  (set! *parameters* (cons parameter *parameters*)))
+
+;;> Applies \var{thunk} as a received call runs: with ports of its own,
+;;> whose output reaches the process's when flushed and when the call
+;;> ends, and with its own bindings of the sandbox's parameters.
+;; What parameterize does, for a list of parameters known only when the
+;; process runs, in one dynamic-wind: a binding is a pair in the thread's
+;; list of them, which setting the parameter changes.
+(define (call-in-sandbox thunk)
+  (let* ((p (thread-call-ports))
+         (outer (thread-parameters))
+         (inner (fold (lambda (param bindings) (cons (cons param (param)) bindings))
+                      (cons* (cons current-input-port (call-ports-in p))
+                             (cons current-output-port (call-ports-out p))
+                             (cons current-error-port (call-ports-err p))
+                             outer)
+                      *parameters*)))
+    (dynamic-wind (lambda () (thread-parameters-set! inner))
+                  thunk
+                  (lambda ()
+                    (thread-parameters-set! outer)
+                    (flush-if-open (call-ports-out p))
+                    (flush-if-open (call-ports-err p))))))
+
+;;; Making the environments
+
+;;> A fresh environment for received code, with the lab's code files
+;;> loaded.  Each file is read here and evaluated in the environment, so
+;;> the files themselves can use no more than received code can.
+(define (make-lab-environment lab)
+  (set! *max-alloc* (lab-setting lab 'max-alloc))
+  (let ((env (apply mutable-environment sandbox-libraries)))
+    (set! *guarded* (cons env *guarded*))
+    (for-each (lambda (file) (load-into (lab-path lab file) env))
+              (lab-code-files lab))
+    env))
+
+;;> The lab's code files, as its (code ...) clause names them.
+(define (lab-code-files lab)
+  (lab-setting lab 'code))
+
+;;> An environment for a person at a REPL: everything Chibi has, Murdoch,
+;;> and the very procedures the lab's code defined in \var{lab-env}, so
+;;> that they travel by name.
+(define (make-repl-environment lab lab-env)
+  (let ((env (mutable-environment '(except (scheme base) lambda define)
+                          '(scheme char) '(scheme cxr) '(scheme inexact)
+                          '(scheme complex) '(scheme lazy) '(scheme time)
+                          '(scheme case-lambda) '(scheme write) '(scheme read)
+                          '(scheme file) '(scheme process-context)
+                          '(scheme eval) '(scheme load) '(srfi 1) '(srfi 18)
+                          '(murdoch))))
+    (for-each (lambda (file)
+                (for-each (lambda (name)
+                            (eval `(define ,name ',(eval name lab-env)) env))
+                          (defined-names (lab-path lab file))))
+              (lab-code-files lab))
+    env))
+
+(define (read-forms file)
+  (map car (car (read-source file))))
+
+;; Evaluates each form of file in env, as a load would; an error, in
+;; reading or in evaluating, names the file and the line of its form.
+(define (load-into file env)
+  (for-each (lambda (entry)
+              (guard (e ((error-object? e)
+                         (error (string-append file ":" (number->string (cdr entry))
+                                               ": " (error-line e)))))
+                (eval (car entry) env)))
+            (car (read-source file))))
+
+;; An error's message and irritants, on one line.
+(define (error-line e)
+  (let ((out (open-output-string)))
+    (write-string (error-object-message e) out)
+    (for-each (lambda (x) (write-char #\space out) (write x out))
+              (error-object-irritants e))
+    (let ((text (get-output-string out)))
+      (if (> (string-length text) 200)
+          (string-append (substring text 0 196) " ...")
+          text))))
+
+(define (defined-names file)
+  (filter-map (lambda (form)
+                (and (pair? form) (eq? (car form) 'define) (pair? (cdr form))
+                     (if (pair? (cadr form)) (car (cadr form)) (cadr form))))
+              (read-forms file)))

@@ -1,0 +1,17 @@
+;;> The sandbox: the environment received code runs in, and the dynamic
+;;> extent each received call runs in.
+(define-library (murdoch code sandbox)
+  (export make-lab-environment make-repl-environment lab-code-files
+          guarded-set! guarded-thread-terminate! make-guarded-thread
+          make-logged-thread sized-make-vector sized-make-string
+          sized-make-bytevector sized-make-list sized-list-tabulate
+          sized-iota sized-read-bytevector sized-expt
+          call-in-sandbox sandbox-parameter! set-sandbox-ports!)
+  (import (scheme base) (scheme read) (scheme eval) (scheme file) (scheme inexact)
+          (scheme write) (srfi 1) (srfi 18) (srfi 69)
+          (only (chibi) env-parent identifier? identifier->symbol port-open? thread-parameters thread-parameters-set! make-syntactic-closure call-with-output-string)
+          (only (chibi ast) env-cell)
+          (only (chibi io) make-custom-output-port make-null-input-port)
+          (only (meta) mutable-environment) (murdoch sys)
+          (only (murdoch wire) error-message) (murdoch lab))
+  (include "sandbox.scm"))

@@ -1,9 +1,0 @@
-;;> \procedure{(start-heap-guard! bytes line)}
-;;> Ends this process, writing \var{line} to standard error, once its
-;;> heap passes \var{bytes}: the lab's heap-max, which Chibi's own ceiling
-;;> does not hold (lib/murdoch/heap-watch.c says why).  The body is
-;;> lib/murdoch/guard.stub and heap-watch.c, built into lib/murdoch/guard.so by
-;;> \scheme{make native}.
-(define-library (murdoch guard)
-  (export start-heap-guard!)
-  (include-shared "guard"))

@@ -1,8 +1,0 @@
-(define-library (murdoch netstring)
-  (export read-netstring write-netstring buffered-byte-count
-          reset-output-string! nests-within?
-          netstring-error? netstring-error-message)
-  (import (scheme base) (only (chibi) string-size)
-          (murdoch remote-error))
-  (include-shared "netstring")
-  (include "netstring.scm"))

@@ -1,0 +1,14 @@
+(define-library (murdoch pubsub messaging)
+  (export subscribe unsubscribe subscriptions topic-status set-topic-status!
+          subscribe-remote unsubscribe-remote
+          publish request request-exclusive request-non-exclusive
+          request-components
+          capability-layout check-subjects
+          request-status subscription-statuses
+          receive-publication receive-request receive-request-exclusive
+          receive-request-non-exclusive receive-components set-lease! start-leases!
+          on-free! offer-subjects!)
+  (import (scheme base) (only (murdoch sys) monotonic-seconds) (srfi 1) (srfi 18)
+          (murdoch sys) (murdoch lab) (murdoch remote)
+          (only (murdoch wire) error-message))
+  (include "messaging.scm"))

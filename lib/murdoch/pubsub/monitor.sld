@@ -1,0 +1,12 @@
+;;> Monitors (appendix A.6): idle while the load is low, untethered while
+;;> the battery is off its charger; and the first subscriptions of an
+;;> address space, from its lab clause (A.2).
+
+(define-library (murdoch pubsub monitor)
+  (export get-system-load load-monitor battery-monitor
+          *battery-charging* *battery-low* *load-threshold*
+          set-battery-charging! set-battery-low! set-load-threshold!
+          initialize-subscriptions!)
+  (import (scheme base) (scheme read) (scheme file) (srfi 1) (srfi 18) (murdoch sys)
+          (murdoch lab) (murdoch remote) (murdoch robot) (murdoch pubsub messaging))
+  (include "monitor.scm"))

@@ -1,0 +1,12 @@
+;;> remote-run! and remote-apply, their -all forms, and the waiting for
+;;> answers that delivery's datagram calls share.
+
+(define-library (murdoch remote call)
+  (export remote-run! remote-apply remote-apply-all remote-run-all!
+          encode-arguments send-all local-call capture
+          capture-each await-answers answer-value expect-answers! forget-answers!
+          take-datagram-answer! prober)
+  (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (chibi match) (murdoch sys)
+          (murdoch wire) (murdoch code) (murdoch remote aspace)
+          (murdoch remote connection) (murdoch remote worker))
+  (include "call.scm"))

@@ -1,0 +1,13 @@
+;;> The caller's side of the wire: one greeted connection to each address
+;;> space called, and the poller that reads them all and hands each
+;;> answer to the call awaiting it.
+
+(define-library (murdoch remote connection)
+  (export connection-to send-call! give-up-call! send-datagram-answer!
+          make-pending-call pending-call? pending-call-uid
+          pending-call-connection pending-call-id pending-call-answer
+          answer-call!)
+  (import (scheme base) (srfi 18) (srfi 69) (only (chibi string) string-prefix?)
+          (chibi match) (murdoch sys) (murdoch wire) (murdoch lab)
+          (murdoch remote aspace))
+  (include "connection.scm"))

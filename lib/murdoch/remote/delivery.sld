@@ -1,0 +1,11 @@
+;;> Delivery: broadcast-apply and broadcast-run! reach every live address
+;;> space, by one multicast datagram when the lab says so, else each in
+;;> turn; serve-group serves the calls that come by the group.
+
+(define-library (murdoch remote delivery)
+  (export broadcast-apply broadcast-run! serve-group)
+  (import (scheme base) (srfi 1) (srfi 18) (chibi match) (murdoch sys) (murdoch code)
+          (murdoch wire) (murdoch lab) (murdoch remote aspace)
+          (murdoch remote connection) (murdoch remote call) (murdoch remote serve)
+          (murdoch remote group))
+  (include "delivery.scm"))

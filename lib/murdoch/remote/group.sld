@@ -1,0 +1,10 @@
+;;> The lab's multicast group: authentic datagrams that cannot be
+;;> replayed, and beacons that keep the live set.  What a call means is
+;;> left to the procedure start-group! is handed.
+
+(define-library (murdoch remote group)
+  (export start-group! delivery-mode send-datagram!)
+  (import (scheme base) (scheme write) (srfi 18) (srfi 69)
+          (only (chibi) call-with-output-string) (chibi net) (chibi match) (murdoch sys)
+          (murdoch wire) (murdoch lab) (murdoch remote aspace) (murdoch remote worker))
+  (include "group.scm"))

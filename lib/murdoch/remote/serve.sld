@@ -1,0 +1,14 @@
+;;> The callee's side of the wire: accepting connections, reading calls,
+;;> running them, and the janitor that ends stalled connections and
+;;> relieves readers held by a long apply.
+
+(define-library (murdoch remote serve)
+  (export start-serving! frame-timeout
+          new-serving! read-as-reader reader? read-calls serve-call
+          serving-read-on serving-read-on-set!)
+  (import (scheme base) (srfi 1) (srfi 18)
+          (only (chibi filesystem) open-input-file-descriptor open-output-file-descriptor)
+          (chibi net) (chibi match) (murdoch sys) (murdoch code) (murdoch wire)
+          (only (murdoch wire) socket-port) (murdoch lab) (murdoch remote aspace)
+          (murdoch remote worker) (murdoch remote call))
+  (include "serve.scm"))

@@ -1,0 +1,13 @@
+;;> The process: green threads over ppoll, the heap guard, the process's
+;;> name, one-line logs, and one clock and one way to wait.
+;;> Its members are each a library of their own in sys/.
+
+(define-library (murdoch sys)
+  (export start-heap-guard! utc-seconds set-log-name! stamp-log-lines! log-note log-warn
+          set-process-name! poll-scheduler-installed? monotonic-seconds
+          wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!
+          poller-unwatch! poller-ready poller-frames! with-lock with-lock-by
+          seconds-until undo-on-raise make-mailbox mailbox-put! mailbox-take
+          take-mailbox! take-all-mailboxes! make-gathering gathering-put! gathering-wait)
+  (import (murdoch sys guard) (murdoch sys log) (murdoch sys process-name)
+          (murdoch sys scheduler) (murdoch sys wait)))

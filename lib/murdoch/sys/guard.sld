@@ -1,0 +1,9 @@
+;;> \procedure{(start-heap-guard! bytes line)}
+;;> Ends this process, writing \var{line} to standard error, once its
+;;> heap passes \var{bytes}: the lab's heap-max, which Chibi's own ceiling
+;;> does not hold (lib/murdoch/sys/heap-watch.c says why).  The body is
+;;> lib/murdoch/sys/guard.stub and heap-watch.c, built into lib/murdoch/sys/guard.so by
+;;> \scheme{make native}.
+(define-library (murdoch sys guard)
+  (export start-heap-guard!)
+  (include-shared "guard"))

@@ -1,0 +1,12 @@
+;;> The robot's side of the task life cycle: run-component runs a started
+;;> task's component here and stops it when its poser falls silent;
+;;> component-heartbeat! and stop-component! are what the poser calls, and
+;;> lost-periods how many silent heartbeat periods it waits before it
+;;> declares a robot lost (component.scm says why).
+
+(define-library (murdoch task component)
+  (export run-component component-heartbeat! stop-component!
+          components-running lost-periods)
+  (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
+          (murdoch robot))
+  (include "component.scm"))

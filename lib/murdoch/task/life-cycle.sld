@@ -1,0 +1,16 @@
+;;> The task life cycle: start-task answers a task record at once;
+;;> task-status, task-wait, cancel-task and tasks read and act on it; the
+;;> components are watched by heartbeats, and a lost robot's restartable
+;;> component is given to another.  See lib/murdoch/task/life-cycle.scm's header.
+
+(define-library (murdoch task life-cycle)
+  (export start-task task? task-id task-name task-status task-wait cancel-task
+          tasks task-step start-steps pose-steps
+          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
+  (import (scheme base) (scheme char) (scheme cxr) (scheme time) (srfi 1) (srfi 18)
+          (srfi 132) (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
+          (murdoch wire) (murdoch lab) (murdoch remote) (murdoch task progress)
+          (murdoch task team) (murdoch task pose-task) (murdoch task component)
+          (only (murdoch pubsub) subscribe unsubscribe publish request capability-layout subscription-statuses on-free! offer-subjects!)
+          (only (murdoch task takers) explain-components))
+  (include "life-cycle.scm"))

@@ -1,0 +1,14 @@
+;;> The wire: the table of message kinds, and frames -- netstrings
+;;> carrying a MAC'd S-expression -- and datagrams.  The protocol is
+;;> written at the head of lib/murdoch/wire/frame.scm.
+
+(define-library (murdoch wire frame)
+  (export message-kinds make-message check-message check-datagram
+          configure-wire! frame-text write-frame! send-frame! read-frame
+          open-frame max-frame
+          frame-fail parse-message protocol-fault? fault-message log-fault
+          datagram-bytes open-datagram-text)
+  (import (scheme base) (scheme write) (rename (only (chibi) read) (read read-datum))
+          (only (chibi) string-size) (murdoch sys) (murdoch wire remote-error)
+          (murdoch wire netstring) (murdoch wire hmac))
+  (include "frame.scm"))

@@ -1,0 +1,8 @@
+(define-library (murdoch wire netstring)
+  (export read-netstring write-netstring buffered-byte-count
+          reset-output-string! nests-within?
+          netstring-error? netstring-error-message)
+  (import (scheme base) (only (chibi) string-size)
+          (murdoch wire remote-error))
+  (include-shared "netstring")
+  (include "netstring.scm"))

@@ -1,9 +1,0 @@
-;;> A peer that speaks the wire by hand, for what a well-behaved peer never
-;;> sends: the tests of bad frames and of hostile peers.
-(define-library (murdoch raw)
-  (export raw-connect raw-send! raw-closed? raw-close! framed frame-mac
-          hello-text hello-frame welcomed-raw-connect counted raw-answer
-          text-of)
-  (import (scheme base) (scheme read) (scheme write)
-          (chibi net) (murdoch netstring) (murdoch hmac))
-  (include "raw.scm"))
