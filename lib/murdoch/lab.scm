@@ -115,7 +115,8 @@
     ;; Chibi grows its heap by twice one allocation (sandbox.scm).
     (max-alloc "32M" (,size-bytes . "bytes, or a size in quotes such as \"32M\""))
     (code () (,(lambda (x) (and (every string? x) x)) . "file names, in quotes"))
-    (delivery (broadcast) (,delivery-clause . "broadcast, or multicast \"GROUP\" [PORT]"))))
+    (delivery (broadcast)
+              (,delivery-clause . "broadcast, or multicast \"GROUP\" [PORT]"))))
 
 ;; The clauses the simulator reads (docs/trip-protocol.md), and address
 ;; spaces.

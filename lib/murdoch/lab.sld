@@ -1,10 +1,12 @@
 (define-library (murdoch lab)
   (export read-lab lab? lab-name lab-directory lab-settings lab-aspaces
-          lab-setting lab-port-base lab-guest-port lab-trip-port lab-trip-host lab-path lab-aspace-by-uid lab-robots lab-key
+          lab-setting lab-port-base lab-guest-port lab-trip-port lab-trip-host lab-path
+          lab-aspace-by-uid lab-robots lab-key
           lab-clause lab-robot-radius read-source unread-lab-port-base
           lab-aspace? lab-aspace-uid lab-aspace-index lab-aspace-host
           lab-aspace-port lab-aspace-clause lab-aspace-clauses random-hex)
-  (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file) (scheme process-context)
+  (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
+          (scheme process-context)
           (scheme inexact)
           (srfi 1) (srfi 151)
           (only (chibi filesystem) open open/write open/create open/exclusive

@@ -3,7 +3,8 @@
 ;;> Its members are each a library of their own in task/.
 
 (define-library (murdoch task)
-  (export assign-optimal assign-greedy assignment-cost dominant-cost run-component
+  (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
+          dominant-cost run-component
           component-heartbeat! stop-component! components-running lost-periods
           start-task task? task-id task-name task-status task-wait cancel-task tasks
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer

@@ -8,13 +8,13 @@
           lab-header default-trace view-snapshot new-view-state make-task-table
           task-table-update!
           task-table->json reservation-task json-text box-seen)
-  (import (scheme base) (scheme write) (scheme file) (scheme eval) (scheme inexact)
-          (scheme char) (srfi 1) (srfi 18) (chibi net) (chibi net http-server)
-          (chibi net servlet) (only (chibi config) make-conf)
-          (only (chibi process) current-process-id)
-          (only (chibi filesystem) create-directory* open open/write open/append open/create open/exclusive open-output-file-descriptor)
-          (only (srfi 151) bitwise-ior) (chibi json)
-          (only (murdoch sys) monotonic-seconds) (only (murdoch sys) utc-seconds)
-          (only (murdoch sys) with-lock seconds-until) (murdoch sys) (murdoch lab)
+  (import (only (murdoch code) make-logged-thread) (only (murdoch task) task-key-parts)
+          (scheme base) (scheme write)
+          (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)
+          (chibi net) (chibi net http-server) (chibi net servlet)
+          (only (chibi config) make-conf) (only (chibi process) current-process-id)
+          (only (chibi filesystem) create-directory* open open/write open/append
+                open/create open/exclusive open-output-file-descriptor)
+          (only (srfi 151) bitwise-ior) (chibi json) (murdoch sys) (murdoch lab)
           (murdoch cli) (murdoch remote))
   (include "view.scm" "view-tasks.scm"))

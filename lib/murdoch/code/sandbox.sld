@@ -9,7 +9,9 @@
           call-in-sandbox sandbox-parameter! set-sandbox-ports!)
   (import (scheme base) (scheme read) (scheme eval) (scheme file) (scheme inexact)
           (scheme write) (srfi 1) (srfi 18) (srfi 69)
-          (only (chibi) env-parent identifier? identifier->symbol port-open? thread-parameters thread-parameters-set! make-syntactic-closure call-with-output-string)
+          (only (chibi) env-parent identifier? identifier->symbol port-open?
+                thread-parameters thread-parameters-set! make-syntactic-closure
+                call-with-output-string)
           (only (chibi ast) env-cell)
           (only (chibi io) make-custom-output-port make-null-input-port)
           (only (meta) mutable-environment) (murdoch sys)

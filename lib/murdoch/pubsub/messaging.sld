@@ -8,7 +8,7 @@
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive receive-components set-lease! start-leases!
           on-free! offer-subjects!)
-  (import (scheme base) (only (murdoch sys) monotonic-seconds) (srfi 1) (srfi 18)
+  (import (only (murdoch code) make-logged-thread) (scheme base) (srfi 1) (srfi 18)
           (murdoch sys) (murdoch lab) (murdoch remote)
           (only (murdoch wire) error-message))
   (include "messaging.scm"))

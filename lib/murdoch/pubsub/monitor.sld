@@ -7,6 +7,7 @@
           *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)
-  (import (scheme base) (scheme read) (scheme file) (srfi 1) (srfi 18) (murdoch sys)
+  (import (only (murdoch code) make-logged-thread)
+          (scheme base) (scheme read) (scheme file) (srfi 1) (srfi 18) (murdoch sys)
           (murdoch lab) (murdoch remote) (murdoch robot) (murdoch pubsub messaging))
   (include "monitor.scm"))

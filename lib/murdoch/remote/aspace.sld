@@ -9,6 +9,6 @@
           live-uids current-lab join-lab!
           remote-timeout set-remote-timeout! current-timeout
           lab-environment decode-value describe-procedure)
-  (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (only (murdoch sys) utc-seconds)
-          (murdoch sys) (murdoch lab) (murdoch code))
+  (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (murdoch sys) (murdoch lab)
+          (murdoch code))
   (include "aspace.scm"))

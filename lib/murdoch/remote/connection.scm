@@ -58,7 +58,8 @@
     (or (live-connection-to uid)
         (with-lock-by (connecting-lock uid) deadline
           (lambda ()
-            (remote-error 'timed-out uid 'connect "another call's connect did not end in time"))
+            (remote-error 'timed-out uid 'connect
+                          "another call's connect did not end in time"))
           (lambda ()
             (or (live-connection-to uid)
                 (let ((c (connect! a deadline)))
@@ -141,7 +142,7 @@
 
 (define (start-poller!)
   (set! *poller-port* (poller-port))
-  (thread-start! (make-thread poll-connections 'poller)))
+  (thread-start! (make-logged-thread poll-connections 'poller)))
 
 ;; Reads each connection as its bytes come.  A frame that breaks the
 ;; protocol closes its connection; the others carry on.  One handler for

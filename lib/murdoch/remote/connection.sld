@@ -7,7 +7,8 @@
           make-pending-call pending-call? pending-call-uid
           pending-call-connection pending-call-id pending-call-answer
           answer-call!)
-  (import (scheme base) (srfi 18) (srfi 69) (only (chibi string) string-prefix?)
+  (import (only (murdoch code) make-logged-thread)
+          (scheme base) (srfi 18) (srfi 69) (only (chibi string) string-prefix?)
           (chibi match) (murdoch sys) (murdoch wire) (murdoch lab)
           (murdoch remote aspace))
   (include "connection.scm"))

@@ -9,6 +9,6 @@
   (import (scheme base) (srfi 1) (srfi 18)
           (only (chibi filesystem) open-input-file-descriptor open-output-file-descriptor)
           (chibi net) (chibi match) (murdoch sys) (murdoch code) (murdoch wire)
-          (only (murdoch wire) socket-port) (murdoch lab) (murdoch remote aspace)
-          (murdoch remote worker) (murdoch remote call))
+          (murdoch lab) (murdoch remote aspace) (murdoch remote worker)
+          (murdoch remote call))
   (include "serve.scm"))

@@ -2,7 +2,8 @@
 ;;> procedures the thesis's robot code calls, acting on the robot whose
 ;;> trip connection is \scheme{(current-robot)}.
 (define-library (murdoch robot trip)
-  (export trip-connect trip-close trip-request trip-connection? trip-timeout trip-motion-timeout
+  (export trip-connect trip-close trip-request trip-connection? trip-timeout
+          trip-motion-timeout
           current-robot set-current-robot!
           trip-error? trip-error-robot trip-error-code trip-error-text
           im goto-xy goto-goal rotate translate angle-to-heading set-velocity stop-base
@@ -12,8 +13,9 @@
           safe-im safe-battery-voltage safe-reckon workstation-position
           split-words)
   (import (scheme base) (scheme write) (srfi 18) (srfi 69) (srfi 151)
-          (only (chibi) make-exception exception? exception-kind exception-irritants call-with-output-string)
+          (only (chibi) make-exception exception? exception-kind exception-irritants
+                call-with-output-string)
           (murdoch code) (murdoch wire)
-          (only (murdoch sys) with-lock make-mailbox mailbox-put! mailbox-take take-mailbox! take-all-mailboxes!)
-          (only (murdoch sys) monotonic-seconds port-wait!))
+          (only (murdoch sys) with-lock make-mailbox mailbox-put! mailbox-take
+                take-mailbox! take-all-mailboxes! monotonic-seconds port-wait!))
   (include "trip.scm"))

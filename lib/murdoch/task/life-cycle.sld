@@ -11,6 +11,7 @@
           (srfi 132) (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
           (murdoch wire) (murdoch lab) (murdoch remote) (murdoch task progress)
           (murdoch task team) (murdoch task pose-task) (murdoch task component)
-          (only (murdoch pubsub) subscribe unsubscribe publish request capability-layout subscription-statuses on-free! offer-subjects!)
+          (only (murdoch pubsub) subscribe unsubscribe publish request
+                capability-layout subscription-statuses on-free! offer-subjects!)
           (only (murdoch task takers) explain-components))
   (include "life-cycle.scm"))

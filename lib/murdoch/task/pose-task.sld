@@ -7,13 +7,14 @@
   (export pose-task negotiate check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
           pose-task-backoff pose-task-excluded receive-rival pose-negotiations
-          reservation-aspace-uid
+          reservation-aspace-uid task-key task-key-parts
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between sort-response resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t
           sort-list make-maxrandom)
-  (import (scheme base) (scheme write) (scheme inexact) (scheme cxr) (scheme time)
+  (import (only (murdoch wire) error-message)
+          (scheme base) (scheme write) (scheme inexact) (scheme cxr) (scheme time)
           (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) procedure-code procedure-vars opcode? thread-interrupt!)
           (only (chibi) call-with-output-string)

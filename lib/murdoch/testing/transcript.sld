@@ -10,6 +10,7 @@
           (chibi test)
           (only (chibi filesystem) delete-file-hierarchy)
           (only (chibi process) system? call-with-process-io waitpid)
-          (only (murdoch testing harness) read-lines free-port-base start-murdoch-lab! tool-path
+          (only (murdoch testing harness) read-lines free-port-base start-murdoch-lab!
+                tool-path
                 file-text wait-until temporary-directory stop-process!))
   (include "transcript.scm"))

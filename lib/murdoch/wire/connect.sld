@@ -13,7 +13,9 @@
   (import (scheme base) (srfi 18) (srfi 151)
           (only (chibi net) socket address-family/inet socket-type/stream)
           (only (chibi) fileno?)
-          (only (chibi filesystem) open-input-file-descriptor open-output-file-descriptor get-file-descriptor-status set-file-descriptor-status! open/non-block)
+          (only (chibi filesystem) open-input-file-descriptor
+                open-output-file-descriptor get-file-descriptor-status
+                set-file-descriptor-status! open/non-block)
           (only (murdoch sys) monotonic-seconds port-wait!))
   (include-shared "connect")
   (include "connect.scm"))

@@ -7,6 +7,7 @@
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
           remote-protocol-error?)
   (import (scheme base) (scheme write) (srfi 18)
-          (only (chibi) call-with-output-string make-exception exception? exception-kind exception-irritants strip-syntactic-closures)
+          (only (chibi) call-with-output-string make-exception exception?
+                exception-kind exception-irritants strip-syntactic-closures)
           (only (murdoch sys) stack-guard-tripped?))
   (include "remote-error.scm"))
