@@ -363,7 +363,7 @@
          (start (cdr (assq 'started header))))
     (tell-who-is-away lab)
     (thread-start!
-     (make-thread
+     (make-logged-thread
       (lambda ()
         (let loop ()
           ;; The trace counts wall-clock seconds from its start; the
@@ -371,10 +371,10 @@
           (let ((t0 (monotonic-seconds))
                 (at (- (utc-seconds) start)))
             (feed-add! feed (json-text
-                             (view-snapshot lab at
-                                            (parameterize ((remote-timeout 1))
-                                              (remote-apply-all aspaces proc))
-                                            state)))
+                                    (view-snapshot lab at
+                                                   (parameterize ((remote-timeout 1))
+                                                     (remote-apply-all aspaces proc))
+                                                   state)))
             (thread-sleep! (max 0.05 (- (+ t0 poll-seconds) (monotonic-seconds))))
             (loop))))
       'view-poll))

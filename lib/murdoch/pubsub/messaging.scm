@@ -354,7 +354,7 @@
 ;;> Starts freeing the subjects of promises unapplied for \var{seconds}.
 (define (start-leases! seconds)
   (set-lease! seconds)
-  (thread-start! (make-thread lease-keeper 'lease-keeper)))
+  (thread-start! (make-logged-thread lease-keeper 'lease-keeper)))
 
 ;; A subject is free for task when it is free or already held by task: two
 ;; components of one task may both get a promise from one robot, and

@@ -39,7 +39,7 @@
   (number->string (*load-source*)))
 
 (define (start-thread! name thunk)
-  (thread-start! (make-thread thunk name)))
+  (thread-start! (make-logged-thread thunk name)))
 
 (define *load-monitor-thread* #f)
 (define *battery-monitor-thread* #f)

@@ -146,7 +146,7 @@
       (trip-connection-tag-set! c 0)
       (trip-connection-open?-set! c #t)
       (trip-connection-goal-set! c #f)
-      (thread-start! (make-thread (lambda () (read-replies c)) 'trip-replies))
+      (thread-start! (make-logged-thread (lambda () (read-replies c)) 'trip-replies))
       (guard (e (#t (trip-close c) (raise e)))
         (trip-connection-name-set! c (car (request c "who"))))
       c)))
@@ -315,7 +315,8 @@
                 (exchange c "base await" (+ (monotonic-seconds) (trip-motion-timeout))
                           (lambda ()
                             (stop-base)
-                            (trip-error (robot-name c) what "timeout" "motion took too long"))))))
+                            (trip-error (robot-name c) what "timeout"
+                                        "motion took too long"))))))
     (if (= 1 (list-ref end 3))
         (trip-error (robot-name c) what "stalled" "the base is blocked"))
     (list (car end) (cadr end) (car (cddr end)) 0)))
@@ -398,7 +399,8 @@
   (let ((ls (if (and (pair? which) (list? (car which))) (car which) which)))
     (if (null? ls)
         (device 'lights "read")
-        (begin (apply device 'lights "set" (map (lambda (x) (if (memv x '(#f 0)) 0 1)) ls))
+        (begin (apply device 'lights "set"
+                      (map (lambda (x) (if (memv x '(#f 0)) 0 1)) ls))
                #t))))
 
 ;;> Says the things given, displayed and joined.

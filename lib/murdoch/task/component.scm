@@ -25,7 +25,7 @@
   (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
     (running-over?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
-    (thread-start! (make-thread (lambda () (watch-poser r period)) 'watch-poser))
+    (thread-start! (make-logged-thread (lambda () (watch-poser r period)) 'watch-poser))
     (let ((outcome
            (dynamic-wind
             (lambda () #f)

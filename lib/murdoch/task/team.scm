@@ -79,7 +79,7 @@
            (join-or-interrupt
             (map (lambda (uid proc)
                    (thread-start!
-                    (make-thread
+                    (make-logged-thread
                      (lambda ()
                        (parameterize ((pose-task-progress port))
                          (run-on uid proc seconds on-error debug?))))))
@@ -109,7 +109,7 @@
 ;; (abandon.scm).
 (define (apply-here-by proc seconds)
   (let* ((outcome #f)
-         (runner (make-thread
+         (runner (make-logged-thread
                   (lambda ()
                     (set! outcome
                           (guard (e (#t (cons 'raised e)))
