@@ -117,8 +117,8 @@
 (test-group "the task table"
   (let ((table (make-task-table)))
     ;; pose-task: the winners hold their exclusive subjects.
-    (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |t@pose-1#1|) (sonar |t@pose-1#1|)) '()))
-                                      (list 'ernst (report 'ernst '((mobile |t@pose-1#1|)) '()))))
+    (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile t@pose-1/1) (sonar t@pose-1/1)) '()))
+                                      (list 'ernst (report 'ernst '((mobile t@pose-1/1)) '()))))
     (test "a subject held is a component on that robot"
         '(("t" (null "moseley" ("mobile" "sonar") null null null)
                (null "ernst" ("mobile") null null null)))
@@ -138,7 +138,7 @@
       (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0)))
     ;; A robot killed and started again answers at once, holding nothing.
     (let ((table (make-task-table)))
-      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |u@pose-3#1|))
+      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile u@pose-3/1))
                                                               '()))))
       (task-table-update! table 2 (list (list 'moseley (cons 'moseley
                                                              (cons 99 (cddr (report 'moseley '() '())))))))
@@ -147,7 +147,7 @@
         (components table)))
     ;; start-task: components by index, and a reassignment.
     (let ((table (make-task-table)))
-      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |s@tester#4|))
+      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |s@tester/4|))
                                                                '((running |s@tester/1| 1 tester))))
                                         (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
       (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))

@@ -4,7 +4,7 @@
 ;;; The tasks: what the address spaces say they hold and run
 ;;
 ;; A robot tells the subjects it holds and for whom -- a reservation
-;; name, NAME@POSER#N (pose-task.scm) -- and the components of started
+;; name, NAME@POSER/N (pose-task.scm) -- and the components of started
 ;; tasks that it runs, (running ID INDEX POSER) with ID NAME@POSER/N
 ;; (task.scm).  The table remembers each component from when it is first
 ;; seen on a robot to when that robot no longer shows it; a component of
@@ -48,21 +48,10 @@
 (define away-polls 3)
 
 ;;> The task name and poser that reservation name or task id \var{key}
-;;> (a string, NAME@POSER#N or NAME@POSER/N) holds, as a list, or the key
-;;> and #f when it is neither.
+;;> (a string, NAME@POSER/N: task-key's) holds, as a list, or the key and
+;;> #f when it is not one.
 (define (reservation-task key)
-  (let* ((n (string-length key))
-         (mark (last-index key (lambda (c) (memv c '(#\# #\/))) n))
-         (at (and mark (last-index key (lambda (c) (char=? c #\@)) mark))))
-    (if at
-        (list (substring key 0 at) (substring key (+ at 1) mark))
-        (list key #f))))
-
-(define (last-index s pred end)
-  (let loop ((i (- end 1)))
-    (cond ((< i 0) #f)
-          ((pred (string-ref s i)) i)
-          (else (loop (- i 1))))))
+  (or (task-key-parts key) (list key #f)))
 
 ;; NAME@POSER of a key: what a started task's id and its reservations share.
 (define (key-base key)

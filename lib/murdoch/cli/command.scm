@@ -32,9 +32,10 @@
     (let ((host (lab-trip-host lab entry))
           (port (lab-trip-port lab entry)))
       (set-current-robot!
-       (guard (e (#t (error "cannot reach the robot's trip server (is the simulator running?)"
+       (guard (e (#t (error (string-append "cannot reach the robot's trip server"
+                                           " (is the simulator running?)")
                             (lab-aspace-uid entry) host port
-                            (if (error-object? e) (error-object-message e) e))))
+                            (error-message e))))
          (trip-connect host port)))
       (im)))
    ((lab-aspace-clause entry 'position)

@@ -299,14 +299,10 @@
 
 ;; An error's message and irritants, on one line.
 (define (error-line e)
-  (let ((out (open-output-string)))
-    (write-string (error-object-message e) out)
-    (for-each (lambda (x) (write-char #\space out) (write x out))
-              (error-object-irritants e))
-    (let ((text (get-output-string out)))
-      (if (> (string-length text) 200)
-          (string-append (substring text 0 196) " ...")
-          text))))
+  (let ((text (error-message e)))
+    (if (> (string-length text) 200)
+        (string-append (substring text 0 196) " ...")
+        text)))
 
 (define (defined-names file)
   (filter-map (lambda (form)

@@ -64,7 +64,6 @@
 
 (define *posed* '())                    ; the tasks started here, newest first
 (define *tasks-lock* (make-mutex 'tasks))
-(define *started* 0)
 
 ;;> Poses a task as pose-task does, with the same arguments, and answers
 ;;> at once with its task record.  \var{options} are the components'
@@ -91,20 +90,17 @@
     (let* ((turn (read-turn "start-task" (drop options (length lists))))
            (t (new-task task-name capability-list metrics procs restartable turn)))
       (thread-start!
-       (make-thread (inheriting
-                     (lambda () (run-task t priorities)))
-                    (task-id t)))
+       (make-logged-thread (inheriting
+                            (lambda () (run-task t priorities)))
+                           (task-id t)))
       t)))
 
 (define (new-task task-name capability-list metrics procs restartable turn)
   (with-lock *tasks-lock*
     (lambda ()
       (check-waiting-room turn)
-      (set! *started* (+ *started* 1))
       (let ((t (make-task
-                (string->symbol (string-append (symbol->string task-name) "@"
-                                               (symbol->string (local-aspace-uid))
-                                               "/" (number->string *started*)))
+                (task-key task-name)
                 task-name
                 (map (lambda (k caps metric proc r)
                        (let ((c (make-component k caps metric proc r)))
@@ -166,10 +162,10 @@
       (for-each thread-join!
                 (map (lambda (c winner type)
                        (thread-start!
-                        (make-thread (inheriting
-                                      (lambda ()
-                                        (supervise t c (car winner)
-                                                   (work-for winner type c)))))))
+                        (make-logged-thread (inheriting
+                                             (lambda ()
+                                               (supervise t c (car winner)
+                                                          (work-for winner type c)))))))
                      cs (car team) (cadr team)))
       (finish! t (map component-result cs))))))
 
@@ -256,9 +252,9 @@
   (let* ((a (uid->aspace uid))
          (period (lab-setting (current-lab) 'heartbeat))
          (answer (make-mailbox))
-         (runner (make-thread
+         (runner (make-logged-thread
                   (call-there a answer (task-id t) (component-index c)
-                              (local-aspace-uid) period work))))
+                                     (local-aspace-uid) period work))))
     (thread-start! runner)
     (let watch ((heard (monotonic-seconds)))
       (let ((got (mailbox-take answer (+ (monotonic-seconds) period)
@@ -430,8 +426,9 @@
     (for-each check-same steps (iota (length steps) 1))
     (let ((t (new-task task-name '() '() '() '() #f)))
       (task-steps-set! t '())
-      (thread-start! (make-thread (inheriting (lambda () (run-steps t steps options)))
-                                  (task-id t)))
+      (thread-start!
+       (make-logged-thread (inheriting (lambda () (run-steps t steps options)))
+                           (task-id t)))
       t)))
 
 ;;> Runs a task of steps and answers, as task-wait, each step's results.
@@ -447,7 +444,8 @@
               (if (and (same? c)
                        (not (and (= (length c) 3) (exact-integer? (cadr c))
                                  (< 0 (cadr c) i) (exact-integer? (car (cddr c))))))
-                  (error "task-step: (same J K) names component K of a step J before this one"
+                  (error (string-append "task-step: (same J K) names component K"
+                                        " of a step J before this one")
                          c)))
             (step-capabilities s)))
 
@@ -971,7 +969,7 @@
                (if *offering*
                    (begin (set! *offer-again* #t) #f)
                    (begin (set! *offering* #t) #t)))))
-      (thread-start! (make-thread offer-rounds 'offers))))
+      (thread-start! (make-logged-thread offer-rounds 'offers))))
 
 (define (offer-rounds)
   (guard (e (#t (log-warn "offering this robot: " (error-message e))))

@@ -56,22 +56,30 @@
 
 (define (with-poses thunk) (with-lock *poses-lock* thunk))
 
-;; Reservations are made under a name of this pose's own, so that the same
-;; task posed twice at once, from here or elsewhere, never shares a robot.
-;; The name says where it was posed: NAME@UID#N.
-(define (reservation-name task-name)
+;;> A key of this address space's own for a task named \var{task-name},
+;;> NAME@UID/N, the one form of a started task's id and of the name a
+;;> pose's reservations are made under: the same task posed twice at once,
+;;> from here or elsewhere, never shares a robot, and the key says where it
+;;> was posed.
+(define (task-key task-name)
   (let ((n (with-poses (lambda () (set! *poses* (+ *poses* 1)) *poses*))))
     (string->symbol (string-append (symbol->string task-name) "@"
-                                   (symbol->string (local-aspace-uid)) "#"
+                                   (symbol->string (local-aspace-uid)) "/"
                                    (number->string n)))))
 
-;; The uid of the address space that made reservation name, or #f for a
-;; task-name not made by reservation-name.
+;;> The task name and the poser's uid of \var{key} (a symbol or string
+;;> NAME@UID/N, as task-key makes), as two strings in a list, or #f for a
+;;> key task-key did not make.
+(define (task-key-parts key)
+  (let* ((s (if (symbol? key) (symbol->string key) key))
+         (slash (last-index s #\/ (string-length s)))
+         (at (and slash (last-index s #\@ slash))))
+    (and at (list (substring s 0 at) (substring s (+ at 1) slash)))))
+
+;; The uid of the address space that made reservation name, or #f.
 (define (reservation-aspace-uid name)
-  (let* ((s (symbol->string name))
-         (hash (last-index s #\# (string-length s)))
-         (at (and hash (last-index s #\@ hash))))
-    (and at (string->symbol (substring s (+ at 1) hash)))))
+  (let ((parts (task-key-parts name)))
+    (and parts (string->symbol (cadr parts)))))
 
 (define (last-index s char end)
   (let loop ((i (- end 1)))
@@ -125,7 +133,7 @@
     (check-task task-name num-robots capability-list metrics procs priorities)
     (let* ((layouts (map capability-layout capability-list))
            (type-list (map component-type layouts))
-           (name (reservation-name task-name))
+           (name (task-key task-name))
            (task (make-pose name layouts type-list (map metric-keys metrics)
                             procs priorities)))
       (progress task-name ": " (length procs) " components")
@@ -249,7 +257,7 @@
                   (for-each (lambda (entry)
                               (if (not (memq entry winners))
                                   (guard (e (#t (log-warn "releasing " (car entry)
-                                                          ": " (error-object-message e))))
+                                                          ": " (error-message e))))
                                     ((cadr entry) #f)
                                     (release-proxy! (cadr entry)))))
                             response)))
@@ -276,7 +284,8 @@
          (optimal (filter (lambda (i) (one-measure? (list-ref keys-list i))) all))
          (greedy (remove (lambda (i) (memv i optimal)) all))
          (picks (make-vector (length measured) #f)))
-    (for-each (lambda (i) (progress "  component " (+ i 1) " is not by one measure: greedy"))
+    (for-each (lambda (i)
+                (progress "  component " (+ i 1) " is not by one measure: greedy"))
               greedy)
     (and (fill! picks greedy
                 (resolve-conflicts (map sorted-entries (pick-out measured greedy)
@@ -378,7 +387,8 @@
      (with-poses
       (lambda () (set! *negotiating* (cons (list name (own-rank name)) *negotiating*)))))
    thunk
-   (lambda () (with-poses (lambda () (set! *negotiating* (del-ass name *negotiating*)))))))
+   (lambda ()
+     (with-poses (lambda () (set! *negotiating* (del-ass name *negotiating*)))))))
 
 (define (del-ass key alist) (remove (lambda (entry) (eq? (car entry) key)) alist))
 
@@ -475,8 +485,7 @@
 (define (tell-rival! holder rank)
   (let ((uid (reservation-aspace-uid holder)))
     (if uid
-        (guard (e (#t (log-warn "telling " holder " of " rank ": "
-                                (if (error-object? e) (error-object-message e) e))))
+        (guard (e (#t (log-warn "telling " holder " of " rank ": " (error-message e))))
           (remote-apply (uid->aspace uid) receive-rival holder rank)))))
 
 ;; Waits a random while, below (pose-task-backoff) doubled for each try

@@ -10,7 +10,7 @@
 ;;> Writes to \var{port} why task \var{task-name} found no takers: for
 ;;> each of \var{layouts} (a component's (EXCLUSIVE SHARED) subjects), the
 ;;> address spaces capable of it, each free, held (and by which
-;;> reservation, TASK@POSER#N) or away.
+;;> reservation, TASK@POSER/N) or away.
 (define (explain-no-takers task-name layouts port)
   (let ((lines (explain-components layouts)))
     (write-string (string-append "pose-task: not enough takers for "
