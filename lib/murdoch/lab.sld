@@ -1,3 +1,6 @@
+;;> The lab file (docs/lab-file.md): who is in the lab and where, and every
+;;> setting in one table.
+
 (define-library (murdoch lab)
   (export read-lab lab? lab-name lab-directory lab-settings lab-aspaces
           lab-setting lab-port-base lab-guest-port lab-trip-port lab-trip-host lab-path

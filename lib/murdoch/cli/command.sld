@@ -1,3 +1,5 @@
+;;> bin/murdoch's commands: start an address space, join a lab at a REPL.
+
 (define-library (murdoch cli command)
   (export join-lab run-aspace run-repl tell-who-is-away make-lab-environment
           make-repl-environment)

@@ -1,3 +1,6 @@
+;;> Sendable procedures: Murdoch's lambda, closures that travel as
+;;> S-expressions, with bounded depth and size.
+
 (define-library (murdoch code sendable)
   (export sendable-lambda sendable-define sendable-procedure?
           encode make-decoder send-error? abridged set-value-limits!

@@ -1,3 +1,6 @@
+;;> Publish/subscribe messaging (thesis §4.1, appendix A.8): subjects,
+;;> publish, request, request-exclusive and its promises, leases.
+
 (define-library (murdoch pubsub messaging)
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote

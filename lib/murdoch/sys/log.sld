@@ -1,3 +1,5 @@
+;;> One-line log messages on standard error, and the clock a person reads.
+
 (define-library (murdoch sys log)
   (export utc-seconds set-log-name! stamp-log-lines! log-note log-warn)
   (import (scheme base) (scheme write)

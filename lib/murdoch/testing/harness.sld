@@ -1,3 +1,6 @@
+;;> For tests alone: labs in temporary folders on free ports, and child
+;;> processes that are always stopped.
+
 (define-library (murdoch testing harness)
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
           start-process! stop-process! kill-process! reap! stop-all-processes!

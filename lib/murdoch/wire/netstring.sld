@@ -1,3 +1,6 @@
+;;> Netstrings, the frames every Murdoch message travels in, and the
+;;> nesting scan a message passes before it is read.
+
 (define-library (murdoch wire netstring)
   (export read-netstring write-netstring buffered-byte-count
           reset-output-string! nests-within?
