@@ -98,7 +98,7 @@
                   (error (string-append who ": a subject is a symbol") s)))
             subjects))
 
-(define (check-message who subjects proc)
+(define (check-subjects-and-procedure who subjects proc)
   (check-subjects who subjects)
   (if (not (procedure? proc))
       (error (string-append who ": not a procedure") proc)))
@@ -162,7 +162,7 @@
 ;;> \var{args}.  Answers the uids of the address spaces that acknowledged,
 ;;> which says nothing of who evaluated it.
 (define (publish topic proc . args)
-  (check-message "publish" (subject-list topic) proc)
+  (check-subjects-and-procedure "publish" (subject-list topic) proc)
   (filter-map (lambda (r) (and (cadr r) (car r)))
               (told-failures 'publish
                              (deliver 'run topic receive-publication topic
@@ -174,7 +174,7 @@
 ;;> that dies or stalls after (remote-timeout) seconds; the log tells of
 ;;> each.
 (define (request topic proc . args)
-  (check-message "request" (subject-list topic) proc)
+  (check-subjects-and-procedure "request" (subject-list topic) proc)
   (answers 'request (deliver 'apply topic receive-request topic
                              (local-aspace-uid) proc args)))
 
@@ -216,7 +216,7 @@
 ;;> applied is freed after the lab's lease.
 (define (request-exclusive topic task-name proc . args)
   (let ((layout (capability-layout topic)))
-    (check-message "request-exclusive" (apply append layout) proc)
+    (check-subjects-and-procedure "request-exclusive" (apply append layout) proc)
     (answers 'request-exclusive
              (broadcast-apply receive-request-exclusive layout task-name
                               (local-aspace-uid) proc args))))
@@ -226,7 +226,7 @@
 ;;> are refused until every promise is applied (the thesis's chapter 6).
 (define (request-non-exclusive topic task-name proc . args)
   (let ((subjects (subject-list topic)))
-    (check-message "request-non-exclusive" subjects proc)
+    (check-subjects-and-procedure "request-non-exclusive" subjects proc)
     (answers 'request-non-exclusive
              (broadcast-apply receive-request-non-exclusive subjects task-name
                               (local-aspace-uid) proc args))))

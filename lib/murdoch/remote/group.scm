@@ -35,7 +35,7 @@
 (define *buffer* #f)                    ; datagrams are received into it
 (define *sequence* 0)                   ; of the last datagram sent
 (define *sequence-lock* (make-mutex 'sequence))
-(define *started* 0)                    ; microseconds, at start-group!
+(define *started-microseconds* 0)       ; (wall-microseconds) at start-group!
 (define *window* 5)                     ; the lab's frame-timeout, seconds
 (define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
 (define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
@@ -66,7 +66,7 @@
         ;; would cost more than serving them.
         (set! *buffer* (make-bytevector 65536))
         (set! *window* (lab-setting lab 'frame-timeout))
-        (set! *started* (wall-microseconds))
+        (set! *started-microseconds* (wall-microseconds))
         (spawn (lambda () (serve receive-call)) 'multicast)
         (spawn send-beacons 'beacon)))))
 
@@ -142,7 +142,7 @@
 (define (check-fresh sender sequence)
   (cond ((<= sequence (hash-table-ref/default *last-sequence* sender 0))
          (frame-fail "replayed or out of order"))
-        ((< sequence *started*)
+        ((< sequence *started-microseconds*)
          (frame-fail "sent before this address space started"))
         ((< sequence (- (wall-microseconds) (* 1000000 *window*)))
          (frame-fail "older than frame-timeout"))))

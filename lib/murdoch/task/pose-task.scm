@@ -388,9 +388,9 @@
       (lambda () (set! *negotiating* (cons (list name (own-rank name)) *negotiating*)))))
    thunk
    (lambda ()
-     (with-poses (lambda () (set! *negotiating* (del-ass name *negotiating*)))))))
+     (with-poses (lambda () (set! *negotiating* (without-key name *negotiating*)))))))
 
-(define (del-ass key alist) (remove (lambda (entry) (eq? (car entry) key)) alist))
+(define (without-key key alist) (remove (lambda (entry) (eq? (car entry) key)) alist))
 
 ;;> What a pose that wants robots held by pose \var{name} calls where
 ;;> \var{name} was posed, with its \var{rank} (priority name): answers #t
@@ -423,7 +423,7 @@
    (lambda ()
      (let ((entry (assq name *negotiating*)))
        (and (not (any (lambda (rank) (outranks? rank (cadr entry))) (cddr entry)))
-            (begin (set! *negotiating* (del-ass name *negotiating*)) #t))))))
+            (begin (set! *negotiating* (without-key name *negotiating*)) #t))))))
 
 ;; Whether a rival that outranks pose name is still negotiating where it
 ;; was posed.  Rivals that are done are forgotten, so that they no longer
@@ -433,7 +433,8 @@
     (with-poses
      (lambda ()
        (let ((entry (assq name *negotiating*)))
-         (set-cdr! (cdr entry) (remove (lambda (rank) (member rank done)) (cddr entry))))))
+         (set-cdr! (cdr entry)
+                   (remove (lambda (rank) (member rank done)) (cddr entry))))))
     (pair? (outranking-rivals name))))
 
 (define (rival-negotiating? rank)
