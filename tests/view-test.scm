@@ -97,7 +97,7 @@
     (mm (box-seen '(0 0 0 0) 2000 90 0))))
 
 (test-group "reservation names and task ids"
-  (test '("dual-sonar-task" "pose-12") (reservation-task "dual-sonar-task@pose-12#3"))
+  (test '("dual-sonar-task" "pose-12") (reservation-task "dual-sonar-task@pose-12/3"))
   (test '("box@move" "tester") (reservation-task "box@move@tester/2"))
   (test '("plain" #f) (reservation-task "plain")))
 
