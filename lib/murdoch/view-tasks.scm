@@ -227,7 +227,9 @@
                             (robot . ,(component-entry-robot c))
                             (subjects . ,(list->vector (component-entry-subjects c)))
                             (since . ,(num (component-entry-since c)))
-                            (until . ,(if (open? c) 'null (num (component-entry-until c))))
+                            (until . ,(if (open? c)
+                                          'null
+                                          (num (component-entry-until c))))
                             (end . ,(or (component-entry-end c) 'null))
                             (from . ,(or (component-entry-from c) 'null))))
                         cs))))))

@@ -48,7 +48,9 @@
            (for-each (lambda (i) (write-char #\space out) (display i out))
                      (error-object-irritants x))
            (get-output-string out)))
-        (else (let ((out (open-output-string))) (display x out) (get-output-string out)))))
+        (else (let ((out (open-output-string)))
+                (display x out)
+                (get-output-string out)))))
 
 (define (numbers ls) (list->vector (map num ls)))
 
@@ -71,7 +73,9 @@
     (walls . ,(list->vector
                (map (lambda (w)
                       (numbers (append (take w 4)
-                                       (if (> (length w) 4) (list (list-ref w 4)) '(50)))))
+                                       (if (> (length w) 4)
+                                           (list (list-ref w 4))
+                                           '(50)))))
                     (world-items lab 'wall 4))))
     (boxes . ,(list->vector (map (lambda (b) (numbers (take b 5)))
                                  (world-items lab 'box 5))))
@@ -127,12 +131,14 @@
 ;;> \var{state} what the view remembers (new-view-state), brought up to
 ;;> date.
 (define (view-snapshot lab t answers state)
-  (let ((reports (filter-map (lambda (a) (and (cadr a) (list (car a) (car (car (cddr a))))))
+  (let ((reports (filter-map (lambda (a)
+                                (and (cadr a) (list (car a) (car (car (cddr a))))))
                              answers))
         (boxes (view-state-boxes state)))
     (task-table-update! (view-state-table state) t reports)
     (for-each (lambda (a) (if (cadr a) (move-boxes! boxes (car (cddr a))))) answers)
-    (for-each (lambda (a) (if (cadr a) (note-sonar! state (car a) (car (cddr a))))) answers)
+    (for-each (lambda (a) (if (cadr a) (note-sonar! state (car a) (car (cddr a)))))
+              answers)
     `((kind . "state")
       (t . ,(num t))
       (clock . ,(num (utc-seconds)))
@@ -150,7 +156,8 @@
              (not (and old (equal? (cadr old) ranges))))
         (view-state-sonars-set!
          state (cons (list uid ranges (take pose 3))
-                     (remove (lambda (s) (eq? (car s) uid)) (view-state-sonars state)))))))
+                     (remove (lambda (s) (eq? (car s) uid))
+                             (view-state-sonars state)))))))
 
 (define (move-boxes! boxes answer)
   (let ((pose (list-ref (car answer) 2))
@@ -179,9 +186,12 @@
           `((name . ,name)
             (away . #f)
             (since . ,(num (list-ref report 1)))
-            (pose . ,(if (and (list? pose) (>= (length pose) 3)) (numbers (take pose 3)) 'null))
+            (pose . ,(if (and (list? pose) (>= (length pose) 3))
+                         (numbers (take pose 3))
+                         'null))
             (battery . ,(if (real? battery) (num (/ battery 10)) 'null))
-            (held . ,(list->vector (map (lambda (h) (vector (text (car h)) (text (cadr h))))
+            (held . ,(list->vector (map (lambda (h)
+                                          (vector (text (car h)) (text (cadr h))))
                                         (list-ref report 4))))
             ;; The last sonar ring, and the pose it was read at.
             (sonar . ,(cond ((assq (car answer) (view-state-sonars state))
@@ -192,7 +202,8 @@
                                (else 'null)))
             ;; Where the robot's goto-xy is going (aspace-report's GOAL).
             (goal . ,(let ((goal (and (> (length report) 6) (list-ref report 6))))
-                       (if (and (list? goal) (>= (length goal) 2) (every real? (take goal 2)))
+                       (if (and (list? goal) (>= (length goal) 2)
+                                (every real? (take goal 2)))
                            (numbers (take goal 2))
                            'null))))))))
 
@@ -222,7 +233,9 @@
     (lambda ()
       (let ((k (feed-count feed)))
         (feed-recent-set! feed (let ((r (cons (cons k line) (feed-recent feed))))
-                                 (if (> (length r) kept-snapshots) (take r kept-snapshots) r)))
+                                 (if (> (length r) kept-snapshots)
+                                     (take r kept-snapshots)
+                                     r)))
         (feed-count-set! feed (+ k 1))
         (condition-variable-broadcast! (feed-changed feed))))))
 
@@ -339,8 +352,8 @@
   (flush-output-port (current-output-port)))
 
 ;;> `murdoch view LAB [PORT]`: joins the running lab at \var{lab-file} as
-;;> a guest (listening on port-base + 147), polls it twice a second, appends each snapshot to
-;;> \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl), and serves the
+;;> a peer listening on port-base + 147, polls it twice a second,
+;;> appends each snapshot to \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl), and serves the
 ;;> page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
 ;;> lab's port-base + 148), until killed.
 (define (run-view web lab-file port trace)
@@ -349,7 +362,8 @@
          (port (or port (+ (lab-port-base lab) 148)))
          (listener (listen-on port))
          (trace (or trace (default-trace lab)))
-         (uid (string->symbol (string-append "view-" (number->string (current-process-id)))))
+         (uid (string->symbol
+               (string-append "view-" (number->string (current-process-id)))))
          ;; Not a guest's port, which is one of fifty by process id: the
          ;; view stays as long as the lab, and a REPL or pose that drew
          ;; the same would not start.
@@ -381,8 +395,9 @@
     (say "view: http://127.0.0.1:" port "/ (trace " trace ")")
     (serve! listener
             (view-servlet web trace feed
-                          (lambda () `((live . #t) (lab . ,(symbol->string (lab-name lab)))
-                                       (trace . ,trace)))))))
+                          (lambda ()
+                            `((live . #t) (lab . ,(symbol->string (lab-name lab)))
+                              (trace . ,trace)))))))
 
 ;; The header of the trace already at path, or #f: the view started
 ;; again by the lab carries on with the trace it was writing.
