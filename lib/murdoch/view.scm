@@ -352,9 +352,9 @@
   (flush-output-port (current-output-port)))
 
 ;;> `murdoch view LAB [PORT]`: joins the running lab at \var{lab-file} as
-;;> a peer listening on port-base + 147, polls it twice a second,
-;;> appends each snapshot to \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl), and serves the
-;;> page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
+;;> a peer listening on port-base + 147, polls it twice a second, appends
+;;> each snapshot to \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl),
+;;> and serves the page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
 ;;> lab's port-base + 148), until killed.
 (define (run-view web lab-file port trace)
   (set-process-name! "murdoch-view")
