@@ -90,7 +90,8 @@
 (define (prompt-end line)
   (let loop ((i 0))
     (cond ((>= (+ i 1) (string-length line)) #f)
-          ((and (char=? (string-ref line i) #\>) (char=? (string-ref line (+ i 1)) #\space))
+          ((and (char=? (string-ref line i) #\>)
+                (char=? (string-ref line (+ i 1)) #\space))
            (and (> i 0) i))
           ((or (char-alphabetic? (string-ref line i)) (char-numeric? (string-ref line i))
                (char=? (string-ref line i) #\-))
@@ -254,7 +255,8 @@
   (let ((out (string-append dir "/output")))
     (call-with-process-io
      (list "sh" "-c"
-           "MURDOCH_PORT_BASE=$1 exec timeout -s KILL 90 \"$2\" repl \"$3\" $4 >\"$5\" 2>&1"
+           (string-append "MURDOCH_PORT_BASE=$1 exec timeout -s KILL 90"
+                          " \"$2\" repl \"$3\" $4 >\"$5\" 2>&1")
            "replay" base (tool-path "bin/murdoch") (tool-path (transcript-lab t))
            (if (transcript-as t) (symbol->string (transcript-as t)) "")
            out)
