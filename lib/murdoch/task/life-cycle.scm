@@ -961,18 +961,23 @@
 (define (note-waiters!) (set! *waiters-here?* #t))
 
 ;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
-;; starts an offer round, or asks the one running for another.
+;; starts an offer round, or asks the one running for another.  A round
+;; that runs keeps the robot as it is: offered to a poser, a runner-up of
+;; that poser's negotiation is freed while the robot waits for its answer,
+;; and the task that tries must still find the robot its poser's.
 (define (robot-freed!)
-  ;; At once, not in the round's thread, which may start late.
-  (if (and *waiters-here?* *waiters-seen*) (offer-subjects! 'nobody 3))
-  (if (and *waiters-here?*
-           (with-lock *offer-lock*
-             (lambda ()
-               (if *offering*
-                   (begin (set! *offer-again* #t) #f)
-                   (begin (set! *offering* #t) #t)))))
-      (thread-start! (make-thread offer-rounds 'offers))))
+  (when (and *waiters-here?*
+             (with-lock *offer-lock*
+               (lambda ()
+                 (if *offering*
+                     (begin (set! *offer-again* #t) #f)
+                     (begin (set! *offering* #t) #t)))))
+    ;; At once, not in the round's thread, which may start late.
+    (if *waiters-seen* (offer-subjects! 'nobody 3))
+    (thread-start! (make-thread offer-rounds 'offers))))
 
+;; The robot is kept for the poser it was last offered to until the
+;; rounds end, so that no task takes it between two rounds.
 (define (offer-rounds)
   (guard (e (#t (log-warn "offering this robot: " (error-message e))))
     (offer-round))
@@ -980,7 +985,9 @@
         (lambda ()
           (let ((again *offer-again*))
             (set! *offer-again* #f)
-            (if (not again) (set! *offering* #f))
+            (when (not again)
+              (offer-subjects! #f)
+              (set! *offering* #f))
             again)))
       (offer-rounds)))
 
@@ -994,7 +1001,7 @@
 (define (offer-round)
   (let ((me (local-aspace-uid)))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
-    (if *waiters-seen* (offer-subjects! 'nobody 3))
+    (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                               (guard (e (#t '()))
                                 (append-map cadr (request 'waiting-tasks
@@ -1011,8 +1018,7 @@
         (parameterize ((remote-timeout 3))
           (remote-apply (uid->aspace poser) receive-offer
                         (car (cddr (car waiting))) me)))
-      (offer-to me (cdr waiting))))
-  (offer-subjects! #f))
+      (offer-to me (cdr waiting)))))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
