@@ -663,7 +663,9 @@
 ;; Tries, answers the offers that woke it, and waits for the next.  It
 ;; tries only when news came (it was posed, offered a robot, asked to give
 ;; way), and looks at the lab again when what it holds changed, or a
-;; second after its last look: an offer is answered by one try.
+;; second after its last look: an offer is answered by one try.  Newly
+;; posed behind a better-ranked waiting task, it does not try but waits
+;; for the free robots' offers, which come in rank order.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
         (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
@@ -673,7 +675,8 @@
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (if (null? news)
+      (let ((team (if (or (null? news)
+                          (and (equal? news '((posed))) (behind-others? w)))
                       'not-enough-takers
                       (quiet-try (lambda ()
                                    (parameterize ((pose-task-excluded
@@ -887,6 +890,12 @@
                       (component-state-set! c (list 'waiting place (car (cddr state)))))))
               (waiter-components w))))
 
+;; Whether a better-ranked task of the lab waits for a robot w may use.
+(define (behind-others? w)
+  (> (place-in-line w (guard (e (#t '()))
+                        (append-map cadr (request 'waiting-tasks waiting-ranks))))
+     1))
+
 ;; w's place among the tasks of the lab that wait for a robot it may use:
 ;; 1 + how many of them rank before it.
 (define (place-in-line w others)
@@ -957,8 +966,15 @@
 (define *waiters-here?* #f)
 
 ;;> What a poser publishes to the lab when one of its tasks starts to
-;;> wait: the robots offer themselves when freed.
-(define (note-waiters!) (set! *waiters-here?* #t))
+;;> wait: the robots offer themselves when freed, and a free robot at
+;;> once, since a task posed behind others waits for the offers.
+(define (note-waiters!)
+  (set! *waiters-here?* #t)
+  (if (and (robot-here?) (free-here?)) (robot-freed!)))
+
+(define (robot-here?)
+  (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
+    (and a (lab-aspace-clause a 'capabilities) #t)))
 
 ;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
 ;; starts an offer round, or asks the one running for another.  A round
