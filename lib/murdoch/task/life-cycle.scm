@@ -926,16 +926,20 @@
 
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
 ;;> task tries again at once; answers whether it started, #f when it is
-;;> no longer waiting here or did not answer within two seconds.
+;;> no longer waiting here, is already offered a robot for each component
+;;> it does not hold, or did not answer within two seconds.
 (define (receive-offer id uid)
-  (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
-                 (with-lock *tasks-lock* (lambda () *waiters*))))
-        (reply (make-mailbox))
-        (offer (cons uid id)))
+  (let* ((reply (make-mailbox))
+         (offer (cons uid id))
+         (w (with-lock *tasks-lock*
+              (lambda ()
+                (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
+                               *waiters*)))
+                  (and w (not (offered-enough? w))
+                       (begin (set! *offers* (cons offer *offers*)) w)))))))
     (and w
          (dynamic-wind
-          (lambda ()
-            (with-lock *tasks-lock* (lambda () (set! *offers* (cons offer *offers*)))))
+          (lambda () #f)
           (lambda ()
             (tell-waiter! w (list 'offer reply uid))
             (mailbox-take reply (+ (monotonic-seconds) 2) (lambda () #f)))
@@ -943,6 +947,15 @@
             (with-lock *tasks-lock*
               (lambda ()
                 (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+
+;; Whether w is offered a robot for each component it does not hold: two
+;; robots freed together offer themselves to one task, and the second
+;; goes on to the next task at once rather than after the first's try.
+;; Under *tasks-lock*.
+(define (offered-enough? w)
+  (let ((id (task-id (waiter-task w))))
+    (>= (count (lambda (o) (eq? (cdr o) id)) *offers*)
+        (- (length (waiter-components w)) (length (waiter-held w))))))
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
