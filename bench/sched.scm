@@ -21,7 +21,13 @@
 ;;;   bench: sched-makespan-over-bound X x, over
 ;;;          max(sum of robots x seconds / 8, the longest task)
 ;;;   bench: sched-start-latency-p50 / -p95 X ms, from a robot's release
-;;;          to the next component starting on it, while tasks wait
+;;;          to the next component starting on it, while tasks wait: with
+;;;          'hold, the time a robot is held for a task of several
+;;;          robots until its others are free is part of it
+;;;   bench: sched-start-latency-one-robot-p50 / -p95 X ms, the same
+;;;          where the next start is of a task of one robot
+;;;   bench: sched-start-latency-last-release-p50 / -p95 X ms, from the
+;;;          last release among a task's robots to its start
 ;;;   bench: sched-utilization X %
 ;;;   bench: sched-wait-p95-priority-K X s
 ;;; MURDOCH_SCHED_SEED sets the seed (default 30).
@@ -214,6 +220,26 @@
 (define latencies (latencies-where (lambda (s) #t)))
 (define one-robot-latencies (latencies-where one-robot-start?))
 
+;; From the last release among the robots a task starts on to its start,
+;; for a task posed before that release: what the turns add, without the
+;; time its other robots were held for it before, which 'hold means.
+(define last-release-latencies
+  (filter-map
+   (lambda (sp)
+     (let* ((mine (filter (lambda (s) (= (list-ref s 2) (car sp))) starts))
+            (releases (filter-map
+                       (lambda (s)
+                         (let ((before (filter (lambda (e) (and (eq? (list-ref e 4)
+                                                                     (list-ref s 4))
+                                                                (<= (car e) (cadr sp))))
+                                               ends)))
+                           (and (pair? before) (apply max (map car before)))))
+                       mine))
+            (last (and (pair? releases) (apply max releases))))
+       (and last (< (vector-ref posed-at (car sp)) last)
+            (* 1000 (- (cadr sp) last)))))
+   spans))
+
 ;;; The ideal schedule: the same arrivals and rank rule, the measured
 ;;; work, no messages.  At each moment the waiting tasks, best rank
 ;;; first, each take free robots, keeping them until they have all they
@@ -290,6 +316,10 @@
        (round-to (percentile one-robot-latencies 0.5) 1) "ms")
 (bench "sched-start-latency-one-robot-p95"
        (round-to (percentile one-robot-latencies 0.95) 1) "ms")
+(bench "sched-start-latency-last-release-p50"
+       (round-to (percentile last-release-latencies 0.5) 1) "ms")
+(bench "sched-start-latency-last-release-p95"
+       (round-to (percentile last-release-latencies 0.95) 1) "ms")
 (bench "sched-utilization" (round-to (* 100 (/ robot-seconds (* (length robots) makespan))) 1) "%")
 (for-each (lambda (k)
             (bench (string-append "sched-wait-p95-priority-" (number->string k))

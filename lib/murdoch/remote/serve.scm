@@ -146,6 +146,17 @@
       (thread-start! t)))
   (mutex-unlock! *serving-lock*))
 
+;;> Run by an apply served here that runs long, a task's component say:
+;;> its connection gets a new reader at once, so that the caller's next
+;;> calls do not wait behind it for the janitor's takeover.
+(define (hand-over-connection!)
+  (mutex-lock! *serving-lock*)
+  (let ((s (find (lambda (s) (and (eq? (serving-thread s) (current-thread))
+                                  (serving-busy-since s)))
+                 *serving*)))
+    (mutex-unlock! *serving-lock*)
+    (if s (take-over! s))))
+
 ;; Marks the start and the end of the reader's inline apply of call id;
 ;; ending answers whether this thread is still the reader.  Until it ends,
 ;; the thread is found by id when its caller gives up.

@@ -3,7 +3,7 @@
 ;;> relieves readers held by a long apply.
 
 (define-library (murdoch remote serve)
-  (export start-serving! frame-timeout
+  (export start-serving! frame-timeout hand-over-connection!
           new-serving! read-as-reader reader? read-calls serve-call
           serving-read-on serving-read-on-set!)
   (import (scheme base) (srfi 1) (srfi 18)

@@ -22,6 +22,7 @@
 ;;> A robot failure comes back as (robot-failure WHY); any other condition
 ;;> is raised again once the component has left its dynamic extent.
 (define (run-component id k poser period work)
+  (hand-over-connection!)               ; its poser calls here meanwhile
   (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
     (running-over?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))

@@ -8,5 +8,5 @@
   (export run-component component-heartbeat! stop-component!
           components-running lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
-          (murdoch robot))
+          (murdoch robot) (only (murdoch remote) hand-over-connection!))
   (include "component.scm"))

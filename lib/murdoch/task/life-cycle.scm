@@ -661,7 +661,9 @@
 ;; Tries, answers the offers that woke it, and waits for the next.  It
 ;; tries only when news came (it was posed, offered a robot, asked to give
 ;; way), and looks at the lab again when what it holds changed, or a
-;; second after its last look: an offer is answered by one try.
+;; second after its last look: an offer is answered by one try.  Newly
+;; posed behind a better-ranked waiting task, it does not try but waits
+;; for the free robots' offers, which come in rank order.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
         (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
@@ -671,7 +673,8 @@
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (if (null? news)
+      (let ((team (if (or (null? news)
+                          (and (equal? news '((posed))) (behind-others? w)))
                       'not-enough-takers
                       (quiet-try (lambda ()
                                    (parameterize ((pose-task-excluded
@@ -885,6 +888,12 @@
                       (component-state-set! c (list 'waiting place (car (cddr state)))))))
               (waiter-components w))))
 
+;; Whether a better-ranked task of the lab waits for a robot w may use.
+(define (behind-others? w)
+  (> (place-in-line w (guard (e (#t '()))
+                        (append-map cadr (request 'waiting-tasks waiting-ranks))))
+     1))
+
 ;; w's place among the tasks of the lab that wait for a robot it may use:
 ;; 1 + how many of them rank before it.
 (define (place-in-line w others)
@@ -915,16 +924,20 @@
 
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
 ;;> task tries again at once; answers whether it started, #f when it is
-;;> no longer waiting here or did not answer within two seconds.
+;;> no longer waiting here, is already offered a robot for each component
+;;> it does not hold, or did not answer within two seconds.
 (define (receive-offer id uid)
-  (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
-                 (with-lock *tasks-lock* (lambda () *waiters*))))
-        (reply (make-mailbox))
-        (offer (cons uid id)))
+  (let* ((reply (make-mailbox))
+         (offer (cons uid id))
+         (w (with-lock *tasks-lock*
+              (lambda ()
+                (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
+                               *waiters*)))
+                  (and w (not (offered-enough? w))
+                       (begin (set! *offers* (cons offer *offers*)) w)))))))
     (and w
          (dynamic-wind
-          (lambda ()
-            (with-lock *tasks-lock* (lambda () (set! *offers* (cons offer *offers*)))))
+          (lambda () #f)
           (lambda ()
             (tell-waiter! w (list 'offer reply uid))
             (mailbox-take reply (+ (monotonic-seconds) 2) (lambda () #f)))
@@ -932,6 +945,15 @@
             (with-lock *tasks-lock*
               (lambda ()
                 (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+
+;; Whether w is offered a robot for each component it does not hold: two
+;; robots freed together offer themselves to one task, and the second
+;; goes on to the next task at once rather than after the first's try.
+;; Under *tasks-lock*.
+(define (offered-enough? w)
+  (let ((id (task-id (waiter-task w))))
+    (>= (count (lambda (o) (eq? (cdr o) id)) *offers*)
+        (- (length (waiter-components w)) (length (waiter-held w))))))
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
@@ -955,22 +977,34 @@
 (define *waiters-here?* #f)
 
 ;;> What a poser publishes to the lab when one of its tasks starts to
-;;> wait: the robots offer themselves when freed.
-(define (note-waiters!) (set! *waiters-here?* #t))
+;;> wait: the robots offer themselves when freed, and a free robot at
+;;> once, since a task posed behind others waits for the offers.
+(define (note-waiters!)
+  (set! *waiters-here?* #t)
+  (if (and (robot-here?) (free-here?)) (robot-freed!)))
+
+(define (robot-here?)
+  (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
+    (and a (lab-aspace-clause a 'capabilities) #t)))
 
 ;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
-;; starts an offer round, or asks the one running for another.
+;; starts an offer round, or asks the one running for another.  A round
+;; that runs keeps the robot as it is: offered to a poser, a runner-up of
+;; that poser's negotiation is freed while the robot waits for its answer,
+;; and the task that tries must still find the robot its poser's.
 (define (robot-freed!)
-  ;; At once, not in the round's thread, which may start late.
-  (if (and *waiters-here?* *waiters-seen*) (offer-subjects! 'nobody 3))
-  (if (and *waiters-here?*
-           (with-lock *offer-lock*
-             (lambda ()
-               (if *offering*
-                   (begin (set! *offer-again* #t) #f)
-                   (begin (set! *offering* #t) #t)))))
-      (thread-start! (make-logged-thread offer-rounds 'offers))))
+  (when (and *waiters-here?*
+             (with-lock *offer-lock*
+               (lambda ()
+                 (if *offering*
+                     (begin (set! *offer-again* #t) #f)
+                     (begin (set! *offering* #t) #t)))))
+    ;; At once, not in the round's thread, which may start late.
+    (if *waiters-seen* (offer-subjects! 'nobody 3))
+    (thread-start! (make-logged-thread offer-rounds 'offers))))
 
+;; The robot is kept for the poser it was last offered to until the
+;; rounds end, so that no task takes it between two rounds.
 (define (offer-rounds)
   (guard (e (#t (log-warn "offering this robot: " (error-message e))))
     (offer-round))
@@ -978,7 +1012,9 @@
         (lambda ()
           (let ((again *offer-again*))
             (set! *offer-again* #f)
-            (if (not again) (set! *offering* #f))
+            (when (not again)
+              (offer-subjects! #f)
+              (set! *offering* #f))
             again)))
       (offer-rounds)))
 
@@ -992,7 +1028,7 @@
 (define (offer-round)
   (let ((me (local-aspace-uid)))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
-    (if *waiters-seen* (offer-subjects! 'nobody 3))
+    (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                               (guard (e (#t '()))
                                 (append-map cadr (request 'waiting-tasks
@@ -1009,8 +1045,7 @@
         (parameterize ((remote-timeout 3))
           (remote-apply (uid->aspace poser) receive-offer
                         (car (cddr (car waiting))) me)))
-      (offer-to me (cdr waiting))))
-  (offer-subjects! #f))
+      (offer-to me (cdr waiting)))))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
