@@ -301,10 +301,10 @@
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
 ;; pushes harder.  A pusher alone (its partner has not said it is at the
-;; face for three rounds) pushes at the middle of the face, off it by a
-;; little to steer (lone-offset), so that the box goes straight and off
-;; a lost pusher's body.  Once a spare coming is near its place, the lone
-;; pusher holds at its own place, leaving the spare's free.
+;; face for three rounds) turns the box by where it pushes on its own half
+;; (lone-offset).  A spare coming turns the box the most: once the spare
+;; has a way to its place, the lone pusher holds at its own, leaving the
+;; spare's free.
 (define (steer! view side)
   (let* ((box (car view)) (bodies (cadr view))
          (d (heading-to box (aim-point box)))
@@ -313,21 +313,22 @@
     (cond ((< (- tick partner-here) 4)
            (push-at! box axis (* side pusher-offset)
                      (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
-          ((spare-near?) (push-at! box axis (* side pusher-offset) 0))
+          ((spare-on-its-way?) (push-at! box axis (* side pusher-offset) 0))
           (else (push-at! box axis (lone-offset box axis side err bodies) 0.5)))))
 
-;; Whether a spare said lately that it has a way to its place and is
-;; within 900 mm of it.
-(define (spare-near?)
-  (and (< (- tick partner-coming) 10) (< partner-coming-mm 900)))
+;; Whether a spare said lately that it has a way to its place.
+(define (spare-on-its-way?)
+  (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
 
 ;; Where a pusher alone on side pushes, mm left of the middle, for a box
-;; that must turn err degrees left: the middle, within 3 degrees, else off
-;; it toward the side that turns the box, by at most 120 mm; and, while a
-;; lost pusher's body lies there, as near that as it can keep its distance
-;; from the body, on its own side.
+;; that must turn err degrees left: the middle, within 4 degrees, else to
+;; the side that turns it, as far as its own half of the face goes: it
+;; never crosses the middle, and it keeps its distance from a lost
+;; pusher's body, which would stop it.
 (define (lone-offset box axis side err bodies)
-  (let loop ((offset (if (< (abs err) 3) 0 (clip (* -8 err) 120))))
+  (let loop ((offset (* side (max 0 (* side (if (< (abs err) 4)
+                                                 0
+                                                 (clip (* -8 err) pusher-offset)))))))
     (if (or (>= (* side offset) pusher-offset)
             (clear-of? bodies (list (behind-at box axis offset))))
         offset
