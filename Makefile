@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
+.PHONY: all deps native sim test test-box-faults bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
 	demo demo-box clean
 
 all: deps
@@ -17,6 +17,11 @@ include lib/native.mk
 
 test: all
 	tests/run
+
+# The box team with a pusher killed (docs/box-move.md): not yet reliable,
+# and 3 to 5 minutes a case, so not in `make test` (issue 31).
+test-box-faults: all
+	tests/run tests/box-faults/*-test.scm
 
 bench: all
 	bench/run
