@@ -30,7 +30,8 @@ lib/murdoch/%.c: lib/murdoch/%.stub
 	tools/chibi-ffi $< $@
 
 lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
-	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< $(NATIVE_LIBS_$(notdir $*))
+	$(CC) $(NATIVE_CFLAGS) $(NATIVE_CHIBI_CFLAGS) -shared -fPIC -o $@ $< \
+	    $(NATIVE_LIBS_$(notdir $*))
 
 # The plain C that a stub includes.
 lib/murdoch/sys/guard.so: lib/murdoch/sys/heap-watch.c

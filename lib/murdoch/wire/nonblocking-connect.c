@@ -3,7 +3,7 @@
  *
  *  (chibi net)'s open-net-io connects in blocking mode: a host that drops
  *  our SYN holds the whole process, every green thread, for the kernel's
- *  minutes of retries.  Here the connect is non-blocking, and lib/murdoch/wire/connect.scm
+ *  minutes of retries.  Here the connect is non-blocking, and connect.scm
  *  asks every millisecond whether it is done, sleeping its own thread only.
  *
  *  The socket itself is made, owned and closed in Scheme, as (chibi net)
