@@ -17,16 +17,20 @@
 ;; Medians over many runs.  Usage: tools/chibi bench/pubsub.scm N [multicast]
 ;; (one lab a process: an address space joins one lab); bench/run runs 4, 16
 ;; and 64, by simulated broadcast and by multicast (NAME-mcast-NN).
-;; With "scale" after N (bench/scale) it also prints lab-start-seconds-NN,
-;; from the first address space's start to the last's port open, and
-;; aspace-rss-mb-NN, the median address space's resident memory.
+;; The lab is started as a user starts one, by `murdoch lab` (all but the
+;; bencher, which is this process), whose address spaces are forks of its
+;; loader.  With "scale" after N (bench/scale) it also prints
+;; lab-start-seconds-NN, from `murdoch lab` to its "lab: ready", and
+;; aspace-rss-mb-NN and aspace-pss-mb-NN, the median address space's
+;; resident memory, and its proportional share of it (a page it shares with
+;; k others counts 1/(k+1)).
 ;; With "busy SECONDS" after N it measures nothing: it prints "busy" and the
 ;; lab's pids, sends requests to all back to back for that long, then prints
 ;; "requests K in SECONDS s", for bench/profile to sample the lab meanwhile.
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
         (scheme process-context) (scheme file) (srfi 1) (srfi 132)
-        (only (chibi process) current-process-id)
+        (only (chibi process) current-process-id system?)
         (only (chibi time) get-resource-usage resource-usage/self
               resource-usage-time resource-usage-system-time
               timeval-seconds timeval-microseconds)
@@ -44,34 +48,44 @@
 (define lab-pids '())
 
 (define (start-lab n delivery)
-  (let ((lab (make-test-lab
-              `((code ,(tool-path "examples/dual-sonar.scm")) ,@delivery
-                ,@(if scale? (scale-settings n) '())
-                (aspace bencher)
-                ,@(map aspace-clause (iota n 1)))))
-        (started (current-second)))
+  (let* ((lab (make-test-lab
+               `((code ,(tool-path "examples/dual-sonar.scm")) ,@delivery
+                 ,@(if scale? (scale-settings n) '())
+                 (aspace bencher)
+                 ,@(map aspace-clause (iota n 1)))))
+         (dir (test-lab-directory lab))
+         (out (string-append dir "/lab.out")))
     (if scale? (move-lab! lab scale-port-base))
-    (set! lab-pids
-          (map (lambda (i)
-                 (start-process!
-                  (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
-                        (string-append "w" (number->string i)))
-                  (string-append (test-lab-directory lab) "/w"
-                                 (number->string i) ".log")))
-               (iota n 1)))
-    (for-each (lambda (i)
-                ;; Sixty-four address spaces starting at once take a
-                ;; minute of two cores, more while others' tests run.
-                (if (not (wait-for-port (+ (if scale? scale-port-base
-                                                 (test-lab-port-base lab))
-                                             i)
-                                          900))
-                    (begin (stop-all-processes!)
-                           (error "an address space did not start; see its log"
-                                  (test-lab-directory lab) i))))
-              (iota n 1))
-    (if scale? (report "lab-start-seconds" n (- (current-second) started) "s"))
-    lab))
+    (let* ((started (current-second))
+           (pid (start-process! (list (tool-path "bin/murdoch") "lab" (test-lab-file lab)
+                                      "--except" "bencher" "--logs" (string-append dir "/logs"))
+                                out)))
+      ;; Sixty-four address spaces starting at once took a minute of two
+      ;; cores, more while others' tests ran, when each loaded Murdoch.
+      (wait-until 900 (lambda ()
+                        (let ((text (file-text out)))
+                          (or (text-contains? text "lab: ready")
+                              (text-contains? text "stopping the lab")))))
+      (if (not (text-contains? (file-text out) "lab: ready"))
+          (begin (stop-all-processes!)
+                 (error "the lab did not start; see its output" out (file-text out))))
+      (if scale? (report "lab-start-seconds" n (- (current-second) started) "s"))
+      (set! lab-pids (aspace-pids pid (string-append dir "/pids")))
+      (if (not (= (length lab-pids) n))
+          (error "not every address space was found" (length lab-pids) n))
+      lab)))
+
+;; The pids of the address spaces w1, w2 ... under process root, as ps
+;; names them (murdoch-wN): the lab's loader's children.
+(define (aspace-pids root file)
+  (system? "sh" "-c" "ps -eo pid=,ppid=,comm= | awk -v root=\"$1\" '
+              { up[$1] = $2; name[$1] = $3 }
+              END { for (p in up) { q = p
+                                    while (q in up && q != root) q = up[q]
+                                    if (q == root && name[p] ~ /^murdoch-w[0-9]/) print p } }
+            ' >\"$2\""
+           "pids" (number->string root) file)
+  (map string->number (read-lines file)))
 
 ;;; bench-scale: labs of 64 to 256 (bench/scale)
 
@@ -101,21 +115,25 @@
                            form)
                       out)))))
 
-;; Median resident memory of the lab's address spaces, in MB (Linux's
-;; /proc/PID/status).
-(define (resident-mb pid)
-  (call-with-input-file (string-append "/proc/" (number->string pid) "/status")
+;; The MB of memory that the line of Linux's /proc/PID/FILE starting with
+;; field says process pid has: its resident set in status (VmRSS), its
+;; proportional share of it in smaps_rollup (Pss).
+(define (memory-mb pid file field)
+  (call-with-input-file (string-append "/proc/" (number->string pid) "/" file)
     (lambda (in)
       (let loop ()
         (let ((line (read-line in)))
           (cond ((eof-object? line) 0)
-                ((string-prefix? "VmRSS:" line)
+                ((string-prefix? field line)
                  (/ (string->number (cadr (split-words line))) 1024.))
                 (else (loop))))))))
 
 (define (report-resident n)
-  (let ((mbs (list-sort < (map resident-mb lab-pids))))
-    (report "aspace-rss-mb" n (list-ref mbs (quotient (length mbs) 2)) "MB")))
+  (define (median-mb file field)
+    (let ((mbs (list-sort < (map (lambda (pid) (memory-mb pid file field)) lab-pids))))
+      (list-ref mbs (quotient (length mbs) 2))))
+  (report "aspace-rss-mb" n (median-mb "status" "VmRSS:") "MB")
+  (report "aspace-pss-mb" n (median-mb "smaps_rollup" "Pss:") "MB"))
 
 (define (median-ms runs thunk) (* 1000 (median-seconds runs thunk)))
 

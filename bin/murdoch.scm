@@ -43,7 +43,10 @@
         (unsetenv "MURDOCH_VIEW"))
     (run-lab bin lab-file (except (option 'except)) (option 'logs) (option 'trace)
              (let ((speed (option 'speed)))
-               (and speed (number->string speed))))))
+               (and speed (number->string speed)))
+             ;; A fork of the lab's loader becomes address space uid as
+             ;; `murdoch aspace LAB UID` would: its ERROR line says so.
+             (lambda (uid) (run (command-named "aspace") (list lab-file uid))))))
 
 ;; name, arguments (those in parentheses may be left out), what it does, its
 ;; options as (chibi app) writes them, and what runs it: a procedure of

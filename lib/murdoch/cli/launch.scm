@@ -2,7 +2,9 @@
 ;;
 ;; Supervising processes is left to sh scripts beside bin/murdoch
 ;; (murdoch-lab, murdoch-demo): this side reads the lab file, which only
-;; Scheme can, and hands them what they need on their command line.
+;; Scheme can, and hands them what they need on their command line.  The
+;; lab's address spaces are forked by its loader, which has Murdoch
+;; loaded already; the script says when.
 
 ;;> One line per address space of \var{lab} but those named in the list
 ;;> \var{except}: name, where it listens, robot
@@ -37,13 +39,127 @@
 ;;> lab at \var{lab-file} but for the address spaces named in \var{except},
 ;;> which someone will start by hand (a REPL that joins as one of them,
 ;;> say).  \var{logs}, \var{trace} and \var{speed} are strings or #f.
-(define (run-lab bin lab-file except logs trace speed)
-  (let ((lab (read-lab lab-file)))
-    (execute "/bin/sh"
-             (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
-                    (or logs "") (or trace "") (or speed "")
-                    (if (pair? (lab-robots lab)) "sim" "")
-                    (lab-lines lab except)))))
+;;> First it forks the lab's loader (see serve-loader), which starts each
+;;> address space as \scheme{(start-aspace uid)} in a fork of its own.
+(define (run-lab bin lab-file except logs trace speed start-aspace)
+  (let* ((lab (read-lab lab-file))
+         (requests (open-pipe))         ; bin/murdoch-lab -> the loader
+         (answers (open-pipe))          ; the loader -> bin/murdoch-lab
+         (loader (fork)))
+    (cond
+     ((zero? loader)
+      (close-fileno (cadr requests) open-output-file-descriptor)
+      (close-fileno (car answers) open-input-file-descriptor)
+      (serve-loader (open-input-file-descriptor (car requests))
+                    (open-output-file-descriptor (cadr answers))
+                    start-aspace))
+     (else
+      (for-each close-on-exec! (append requests answers))
+      (renumber-for-exec! (list (cadr requests) (car answers)) '(3 4))
+      (execute "/bin/sh"
+               (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
+                      (or logs "") (or trace "") (or speed "")
+                      (if (pair? (lab-robots lab)) "sim" "")
+                      (number->string loader)
+                      (lab-lines lab except)))))))
+
+;; Closes a fileno through a port, which marks it closed: the collector
+;; closes the descriptor of a fileno left open, whatever it is by then.
+(define (close-fileno fileno open-port)
+  (close-port (open-port fileno)))
+
+(define (close-on-exec! fd) (set-file-descriptor-flags! fd 1))   ; FD_CLOEXEC
+
+;; Makes the descriptors fds into the numbers to, for the program about
+;; to be executed: by way of numbers nothing holds, so that one of fds
+;; already at a number of to is not overwritten before it is copied.
+(define (renumber-for-exec! fds to)
+  (let ((spare (map (lambda (n) (+ n 90)) to)))
+    (for-each duplicate-file-descriptor-to fds spare)
+    (for-each close-on-exec! spare)
+    (for-each duplicate-file-descriptor-to spare to)))
+
+;;; The lab's loader
+;;
+;; Loading Murdoch costs a process most of a second of CPU (docs/speed.md),
+;; and a lab of hundreds of address spaces paid it once each.  The loader
+;; is forked from `murdoch lab` with Murdoch loaded and nothing else
+;; started: no thread, no socket, no poller.  Each address space is a fork
+;; of it, which shares its loaded pages until it writes them.  It reads
+;; requests from bin/murdoch-lab, one a line, and answers each:
+;;   start UID       forks address space UID, its output going to the file
+;;                   the next line names; answers the child's pid;
+;;   reap            answers "PID STATUS" for each child that has ended, its
+;;                   status as the shell's $? has it, then "end".
+;; bin/murdoch-lab, the lab's supervisor, decides what to start and when;
+;; the end of its requests ends the loader.
+(define (serve-loader in out start-aspace)
+  (set-process-name! "murdoch-loader")
+  ;; Ctrl-C is for bin/murdoch-lab, which stops the lab; the children
+  ;; inherit this, as those of sh's `&` do.
+  (set-signal-action! signal/interrupt #f)
+  (set-signal-action! signal/quit #f)
+  (let loop ()
+    (let ((line (read-line in)))
+      (cond
+       ((eof-object? line) (exit 0))
+       ((equal? line "reap")
+        (for-each (lambda (ended) (write-line ended out)) (reap-children))
+        (write-line "end" out))
+       ((string-prefix? "start " line)
+        (let ((uid (substring line 6 (string-length line)))
+              (log (read-line in)))
+          (write-line (number->string (fork-aspace uid log in out start-aspace))
+                      out)))
+       (else (error "the lab's loader: not a request" line)))
+      (flush-output-port out)
+      (loop))))
+
+(define (write-line text out) (write-string text out) (newline out))
+
+;; "PID STATUS" for each child that has ended, until none has.
+(define (reap-children)
+  (let ((ended (waitpid -1 wait/no-hang)))
+    (if (positive? (car ended))
+        (cons (string-append (number->string (car ended)) " "
+                             (number->string (shell-status (cadr ended))))
+              (reap-children))
+        '())))
+
+;; A wait status as $? has it: the exit code, or 128 + the signal that
+;; ended the process.
+(define (shell-status status)
+  (let ((signal (bitwise-and status #x7f)))
+    (if (zero? signal)
+        (bitwise-and (arithmetic-shift status -8) #xff)
+        (+ 128 signal))))
+
+;; Forks address space uid; the child leaves the loader's requests to it,
+;; writes to log and reads nothing, as sh's `>>LOG 2>&1 &` would have it.
+(define (fork-aspace uid log in out start-aspace)
+  (let ((pid (fork)))
+    (cond
+     ((zero? pid)
+      (close-port in)
+      (close-port out)
+      (redirect! 0 "/dev/null" open/read)
+      (redirect! 1 log (bitwise-ior open/write open/append open/create))
+      (duplicate-file-descriptor-to 1 2)
+      ;; Chibi seeds its random source when it is loaded: every fork of
+      ;; the loader would draw the same numbers.
+      (random-source-pseudo-randomize! default-random-source (current-process-id)
+                                       (exact (floor (current-second))))
+      (start-aspace uid)
+      (exit 0))
+     ((negative? pid) (error "the lab's loader cannot fork" uid))
+     (else pid))))
+
+;; Makes descriptor fd the file at path, opened with flags.
+(define (redirect! fd path flags)
+  (let ((fileno (open path flags)))
+    (if (not fileno) (error "cannot open" path))
+    (duplicate-file-descriptor-to fileno fd)
+    (close-fileno fileno open-input-file-descriptor)))
 
 ;;> `murdoch check LAB`: reads the lab file at \var{lab-file} as every
 ;;> peer does, and loads its code files into an environment of received

@@ -499,8 +499,14 @@
               (/ (round (* 1000 seconds)) 1000) " s")
     (thread-sleep! seconds)))
 
+;; Seeded at the first draw, not when loaded: the lab's address spaces are
+;; forks of one loaded process (run-lab), and would share its seed.
 (define backoff-random
-  (let ((source (make-random-source)))
-    (random-source-pseudo-randomize! source (current-process-id)
-                                     (exact (floor (current-second))))
-    (random-source-make-reals source)))
+  (let ((reals #f))
+    (lambda ()
+      (if (not reals)
+          (let ((source (make-random-source)))
+            (random-source-pseudo-randomize! source (current-process-id)
+                                             (exact (floor (current-second))))
+            (set! reals (random-source-make-reals source))))
+      (reals))))
