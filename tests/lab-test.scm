@@ -1,7 +1,7 @@
 ;;; bin/murdoch lab and pose, as real processes: a lab comes up and goes
 ;;; down whole, an address space that dies is started again, one that
 ;;; cannot start stops the lab, and pose poses the task a file names.
-(import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
+(import (scheme base) (scheme write) (scheme file) (scheme read) (srfi 1) (chibi test)
         (only (chibi process) system system? kill signal/kill)
         (chibi io) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor)
@@ -21,13 +21,6 @@
 
 (define (listening? port) (wait-for-port port 0))
 
-;; The children of process `pid`, as ps lists them.
-(define (children-of pid)
-  (let ((file (in-dir "children")))
-    (system? "sh" "-c" "ps -o pid= --ppid \"$1\" >\"$2\"" "ps"
-             (number->string pid) file)
-    (map string->number (read-lines file))))
-
 ;; The pid of the child of process `pid` that ps names `name`, or #f.
 (define (child-named pid name)
   (let ((found (string->number
@@ -37,6 +30,14 @@
                                                 " END { print p + 0 }'")
                        (number->string pid))))))
     (and (positive? found) found)))
+
+;; The lab's loader: the child of the lab's process `pid` that forks its
+;; address spaces.
+(define (loader-of pid) (child-named pid "murdoch-loader"))
+
+;; The parent of process `pid`, as /proc has it.
+(define (parent-of pid)
+  (string->number (command-output (list "ps" "-o" "ppid=" "-p" (number->string pid)))))
 
 ;; The lines `bin/murdoch COMMAND LAB ARG ...` prints.
 (define (command-lines command . args)
@@ -74,6 +75,12 @@
       (let ((line (car (read-lines (in-dir "logs/troy.log")))))
         (and (char=? (string-ref line 4) #\-) (char=? (string-ref line 10) #\T)
              (text-contains? line "Z murdoch troy: listening on"))))
+    (test "its address spaces are forks of one loader, a child of the lab" #t
+      (let ((loader (loader-of pid)))
+        (and loader
+             (equal? (list loader loader)
+                     (map (lambda (uid) (parent-of (child-named loader uid)))
+                          '("murdoch-troy" "murdoch-praline"))))))
     (test "ps names each address space murdoch-UID" '(#t #t)
       (map (lambda (uid)
              (not (equal? "0" (command-output
@@ -131,6 +138,16 @@
         (for-each (lambda (sock) (close-port (open-input-file-descriptor sock)))
                   squatters))
       (test "a task done: pose exits 0" 0 (command-status "pose" (in-dir "task.scm")))
+      (call-with-output-file (in-dir "draw.scm")
+        (lambda (out)
+          (write-string "(list 'draw 2 (list (list '() (list 'troy)) (list '() (list 'praline)))
+                               (list #f #f)
+                               (list (lambda () ((make-maxrandom 1000000000)))
+                                     (lambda () ((make-maxrandom 1000000000)))))\n"
+                        out)))
+      (test "forks of one loader draw random numbers of their own" #t
+        (let ((draws (read (open-input-string (last (pose-output "draw.scm"))))))
+          (and (= (length draws) 2) (not (= (car draws) (cadr draws))))))
       (call-with-output-file (in-dir "failing.scm")
         (lambda (out)
           (write-string "(list 'fails 1 (list (list '() (list 'camera))) (list #f)
@@ -158,7 +175,8 @@
 
 (test-group "an address space that dies is started again"
   (let* ((pid (start-lab! (in-dir "lab2.out")))
-         (troy (car (children-of pid))))
+         (loader (loader-of pid))
+         (troy (child-named loader "murdoch-troy")))
     (kill troy signal/kill)
     (test "the lab names it, and how it died" #t
       (wait-until 10 (lambda () (text-contains? (file-text (in-dir "lab2.out"))
@@ -170,12 +188,15 @@
                                                      "starting troy again")
                                      (listening? base)))))
     (test "the others carry on" #t (listening? (+ base 1)))
+    (test "forked again by the same loader" #t
+      (let ((again (child-named loader "murdoch-troy")))
+        (and again (not (= again troy)))))
     ;; Three restarts a minute: the fourth death is the last.
     (let loop ((deaths 1) (killed troy))
       (when (< deaths 4)
         (let ((next #f))
           (wait-until 30 (lambda ()
-                           (set! next (child-named pid "murdoch-troy"))
+                           (set! next (child-named loader "murdoch-troy"))
                            (and next (not (= next killed)) (listening? base))))
           (kill next signal/kill)
           (loop (+ deaths 1) next))))
@@ -183,6 +204,15 @@
       (wait-until 30 (lambda () (text-contains? (file-text (in-dir "lab2.out"))
                                                 "troy died 4 times in a minute"))))
     (test "the lab runs on, and stops whole" 0 (stop-process! pid))))
+
+(test-group "the loader's death stops the lab"
+  (let* ((pid (start-lab! (in-dir "lab5.out"))))
+    (kill (loader-of pid) signal/kill)
+    (test "the lab exits non-zero" #t (not (zero? (reap! pid))))
+    (test "saying so" #t
+      (text-contains? (file-text (in-dir "lab5.out")) "the loader"))
+    (test "and stops the address spaces" '(#f #f)
+      (map listening? (list base (+ base 1))))))
 
 (test-group "a child that cannot start stops the lab, with its ERROR line"
   ;; troy's port is taken before the lab starts.
