@@ -10,7 +10,7 @@
 ;; Workstations only, so that no simulator is needed: the launcher starts
 ;; one only for labs with robots.
 (define lab
-  (make-test-lab '((aspace troy (capabilities camera)) (aspace praline))))
+  (make-test-lab '((heap-max "160M") (aspace troy (capabilities camera)) (aspace praline))))
 (define dir (test-lab-directory lab))
 (define base (test-lab-port-base lab))
 
@@ -204,6 +204,28 @@
       (wait-until 30 (lambda () (text-contains? (file-text (in-dir "lab2.out"))
                                                 "troy died 4 times in a minute"))))
     (test "the lab runs on, and stops whole" 0 (stop-process! pid))))
+
+(test-group "a fork past heap-max ends, and is forked again"
+  ;; Logs of its own: the group before used up troy's restarts this minute.
+  (let ((pid (start-murdoch-lab! (list (test-lab-file lab) "--logs" (in-dir "logs6"))
+                                 (in-dir "lab6.out"))))
+    (call-with-output-file (in-dir "hog.scm")
+      (lambda (out)
+        (write-string "(list 'hog 1 (list (list '() (list 'troy))) (list #f)
+                             (list (lambda () (let loop ((kept '()))
+                                                (loop (cons (make-vector 1000 0) kept))))))\n"
+                      out)))
+    (test "its component fails: pose exits 1" 1 (command-status "pose" (in-dir "hog.scm")))
+    (test "the lab names it, with the heap guard's line" #t
+      (wait-until 10 (lambda ()
+                       (let ((text (file-text (in-dir "lab6.out"))))
+                         (and (text-contains? text "troy died (exit code 3)")
+                              (text-contains? text "the heap passed the lab's heap-max"))))))
+    (test "and starts it again" #t
+      (wait-until 30 (lambda () (and (text-contains? (file-text (in-dir "lab6.out"))
+                                                     "starting troy again")
+                                     (listening? base)))))
+    (test "the lab stops whole" 0 (stop-process! pid))))
 
 (test-group "the loader's death stops the lab"
   (let* ((pid (start-lab! (in-dir "lab5.out"))))
