@@ -58,7 +58,8 @@
     (if scale? (move-lab! lab scale-port-base))
     (let* ((started (current-second))
            (pid (start-process! (list (tool-path "bin/murdoch") "lab" (test-lab-file lab)
-                                      "--except" "bencher" "--logs" (string-append dir "/logs"))
+                                      "--except" "bencher"
+                                      "--logs" (string-append dir "/logs"))
                                 out)))
       ;; Sixty-four address spaces starting at once took a minute of two
       ;; cores, more while others' tests ran, when each loaded Murdoch.
@@ -82,7 +83,8 @@
               { up[$1] = $2; name[$1] = $3 }
               END { for (p in up) { q = p
                                     while (q in up && q != root) q = up[q]
-                                    if (q == root && name[p] ~ /^murdoch-w[0-9]/) print p } }
+                                    if (q == root && name[p] ~ /^murdoch-w[0-9]/)
+                                      print p } }
             ' >\"$2\""
            "pids" (number->string root) file)
   (map string->number (read-lines file)))

@@ -10,7 +10,8 @@
 ;; Workstations only, so that no simulator is needed: the launcher starts
 ;; one only for labs with robots.
 (define lab
-  (make-test-lab '((heap-max "160M") (aspace troy (capabilities camera)) (aspace praline))))
+  (make-test-lab '((heap-max "160M")
+                   (aspace troy (capabilities camera)) (aspace praline))))
 (define dir (test-lab-directory lab))
 (define base (test-lab-port-base lab))
 
@@ -140,7 +141,8 @@
       (test "a task done: pose exits 0" 0 (command-status "pose" (in-dir "task.scm")))
       (call-with-output-file (in-dir "draw.scm")
         (lambda (out)
-          (write-string "(list 'draw 2 (list (list '() (list 'troy)) (list '() (list 'praline)))
+          (write-string "(list 'draw 2 (list (list '() (list 'troy))
+                                             (list '() (list 'praline)))
                                (list #f #f)
                                (list (lambda () ((make-maxrandom 1000000000)))
                                      (lambda () ((make-maxrandom 1000000000)))))\n"
@@ -212,15 +214,18 @@
     (call-with-output-file (in-dir "hog.scm")
       (lambda (out)
         (write-string "(list 'hog 1 (list (list '() (list 'troy))) (list #f)
-                             (list (lambda () (let loop ((kept '()))
-                                                (loop (cons (make-vector 1000 0) kept))))))\n"
+                             (list (lambda ()
+                                     (let loop ((kept '()))
+                                       (loop (cons (make-vector 1000 0) kept))))))\n"
                       out)))
-    (test "its component fails: pose exits 1" 1 (command-status "pose" (in-dir "hog.scm")))
+    (test "its component fails: pose exits 1" 1
+      (command-status "pose" (in-dir "hog.scm")))
     (test "the lab names it, with the heap guard's line" #t
       (wait-until 10 (lambda ()
                        (let ((text (file-text (in-dir "lab6.out"))))
                          (and (text-contains? text "troy died (exit code 3)")
-                              (text-contains? text "the heap passed the lab's heap-max"))))))
+                              (text-contains? text
+                                              "the heap passed the lab's heap-max"))))))
     (test "and starts it again" #t
       (wait-until 30 (lambda () (and (text-contains? (file-text (in-dir "lab6.out"))
                                                      "starting troy again")
