@@ -361,6 +361,25 @@
              (and at (substring line (+ at (string-length word)) (string-length line)))))
          (if (file-exists? file) (read-lines file) '()))))
 
+;; A task that troy, an address space of the lab, starts and waits for
+;; (the task file does so before it answers a task of no components to
+;; pose): the view takes troy's word on it, and troy's report leaves out
+;; the tasks that are over.
+(define (posed-in-the-lab state)
+  (write-task "in-the-lab.scm"
+              "(begin
+                 (remote-apply (uid->aspace 'troy)
+                               (lambda ()
+                                 (task-wait (start-task 'lab-posed 1 (list (list (list 'mobile) '()))
+                                                        (list #f)
+                                                        (list (lambda () (thread-sleep! 2) 'ok))))
+                                 #t))
+                 (list 'nothing 0 '() '() '()))\n")
+  (reap! (start-pose! "in-the-lab.scm"))
+  (let ((t (task-over state "lab-posed")))
+    (test "a task posed in the lab ends in the state its poser gives it" '("troy" "done")
+      (and t (list (assq-ref 'poser t) (assq-ref 'state t))))))
+
 ;; pose-task posed by `murdoch pose`, a guest the view does not ask: each
 ;; component is shown by its number, the one that holds no subject too,
 ;; and each ends as the pose saw it -- failed by raising, on a robot
@@ -453,6 +472,7 @@
                                (vector->list (assq-ref 'aspaces s))))))
                  (cdr (text-lines (http-get view-port "/trace")))))
           (posed-from-a-guest pid state)
+          (posed-in-the-lab state)
           (if (not chromium)
               (display "skipped: no chromium on this machine, so the page is not tried in a browser\n")
               (let ((dom (browser-dom (string-append "http://127.0.0.1:" (number->string view-port)
