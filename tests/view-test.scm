@@ -116,9 +116,14 @@
                     (vector->list (assq-ref 'components t)))))
        (vector->list (string->json (json-text (task-table->json table 10))))))
 
-;; The state of the newest task of table.
-(define (task-state table)
-  (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0)))
+;; The newest task of table, as the JSON reader reads it, and its state.
+(define (newest-task table)
+  (vector-ref (string->json (json-text (task-table->json table 10))) 0))
+(define (task-state table) (assq-ref 'state (newest-task table)))
+
+;; A look at time t that finds each robot of robot-reports, (UID REPORT).
+(define (look table t . robot-reports) (task-table-update! table t robot-reports))
+(define (robot uid held tasks . ended) (list uid (apply report uid held tasks ended)))
 
 (test-group "the task table"
   (let ((table (make-task-table)))
@@ -131,7 +136,7 @@
       (components table))
     (test "the task negotiates" "negotiating" (task-state table))
     (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))))
-    (test "a reservation no longer held was released; one whose robot did not answer was not"
+    (test "a reservation no longer held was released; one whose robot did not answer, not"
         '(("t" (null "moseley" ("mobile" "sonar") 2 "released" null)
                (null "ernst" ("mobile") null null null)))
       (components table))
@@ -171,31 +176,28 @@
         (task-state table))))
   ;; pose-task's components, as their robots list them (run-posed-component).
   (let ((table (make-task-table)))
-    (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile p@guest-1/1))
-                                                             '()))))
-    (task-table-update! table 2 (list (list 'moseley (report 'moseley '((mobile p@guest-1/1))
-                                                             '((running p@guest-1/1 1 guest-1))))
-                                      (list 'ernst (report 'ernst '()
-                                                           '((running p@guest-1/1 2 guest-1))))))
+    (look table 1 (robot 'moseley '((mobile p@guest-1/1)) '()))
+    (look table 2
+          (robot 'moseley '((mobile p@guest-1/1)) '((running p@guest-1/1 1 guest-1)))
+          (robot 'ernst '() '((running p@guest-1/1 2 guest-1))))
     (test "each component by its number; a reservation becomes the component run under it"
         '(("p" (1 "moseley" ("mobile") null null null) (2 "ernst" () null null null)))
       (components table))
     (test "seen since its reservation was" '(1 2)
       (map (lambda (c) (assq-ref 'since c))
-           (vector->list (assq-ref 'components
-                                   (vector-ref (string->json (json-text (task-table->json table 10)))
-                                               0)))))
+           (vector->list (assq-ref 'components (newest-task table)))))
     (test "running" "running" (task-state table))
     ;; Component 1 raised; a third, on troy, began and ended between two looks.
-    (task-table-update! table 4 (list (list 'moseley (report 'moseley '() '()
-                                                             '((p@guest-1/1 1 guest-1 2.5 0.5
-                                                                (failed "car: not a pair ()")))))
-                                      (list 'ernst (report 'ernst '()
-                                                           '((running p@guest-1/1 2 guest-1))))
-                                      (list 'troy (report 'troy '() '()
-                                                          '((p@guest-1/1 3 guest-1 1 0.5 (done))
-                                                            (old@guest-1/1 1 guest-1 9 8 (done)))))))
-    (test "a component ends as its robot says, which is what its poser was told; one that ran between two looks is there, with its times"
+    (look table 4
+          (robot 'moseley '() '()
+                 '((p@guest-1/1 1 guest-1 2.5 0.5 (failed "car: not a pair ()"))))
+          (robot 'ernst '() '((running p@guest-1/1 2 guest-1)))
+          (robot 'troy '() '()
+                 '((p@guest-1/1 3 guest-1 1 0.5 (done))
+                   (old@guest-1/1 1 guest-1 9 8 (done)))))
+    (test (string-append "a component ends as its robot says, which is what its poser"
+                         " was told; one that ran between two looks is there, with its"
+                         " times")
         '(("p" (1 "moseley" ("mobile") 3.5 "failed: car: not a pair ()" null)
                (2 "ernst" () null null null)
                (3 "troy" () 3.5 "done" null)))
@@ -203,14 +205,14 @@
     (test "one that ended before the view started is left out" '("p")
       (map car (components table)))
     (test "a task runs while a component does" "running" (task-state table))
-    (task-table-update! table 5 (list (list 'moseley (report 'moseley '() '()))
-                                      (list 'ernst (report 'ernst '() '()
-                                                           '((p@guest-1/1 2 guest-1 4 0.2 (done)))))
-                                      (list 'troy (report 'troy '() '()))))
+    (look table 5
+          (robot 'moseley '() '())
+          (robot 'ernst '() '() '((p@guest-1/1 2 guest-1 4 0.2 (done))))
+          (robot 'troy '() '()))
     (test "and then failed, as its poser saw it" "failed" (task-state table)))
   (let ((table (make-task-table)))
-    (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile n@guest-2/1)) '()))))
-    (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))))
+    (look table 1 (robot 'moseley '((mobile n@guest-2/1)) '()))
+    (look table 2 (robot 'moseley '() '()))
     (test "a task whose robots were only reserved, then released, never started"
         "not started" (task-state table))))
 
@@ -331,8 +333,8 @@
 
 ;; `murdoch pose` of the task file name, its output in NAME.out; its pid.
 (define (start-pose! name)
-  (start-process! (list "timeout" "60" (tool-path "bin/murdoch") "pose" (test-lab-file lab)
-                        (in-dir name))
+  (start-process! (list "timeout" "60" (tool-path "bin/murdoch") "pose"
+                        (test-lab-file lab) (in-dir name))
                   (in-dir (string-append name ".out"))))
 
 ;; The task named name in the view's snapshot, or #f.
@@ -370,9 +372,11 @@
               "(begin
                  (remote-apply (uid->aspace 'troy)
                                (lambda ()
-                                 (task-wait (start-task 'lab-posed 1 (list (list (list 'mobile) '()))
-                                                        (list #f)
-                                                        (list (lambda () (thread-sleep! 2) 'ok))))
+                                 (task-wait
+                                  (start-task 'lab-posed 1
+                                              (list (list (list 'mobile) '()))
+                                              (list #f)
+                                              (list (lambda () (thread-sleep! 2) 'ok))))
                                  #t))
                  (list 'nothing 0 '() '() '()))\n")
   (reap! (start-pose! "in-the-lab.scm"))
@@ -393,7 +397,9 @@
   (let ((first (starts-on (in-dir "trip-up.scm.out") 1))
         (second (starts-on (in-dir "trip-up.scm.out") 2))
         (t (task-over state "trip-up")))
-    (test "pose-task's components by their numbers; the one that holds no subject is there; the one that raised failed, as its poser saw"
+    (test (string-append "pose-task's components by their numbers; the one that holds"
+                         " no subject is there; the one that raised failed, as its"
+                         " poser saw")
         (list (list 1 first "failed: car: not a pair ()") (list 2 second "done"))
       (and t (component-ends t)))
     (test "and so did its task" "failed" (and t (assq-ref 'state t))))
@@ -415,7 +421,8 @@
                      (assq-ref 'state t))))
       (test "as its poser was told" #t
         (text-contains? (file-text (in-dir "cut-off.scm.out"))
-                        (string-append "(error " (or winner "none") " \"connection lost\")")))
+                        (string-append "(error " (or winner "none")
+                                       " \"connection lost\")")))
       ;; The lab starts the robot again; the page is tried once it is back.
       (wait-until 30 (lambda ()
                        (not (any (lambda (a) (assq-ref 'away a))
@@ -492,8 +499,11 @@
                 (test "the winner's path: more than one point" #t
                   (> (length (path-points dom winner)) 1))
                 (test "a clock" #t (text-contains? dom "t = "))
-                (test "a component of pose-task by its number, and one that holds nothing" '(#t #t)
-                  (map (lambda (k) (text-contains? dom (string-append "<td>" k "</td><td class=\"winner\"")))
+                (test "pose-task's components by number, one that holds nothing too"
+                    '(#t #t)
+                  (map (lambda (k)
+                         (text-contains? dom (string-append "<td>" k
+                                                            "</td><td class=\"winner\"")))
                        '("1" "2")))
                 (test "a component failed as its poser saw it" #t
                   (text-contains? dom "<td>failed: car: not a pair ()</td>"))
