@@ -210,6 +210,19 @@
           (robot 'ernst '() '() '((p@guest-1/1 2 guest-1 4 0.2 (done))))
           (robot 'troy '() '()))
     (test "and then failed, as its poser saw it" "failed" (task-state table)))
+  ;; A started task whose poser is a guest: lost on moseley, done on ernst.
+  (let ((table (make-task-table)))
+    (look table 1 (robot 'moseley '() '((running r@guest-3/1 1 guest-3))))
+    (look table 2
+          (robot 'moseley '() '() '((r@guest-3/1 1 guest-3 1.5 0.5 (lost "stalled"))))
+          (robot 'ernst '() '((running r@guest-3/1 1 guest-3))))
+    (look table 3
+          (robot 'moseley '() '())
+          (robot 'ernst '() '() '((r@guest-3/1 1 guest-3 1.5 0.5 (done)))))
+    (test "a component lost on one robot and done on the next is done, and so its task"
+        '(("r" (1 "moseley" () 1.5 "lost: stalled" null) (1 "ernst" () 2.5 "done" "moseley"))
+          "done")
+      (list (car (components table)) (task-state table))))
   (let ((table (make-task-table)))
     (look table 1 (robot 'moseley '((mobile n@guest-2/1)) '()))
     (look table 2 (robot 'moseley '() '()))

@@ -152,12 +152,21 @@
                      (string=? word (substring end 0 (string-length word)))))
               '("lost:" "failed:")))))
 
+;; Whether c of cs failed or was lost, and no later entry took its number:
+;; a started task's component may be lost on one robot and done on the
+;; next.
+(define (failed-for-good? c cs)
+  (and (failed? c)
+       (let ((k (component-entry-index c)))
+         (not (and k (any (lambda (later) (eqv? (component-entry-index later) k))
+                          (cdr (memq c cs))))))))
+
 ;; A task's state, when its poser does not say it: what its components
 ;; say.
 (define (components-state cs)
   (cond ((any (lambda (c) (and (open? c) (component-entry-index c))) cs) "running")
         ((any open? cs) "negotiating")
-        ((any failed? cs) "failed")
+        ((any (lambda (c) (failed-for-good? c cs)) cs) "failed")
         ((any component-entry-index cs) "done")
         (else "not started")))
 
