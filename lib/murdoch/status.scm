@@ -12,9 +12,10 @@
 (define (aspace-report)
   ;; The components running are read before those ended: one that ends
   ;; in between is then in both lists, never in neither.
-  (let* ((not-over (remove (lambda (t) (and (eq? (car t) 'posed)
-                                         (memq (car (cddr t)) '(done failed cancelled))))
-                        (tasks)))
+  (let* ((not-over (remove (lambda (t)
+                             (and (eq? (car t) 'posed)
+                                  (memq (car (cddr t)) '(done failed cancelled))))
+                           (tasks)))
          (ended (components-ended)))
     (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
           (safe-battery-voltage)

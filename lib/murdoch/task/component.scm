@@ -64,8 +64,8 @@
        (note-ended! r outcome)))
     (if (raised? outcome) (raise (raised-condition outcome)) outcome)))
 
-;; What a component has answered until it answers: the thread that ran
-;; it left by no answer, a continuation or thread-terminate!.
+;; The outcome of a component until it has one: it keeps it when run-listed
+;; is left with no answer, by a continuation or thread-terminate!.
 (define unfinished (list 'unfinished))
 
 ;; A condition that a component raised, held until it is outside.
