@@ -35,7 +35,8 @@
           sort-list make-maxrandom
           ;; the task life cycle (lib/murdoch/task/life-cycle.scm)
           start-task task? task-id task-name task-status task-wait cancel-task
-          tasks run-component component-heartbeat! stop-component!
+          tasks run-component run-posed-component components-ended
+          component-heartbeat! stop-component!
           waiting-ranks waiting-for receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
           team-send! team-receive step-team

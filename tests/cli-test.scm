@@ -3,7 +3,7 @@
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
         (only (chibi process) system)
         (only (chibi filesystem) delete-file-hierarchy)
-        (murdoch testing harness))
+        (chibi json) (murdoch testing harness))
 
 (define dir (temporary-directory))
 (define out (string-append dir "/out"))
@@ -172,13 +172,44 @@
     (list (quotient (if (pair? status) (cadr status) status) 256)
           (file-text (string-append lab-dir "/demo.out")))))
 
+;; The tasks of the last snapshot of the trace that the demo's output
+;; names, as a list, or #f.
+(define (last-snapshot-tasks output)
+  (let* ((line (find (lambda (l) (text-contains? l "replay the run in the browser: "))
+                     (text-lines output)))
+         (path (and line (last-word line)))
+         (trace (and path (if (char=? #\/ (string-ref path 0))
+                              path
+                              (string-append (test-lab-directory demo-lab) "/" path)))))
+    (and trace (file-exists? trace)
+         (vector->list (cdr (assq 'tasks (string->json (last (read-lines trace)))))))))
+
+(define (last-word line)
+  (let loop ((i (string-length line)))
+    (cond ((zero? i) line)
+          ((char=? #\space (string-ref line (- i 1)))
+           (substring line i (string-length line)))
+          (else (loop (- i 1))))))
+
 (test-group "demo: its output, always, and its exit status"
   (let ((r (demo "camera.scm")))
     (test "a task done: exit 0" 0 (status r))
     (test "the pose's output is shown, to its result" #t
       (text-contains? (cadr r) "(snapped)"))
     (test "and no file is read before it is made" #f
-      (text-contains? (cadr r) "No such file")))
+      (text-contains? (cadr r) "No such file"))
+    ;; troy's component holds no subject and is over at once: the view
+    ;; sees it by what troy says ended there, and the demo stops the lab
+    ;; once the view has looked after the pose's end.
+    (test "its replay ends on the task done, and who won its component"
+        '("snap" "done" ((1 "troy" "done")))
+      (let ((last-tasks (last-snapshot-tasks (cadr r))))
+        (and (pair? last-tasks)
+             (let ((t (car last-tasks)))
+               (list (cdr (assq 'name t)) (cdr (assq 'state t))
+                     (map (lambda (c)
+                            (map (lambda (k) (cdr (assq k c))) '(index robot end)))
+                          (vector->list (cdr (assq 'components t))))))))))
   (let ((r (demo "laser.scm")))
     (test "a task nobody takes: exit non-zero" #t (positive? (status r)))
     (test "its output is shown" #t (text-contains? (cadr r) "not-enough-takers"))

@@ -101,8 +101,10 @@
   (test '("box@move" "tester") (reservation-task "box@move@tester/2"))
   (test '("plain" #f) (reservation-task "plain")))
 
-;; A report as aspace-report makes it: (UID UP-SINCE POSE BATTERY HELD TASKS).
-(define (report uid held tasks) (list uid 0 '(0 0 0 0) 136 held tasks))
+;; A report as aspace-report makes it: (UID UP-SINCE POSE BATTERY HELD TASKS
+;; GOAL ENDED).
+(define (report uid held tasks . ended) (list uid 0 '(0 0 0 0) 136 held tasks #f
+                                              (if (pair? ended) (car ended) '())))
 
 (define (components table)
   (map (lambda (t)
@@ -114,28 +116,37 @@
                     (vector->list (assq-ref 'components t)))))
        (vector->list (string->json (json-text (task-table->json table 10))))))
 
+;; The newest task of table, as the JSON reader reads it, and its state.
+(define (newest-task table)
+  (vector-ref (string->json (json-text (task-table->json table 10))) 0))
+(define (task-state table) (assq-ref 'state (newest-task table)))
+
+;; A look at time t that finds each robot of robot-reports, (UID REPORT).
+(define (look table t . robot-reports) (task-table-update! table t robot-reports))
+(define (robot uid held tasks . ended) (list uid (apply report uid held tasks ended)))
+
 (test-group "the task table"
   (let ((table (make-task-table)))
-    ;; pose-task: the winners hold their exclusive subjects.
+    ;; pose-task negotiating: the candidates hold their exclusive subjects.
     (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile t@pose-1/1) (sonar t@pose-1/1)) '()))
                                       (list 'ernst (report 'ernst '((mobile t@pose-1/1)) '()))))
-    (test "a subject held is a component on that robot"
+    (test "a subject held for a task that runs nothing there is a reservation, unnumbered"
         '(("t" (null "moseley" ("mobile" "sonar") null null null)
                (null "ernst" ("mobile") null null null)))
       (components table))
+    (test "the task negotiates" "negotiating" (task-state table))
     (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))))
-    (test "a robot that no longer holds it is done; one that did not answer is not"
-        '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
+    (test "a reservation no longer held was released; one whose robot did not answer, not"
+        '(("t" (null "moseley" ("mobile" "sonar") 2 "released" null)
                (null "ernst" ("mobile") null null null)))
       (components table))
     (task-table-update! table 3 (list (list 'moseley (report 'moseley '() '()))))
     (task-table-update! table 4 (list (list 'moseley (report 'moseley '() '()))))
     (test "one silent for three looks in a row was lost, and its task failed"
-        '(("t" (null "moseley" ("mobile" "sonar") 2 "done" null)
+        '(("t" (null "moseley" ("mobile" "sonar") 2 "released" null)
                (null "ernst" ("mobile") 4 "lost: ernst does not answer" null)))
       (components table))
-    (test "the task's state" "failed"
-      (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0)))
+    (test "the task's state" "failed" (task-state table))
     ;; A robot killed and started again answers at once, holding nothing.
     (let ((table (make-task-table)))
       (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile u@pose-3/1))
@@ -157,8 +168,66 @@
           '(("s" (1 "moseley" ("mobile") 2 "moved to ernst" null)
                  (1 "ernst" () null null "moseley")))
         (components table))
-      (test "the task's state is what its poser says" "running"
-        (assq-ref 'state (vector-ref (string->json (json-text (task-table->json table 10))) 0))))))
+      (test "the task's state is what its poser says" "running" (task-state table))
+      (task-table-update! table 3 (list (list 'ernst (report 'ernst '() '()))
+                                        (list 'tester (report 'tester '() '())
+                                              '((posed |s@tester/1| cancelled)))))
+      (test "to its end, when the report leaves a task that is over out" "cancelled"
+        (task-state table))))
+  ;; pose-task's components, as their robots list them (run-posed-component).
+  (let ((table (make-task-table)))
+    (look table 1 (robot 'moseley '((mobile p@guest-1/1)) '()))
+    (look table 2
+          (robot 'moseley '((mobile p@guest-1/1)) '((running p@guest-1/1 1 guest-1)))
+          (robot 'ernst '() '((running p@guest-1/1 2 guest-1))))
+    (test "each component by its number; a reservation becomes the component run under it"
+        '(("p" (1 "moseley" ("mobile") null null null) (2 "ernst" () null null null)))
+      (components table))
+    (test "seen since its reservation was" '(1 2)
+      (map (lambda (c) (assq-ref 'since c))
+           (vector->list (assq-ref 'components (newest-task table)))))
+    (test "running" "running" (task-state table))
+    ;; Component 1 raised; a third, on troy, began and ended between two looks.
+    (look table 4
+          (robot 'moseley '() '()
+                 '((p@guest-1/1 1 guest-1 2.5 0.5 (failed "car: not a pair ()"))))
+          (robot 'ernst '() '((running p@guest-1/1 2 guest-1)))
+          (robot 'troy '() '()
+                 '((p@guest-1/1 3 guest-1 1 0.5 (done))
+                   (old@guest-1/1 1 guest-1 9 8 (done)))))
+    (test (string-append "a component ends as its robot says, which is what its poser"
+                         " was told; one that ran between two looks is there, with its"
+                         " times")
+        '(("p" (1 "moseley" ("mobile") 3.5 "failed: car: not a pair ()" null)
+               (2 "ernst" () null null null)
+               (3 "troy" () 3.5 "done" null)))
+      (components table))
+    (test "one that ended before the view started is left out" '("p")
+      (map car (components table)))
+    (test "a task runs while a component does" "running" (task-state table))
+    (look table 5
+          (robot 'moseley '() '())
+          (robot 'ernst '() '() '((p@guest-1/1 2 guest-1 4 0.2 (done))))
+          (robot 'troy '() '()))
+    (test "and then failed, as its poser saw it" "failed" (task-state table)))
+  ;; A started task whose poser is a guest: lost on moseley, done on ernst.
+  (let ((table (make-task-table)))
+    (look table 1 (robot 'moseley '() '((running r@guest-3/1 1 guest-3))))
+    (look table 2
+          (robot 'moseley '() '() '((r@guest-3/1 1 guest-3 1.5 0.5 (lost "stalled"))))
+          (robot 'ernst '() '((running r@guest-3/1 1 guest-3))))
+    (look table 3
+          (robot 'moseley '() '())
+          (robot 'ernst '() '() '((r@guest-3/1 1 guest-3 1.5 0.5 (done)))))
+    (test "a component lost on one robot and done on the next is done, and so its task"
+        '(("r" (1 "moseley" () 1.5 "lost: stalled" null) (1 "ernst" () 2.5 "done" "moseley"))
+          "done")
+      (list (car (components table)) (task-state table))))
+  (let ((table (make-task-table)))
+    (look table 1 (robot 'moseley '((mobile n@guest-2/1)) '()))
+    (look table 2 (robot 'moseley '() '()))
+    (test "a task whose robots were only reserved, then released, never started"
+        "not started" (task-state table))))
 
 ;; An answer of remote-apply-all to report-source, from a robot at pose.
 (define (answer uid pose ranges fiducials . goal)
@@ -272,6 +341,106 @@
 
 (define view-port (+ (test-lab-port-base lab) 148))
 
+(define (write-task name text)
+  (call-with-output-file (in-dir name) (lambda (out) (write-string text out))))
+
+;; `murdoch pose` of the task file name, its output in NAME.out; its pid.
+(define (start-pose! name)
+  (start-process! (list "timeout" "60" (tool-path "bin/murdoch") "pose"
+                        (test-lab-file lab) (in-dir name))
+                  (in-dir (string-append name ".out"))))
+
+;; The task named name in the view's snapshot, or #f.
+(define (task-named-in snapshot name)
+  (find (lambda (t) (equal? name (assq-ref 'name t)))
+        (vector->list (assq-ref 'tasks snapshot))))
+
+;; The task named name in the view's newest snapshot, once it is over
+;; (at most 20 s), or #f.
+(define (task-over state name)
+  (wait-until 20
+    (lambda ()
+      (let ((t (task-named-in (state) name)))
+        (and t (member (assq-ref 'state t) '("done" "failed")) t)))))
+
+;; (INDEX ROBOT END) of each component of task t.
+(define (component-ends t)
+  (map (lambda (c) (list (assq-ref 'index c) (assq-ref 'robot c) (assq-ref 'end c)))
+       (vector->list (assq-ref 'components t))))
+
+;; The robot that the pose's output in file says component k starts on.
+(define (starts-on file k)
+  (let ((word (string-append "component " (number->string k) " starts on ")))
+    (any (lambda (line)
+           (let ((at (string-search word line)))
+             (and at (substring line (+ at (string-length word)) (string-length line)))))
+         (if (file-exists? file) (read-lines file) '()))))
+
+;; A task that troy, an address space of the lab, starts and waits for
+;; (the task file does so before it answers a task of no components to
+;; pose): the view takes troy's word on it, and troy's report leaves out
+;; the tasks that are over.
+(define (posed-in-the-lab state)
+  (write-task "in-the-lab.scm"
+              "(begin
+                 (remote-apply (uid->aspace 'troy)
+                               (lambda ()
+                                 (task-wait
+                                  (start-task 'lab-posed 1
+                                              (list (list (list 'mobile) '()))
+                                              (list #f)
+                                              (list (lambda () (thread-sleep! 2) 'ok))))
+                                 #t))
+                 (list 'nothing 0 '() '() '()))\n")
+  (reap! (start-pose! "in-the-lab.scm"))
+  (let ((t (task-over state "lab-posed")))
+    (test "a task posed in the lab ends in the state its poser gives it" '("troy" "done")
+      (and t (list (assq-ref 'poser t) (assq-ref 'state t))))))
+
+;; pose-task posed by `murdoch pose`, a guest the view does not ask: each
+;; component is shown by its number, the one that holds no subject too,
+;; and each ends as the pose saw it -- failed by raising, on a robot
+;; that lives on; lost, on a robot that was killed.
+(define (posed-from-a-guest lab-pid state)
+  (write-task "trip-up.scm"
+              "(list 'trip-up 2 (list (list (list 'mobile) '()) (list '() (list 'mobile)))
+                     (list #f #f)
+                     (list (lambda () (thread-sleep! 1) (car '())) (lambda () 'fine)))\n")
+  (reap! (start-pose! "trip-up.scm"))
+  (let ((first (starts-on (in-dir "trip-up.scm.out") 1))
+        (second (starts-on (in-dir "trip-up.scm.out") 2))
+        (t (task-over state "trip-up")))
+    (test (string-append "pose-task's components by their numbers; the one that holds"
+                         " no subject is there; the one that raised failed, as its"
+                         " poser saw")
+        (list (list 1 first "failed: car: not a pair ()") (list 2 second "done"))
+      (and t (component-ends t)))
+    (test "and so did its task" "failed" (and t (assq-ref 'state t))))
+  (write-task "cut-off.scm"
+              "(list 'cut-off 1 (list (list (list 'mobile) '())) (list #f)
+                     (list (lambda () (thread-sleep! 30) 'slept)))\n")
+  (let* ((pose (start-pose! "cut-off.scm"))
+         (winner (wait-until 30 (lambda () (starts-on (in-dir "cut-off.scm.out") 1)))))
+    ;; Killed once the view has seen it run: a robot that dies takes with
+    ;; it what the view had not yet seen.
+    (wait-until 20 (lambda () (task-named-in (state) "cut-off")))
+    (system? (tool-path "tools/kill-aspace") (number->string lab-pid) (or winner "none"))
+    (reap! pose)
+    (let ((t (task-over state "cut-off")))
+      (test "the pose whose robot was killed: its component lost, its task failed"
+          (list (list 1 winner #t) "failed")
+        (and t (list (let ((c (car (component-ends t))))
+                       (list (car c) (cadr c) (text-contains? (car (cddr c)) "lost: ")))
+                     (assq-ref 'state t))))
+      (test "as its poser was told" #t
+        (text-contains? (file-text (in-dir "cut-off.scm.out"))
+                        (string-append "(error " (or winner "none")
+                                       " \"connection lost\")")))
+      ;; The lab starts the robot again; the page is tried once it is back.
+      (wait-until 30 (lambda ()
+                       (not (any (lambda (a) (assq-ref 'away a))
+                                 (vector->list (assq-ref 'aspaces (state))))))))))
+
 (if (not (file-exists? (tool-path "sim/b14")))
     (begin (display "no simulator (make -C sim): the lab part is left out\n"))
     (let ((pid (start-murdoch-lab! (list (test-lab-file lab) "--logs" (in-dir "logs") "--view")
@@ -322,6 +491,8 @@
                                                 (equal? '#(0 -1000) (assq-ref 'goal a))))
                                (vector->list (assq-ref 'aspaces s))))))
                  (cdr (text-lines (http-get view-port "/trace")))))
+          (posed-from-a-guest pid state)
+          (posed-in-the-lab state)
           (if (not chromium)
               (display "skipped: no chromium on this machine, so the page is not tried in a browser\n")
               (let ((dom (browser-dom (string-append "http://127.0.0.1:" (number->string view-port)
@@ -341,6 +512,14 @@
                 (test "the winner's path: more than one point" #t
                   (> (length (path-points dom winner)) 1))
                 (test "a clock" #t (text-contains? dom "t = "))
+                (test "pose-task's components by number, one that holds nothing too"
+                    '(#t #t)
+                  (map (lambda (k)
+                         (text-contains? dom (string-append "<td>" k
+                                                            "</td><td class=\"winner\"")))
+                       '("1" "2")))
+                (test "a component failed as its poser saw it" #t
+                  (text-contains? dom "<td>failed: car: not a pair ()</td>"))
                 (let ((shot (string-append (or (get-environment-variable "TMPDIR") "/tmp")
                                            "/murdoch-view-test.png")))
                   (screenshot (string-append "http://127.0.0.1:" (number->string view-port)

@@ -184,7 +184,7 @@ function drawTasks(state) {
     const h = el("h3", {}, div);
     textEl("span", t.name, { class: "task-name" }, h);
     textEl("span", ` posed by ${t.poser || "?"}: `, {}, h);
-    textEl("span", t.state, { class: `state-${t.state}` }, h);
+    textEl("span", t.state, { class: `state-${t.state.replace(/ /g, "-")}` }, h);
     const table = el("table", {}, div);
     const head = el("tr", {}, table);
     for (const c of ["component", "won by", "subjects", "from", "to", "note"]) textEl("th", c, {}, head);

@@ -2,20 +2,26 @@
 ;;;; what they all say, asked at once.
 
 ;;> What this address space says of itself: (UID UP-SINCE POSE BATTERY
-;;> HELD TASKS GOAL), UP-SINCE the wall-clock second it joined the lab,
-;;> POSE what safe-reckon answers, BATTERY safe-battery-voltage in tenths
-;;> of a volt, HELD the (subject holder) of each subject held here, TASKS
-;;> what (tasks) answers: the tasks it started that are not over, and the
-;;> components it runs; GOAL where goto-xy is driving its robot, or #f.
+;;> HELD TASKS GOAL ENDED), UP-SINCE the wall-clock second it joined the
+;;> lab, POSE what safe-reckon answers, BATTERY safe-battery-voltage in
+;;> tenths of a volt, HELD the (subject holder) of each subject held here,
+;;> TASKS what (tasks) answers: the tasks it started that are not over,
+;;> and the components it runs; GOAL where goto-xy is driving its robot,
+;;> or #f; ENDED what (components-ended) answers, the components that
+;;> ended here lately.
 (define (aspace-report)
-  (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
-        (safe-battery-voltage)
-        (filter (lambda (s) (not (null? (cadr s))))
-                (subscription-statuses '>))
-        (remove (lambda (t) (and (eq? (car t) 'posed)
-                                 (memq (car (cddr t)) '(done failed cancelled))))
-                (tasks))
-        (goto-goal)))
+  ;; The components running are read before those ended: one that ends
+  ;; in between is then in both lists, never in neither.
+  (let* ((not-over (remove (lambda (t)
+                             (and (eq? (car t) 'posed)
+                                  (memq (car (cddr t)) '(done failed cancelled))))
+                           (tasks)))
+         (ended (components-ended)))
+    (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
+          (safe-battery-voltage)
+          (filter (lambda (s) (not (null? (cadr s))))
+                  (subscription-statuses '>))
+          not-over (goto-goal) ended)))
 
 ;;> The lab's status: for each address space of \var{lab}, in file order,
 ;;> its report (see aspace-report) when it answered within

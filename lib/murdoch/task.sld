@@ -4,8 +4,9 @@
 
 (define-library (murdoch task)
   (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
-          dominant-cost run-component
-          component-heartbeat! stop-component! components-running lost-periods
+          dominant-cost run-component run-posed-component
+          component-heartbeat! stop-component! components-running components-ended
+          lost-periods
           start-task task? task-id task-name task-status task-wait cancel-task tasks
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer
           receive-give-way note-waiters! location-metric-maker load-metric-maker

@@ -4,17 +4,24 @@
 ;;; The tasks: what the address spaces say they hold and run
 ;;
 ;; A robot tells the subjects it holds and for whom -- a reservation
-;; name, NAME@POSER/N (pose-task.scm) -- and the components of started
-;; tasks that it runs, (running ID INDEX POSER) with ID NAME@POSER/N
-;; (task.scm).  The table remembers each component from when it is first
-;; seen on a robot to when that robot no longer shows it; a component of
-;; a started task seen on another robot than before was reassigned.  A
-;; task's own state is what its poser says, when the poser is an address
-;; space of the lab; else running while a component is seen, then done,
-;; or failed when a component was lost.  A component is lost when its
-;; robot started again (its up-since moved) or has not answered for
-;; away-polls looks in a row: a robot that died does not say that it
-;; stopped, and its poser was told "connection lost".
+;; name, NAME@POSER/N (pose-task.scm) -- the components it runs, (running
+;; ID INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed
+;; task's reservation name (component.scm), and the components that ended
+;; there lately, each with how it ended, which its poser was told.  The
+;; table remembers each component from when it is first seen on a robot
+;; to when it ended there, and how; one that ended between two looks is
+;; added whole.  A component of a started task seen on another robot than
+;; before was reassigned.  Subjects held for a task that its robot runs no
+;; component of are a reservation of its negotiation, shown without a
+;; number until a component of that task starts on that robot, or it is
+;; released.  A task's own state is what its poser says, when the poser
+;; is an address space of the lab; else what its components say: running
+;; while one runs, negotiating while only reservations are held, failed
+;; when one failed or was lost, not started when none started, else done.
+;; A component is lost when its robot started again (its up-since moved)
+;; or has not answered for away-polls looks in a row: a robot that died
+;; does not say that it stopped, and its poser was told "connection
+;; lost".
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)
@@ -83,8 +90,9 @@
             (list holder #f (subjects-of (lambda (h) (equal? h holder)))))
           (delete-duplicates (remove covered? (map cdr held)))))))
 
-;; (KEY STATE) for each task the report says this address space posed.
-(define (report-posed report)
+;; (KEY STATE) for each task of tasks, entries as (tasks) answers, posed
+;; by the address space that answered them.
+(define (posed-states tasks)
   (filter-map (lambda (t)
                 (and (pair? t) (eq? (car t) 'posed) (memv (length t) '(3 5))
                      (list (text (cadr t))
@@ -92,10 +100,42 @@
                                (string-append "waiting, " (text (list-ref t 3))
                                               " in line")
                                (text (car (cddr t)))))))
-              (list-ref report 5)))
+              tasks))
+
+;; Whether the table takes a posed task's state: it goes on, or it is
+;; one the table has; a task over before the view saw it is left out.
+(define (posed-news? table posed)
+  (or (task-known table (car posed))
+      (not (member (cadr posed) '("done" "failed" "cancelled")))))
+
+;; (KEY INDEX SINCE UNTIL END) for each component the report says ended
+;; there (components-ended): SINCE and UNTIL in seconds before the
+;; report, END as the table shows it.
+(define (report-ended report)
+  (filter-map (lambda (e)
+                (and (list? e) (= (length e) 6) (exact-integer? (cadr e))
+                     (real? (list-ref e 3)) (real? (list-ref e 4))
+                     (pair? (list-ref e 5))
+                     (list (text (car e)) (cadr e) (list-ref e 3) (list-ref e 4)
+                           (end-text (list-ref e 5)))))
+              (if (> (length report) 7) (list-ref report 7) '())))
+
+;; (done), (failed WHY) or (lost WHY), as "done", "failed: WHY" ...; a
+;; long WHY cut short.
+(define (end-text end)
+  (if (pair? (cdr end))
+      (let ((why (text (cadr end))))
+        (string-append (text (car end)) ": "
+                       (if (> (string-length why) 160)
+                           (string-append (substring why 0 160) " ...")
+                           why)))
+      (text (car end))))
+
+(define (task-known table key)
+  (find (lambda (t) (equal? (task-entry-key t) key)) (table-tasks table)))
 
 (define (task-named table key)
-  (or (find (lambda (t) (equal? (task-entry-key t) key)) (table-tasks table))
+  (or (task-known table key)
       (let* ((nt (reservation-task key))
              (t (make-task-entry key (car nt) (cadr nt) #f '())))
         (set-cdr! table (append (table-tasks table) (list t)))
@@ -103,15 +143,39 @@
 
 (define (open? c) (not (component-entry-until c)))
 
-(define (lost? c)
+;; Whether c ended lost or failed.
+(define (failed? c)
   (let ((end (component-entry-end c)))
-    (and (string? end) (>= (string-length end) 5)
-         (string=? "lost:" (substring end 0 5)))))
+    (and (string? end)
+         (any (lambda (word)
+                (and (>= (string-length end) (string-length word))
+                     (string=? word (substring end 0 (string-length word)))))
+              '("lost:" "failed:")))))
 
-;;> Brings \var{table} up to the time \var{t} (seconds) with
-;;> \var{reports}: (UID REPORT) for each address space that answered,
-;;> REPORT as aspace-report makes it.  Components that an address space
-;;> that answered no longer shows have ended.
+;; Whether c of cs failed or was lost, and no later entry took its number:
+;; a started task's component may be lost on one robot and done on the
+;; next.
+(define (failed-for-good? c cs)
+  (and (failed? c)
+       (let ((k (component-entry-index c)))
+         (not (and k (any (lambda (later) (eqv? (component-entry-index later) k))
+                          (cdr (memq c cs))))))))
+
+;; A task's state, when its poser does not say it: what its components
+;; say.
+(define (components-state cs)
+  (cond ((any (lambda (c) (and (open? c) (component-entry-index c))) cs) "running")
+        ((any open? cs) "negotiating")
+        ((any (lambda (c) (failed-for-good? c cs)) cs) "failed")
+        ((any component-entry-index cs) "done")
+        (else "not started")))
+
+;;> Brings \var{table} up to the time \var{t} (seconds since the view
+;;> started) with \var{reports}: (UID REPORT [POSED]) for each address
+;;> space that answered, REPORT as aspace-report makes it, POSED the tasks
+;;> it posed lately as (tasks) lists them, those over too (else REPORT's
+;;> TASKS).  A component that an address space that answered no longer
+;;> shows has ended: as it says, or else, a reservation, released.
 (define (task-table-update! table t reports)
   (let ((seen '()))                     ; the component entries seen now
     (for-each
@@ -119,15 +183,20 @@
        (let ((robot (text (car uid+report)))
              (report (cadr uid+report)))
          (for-each (lambda (posed)
-                     (task-entry-state-set! (task-named table (car posed))
-                                            (cadr posed)))
-                   (report-posed report))
+                     (if (posed-news? table posed)
+                         (task-entry-state-set! (task-named table (car posed))
+                                                (cadr posed))))
+                   (posed-states (if (pair? (cddr uid+report))
+                                     (car (cddr uid+report))
+                                     (list-ref report 5))))
          (for-each
           (lambda (obs)
-            (set! seen (cons (observe! (task-named table (car obs)) t robot
+            (set! seen (cons (observe! table (task-named table (car obs)) t robot
                                        (cadr obs) (car (cddr obs)))
                              seen)))
-          (report-components report))))
+          (report-components report))
+         (for-each (lambda (e) (note-ended! table t robot e))
+                   (report-ended report))))
      reports)
     (let* ((answered (map (lambda (r) (text (car r))) reports))
            (gone (note-robots! table t reports)))
@@ -142,7 +211,8 @@
                            ((and (open? c) (not (memq c seen))
                                  (member (component-entry-robot c) answered))
                             (component-entry-until-set! c t)
-                            (component-entry-end-set! c "done"))))
+                            (component-entry-end-set!
+                             c (if (component-entry-index c) "ended" "released")))))
                    (task-entry-components task)))
        (table-tasks table)))))
 
@@ -178,7 +248,7 @@
     gone))
 
 ;; The component entry of task that robot shows at t, made if new.
-(define (observe! task t robot index subjects)
+(define (observe! table task t robot index subjects)
   (let* ((cs (task-entry-components task))
          (same (find (lambda (c)
                        (and (open? c)
@@ -201,14 +271,68 @@
                                   (and (eqv? (component-entry-index c) index)
                                        (not (equal? (component-entry-robot c) robot))))
                                 (reverse cs))))
-             (c (make-component-entry index robot subjects t #f #f
+             (reserved (and index (take-reservations! table task robot)))
+             (c (make-component-entry index robot subjects (or reserved t) #f #f
                                       (and before (component-entry-robot before)))))
-        (task-entry-components-set! task (append cs (list c)))
+        (task-entry-components-set! task (append (task-entry-components task)
+                                                 (list c)))
         c)))))
+
+;; The reservations robot holds, unnumbered, for task -- under its own
+;; name, or under the name a started task negotiated with, which shares
+;; its NAME@POSER -- are the component of task that starts there now:
+;; they are taken out of the table, a task left with nothing with them,
+;; and answers when the first was seen, or #f when there was none.
+(define (take-reservations! table task robot)
+  (let ((base (key-base (task-entry-key task)))
+        (since #f))
+    (for-each
+     (lambda (other)
+       (when (equal? (key-base (task-entry-key other)) base)
+         (let ((held (filter (lambda (c) (and (open? c) (not (component-entry-index c))
+                                              (equal? (component-entry-robot c) robot)))
+                             (task-entry-components other))))
+           (for-each (lambda (c)
+                       (set! since (min (or since +inf.0) (component-entry-since c))))
+                     held)
+           (task-entry-components-set!
+            other (remove (lambda (c) (memq c held)) (task-entry-components other))))))
+     (table-tasks table))
+    (set-cdr! table (remove (lambda (other) (and (null? (task-entry-components other))
+                                                 (not (task-entry-state other))
+                                                 (not (eq? other task))))
+                            (table-tasks table)))
+    since))
+
+;; Brings robot's component that e, an entry of report-ended, tells of to
+;; its end: the open entry seen before, or a new one when it ended since
+;; the view started and the table has none.
+(define (note-ended! table t robot e)
+  (let* ((ended-at (- t (list-ref e 3)))
+         (task (if (>= ended-at 0) (task-named table (car e)) (task-known table (car e))))
+         (c (and task
+                 (find (lambda (c) (and (eqv? (component-entry-index c) (cadr e))
+                                        (equal? (component-entry-robot c) robot)))
+                       (task-entry-components task)))))
+    (cond ((and c (open? c)) (end-component! c ended-at (list-ref e 4)))
+          ((and task (not c))
+           (end-component! (observe! table task (- t (list-ref e 2)) robot (cadr e) '())
+                           ended-at (list-ref e 4))))))
+
+(define (end-component! c until end)
+  (component-entry-until-set! c until)
+  (component-entry-end-set! c end))
+
+;; Whether component a goes before b: a smaller number, or a number
+;; before none.
+(define (by-number a b)
+  (let ((i (component-entry-index a)) (j (component-entry-index b)))
+    (and i (or (not j) (< i j)))))
 
 ;;> The table as JSON: the newest \var{most} tasks, each with its name,
 ;;> poser, state and components (index, robot, subjects, since, until,
-;;> how it ended, and the robot it was reassigned from).
+;;> how it ended, and the robot it was reassigned from), by their number,
+;;> the reservations last.
 (define (task-table->json table most)
   (list->vector
    (map (lambda (task)
@@ -216,10 +340,7 @@
             `((id . ,(task-entry-key task))
               (name . ,(task-entry-name task))
               (poser . ,(or (task-entry-poser task) 'null))
-              (state . ,(or (task-entry-state task)
-                            (cond ((any open? cs) "running")
-                                  ((any lost? cs) "failed")
-                                  (else "done"))))
+              (state . ,(or (task-entry-state task) (components-state cs)))
               (components
                . ,(list->vector
                    (map (lambda (c)
@@ -232,6 +353,6 @@
                                           (num (component-entry-until c))))
                             (end . ,(or (component-entry-end c) 'null))
                             (from . ,(or (component-entry-from c) 'null))))
-                        cs))))))
+                        (list-stable-sort by-number cs)))))))
         (let ((all (table-tasks table)))
           (reverse (if (> (length all) most) (take-right all most) all))))))

@@ -100,13 +100,17 @@
 
 ;;; Snapshots
 
-;; What each address space is asked: its report, and on a robot its
-;; sonar ring and fiducials (#f on a workstation, where they raise).
+;; What each address space is asked: its report, on a robot its sonar
+;; ring and fiducials (#f on a workstation, where they raise), and the
+;; tasks it posed lately, over or not: the report leaves out those over,
+;; and a task ends in the state its poser gives it.
 (define report-source
   '(lambda ()
      (list (aspace-report)
            (guard (e (#t #f)) (sonar-read))
-           (guard (e (#t #f)) (fiducials)))))
+           (guard (e (#t #f)) (fiducials))
+           (let ((posed (filter (lambda (t) (eq? (car t) 'posed)) (tasks))))
+             (if (> (length posed) 12) (take posed 12) posed)))))
 
 ;; What the view remembers from one poll to the next: where the boxes
 ;; are, the task table, and for each robot its last sonar ring with the
@@ -132,7 +136,13 @@
 ;;> date.
 (define (view-snapshot lab t answers state)
   (let ((reports (filter-map (lambda (a)
-                                (and (cadr a) (list (car a) (car (car (cddr a))))))
+                                (and (cadr a)
+                                     (let ((value (car (cddr a))))
+                                       (cons (car a)
+                                             (cons (car value)
+                                                   (if (> (length value) 3)
+                                                       (list (list-ref value 3))
+                                                       '()))))))
                              answers))
         (boxes (view-state-boxes state)))
     (task-table-update! (view-state-table state) t reports)

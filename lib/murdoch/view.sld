@@ -15,6 +15,6 @@
           (only (chibi config) make-conf) (only (chibi process) current-process-id)
           (only (chibi filesystem) create-directory* open open/write open/append
                 open/create open/exclusive open-output-file-descriptor)
-          (only (srfi 151) bitwise-ior) (chibi json) (murdoch sys) (murdoch lab)
-          (murdoch cli) (murdoch remote))
+          (only (srfi 151) bitwise-ior) (only (srfi 132) list-stable-sort) (chibi json)
+          (murdoch sys) (murdoch lab) (murdoch cli) (murdoch remote))
   (include "view.scm" "view-tasks.scm"))

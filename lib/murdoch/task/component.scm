@@ -1,16 +1,20 @@
 ;;;; The robot's side of the task life cycle (task.scm): the components
 ;;;; of started tasks that run here, each watched for its poser's
-;;;; heartbeats.
+;;;; heartbeats; and pose-task's components, which have no heartbeats.
+;;;; Each is listed while it runs, and remembered for a while once it has
+;;;; ended, with how, so that the live view sees every component and how
+;;;; it ended, though its poser be a guest that has gone.
 
 
 ;; A component running here.
 (define-record-type running
-  (make-running id index poser thread heard)
+  (make-running id index poser thread started heard)
   running?
   (id running-id)
   (index running-index)
   (poser running-poser)
   (thread running-thread)
+  (started running-started)                   ; monotonic-seconds
   (heard running-heard running-heard-set!)    ; monotonic-seconds
   (over? running-over? running-over?-set!))
 
@@ -23,26 +27,46 @@
 ;;> is raised again once the component has left its dynamic extent.
 (define (run-component id k poser period work)
   (hand-over-connection!)               ; its poser calls here meanwhile
-  (let ((r (make-running id k poser (current-thread) (monotonic-seconds))))
+  (run-listed id k poser work robot-failure?
+              (lambda (r)
+                (thread-start! (make-logged-thread (lambda () (watch-poser r period))
+                                                   'watch-poser)))))
+
+;;> Runs \var{thunk} here as component \var{k} of the task that
+;;> pose-task posed from \var{poser} under the reservation name \var{id}:
+;;> listed, as run-component's are, while it runs, and then among the
+;;> components ended.  Answers what thunk answers, or raises what it
+;;> raises.
+(define (run-posed-component id k poser thunk)
+  (run-listed id k poser (list thunk) (lambda (e) #f) (lambda (r) #f)))
+
+;; Runs work listed as component k of id, watched as watch! sets it
+;; going; a condition for which lost? is true comes back as
+;; (robot-failure WHY).
+(define (run-listed id k poser work lost? watch!)
+  (let* ((now (monotonic-seconds))
+         (r (make-running id k poser (current-thread) now now))
+         (outcome unfinished))
     (running-over?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
-    (thread-start! (make-logged-thread (lambda () (watch-poser r period)) 'watch-poser))
-    (let ((outcome
-           (dynamic-wind
-            (lambda () #f)
-            (lambda ()
-              ;; Every condition is caught: a guard that lets one through
-              ;; raises it again inside the extent it left, and so runs the
-              ;; component's own dynamic-wind before and after a second time.
-              (guard (e ((robot-failure? e) (list 'robot-failure (error-message e)))
-                        (#t (make-raised e)))
-                (apply (car work) (cdr work))))
-            (lambda ()
-              (running-over?-set! r #t)
-              (with-lock *running-lock*
-                (lambda ()
-                  (set! *running* (remove (lambda (x) (eq? x r)) *running*))))))))
-      (if (raised? outcome) (raise (raised-condition outcome)) outcome))))
+    (watch! r)
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       ;; Every condition is caught: a guard that lets one through raises
+       ;; it again inside the extent it left, and so runs the component's
+       ;; own dynamic-wind before and after a second time.
+       (set! outcome (guard (e ((lost? e) (list 'robot-failure (error-message e)))
+                               (#t (make-raised e)))
+                       (apply (car work) (cdr work)))))
+     (lambda ()
+       (running-over?-set! r #t)
+       (note-ended! r outcome)))
+    (if (raised? outcome) (raise (raised-condition outcome)) outcome)))
+
+;; The outcome of a component until it has one: it keeps it when run-listed
+;; is left with no answer, by a continuation or thread-terminate!.
+(define unfinished (list 'unfinished))
 
 ;; A condition that a component raised, held until it is outside.
 (define-record-type raised
@@ -103,3 +127,44 @@
 (define (components-running)
   (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
        (with-lock *running-lock* (lambda () *running*))))
+
+;;; The components ended here
+;;
+;; The last kept-ended of them, newest first, each as (ID INDEX POSER
+;; STARTED ENDED END), the times by the monotonic clock.  A component
+;; leaves the running list and joins this one at once, under the lock: a
+;; report that reads the running list first, then this one, finds every
+;; component in one or the other.
+
+(define kept-ended 16)
+(define *ended* '())
+
+;; r is over, with outcome, as run-listed catches it.
+(define (note-ended! r outcome)
+  (let ((entry (list (running-id r) (running-index r) (running-poser r)
+                     (running-started r) (monotonic-seconds) (end-of outcome))))
+    (with-lock *running-lock*
+      (lambda ()
+        (set! *running* (remove (lambda (x) (eq? x r)) *running*))
+        (set! *ended* (let ((all (cons entry *ended*)))
+                        (if (> (length all) kept-ended) (take all kept-ended) all)))))))
+
+;; How a component ended, from what it answered or raised: (done), (lost
+;; WHY) for a robot failure, or (failed WHY), WHY the message its poser
+;; is given.
+(define (end-of outcome)
+  (cond ((eq? outcome unfinished) '(failed "it stopped with no answer"))
+        ((raised? outcome) (list 'failed (error-message (raised-condition outcome))))
+        ((and (pair? outcome) (eq? (car outcome) 'robot-failure))
+         (list 'lost (cadr outcome)))
+        (else '(done))))
+
+;;> The components that ended here, the last sixteen, newest first, each
+;;> as (ID INDEX POSER STARTED ENDED END): STARTED and ENDED are seconds
+;;> before now, END is (done), (failed WHY) or (lost WHY).
+(define (components-ended)
+  (let ((now (monotonic-seconds)))
+    (map (lambda (e)
+           (append (take e 3)
+                   (list (- now (list-ref e 3)) (- now (list-ref e 4)) (list-ref e 5))))
+         (with-lock *running-lock* (lambda () *ended*)))))

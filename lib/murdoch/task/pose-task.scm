@@ -102,7 +102,8 @@
         (let ((uids (map car (car team))))
           (for-each (lambda (i uid) (progress "  component " i " starts on " uid))
                     (iota (length uids) 1) uids)
-          (let ((results ((with-team-proc-maker (car team) (cadr team) procs))))
+          (let ((results ((with-team-proc-maker (car team) (cadr team) procs
+                                                (posed-component (car (cddr team)))))))
             ;; Applied promises are of no more use here.
             (for-each (lambda (winner type)
                         (if (eq? type 'exclusive) (release-proxy! (cadr winner))))
@@ -114,8 +115,9 @@
             results)))))
 
 ;;> The negotiation of pose-task without the running: answers (winners
-;;> type-list), where winners are the chosen (uid promise-or-#t) entries,
-;;> or \scheme{not-enough-takers}.  Every promise not among the winners is
+;;> type-list name), where winners are the chosen (uid promise-or-#t)
+;;> entries and name the reservation name they were won under, or
+;;> \scheme{not-enough-takers}.  Every promise not among the winners is
 ;;> freed.
 ;;>
 ;;> Tasks posed at once may want the same robots.  One that fails while
@@ -165,7 +167,7 @@
            (explain-no-takers (pose-name task) (pose-layouts task) (current-error-port))
            'not-enough-takers))))
 
-;; One round of negotiation: (winners type-list), or not-enough-takers, or
+;; One round of negotiation: (winners type-list name), or not-enough-takers, or
 ;; outranked when a rival outranks this pose; on failure everything is
 ;; freed.
 (define (try task)
@@ -188,7 +190,15 @@
         (release-runners-up responses type-list winners)
         (for-each (lambda (i w) (progress "  component " i " goes to " (car w)))
                   (iota (length winners) 1) winners)
-        (list winners type-list))))))
+        (list winners type-list (pose-name task)))))))
+
+;; What runs component k, proc, of the task won under name, on its robot:
+;; proc, listed there as that component (run-posed-component), so that the
+;; live view finds each component, by its number, and how it ended.
+(define (posed-component name)
+  (let ((poser (local-aspace-uid)))
+    (lambda (k proc)
+      (sendable-lambda () (run-posed-component name k poser proc)))))
 
 ;; What request-components asks the lab for each component: the thesis's
 ;; request-exclusive, or request of t for a non-exclusive component, with

@@ -21,5 +21,5 @@
           (only (chibi process) current-process-id) (murdoch sys) (murdoch code)
           (murdoch remote) (murdoch pubsub) (murdoch task assign)
           (murdoch task progress) (murdoch task metric) (murdoch task takers)
-          (murdoch task team))
+          (murdoch task team) (only (murdoch task component) run-posed-component))
   (include "pose-task.scm"))

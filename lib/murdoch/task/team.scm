@@ -33,15 +33,18 @@
 ;; Macros are defined before their first use, which Chibi requires.
 ;;> A thunk that runs the task's components on its chosen robots, as a
 ;;> team: an exclusive component by applying its winner's promise to #t, a
-;;> non-exclusive one by running its procedure on the winner.
-(define (with-team-proc-maker task-uids type-list procs)
-  (let ((proclist (map (lambda (task-uid proc type)
-                         (if (eq? type 'exclusive)
-                             (let ((promise (cadr task-uid)))
-                               (sendable-lambda () (promise #t)))
-                             proc))
-                       task-uids procs type-list))
-        (uids (map car task-uids)))
+;;> non-exclusive one by running its procedure on the winner.  With
+;;> \var{listed}, a procedure of a component's number and the procedure
+;;> that runs it, each component runs as the procedure listed answers.
+(define (with-team-proc-maker task-uids type-list procs . listed)
+  (let* ((as (if (pair? listed) (car listed) (lambda (k proc) proc)))
+         (proclist (map (lambda (k task-uid proc type)
+                          (as k (if (eq? type 'exclusive)
+                                    (let ((promise (cadr task-uid)))
+                                      (sendable-lambda () (promise #t)))
+                                    proc)))
+                        (iota (length procs) 1) task-uids procs type-list))
+         (uids (map car task-uids)))
     (lambda ()
       (with-team uids
         (on-list ((fixed uids)) proclist)))))
