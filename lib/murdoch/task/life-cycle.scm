@@ -519,7 +519,7 @@
   (hold? turn-hold?)
   (priority turn-priority)
   (deadline turn-deadline)              ; monotonic-seconds, or #f
-  (posed turn-posed))                   ; current-second
+  (posed turn-posed))                   ; utc-seconds
 
 ;; A turn from start-task's keywords and their values.
 (define (read-turn who options)
@@ -537,7 +537,7 @@
     (cond
      ((null? kv)
       (make-turn (or wait hold) hold priority
-                 (and deadline (+ (monotonic-seconds) deadline)) (current-second)))
+                 (and deadline (+ (monotonic-seconds) deadline)) (utc-seconds)))
      ((not (and (symbol? (car kv)) (pair? (cdr kv))))
       (bad (string-append "after the lists come keywords, each with its value: "
                           "wait, hold, priority, deadline")))
