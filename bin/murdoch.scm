@@ -8,7 +8,8 @@
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
         (only (chibi ast) setenv unsetenv)
-        (murdoch lab) (murdoch cli command) (murdoch cli launch))
+        (only (murdoch wire) error-message) (murdoch lab) (murdoch cli command)
+        (murdoch cli launch))
 
 (define version "0.3")
 
@@ -284,19 +285,12 @@
   (let ((started? #f))
     (guard (e ((and (error-object? e) started?)
                (write-string (string-append "murdoch " (symbol->string (car c))
-                                            ": ERROR: " (error-text e) "\n")
+                                            ": ERROR: " (error-message e) "\n")
                              (current-error-port))
                (exit 2))
-              ((error-object? e) (mistake c (error-text e))))
+              ((error-object? e) (mistake c (error-message e))))
       (run-application (app-spec c (lambda () (set! started? #t)))
                        (cons* "murdoch" (symbol->string (car c)) (options-first args))))))
-
-(define (error-text e)
-  (let ((out (open-output-string)))
-    (write-string (error-object-message e) out)
-    (for-each (lambda (x) (write-char #\space out) (display x out))
-              (error-object-irritants e))
-    (get-output-string out)))
 
 (define (main args)
   (cond

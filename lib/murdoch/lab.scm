@@ -340,8 +340,9 @@
 ;;> or left of, as when a clause lacks its ), or else the innermost.
 ;;> Lists are read here, for their lines; other data with read.
 (define (read-source path)
-  (let ((in (guard (e (#t (error (string-append "cannot read " path ": "
-                                                (condition-message e)))))
+  (let ((in (guard (e ((file-error? e)
+                        (error (string-append "cannot read " path
+                                              ": couldn't open input file"))))
               (open-input-file path))))
     (let ((source (read-source-port path in)))
       (close-input-port in)
@@ -380,7 +381,7 @@
          ((char=? c #\)) (read-char in) (fail line "a ) that closes nothing"))
          (else
           (guard (e (#t (fail line (string-append "cannot read this: "
-                                                  (condition-message e)))))
+                                                  (error-message e)))))
             (read in))))))
     (define (read-list line open)
       (let loop ((items '()))
@@ -495,9 +496,6 @@
                  '()))))
    (lab-aspaces lab)))
 
-(define (condition-message e)
-  (if (error-object? e) (error-object-message e) e))
-
 ;; form was checked by check-inside.
 (define (parse-aspace path form index base interface)
   (let ((clauses (cddr form)))
@@ -560,7 +558,7 @@
         (make-key-file file))
     (let ((hex (call-with-input-file file read-line)))
       (if (or (eof-object? hex) (< (string-length hex) 32))
-          (error "the lab's key file is too short" file))
+          (error (string-append "the lab's key file is too short " file)))
       (string->utf8 hex))))
 
 (define (make-key-file file)
@@ -568,7 +566,7 @@
                              ".new")))
     (let ((fd (open temp (bitwise-ior open/write open/create open/exclusive)
                     #o600)))
-      (if (not fd) (error "cannot create the key file" temp))
+      (if (not fd) (error (string-append "cannot create the key file " temp)))
       (let ((out (open-output-file-descriptor fd)))
         (write-string (random-hex key-bytes) out)
         (newline out)

@@ -42,12 +42,7 @@
 (define (text x)
   (cond ((string? x) x)
         ((symbol? x) (symbol->string x))
-        ((error-object? x)
-         (let ((out (open-output-string)))
-           (display (error-object-message x) out)
-           (for-each (lambda (i) (write-char #\space out) (display i out))
-                     (error-object-irritants x))
-           (get-output-string out)))
+        ((error-object? x) (error-message x))
         (else (let ((out (open-output-string)))
                 (display x out)
                 (get-output-string out)))))
@@ -442,13 +437,13 @@
              (fd (open name (bitwise-ior open/write open/create open/exclusive) #o644)))
         (cond (fd (close-port (open-output-file-descriptor fd)) name)
               ((file-exists? name) (claim (+ n 1)))
-              (else (error "cannot make the trace" name)))))))
+              (else (error (string-append "cannot make the trace " name))))))))
 
 ;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
 ;;> (default: port-base + 148, MURDOCH_PORT_BASE's or else 7100's, as the
 ;;> view's) to play the run that \var{trace} holds.
 (define (run-replay web trace port)
-  (if (not (file-exists? trace)) (error "no such trace" trace))
+  (if (not (file-exists? trace)) (error (string-append "no such trace " trace)))
   (let ((header (trace-header trace)))
     (if (not (and (list? header) (equal? (assq 'kind header) '(kind . "lab"))))
         (error (string-append "not a trace of the view: " trace " (a trace's first"

@@ -297,8 +297,7 @@
           (list 'lost (cadr what))
           (list 'done what)))
      ((remote-unreachable-error? what) (list 'lost (remote-error-message what)))
-     ((remote-error? what) (list 'failed (remote-error-message what)))
-     (else (list 'failed (error-message what))))))
+     (else (list 'failed (error-why what))))))
 
 ;; A component's result, as pose-task gives it: its value, or (error UID
 ;; WHY) with the last robot it had.
