@@ -153,20 +153,20 @@
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      ((eq? (task-state t) 'cancelled)
-      (for-each (lambda (winner type) (free-winner! winner type)) (car team) (cadr team))
+      (for-each free-winner! (team-winners team) (team-types team))
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
-      (task-team-set! t (map car (car team)))
+      (task-team-set! t (map winner-uid (team-winners team)))
       (for-each thread-join!
                 (map (lambda (c winner type)
                        (thread-start!
                         (make-logged-thread (inheriting
                                              (lambda ()
-                                               (supervise t c (car winner)
+                                               (supervise t c (winner-uid winner)
                                                           (work-for winner type c)))))))
-                     cs (car team) (cadr team)))
+                     cs (team-winners team) (team-types team)))
       (finish! t (map component-result cs))))))
 
 (define (finish! t results)
@@ -174,16 +174,23 @@
   (progress (task-id t) ": " (task-state t))
   (mailbox-put! (task-done t) results))
 
+;; negotiate's answer, (WINNERS TYPES): each component's winner, (UID
+;; PROMISE ...), and its type.
+(define (team-winners team) (car team))
+(define (team-types team) (cadr team))
+(define (winner-uid winner) (car winner))
+(define (winner-promise winner) (cadr winner))
+
 ;; What a winner runs: (proc arg ...), a promise applied to #t for an
 ;; exclusive component.
 (define (work-for winner type c)
   (if (eq? type 'exclusive)
-      (list (cadr winner) #t)
+      (list (winner-promise winner) #t)
       (list (component-proc c))))
 
 (define (free-winner! winner type)
   (if (eq? type 'exclusive)
-      (guard (e (#t #f)) ((cadr winner) #f))))
+      (guard (e (#t #f)) ((winner-promise winner) #f))))
 
 ;; Runs component c on uid, and again elsewhere while its robot is lost
 ;; and it may be restarted.
@@ -244,7 +251,9 @@
                               (list (component-metric c))
                               (list (component-proc c)))))))
       (and (pair? team)
-           (cons (car (caar team)) (work-for (caar team) (caadr team) c))))))
+           (let ((winner (car (team-winners team))))
+             (cons (winner-uid winner)
+                   (work-for winner (car (team-types team)) c)))))))
 
 ;; One run of c on uid, watched by heartbeats: (done VALUE), (failed WHY)
 ;; or (lost WHY).
@@ -722,8 +731,9 @@
                                     (list (component-metric c))
                                     (list (component-proc c))))))
              (if (pair? team)
-                 (waiter-held-set! w (cons (list (component-index c) (caar team)
-                                                 (caadr team))
+                 (waiter-held-set! w (cons (list (component-index c)
+                                                 (car (team-winners team))
+                                                 (car (team-types team)))
                                            (waiter-held w)))))))
      (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
