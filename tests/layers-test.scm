@@ -16,7 +16,7 @@
   '(sys wire lab code robot
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
-    (task (assign progress metric takers) team (pose-task component) life-cycle)
+    (task (assign progress metric takers) team (pose-task running) life-cycle)
     status murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))

@@ -116,13 +116,13 @@
          (lease 30 ,seconds)
          (monitor-period 60 ,seconds)
          ;; A started task's components and their poser hear from each other
-         ;; every heartbeat seconds (task.scm).
+         ;; every heartbeat seconds (task/life-cycle.scm).
          (heartbeat 0.5 ,seconds)
          (max-attempts 3 ,positive-count)
          ;; A started task that finds too few capable robots free waits for
          ;; them or fails with not-enough-takers; its priority rises by aging
          ;; a second while it waits; a poser keeps at most max-waiting such
-         ;; tasks (task.scm, docs/tasks.md).
+         ;; tasks (task/life-cycle.scm, docs/tasks.md).
          (when-robots-busy fail
                            ,(make-reader (lambda (x) (and (memq x '(fail wait)) x))
                                          "fail or wait"))

@@ -24,7 +24,7 @@
 ;;     so frees its reservation: no orphans.  The same rule stops the
 ;;     component of a robot cut off from its poser at least one full
 ;;     period before the poser can declare it lost and start the component
-;;     elsewhere: no ghosts (component.scm gives the margin).
+;;     elsewhere: no ghosts (running.scm gives the margin).
 ;;  5. cancel-task stops every component on its robot so, at once, and
 ;;     what is still being negotiated is freed when the negotiation ends.
 ;;

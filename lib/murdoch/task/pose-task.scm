@@ -36,7 +36,7 @@
 (define pose-task-backoff (make-parameter 0.1))
 
 ;;> Robots that pose-task gives no component to: a task that lost a
-;;> robot renegotiates without it (task.scm).
+;;> robot renegotiates without it (life-cycle.scm).
 (define pose-task-excluded (make-parameter '()))
 
 (for-each sandbox-parameter!

@@ -1,4 +1,4 @@
-;;;; The robot's side of the task life cycle (task.scm): the components
+;;;; The robot's side of the task life cycle (life-cycle.scm): the components
 ;;;; of started tasks that run here, each watched for its poser's
 ;;;; heartbeats.
 
@@ -59,7 +59,7 @@
 ;; poser has been silent for orphan-periods heartbeat periods, looked at
 ;; every quarter period, so by 2.25 periods after the last heartbeat the
 ;; robot heard; its poser declares the robot lost only when no heartbeat
-;; was answered for lost-periods (task.scm), and the robot heard that
+;; was answered for lost-periods (life-cycle.scm), and the robot heard that
 ;; heartbeat before its answer reached the poser.  The stale copy has
 ;; stopped 1.75 periods before the poser can start another: one full
 ;; period, and more, for a loaded robot that is late to look.
