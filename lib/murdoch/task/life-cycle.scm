@@ -62,6 +62,7 @@
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
+;; Global, as *waiters* and the offers' below: peers' calls find them by name.
 (define *posed* '())                    ; the tasks started here, newest first
 (define *tasks-lock* (make-mutex 'tasks))
 

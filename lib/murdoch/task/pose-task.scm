@@ -50,6 +50,7 @@
 ;; The poses made here, counted, and those negotiating, each as
 ;; (name rank rival-rank ...): the ranks of the other tasks that said
 ;; they want robots it holds.  Threads and received calls pose at once.
+;; Global: a rival's call (receive-rival) finds them by name.
 (define *poses* 0)
 (define *negotiating* '())
 (define *poses-lock* (make-mutex 'poses))

@@ -14,6 +14,7 @@
   (heard running-heard running-heard-set!)    ; monotonic-seconds
   (over? running-over? running-over?-set!))
 
+;; Global: the poser's calls (component-heartbeat! ...) find them by name.
 (define *running* '())
 (define *running-lock* (make-mutex 'running))
 
