@@ -96,50 +96,52 @@
          args)
         (else #f)))
 
+(define setting-entries
+  `((port-base 7100 ,(whole-from 1 65535 "a port number"))
+    ;; sim/lab.c keeps an interface, and a robot's name, in 64 bytes.
+    (interface "127.0.0.1"
+               ,(make-reader
+                 (lambda (x) (and (string? x) (< (string-length x) 64) x))
+                 "an IPv4 address, in quotes"))
+    (key-file "murdoch.key" ,(text "a file name, in quotes"))
+    (max-frame 1048576 ,positive-count)
+    ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
+    (max-depth 4000 ,(whole-from 1 9000 "a whole number from 1 to 9000"))
+    (timeout 5 ,seconds)
+    ;; At a REPL a person waits, and Ctrl-C gives a call up: a robot's
+    ;; motion there runs to its end (command.scm).
+    (repl-timeout 600 ,seconds)
+    (frame-timeout 5 ,seconds)
+    (lease 30 ,seconds)
+    (monitor-period 60 ,seconds)
+    ;; A started task's components and their poser hear from each other
+    ;; every heartbeat seconds (task/life-cycle.scm).
+    (heartbeat 0.5 ,seconds)
+    (max-attempts 3 ,positive-count)
+    ;; A started task that finds too few capable robots free waits for
+    ;; them or fails with not-enough-takers; its priority rises by aging
+    ;; a second while it waits; a poser keeps at most max-waiting such
+    ;; tasks (task/life-cycle.scm, docs/tasks.md).
+    (when-robots-busy fail
+                      ,(make-reader (lambda (x) (and (memq x '(fail wait)) x))
+                                    "fail or wait"))
+    (aging 0.1 ,rate)
+    (max-waiting 100 ,positive-count)
+    (max-connections 256 ,positive-count)
+    (max-connections-per-host 64 ,positive-count)
+    (heap-max "512M" ,(make-reader size-bytes
+                                   "bytes, or a size in quotes such as \"512M\""))
+    ;; Chibi grows its heap by twice one allocation (sandbox.scm).
+    (max-alloc "32M" ,(make-reader size-bytes
+                                   "bytes, or a size in quotes such as \"32M\""))
+    (code () ,(make-reader (lambda (x) (and (every string? x) x))
+                           "file names, in quotes"))
+    (delivery (broadcast)
+              ,(make-reader delivery-clause
+                            "broadcast, or multicast \"GROUP\" [PORT]"))))
+
 (define settings-table
-  (map (lambda (entry) (apply make-setting entry))
-       `((port-base 7100 ,(whole-from 1 65535 "a port number"))
-         ;; sim/lab.c keeps an interface, and a robot's name, in 64 bytes.
-         (interface "127.0.0.1"
-                    ,(make-reader
-                      (lambda (x) (and (string? x) (< (string-length x) 64) x))
-                      "an IPv4 address, in quotes"))
-         (key-file "murdoch.key" ,(text "a file name, in quotes"))
-         (max-frame 1048576 ,positive-count)
-         ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
-         (max-depth 4000 ,(whole-from 1 9000 "a whole number from 1 to 9000"))
-         (timeout 5 ,seconds)
-         ;; At a REPL a person waits, and Ctrl-C gives a call up: a robot's
-         ;; motion there runs to its end (command.scm).
-         (repl-timeout 600 ,seconds)
-         (frame-timeout 5 ,seconds)
-         (lease 30 ,seconds)
-         (monitor-period 60 ,seconds)
-         ;; A started task's components and their poser hear from each other
-         ;; every heartbeat seconds (task/life-cycle.scm).
-         (heartbeat 0.5 ,seconds)
-         (max-attempts 3 ,positive-count)
-         ;; A started task that finds too few capable robots free waits for
-         ;; them or fails with not-enough-takers; its priority rises by aging
-         ;; a second while it waits; a poser keeps at most max-waiting such
-         ;; tasks (task/life-cycle.scm, docs/tasks.md).
-         (when-robots-busy fail
-                           ,(make-reader (lambda (x) (and (memq x '(fail wait)) x))
-                                         "fail or wait"))
-         (aging 0.1 ,rate)
-         (max-waiting 100 ,positive-count)
-         (max-connections 256 ,positive-count)
-         (max-connections-per-host 64 ,positive-count)
-         (heap-max "512M" ,(make-reader size-bytes
-                                        "bytes, or a size in quotes such as \"512M\""))
-         ;; Chibi grows its heap by twice one allocation (sandbox.scm).
-         (max-alloc "32M" ,(make-reader size-bytes
-                                        "bytes, or a size in quotes such as \"32M\""))
-         (code () ,(make-reader (lambda (x) (and (every string? x) x))
-                                "file names, in quotes"))
-         (delivery (broadcast)
-                   ,(make-reader delivery-clause
-                                 "broadcast, or multicast \"GROUP\" [PORT]")))))
+  (map (lambda (entry) (apply make-setting entry)) setting-entries))
 
 ;; The clauses the simulator reads (docs/trip-protocol.md), and address
 ;; spaces.

@@ -62,12 +62,12 @@
 ;; SUBJECTS) for each component, INDEX #f when only held subjects show it.
 (define (report-components report)
   (let* ((held (map (lambda (h) (cons (text (car h)) (text (cadr h))))
-                    (list-ref report 4)))
+                    (report-held report)))
          (running (filter-map (lambda (t)
                                 (and (pair? t) (eq? (car t) 'running)
                                      (>= (length t) 3)
                                      (list (text (cadr t)) (list-ref t 2))))
-                              (list-ref report 5)))
+                              (report-tasks report)))
          (subjects-of (lambda (pred)
                         (map car (filter (lambda (h) (pred (cdr h))) held))))
          (covered? (lambda (holder)
@@ -92,7 +92,7 @@
                                (string-append "waiting, " (text (list-ref t 3))
                                               " in line")
                                (text (car (cddr t)))))))
-              (list-ref report 5)))
+              (report-tasks report)))
 
 (define (task-named table key)
   (or (find (lambda (t) (equal? (task-entry-key t) key)) (table-tasks table))

@@ -10,6 +10,8 @@
           task-table->json reservation-task json-text box-seen)
   (import (only (murdoch code) make-logged-thread) (only (murdoch wire) error-message)
           (only (murdoch task) task-key-parts)
+          (only (murdoch status) report-since report-pose report-battery report-held
+                report-tasks report-goal)
           (scheme base) (scheme write)
           (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)
           (chibi net) (chibi net http-server) (chibi net servlet)
