@@ -154,6 +154,9 @@
   (mistake "the end of the file inside the last clause"
            "(lab x\n  (timeout 3)\n  (load 0.5" ":3: this list has no closing )")
   (mistake "a ) too many" "(lab x)\n)" ":2: a ) that closes nothing")
+  (mistake "a datum the reader refuses, with what it refused"
+           "(lab x\n  (timeout #\\xyzw))"
+           ":2: cannot read this: unknown char name \"xyzw\"")
   (mistake "an empty file" "" (string-append file ": the file is empty"))
   (mistake "a file of comments only" "; nothing yet\n" "the file is empty")
   (mistake "two forms" "(lab x)\n(lab y)" ":2: (lab y): a second form")
