@@ -740,25 +740,30 @@
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
       (cond ((every pair? held)
              (waiter-held-set! w '())
-             (list (map cadr held) (map (lambda (h) (car (cddr h))) held)))
+             (list (map held-winner held) (map held-type held)))
             (else 'not-enough-takers)))))
 
-(define (held-uids w) (map (lambda (h) (car (cadr h))) (waiter-held w)))
+;; What w holds of a component, (INDEX WINNER TYPE), read by name.
+(define (held-winner h) (cadr h))
+(define (held-type h) (car (cddr h)))
+(define (held-uid h) (winner-uid (held-winner h)))
+
+(define (held-uids w) (map held-uid (waiter-held w)))
 
 ;; Frees what w holds on robot uid, or on every robot.
 (define (let-go-held! w . uid)
-  (let ((out (filter (lambda (h) (or (null? uid) (eq? (car (cadr h)) (car uid))))
+  (let ((out (filter (lambda (h) (or (null? uid) (eq? (held-uid h) (car uid))))
                      (waiter-held w))))
-    (for-each (lambda (h) (free-winner! (cadr h) (car (cddr h)))) out)
+    (for-each (lambda (h) (free-winner! (held-winner h) (held-type h))) out)
     (waiter-held-set! w (remove (lambda (h) (memq h out)) (waiter-held w)))))
 
 ;; Holds what w holds for another lease.
 (define (keep-held! w)
   (waiter-kept-set! w (monotonic-seconds))
   (for-each (lambda (h)
-              (if (eq? (car (cddr h)) 'exclusive)
-                  (if (not (guard (e (#t #f)) ((cadr (cadr h)) 'keep)))
-                      (let-go-held! w (car (cadr h))))))
+              (if (eq? (held-type h) 'exclusive)
+                  (if (not (guard (e (#t #f)) ((winner-promise (held-winner h)) 'keep)))
+                      (let-go-held! w (held-uid h)))))
             (waiter-held w)))
 
 ;; Acts on the news: gives way on each robot a better-ranked task asked
