@@ -154,12 +154,12 @@
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      ((eq? (task-state t) 'cancelled)
-      (for-each free-winner! (team-winners team) (team-types team))
+      (for-each free-winner! (negotiated-winners team) (negotiated-types team))
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
-      (task-team-set! t (map winner-uid (team-winners team)))
+      (task-team-set! t (map winner-uid (negotiated-winners team)))
       (for-each thread-join!
                 (map (lambda (c winner type)
                        (thread-start!
@@ -167,20 +167,13 @@
                                              (lambda ()
                                                (supervise t c (winner-uid winner)
                                                           (work-for winner type c)))))))
-                     cs (team-winners team) (team-types team)))
+                     cs (negotiated-winners team) (negotiated-types team)))
       (finish! t (map component-result cs))))))
 
 (define (finish! t results)
   (if (memq (task-state t) '(negotiating waiting running)) (task-state-set! t 'done))
   (progress (task-id t) ": " (task-state t))
   (mailbox-put! (task-done t) results))
-
-;; negotiate's answer, (WINNERS TYPES): each component's winner, (UID
-;; PROMISE ...), and its type.
-(define (team-winners team) (car team))
-(define (team-types team) (cadr team))
-(define (winner-uid winner) (car winner))
-(define (winner-promise winner) (cadr winner))
 
 ;; What a winner runs: (proc arg ...), a promise applied to #t for an
 ;; exclusive component.
@@ -252,9 +245,9 @@
                               (list (component-metric c))
                               (list (component-proc c)))))))
       (and (pair? team)
-           (let ((winner (car (team-winners team))))
+           (let ((winner (car (negotiated-winners team))))
              (cons (winner-uid winner)
-                   (work-for winner (car (team-types team)) c)))))))
+                   (work-for winner (car (negotiated-types team)) c)))))))
 
 ;; One run of c on uid, watched by heartbeats: (done VALUE), (failed WHY)
 ;; or (lost WHY).
@@ -733,8 +726,8 @@
                                     (list (component-proc c))))))
              (if (pair? team)
                  (waiter-held-set! w (cons (list (component-index c)
-                                                 (car (team-winners team))
-                                                 (car (team-types team)))
+                                                 (car (negotiated-winners team))
+                                                 (car (negotiated-types team)))
                                            (waiter-held w)))))))
      (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))

@@ -100,14 +100,16 @@
                      procs priorities)))
     (if (symbol? team)
         team
-        (let ((uids (map car (car team))))
+        (let ((uids (map winner-uid (negotiated-winners team))))
           (for-each (lambda (i uid) (progress "  component " i " starts on " uid))
                     (iota (length uids) 1) uids)
-          (let ((results ((with-team-proc-maker (car team) (cadr team) procs))))
+          (let ((results ((with-team-proc-maker (negotiated-winners team)
+                                                (negotiated-types team) procs))))
             ;; Applied promises are of no more use here.
             (for-each (lambda (winner type)
-                        (if (eq? type 'exclusive) (release-proxy! (cadr winner))))
-                      (car team) (cadr team))
+                        (if (eq? type 'exclusive)
+                            (release-proxy! (winner-promise winner))))
+                      (negotiated-winners team) (negotiated-types team))
             (for-each (lambda (i uid result)
                         (progress "  component " i " done on " uid ": "
                                   (abridged result 50)))
@@ -139,6 +141,14 @@
                             procs priorities)))
       (progress task-name ": " (length procs) " components")
       (while-negotiating name (lambda () (negotiate-by-tries task 1))))))
+
+;;> The parts of negotiate's answer, (WINNERS TYPES), by name: its
+;;> winners and their types, in component order, and a winner's uid and
+;;> promise (#t for a non-exclusive component).
+(define (negotiated-winners answer) (car answer))
+(define (negotiated-types answer) (cadr answer))
+(define (winner-uid winner) (car winner))
+(define (winner-promise winner) (cadr winner))
 
 ;; A task being negotiated, as negotiate has checked it.
 (define-record-type pose

@@ -4,7 +4,8 @@
 ;;> new-task.scm had them.
 
 (define-library (murdoch task pose-task)
-  (export pose-task negotiate check-task pose-task-progress task-timeout
+  (export pose-task negotiate negotiated-winners negotiated-types winner-uid
+          winner-promise check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
           pose-task-backoff pose-task-excluded receive-rival pose-negotiations
           reservation-aspace-uid task-key task-key-parts
