@@ -53,7 +53,11 @@
          (remote-apply (uid->aspace 'quiet) (lambda () (leave! who))))))))
 (define (held subjects)
   (apply + (map (lambda (r) (length (filter (lambda (s) (pair? (cadr s))) (cadr r))))
-                (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects))))))
+                (request 'all (lambda ()
+                                (filter-map (lambda (t)
+                                              (let ((s (topic-status t)))
+                                                (and s (list t s))))
+                                            subjects))))))
 ")
 
 (define lab
@@ -70,7 +74,8 @@
                   (cons 'quiet robots)))
 (join-lab (test-lab-file lab) 'tester)
 (define (lab-proc name) (eval name (lab-environment)))
-(define (at-quiet expr) (remote-apply (uid->aspace 'quiet) (eval `(lambda () ,expr) (lab-environment))))
+(define (at-quiet expr)
+  (remote-apply (uid->aspace 'quiet) (eval `(lambda () ,expr) (lab-environment))))
 
 ;;; The killer
 
@@ -177,7 +182,8 @@
     (for-each
      (lambda (line) (display line) (newline))
      (list (string-append "bench: recovery-p50 " (seconds-text (median recoveries)) " s")
-           (string-append "bench: recovery-p95 " (seconds-text (percentile recoveries 0.95)) " s")
+           (string-append "bench: recovery-p95 "
+                          (seconds-text (percentile recoveries 0.95)) " s")
            (string-append "bench: recovery-floor " (seconds-text (median floors)) " s")
            (string-append "bench: chaos-recoveries " (number->string (length recoveries)))
            (string-append "bench: chaos-tasks " (number->string (length outcomes)))
@@ -186,9 +192,11 @@
                           (let ((kinds '(done lost-no-robot not-enough-takers failed)))
                             (apply string-append
                                    (map (lambda (k)
-                                          (string-append (symbol->string k) " "
-                                                         (number->string (count (lambda (o) (eq? o k)) outcomes))
-                                                         " "))
+                                          (string-append
+                                           (symbol->string k) " "
+                                           (number->string (count (lambda (o) (eq? o k))
+                                                                  outcomes))
+                                           " "))
                                         kinds))))
            (string-append "bench: chaos-double-bookings " (number->string doubles))
            (string-append "bench: chaos-leaked " (number->string leaked))

@@ -41,8 +41,10 @@
 (define (aspace-clause i)
   (let ((name (string->symbol (string-append "w" (number->string i)))))
     (case i
-      ((1) `(aspace ,name (position 1200 -400 180) (capabilities mobile sonar) (load 0.5)))
-      ((2) `(aspace ,name (position -1800 -600 90) (capabilities mobile sonar) (load 0.5)))
+      ((1) `(aspace ,name (position 1200 -400 180) (capabilities mobile sonar)
+                    (load 0.5)))
+      ((2) `(aspace ,name (position -1800 -600 90) (capabilities mobile sonar)
+                    (load 0.5)))
       (else `(aspace ,name (position 0 0 0) (load ,(/ i 100.)))))))
 
 (define lab-pids '())

@@ -82,7 +82,8 @@
 (define pids (map (lambda (uid) (cons uid (start-lab-aspace! lab uid)))
                   (append posers robots)))
 (join-lab (test-lab-file lab) 'bench)
-(wait-until 20 (lambda () (every (lambda (u) (memq u (live-uids))) (append posers robots))))
+(wait-until 20 (lambda ()
+                 (every (lambda (u) (memq u (live-uids))) (append posers robots))))
 (define (lab-proc name) (eval name (lab-environment)))
 (eval (list 'set! 'clock current-second) (lab-environment))
 
@@ -198,7 +199,8 @@
                                               (let ((s (span-of (car x))))
                                                 (or (not s) (> (cadr s) t)))))
                              tasks))
-               (running (any (lambda (s) (and (<= (cadr s) t) (< t (car (cddr s))))) spans))
+               (running (any (lambda (s) (and (<= (cadr s) t) (< t (car (cddr s)))))
+                             spans))
                (quiet (if (and waiting (not running)) (+ quiet 0.1) 0)))
           (loop (+ t 0.1) quiet (if (and (>= quiet 2) (< quiet 2.1)) (+ n 1) n))))))
 
@@ -208,7 +210,8 @@
 (define (latencies-where ok?)
   (filter-map
    (lambda (e)
-     (let ((next (find (lambda (s) (and (eq? (list-ref s 4) (list-ref e 4)) (>= (car s) (car e))))
+     (let ((next (find (lambda (s)
+                         (and (eq? (list-ref s 4) (list-ref e 4)) (>= (car s) (car e))))
                        starts)))
        (and next (ok? next)
             (any (lambda (x) (and (< (vector-ref posed-at (car x)) (car e))
@@ -245,11 +248,15 @@
 ;;; first, each take free robots, keeping them until they have all they
 ;;; need, as 'hold does.
 
+;; When task t was posed.
+(define (posed-time t) (vector-ref posed-at (car t)))
+
 (define (ideal-makespan)
   (let loop ((now 0) (free (length robots)) (running '()) (held '()) (done 0) (last 0))
     ;; running: (end . robots); held: (task . robots it holds)
-    (let* ((arrived (filter (lambda (t) (and (work-of t) (<= (vector-ref posed-at (car t)) now)
-                                             (not (memv (car t) done-ids))))
+    (let* ((arrived (filter (lambda (t)
+                              (and (work-of t) (<= (vector-ref posed-at (car t)) now)
+                                   (not (memv (car t) done-ids))))
                             tasks))
            (waiting (list-sort ranks-before? arrived)))
       (let fill ((ws waiting) (free free) (held '()) (started '()))
@@ -260,13 +267,14 @@
                   (fill (cdr ws) (- free take) (cons (cons t take) held) started)))
             (begin
               (for-each (lambda (t) (set! done-ids (cons (car t) done-ids))) started)
-              (let* ((running (append (map (lambda (t) (cons (+ now (work-of t)) (task-robots t)))
+              (let* ((running (append (map (lambda (t)
+                                             (cons (+ now (work-of t)) (task-robots t)))
                                            started)
                                       running))
                      (free (+ free (apply + (map cdr held))))
                      (next-end (and (pair? running) (apply min (map car running))))
                      (next-arrival (let ((later (filter (lambda (x) (> x now))
-                                                        (map (lambda (t) (vector-ref posed-at (car t)))
+                                                        (map posed-time
                                                              (filter work-of tasks)))))
                                      (and (pair? later) (apply min later))))
                      (next (cond ((and next-end next-arrival) (min next-end next-arrival))
@@ -320,16 +328,17 @@
        (round-to (percentile last-release-latencies 0.5) 1) "ms")
 (bench "sched-start-latency-last-release-p95"
        (round-to (percentile last-release-latencies 0.95) 1) "ms")
-(bench "sched-utilization" (round-to (* 100 (/ robot-seconds (* (length robots) makespan))) 1) "%")
+(bench "sched-utilization"
+       (round-to (* 100 (/ robot-seconds (* (length robots) makespan))) 1) "%")
+;; How long the tasks of priority k waited to start.
+(define (waits-at-priority k)
+  (filter-map (lambda (t)
+                (and (= (task-priority t) k) (span-of (car t))
+                     (- (cadr (span-of (car t))) (vector-ref posed-at (car t)))))
+              tasks))
 (for-each (lambda (k)
             (bench (string-append "sched-wait-p95-priority-" (number->string k))
-                   (round-to (percentile (filter-map (lambda (t)
-                                                       (and (= (task-priority t) k) (span-of (car t))
-                                                            (- (cadr (span-of (car t)))
-                                                               (vector-ref posed-at (car t)))))
-                                                     tasks)
-                                         0.95)
-                             2)
+                   (round-to (percentile (waits-at-priority k) 0.95) 2)
                    "s"))
           '(0 1 2 3))
 

@@ -38,8 +38,9 @@
               timeval-seconds timeval-microseconds)
         (only (murdoch robot trip) split-words)
         (murdoch) (murdoch cli command) (murdoch testing harness)
-        (murdoch wire netstring) (murdoch wire hmac) (murdoch wire frame) (murdoch code sendable)
-        (murdoch remote aspace) (murdoch code sandbox) (murdoch lab) (murdoch sys scheduler)
+        (murdoch wire netstring) (murdoch wire hmac) (murdoch wire frame)
+        (murdoch code sendable) (murdoch remote aspace) (murdoch code sandbox)
+        (murdoch lab) (murdoch sys scheduler)
         (only (murdoch remote call) encode-arguments)
         (bench echo))
 

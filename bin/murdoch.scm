@@ -8,7 +8,8 @@
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
         (only (chibi ast) setenv unsetenv)
-        (murdoch lab) (murdoch cli command) (murdoch cli launch))
+        (only (murdoch wire) error-message) (murdoch lab) (murdoch cli command)
+        (murdoch cli launch))
 
 (define version "0.3")
 
@@ -57,30 +58,41 @@
     (repl (LAB (NAME)) "join the lab with a REPL, as NAME or as a guest" ()
           ,(lambda (cfg lab . name)
              (run-repl lab (and (pair? name) (string->symbol (car name))))))
-    (lab (LAB) "start the simulator and every address space of the lab, until stopped (Ctrl-C); an address space that dies is started again, at most three times a minute"
+    (lab (LAB) "start the simulator and every address space of the lab, until stopped \
+                (Ctrl-C); an address space that dies is started again, at most three \
+                times a minute"
          ((trace string "write the simulator's animated SVG trace here")
           (speed real "simulated seconds per wall second")
-          (logs string "the children's logs go in this folder (default: a fresh one, named when the lab starts)")
-          (except (list symbol) "start all but these address spaces (a,b,...), to join by hand")
-          (view integer "also serve the live view in the browser, at http://127.0.0.1:PORT/ (PORT may be left out: the lab's port-base + 148)"))
+          (logs string "the children's logs go in this folder (default: a fresh one, \
+                        named when the lab starts)")
+          (except (list symbol) "start all but these address spaces (a,b,...), to join \
+                                 by hand")
+          (view integer "also serve the live view in the browser, at \
+                         http://127.0.0.1:PORT/ (PORT may be left out: the lab's \
+                         port-base + 148)"))
          ,(lambda (cfg lab) (run-lab* cfg lab)))
     (pose (LAB FILE) "pose the task FILE evaluates to, as a guest of the running lab" ()
           ,(lambda (cfg lab file) (run-pose lab file)))
     (demo (LAB) "start the lab, pose the dual-sonar task, show where the trace is" ()
           ,(lambda (cfg lab) (run-demo bin lab)))
-    (view (LAB (PORT)) "show the running lab in the browser: serve its live view at http://127.0.0.1:PORT/ (default: the lab's port-base + 148), writing its trace as it goes"
+    (view (LAB (PORT)) "show the running lab in the browser: serve its live view at \
+                        http://127.0.0.1:PORT/ (default: the lab's port-base + 148), \
+                        writing its trace as it goes"
           ((trace string "write the view's trace here (default: runs/LAB-SECONDS.jsonl)"))
           ,(lambda (cfg lab . port)
              ((view-procedure 'run-view)
               web lab (and (pair? port) (port-argument (command-named "view") (car port)))
               (conf-get cfg '(command view trace)))))
-    (replay (TRACE (PORT)) "serve the view of a finished run from its trace, to play in the browser (default port 7248)" ()
+    (replay (TRACE (PORT)) "serve the view of a finished run from its trace, to play in \
+                            the browser (default port 7248)" ()
             ,(lambda (cfg trace . port)
                ((view-procedure 'run-replay)
-                web trace (and (pair? port) (port-argument (command-named "replay") (car port))))))
+                web trace
+                (and (pair? port) (port-argument (command-named "replay") (car port))))))
     (check (LAB) "check the lab file for mistakes, and start nothing" ()
            ,(lambda (cfg lab) (run-check lab)))
-    (status (LAB) "show each address space of the running lab: up since, pose, battery, the subjects held and by whom" ()
+    (status (LAB) "show each address space of the running lab: up since, pose, battery, \
+                   the subjects held and by whom" ()
             ,(lambda (cfg lab) (run-status lab)))
     (help ((COMMAND)) "show this help, or a command's" ()
           ,(lambda (cfg . name) (show-help name)))))
@@ -112,7 +124,9 @@
                                            (command-doc c) "\n")
                             out))
             commands)
-  (write-string "\n  murdoch --help, murdoch help COMMAND, murdoch COMMAND --help, murdoch --version\n" out))
+  (write-string "\n  murdoch --help, murdoch help COMMAND, murdoch COMMAND --help, \
+                 murdoch --version\n"
+                out))
 
 (define (show-command-usage c out)
   (write-string (string-append "Usage: " (usage-line c) "\n  " (command-doc c) "\n") out)
@@ -144,7 +158,8 @@
 ;; One line saying what is wrong, the usage, and exit 2.
 (define (mistake c what)
   (let ((err (current-error-port)))
-    (write-string (string-append "murdoch" (if c (string-append " " (symbol->string (car c))) "")
+    (write-string (string-append "murdoch"
+                                 (if c (string-append " " (symbol->string (car c))) "")
                                  ": " what "\n\n")
                   err)
     (if c (show-command-usage c err) (show-usage err))
@@ -287,19 +302,12 @@
   (let ((started? #f))
     (guard (e ((and (error-object? e) started?)
                (write-string (string-append "murdoch " (symbol->string (car c))
-                                            ": ERROR: " (error-text e) "\n")
+                                            ": ERROR: " (error-message e) "\n")
                              (current-error-port))
                (exit 2))
-              ((error-object? e) (mistake c (error-text e))))
+              ((error-object? e) (mistake c (error-message e))))
       (run-application (app-spec c (lambda () (set! started? #t)))
                        (cons* "murdoch" (symbol->string (car c)) (options-first args))))))
-
-(define (error-text e)
-  (let ((out (open-output-string)))
-    (write-string (error-object-message e) out)
-    (for-each (lambda (x) (write-char #\space out) (display x out))
-              (error-object-irritants e))
-    (get-output-string out)))
 
 (define (main args)
   (cond

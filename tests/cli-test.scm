@@ -11,7 +11,9 @@
 ;; (exit-status first-line whole-output) of bin/murdoch with args.
 (define (murdoch . args)
   (let ((status (apply system "sh" "-c"
-                       "cd \"$1\" && shift && exec timeout -s KILL 60 bin/murdoch \"$@\" >\"$0\" 2>&1"
+                       (string-append "cd \"$1\" && shift"
+                                      " && exec timeout -s KILL 60 bin/murdoch \"$@\""
+                                      " >\"$0\" 2>&1")
                        out (tool-path ".") args)))
     (let ((text (file-text out)))
       (list (quotient (if (pair? status) (cadr status) status) 256)
@@ -56,18 +58,23 @@
   (mistake '("labb" "x") "murdoch: no command labb; did you mean lab?")
   (mistake '("aspace" "x.scm") "murdoch aspace: missing NAME")
   (mistake '("pose" "a" "b" "c") "murdoch pose: too many arguments: c")
-  (mistake '("lab" "examples/tulane-lab.scm" "--bogus" "1") "murdoch lab: unknown option --bogus")
+  (mistake '("lab" "examples/tulane-lab.scm" "--bogus" "1")
+           "murdoch lab: unknown option --bogus")
   (mistake '("lab" "--view") "murdoch lab: missing LAB")
-  (mistake '("view" "examples/tulane-lab.scm" "http") "murdoch view: not a port number: http")
-  (mistake '("check" "examples/tulane-lab.scm" "--bogus") "murdoch check: unknown option --bogus")
-  (mistake '("lab" "--bogus" "examples/tulane-lab.scm") "murdoch lab: unknown option --bogus")
+  (mistake '("view" "examples/tulane-lab.scm" "http")
+           "murdoch view: not a port number: http")
+  (mistake '("check" "examples/tulane-lab.scm" "--bogus")
+           "murdoch check: unknown option --bogus")
+  (mistake '("lab" "--bogus" "examples/tulane-lab.scm")
+           "murdoch lab: unknown option --bogus")
   (mistake '("lab" "--spede" "2" "examples/tulane-lab.scm")
            "murdoch lab: unknown option --spede; did you mean --speed?")
   (mistake '("lab" "--speed" "abc" "examples/tulane-lab.scm")
            "murdoch lab: --speed takes a positive number, not abc")
   (mistake '("lab" "--view" "abc" "examples/tulane-lab.scm")
            "murdoch lab: --view takes a port number, or nothing, not abc")
-  (mistake '("lab" "examples/tulane-lab.scm" "--trace") "murdoch lab: --trace takes a name")
+  (mistake '("lab" "examples/tulane-lab.scm" "--trace")
+           "murdoch lab: --trace takes a name")
   (mistake '("lab" "--speed=abc" "examples/tulane-lab.scm")
            "murdoch lab: --speed takes a positive number, not abc")
   (test "--speed=2 takes its value with it, and leaves LAB an argument"
@@ -78,13 +85,18 @@
     (let ((r (murdoch "check" "/no/such/lab.scm")))
       (list (status r)
             (string=? (car (cddr r))
-                      "murdoch check: ERROR: cannot read /no/such/lab.scm: couldn't open input file\n"))))
+                      (string-append "murdoch check: ERROR: cannot read /no/such/lab.scm:"
+                                     " couldn't open input file\n")))))
   (test "a replay of a file that is not a trace, such as a lab file" #t
     (let ((r (murdoch "replay" "examples/tulane-lab.scm")))
       (and (= 2 (status r))
            (equal? (text-lines (car (cddr r)))
-                   '("murdoch replay: ERROR: not a trace of the view: examples/tulane-lab.scm (a trace's first line is the view's header of the room)")))))
-  (test "a replay of a trace that is not there" '(2 "murdoch replay: ERROR: no such trace /no/such.jsonl")
+                   (list (string-append
+                          "murdoch replay: ERROR: not a trace of the view:"
+                          " examples/tulane-lab.scm (a trace's first line is the view's"
+                          " header of the room)"))))))
+  (test "a replay of a trace that is not there"
+      '(2 "murdoch replay: ERROR: no such trace /no/such.jsonl")
     (let ((r (murdoch "replay" "/no/such.jsonl")))
       (list (status r) (first-line r)))))
 
@@ -92,14 +104,20 @@
   (let* ((base (free-port-base dir))
          (trace (string-append dir "/trace.jsonl"))
          (replay-out (string-append dir "/replay.out")))
-    (write-file "trace.jsonl" "{\"kind\":\"lab\",\"lab\":\"x\",\"radius\":180,\"walls\":[],\"boxes\":[],\"aspaces\":[],\"started\":0}\n")
-    (let ((pid (start-process! (list "env" (string-append "MURDOCH_PORT_BASE=" (number->string base))
+    (write-file "trace.jsonl"
+                (string-append "{\"kind\":\"lab\",\"lab\":\"x\",\"radius\":180,"
+                               "\"walls\":[],\"boxes\":[],\"aspaces\":[],"
+                               "\"started\":0}\n"))
+    (let ((pid (start-process! (list "env" (string-append "MURDOCH_PORT_BASE="
+                                                          (number->string base))
                                      (tool-path "bin/murdoch") "replay" trace)
                                replay-out)))
       (test "it serves on port-base + 148" #t
-        (wait-until 30 (lambda () (text-contains? (file-text replay-out)
-                                                  (string-append "http://127.0.0.1:"
-                                                                 (number->string (+ base 148)) "/")))))
+        (wait-until 30 (lambda ()
+                         (text-contains? (file-text replay-out)
+                                         (string-append "http://127.0.0.1:"
+                                                        (number->string (+ base 148))
+                                                        "/")))))
       (stop-process! pid))))
 
 (test-group "before anything is built"
@@ -109,9 +127,11 @@
     (system "sh" "-c" (string-append "mkdir -p \"$1/bin\" \"$1/tools\" \"$1/lib/murdoch\""
                                      " && cp bin/murdoch bin/murdoch.scm \"$1/bin\""
                                      " && cp tools/chibi \"$1/tools\""
-                                     " && echo \"(include-shared \\\"glue\\\")\" >\"$1/lib/murdoch/glue.sld\"")
+                                     " && echo \"(include-shared \\\"glue\\\")\""
+                                     " >\"$1/lib/murdoch/glue.sld\"")
             (tool-path ".") fresh)
-    (let ((status (system "sh" "-c" "PATH=/usr/bin:/bin \"$1/bin/murdoch\" --help >\"$0\" 2>&1"
+    (let ((status (system "sh" "-c"
+                          "PATH=/usr/bin:/bin \"$1/bin/murdoch\" --help >\"$0\" 2>&1"
                           out fresh)))
       (test "--help says what to run, and exits 1" '(1 #t)
         (list (quotient (if (pair? status) (cadr status) status) 256)
@@ -126,12 +146,14 @@
   (test "a misspelt setting" #t
     (let ((r (murdoch "check" (string-append dir "/lab.scm"))))
       (and (= 2 (status r)) (text-contains? (first-line r) "did you mean timeout?"))))
-  (write-file "inside.scm" "(lab x\n  (aspace a (robot (pose 0 0 0)\n    (tetherd #f))))\n")
+  (write-file "inside.scm"
+              "(lab x\n  (aspace a (robot (pose 0 0 0)\n    (tetherd #f))))\n")
   (test "check and lab name the same mistake inside a robot, with its line"
-      (list (list 2 (string-append "murdoch check: ERROR: " dir "/inside.scm:3: (tetherd #f):"
-                                   " no such clause in robot; did you mean tethered?"))
-            (list 2 (string-append "murdoch lab: ERROR: " dir "/inside.scm:3: (tetherd #f):"
-                                   " no such clause in robot; did you mean tethered?")))
+      (map (lambda (command)
+             (list 2 (string-append "murdoch " command ": ERROR: " dir
+                                    "/inside.scm:3: (tetherd #f):"
+                                    " no such clause in robot; did you mean tethered?")))
+           '("check" "lab"))
     (map (lambda (command)
            (let ((r (murdoch command (string-append dir "/inside.scm"))))
              (list (status r) (first-line r))))
@@ -144,8 +166,9 @@
   (test "a code file whose list is not closed: its file and line" #t
     (let ((r (murdoch "check" (string-append dir "/code1.scm"))))
       (and (= 2 (status r))
-           (text-contains? (first-line r)
-                           "/open.scm:1: this list has no closing ): the file ends inside it"))))
+           (text-contains?
+            (first-line r)
+            "/open.scm:1: this list has no closing ): the file ends inside it"))))
   (test "a code file that raises as it loads: its file, line and error" #t
     (let ((r (murdoch "check" (string-append dir "/code2.scm"))))
       (and (= 2 (status r))
@@ -213,7 +236,8 @@
   (let ((r (demo "laser.scm")))
     (test "a task nobody takes: exit non-zero" #t (positive? (status r)))
     (test "its output is shown" #t (text-contains? (cadr r) "not-enough-takers"))
-    (test "and the demo says so" #t (text-contains? (cadr r) "the task did not complete"))))
+    (test "and the demo says so" #t
+      (text-contains? (cadr r) "the task did not complete"))))
 
 (test-end)
 (remove-test-lab! demo-lab)

@@ -5,7 +5,8 @@
 (define (hex->bytevector hex)
   (let ((bv (make-bytevector (quotient (string-length hex) 2))))
     (do ((i 0 (+ i 1))) ((= i (bytevector-length bv)) bv)
-      (bytevector-u8-set! bv i (string->number (substring hex (* 2 i) (+ 2 (* 2 i))) 16)))))
+      (bytevector-u8-set! bv i
+                          (string->number (substring hex (* 2 i) (+ 2 (* 2 i))) 16)))))
 (define (text s) (string->utf8 s))
 
 (test-begin "hmac-sha256 (RFC 4231)")
@@ -32,7 +33,10 @@
 (test "case 7: long key and long data"
     "9b09ffa71b942fcb27635fbcd5b0e944bfdc63644f0713938a7f51535c3a35e2"
   (hmac-sha256 (repeat #xaa 131)
-               (text "This is a test using a larger than block-size key and a larger than block-size data. The key needs to be hashed before being used by the HMAC algorithm.")))
+               (text (string-append
+                      "This is a test using a larger than block-size key and a larger"
+                      " than block-size data. The key needs to be hashed before being"
+                      " used by the HMAC algorithm."))))
 ;; Beyond RFC 4231: the edges of the key, worked out by the RFC 2104
 ;; formula over a separate SHA-256.
 (test "an empty key and an empty message"

@@ -103,7 +103,8 @@
   (let* ((welcomed (welcomed-raw-connect key (aspace-port (troy)) "b1"))
          (conn (car welcomed)))
     (raw-send! conn (counted key (cdr welcomed) 1
-                             '(apply 1 #(murdoch:closure (lambda () (set! cons list) 1) ())
+                             '(apply 1
+                                     #(murdoch:closure (lambda () (set! cons list) 1) ())
                                      ())))
     (test "a raw closure that assigns is answered with the error" 'error
       (car (raw-answer conn)))
@@ -127,7 +128,8 @@
   (test "the next call writes to the process's output" #t
     (begin (remote-apply (troy) (lambda () (display "written after the attack")
                                   (newline)))
-           (wait-until 5 (lambda () (text-contains? (troy-log) "written after the attack")))))
+           (wait-until 5 (lambda ()
+                           (text-contains? (troy-log) "written after the attack")))))
   (let ((conn (raw-connect (aspace-port (troy)))))
     (raw-send! conn (string->utf8 "GET / HTTP/1.0\r\n\r\n"))
     (test "a malformed frame still closes its connection" #t (raw-closed? conn)))
@@ -181,7 +183,8 @@
   (test "runaway recursion" #t
     (starts-with? (refusal (lambda () (let f ((n 0)) (+ 1 (f (+ n 1))))))
                   "recursed too deep"))
-  (test "a call that ends its own thread" "thread-terminate!: this thread serves calls, and a call cannot end it"
+  (test "a call that ends its own thread"
+      "thread-terminate!: this thread serves calls, and a call cannot end it"
     (values (refusal (lambda () (thread-terminate! (current-thread))))))
   (test "a run that ends its worker's thread leaves the worker serving" 8
     (begin (remote-run! (troy) (lambda () (thread-terminate! (current-thread))))
@@ -297,7 +300,8 @@
   (let ((buffer (make-bytevector 65536)))
     (let loop ((tries 200))
       (let ((n (receive! recorder buffer)))
-        (cond ((and (> n 0) (text-contains? (utf8->string (bytevector-copy buffer 0 n)) word))
+        (cond ((and (> n 0)
+                    (text-contains? (utf8->string (bytevector-copy buffer 0 n)) word))
                (bytevector-copy buffer 0 n))
               ((> tries 0) (thread-sleep! 0.05) (loop (- tries 1)))
               (else (error "no datagram recorded" word)))))))
@@ -314,7 +318,8 @@
     (publish 'all bump!)
     (set! datagram (record! "bump!"))
     (test "the original ran on troy" (+ before 1)
-      (wait-until 5 (lambda () (let ((n (counter-of 'troy))) (and (= n (+ before 1)) n)))))
+      (wait-until 5 (lambda ()
+                      (let ((n (counter-of 'troy))) (and (= n (+ before 1)) n)))))
     (replay! datagram)
     (thread-sleep! 0.3)
     (test "sent again, it does not run on a receiver that heard it" (+ before 1)
@@ -330,8 +335,9 @@
     (test "nor on one that restarted since" 0 (counter-of 'troy))
     (test "a fresh publish still reaches both" '(1 1)
       (begin (publish 'all bump!)
-             (wait-until 5 (lambda () (let ((c (list (counter-of 'troy) (counter-of 'beta))))
-                                        (and (equal? c '(1 1)) c))))))
+             (wait-until 5 (lambda ()
+                             (let ((c (list (counter-of 'troy) (counter-of 'beta))))
+                               (and (equal? c '(1 1)) c))))))
     (still-fine "after the replays")))
 
 ;; A write to a socket whose other end is gone raises SIGPIPE, whose
@@ -341,7 +347,8 @@
 (define (ignores-sigpipe? pid)
   (let ((line (find (lambda (line) (and (> (string-length line) 8)
                                         (string=? (substring line 0 7) "SigIgn:")))
-                    (read-lines (string-append "/proc/" (number->string pid) "/status")))))
+                    (read-lines (string-append "/proc/" (number->string pid)
+                                               "/status")))))
     ;; A mask in hexadecimal; SIGPIPE is signal 13, its bit 12.
     (odd? (quotient (string->number (substring line 8 (string-length line)) 16) 4096))))
 

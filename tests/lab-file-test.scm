@@ -48,7 +48,8 @@
   (test "one far from any" #t
     (says? "(lab x (colour blue))" "(colour blue): no such setting"))
   (test "a wrong value" #t
-    (says? "(lab x (timeout -1))" "(timeout -1): timeout takes a positive number of seconds"))
+    (says? "(lab x (timeout -1))"
+           "(timeout -1): timeout takes a positive number of seconds"))
   (test "too many values" #t
     (says? "(lab x (lease 1 2))" "(lease 1 2): lease takes a positive number of seconds"))
   (test "a max-depth past what Chibi's writer keeps" #t
@@ -63,18 +64,19 @@
            ":4: (aspace a): two address spaces of this name: the other on line 2"))
   (test "two things on one port: both named" #t
     (says? "(lab x (port-base 7000)\n (aspace a)\n (aspace b (port 7000)))"
-           (string-append ":3: (aspace b (port 7000)): two things on port 7000: the address"
-                          " space a on line 2, and the address space b")))
+           (string-append ":3: (aspace b (port 7000)): two things on port 7000:"
+                          " the address space a on line 2, and the address space b")))
   (test "a robot's trip server on an address space's port" #t
     (says? "(lab x (port-base 7000)\n (aspace a (robot (trip-port 7001)))\n (aspace b))"
-           (string-append ":3: (aspace b): two things on port 7001: the trip server of the"
-                          " robot a on line 2, and the address space b")))
+           (string-append ":3: (aspace b): two things on port 7001: the trip server"
+                          " of the robot a on line 2, and the address space b")))
   (test "a code file that is not there" #t
     (says? "(lab x (code \"nowhere.scm\"))" "(code \"nowhere.scm\"): no such file")))
 
 (test-group "the line of the clause"
   (test "a mistake on line 4 says :4:" #t
-    (says? "; a lab\n(lab x\n  (lease 30)\n  (timout 3))\n" (string-append file ":4: (timout 3)"))))
+    (says? "; a lab\n(lab x\n  (lease 30)\n  (timout 3))\n"
+           (string-append file ":4: (timout 3)"))))
 
 (define room
   "(lab x (world (wall -3000 -3000 3000 -3000) (box 1500 1500 600 600 30))\n")
@@ -87,33 +89,43 @@
     (says? (string-append room "(aspace a (robot (pose 1500 1700 0))))")
            "the robot a stands on (box 1500 1500 600 600 30)"))
   (test "on another robot: the later is named, on its line, with the other's" #t
-    (says? (string-append room "(aspace a (robot (pose 0 0 0)))\n(aspace b (robot (pose 200 100 0))))")
-           ":3: (aspace b (robot (pose 200 100 0))): the robot b stands on the robot a on line 2"))
+    (says? (string-append room "(aspace a (robot (pose 0 0 0)))\n"
+                          "(aspace b (robot (pose 200 100 0))))")
+           (string-append ":3: (aspace b (robot (pose 200 100 0))): the robot b stands on"
+                          " the robot a on line 2")))
   (test "apart, they are fine" #t
-    (lab? (read-text (string-append room "(aspace a (robot (pose 0 0 0))) (aspace b (robot (pose 1000 0 0))))"))))
+    (lab? (read-text (string-append room "(aspace a (robot (pose 0 0 0)))"
+                                    " (aspace b (robot (pose 1000 0 0))))"))))
   (test "a larger radius from the b14 clause counts" #t
-    (says? (string-append room "(b14 (radius 600)) (aspace a (robot (pose 0 0 0))) (aspace b (robot (pose 1000 0 0))))")
+    (says? (string-append room "(b14 (radius 600)) (aspace a (robot (pose 0 0 0)))"
+                          " (aspace b (robot (pose 1000 0 0))))")
            "the robot b stands on the robot a"))
   (test "outside the walls of a rectangular room" #t
-    (says? (string-append "(lab x (world (wall -3000 -3000 3000 -3000) (wall 3000 -3000 3000 3000)"
+    (says? (string-append "(lab x (world (wall -3000 -3000 3000 -3000)"
+                          " (wall 3000 -3000 3000 3000)"
                           " (wall 3000 3000 -3000 3000) (wall -3000 3000 -3000 -3000))\n"
                           "(aspace a (robot (pose 9000 0 0))))")
-           ":2: (aspace a (robot (pose 9000 0 0))): the robot a stands outside the walls"))
+           (string-append ":2: (aspace a (robot (pose 9000 0 0))): the robot a stands"
+                          " outside the walls")))
   (test "beside a lone wall is no room to be outside of" #t
-    (lab? (read-text "(lab x (world (wall 0 0 1000 0)) (aspace a (robot (pose 9000 0 0))))"))))
+    (lab? (read-text (string-append "(lab x (world (wall 0 0 1000 0))"
+                                    " (aspace a (robot (pose 9000 0 0))))")))))
 
 (test-group "every clause is checked, within aspace, robot, world, simulator, b14"
   (define (mistake name text what)
     (test name #t (says? text what)))
   (mistake "a misspelt clause of an address space, with the nearest"
            "(lab x\n  (aspace a\n    (capabilites camera)))"
-           ":3: (capabilites camera): no such clause in aspace; did you mean capabilities?")
+           (string-append ":3: (capabilites camera): no such clause in aspace;"
+                          " did you mean capabilities?"))
   (mistake "a misspelt setting of a robot"
            "(lab x (aspace a (robot (pose 0 0 0)\n (tetherd #f))))"
            ":2: (tetherd #f): no such clause in robot; did you mean tethered?")
   (mistake "a misspelt item of the world"
-           "(lab x (world (bx 0 0 100 100 0)))" "(bx 0 0 100 100 0): no such clause in world; did you mean box?")
-  (mistake "a coordinate that is no number" "(lab x (aspace a (robot (pose 1200 abc 180))))"
+           "(lab x (world (bx 0 0 100 100 0)))"
+           "(bx 0 0 100 100 0): no such clause in world; did you mean box?")
+  (mistake "a coordinate that is no number"
+           "(lab x (aspace a (robot (pose 1200 abc 180))))"
            "(pose 1200 abc 180): pose takes x y heading, three numbers")
   (mistake "a coordinate in quotes" "(lab x (aspace a (robot (pose \"1200\" 0 180))))"
            "pose takes x y heading")
@@ -125,7 +137,8 @@
            "(wall 0 0 1000): wall takes x1 y1 x2 y2")
   (mistake "a workstation's position" "(lab x (aspace a (position 0 0)))"
            "(position 0 0): position takes x y heading")
-  (mistake "a scripted load" "(lab x (aspace a (load ((0 high)))))" "(load ((0 high))): load takes")
+  (mistake "a scripted load" "(lab x (aspace a (load ((0 high)))))"
+           "(load ((0 high))): load takes")
   (mistake "a simulator setting" "(lab x (simulator (speed slow)))"
            "(speed slow): speed takes a positive number, or fast")
   (mistake "a b14 setting" "(lab x (b14 (sonar-rays 20)))"
@@ -141,19 +154,24 @@
   (mistake "the end of the file inside the last clause"
            "(lab x\n  (timeout 3)\n  (load 0.5" ":3: this list has no closing )")
   (mistake "a ) too many" "(lab x)\n)" ":2: a ) that closes nothing")
+  (mistake "a datum the reader refuses, with what it refused"
+           "(lab x\n  (timeout #\\xyzw))"
+           ":2: cannot read this: unknown char name \"xyzw\"")
   (mistake "an empty file" "" (string-append file ": the file is empty"))
   (mistake "a file of comments only" "; nothing yet\n" "the file is empty")
   (mistake "two forms" "(lab x)\n(lab y)" ":2: (lab y): a second form")
   (test "a long clause is cut, to one line" #t
-    (let ((message (read-text (string-append "(lab x (aspace a (capabilities "
-                                             "sonar ir bumpers speech buttons lights mobile"
-                                             " camera) (colour blue)))"))))
+    (let ((message (read-text
+                    (string-append "(lab x (aspace a (capabilities "
+                                   "sonar ir bumpers speech buttons lights mobile"
+                                   " camera) (colour blue)))"))))
       (and (text-contains? message "(colour blue): no such clause in aspace")
            (not (text-contains? message "\n")))))
   (test "a clause past 60 characters is cut at 56, with ..." #t
     (says? (string-append "(lab x (aspace a (capabilites sonar ir bumpers speech buttons"
                           " lights mobile camera)))")
-           "(capabilites sonar ir bumpers speech buttons lights mobi ...: no such clause"))
+           (string-append "(capabilites sonar ir bumpers speech buttons lights mobi ...:"
+                          " no such clause")))
   (test "every example lab passes" '(#t #t)
     (map (lambda (f) (lab? (read-lab (tool-path (string-append "examples/" f)))))
          '("tulane-lab.scm" "box-lab.scm"))))

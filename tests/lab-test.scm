@@ -85,8 +85,9 @@
     (test "ps names each address space murdoch-UID" '(#t #t)
       (map (lambda (uid)
              (not (equal? "0" (command-output
-                               (list "sh" "-c" (string-append "ps -eo comm | grep -c '^murdoch-"
-                                                              uid "$'"))))))
+                               (list "sh" "-c"
+                                     (string-append "ps -eo comm | grep -c '^murdoch-"
+                                                    uid "$'"))))))
            '("troy" "praline")))
     (test-group "pose"
       (call-with-output-file (in-dir "task.scm")
@@ -102,7 +103,8 @@
                                  (list load-metric)
                                  (list (lambda () 'called))))\n"
                         out)))
-      (test "the task a file's last form evaluates to is posed; the result ends the output"
+      (test (string-append "the task a file's last form evaluates to is posed;"
+                           " the result ends the output")
           "(troy)" (last (pose-output "task.scm")))
       (test "pose-task's progress comes first" #t
         (text-contains? (car (pose-output "task.scm")) "pose-task: where"))
@@ -169,9 +171,11 @@
       (map listening? (list base (+ base 1))))
     (let ((output (pose-output "task.scm")))
       (test "pose with the lab gone says that nobody answers" #t
-        (text-contains? (car output) "no address space of the lab answers; away: (troy praline)"))
+        (text-contains? (car output)
+                        "no address space of the lab answers; away: (troy praline)"))
       (test "and nobody takes the task" "not-enough-takers" (last output)))
-    (test "a task nobody took: pose exits 1" 1 (command-status "pose" (in-dir "task.scm")))
+    (test "a task nobody took: pose exits 1" 1
+      (command-status "pose" (in-dir "task.scm")))
     (test "status, when no address space answers, exits 1" 1
       (command-status "status"))))
 
@@ -263,7 +267,8 @@
         ;; Its input is a FIFO it holds open itself, for writing too.
         (repl (start-process!
                (list "/bin/sh" "-c"
-                     "mkfifo \"$2\" && exec 3<>\"$2\" && exec \"$0\" repl \"$1\" praline <&3 3<&-"
+                     (string-append "mkfifo \"$2\" && exec 3<>\"$2\""
+                                    " && exec \"$0\" repl \"$1\" praline <&3 3<&-")
                      (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "fifo"))
                (in-dir "repl.out"))))
     (call-with-output-file (in-dir "asks-praline.scm")
@@ -278,10 +283,12 @@
       (last (pose-output "asks-praline.scm")))
     (call-with-output-file (in-dir "fifo")
       (lambda (out)
-        (write-string "(remote-apply (uid->aspace 'troy) (lambda () (thread-sleep! 6) 'slept))\n"
+        (write-string (string-append "(remote-apply (uid->aspace 'troy)"
+                                     " (lambda () (thread-sleep! 6) 'slept))\n")
                       out)))
     (test "a call from the REPL outlasts the lab's 5 s timeout (repl-timeout)" #t
-      (wait-until 30 (lambda () (text-contains? (file-text (in-dir "repl.out")) "slept"))))
+      (wait-until 30 (lambda ()
+                       (text-contains? (file-text (in-dir "repl.out")) "slept"))))
     (stop-process! repl)
     (stop-process! pid)))
 
@@ -289,7 +296,8 @@
     "the last line"
   (command-output
    (list "/bin/sh" "-c"
-         "tools/chibi tests/failing-lab.scm 2>&1 | grep -A2 '^--- the last lines of a.log' | tail -1")))
+         (string-append "tools/chibi tests/failing-lab.scm 2>&1"
+                        " | grep -A2 '^--- the last lines of a.log' | tail -1"))))
 
 (test-end)
 (stop-all-processes!)

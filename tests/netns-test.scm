@@ -34,7 +34,8 @@
 
 (define id (number->string (current-process-id)))
 ;; A /24 of its own, by process id: 10.S.77.0/24.
-(define subnet (string-append "10." (number->string (+ 20 (modulo (current-process-id) 200))) ".77."))
+(define subnet
+  (string-append "10." (number->string (+ 20 (modulo (current-process-id) 200))) ".77."))
 (define (address i) (string-append subnet (number->string i)))
 (define bridge (string-append "mdb" id))
 (define robots '(near far spare))
@@ -73,7 +74,8 @@
   (for-each (lambda (args) (apply system? "ip" args)) made)
   (set! made '()))
 
-(define group (string-append "239.255." (number->string (modulo (current-process-id) 250)) ".9"))
+(define group
+  (string-append "239.255." (number->string (modulo (current-process-id) 250)) ".9"))
 
 (define lab-code "
 (define spins 0)
@@ -112,7 +114,8 @@
   (start-process! (list "ip" "netns" "exec" (netns uid)
                         (tool-path "bin/murdoch") "aspace" (test-lab-file lab)
                         (symbol->string uid))
-                  (string-append (test-lab-directory lab) "/" (symbol->string uid) ".log")))
+                  (string-append (test-lab-directory lab) "/" (symbol->string uid)
+                                 ".log")))
 
 (define (spins-at uid)
   (remote-apply (uid->aspace uid) (eval '(lambda () spins) (lab-environment))))
@@ -217,9 +220,12 @@
           `((code "code.scm") (heartbeat 0.3) (timeout 2)
             (delivery multicast ,group)
             (aspace tester (host ,(address 1)))
-            (aspace near (host ,(address 2)) (position 100 0 0) (capabilities mobile) (load 0.5))
-            (aspace far (host ,(address 3)) (position 3000 0 0) (capabilities mobile) (load 0.5))
-            (aspace spare (host ,(address 4)) (position 6000 0 0) (capabilities mobile) (load 0.5)))
+            (aspace near (host ,(address 2)) (position 100 0 0) (capabilities mobile)
+                    (load 0.5))
+            (aspace far (host ,(address 3)) (position 3000 0 0) (capabilities mobile)
+                    (load 0.5))
+            (aspace spare (host ,(address 4)) (position 6000 0 0) (capabilities mobile)
+                    (load 0.5)))
           `(("code.scm" . ,lab-code))))
    (set! robot-pids (map (lambda (uid) (cons uid (start-robot! uid))) robots))
    (join-lab (test-lab-file lab) 'tester)
@@ -227,14 +233,16 @@
    (test-group "every host answers, from its own address"
      (test "each robot, in its namespace" robots
        (map (lambda (uid)
-              (wait-until 20 (lambda () (guard (e (#t #f))
-                                          (remote-apply (uid->aspace uid) local-aspace-uid)))))
+              (wait-until 20 (lambda ()
+                               (guard (e (#t #f))
+                                 (remote-apply (uid->aspace uid) local-aspace-uid)))))
             robots))
      (test "delivery is multicast" 'multicast (delivery-mode))
      (test "one datagram reaches all four" '(far near spare tester)
        (wait-until 10 (lambda ()
-                        (let ((acks (list-sort (lambda (a b) (string<? (symbol->string a)
-                                                                        (symbol->string b)))
+                        (let ((acks (list-sort (lambda (a b)
+                                                 (string<? (symbol->string a)
+                                                           (symbol->string b)))
                                                (publish 'all (lambda () #t)))))
                           (and (= (length acks) 4) acks))))))
 

@@ -24,7 +24,10 @@
   (spin))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
-         (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects)))))
+         (request 'all (lambda ()
+                         (filter-map (lambda (t)
+                                       (let ((s (topic-status t))) (and s (list t s))))
+                                     subjects)))))
 (define (pose-one name)
   (pose-task name 1 (list '((mobile) ())) (list #f) (list who-am-i)))
 ")
@@ -149,7 +152,8 @@
                                             (by-second)))))
 (test "composed with a comparator, which ties when it prefers neither" '(far)
   (pose-by (compose-metrics (lambda (a b) #f) (by-second))))
-(test "a tolerance takes a metric by one measure" "metric-within: a tolerance >= 0 and a metric by one measure"
+(test "a tolerance takes a metric by one measure"
+    "metric-within: a tolerance >= 0 and a metric by one measure"
   (error-text (lambda () (metric-within 1 (lambda (a b) #t)))))
 
 (test "a candidate that cannot be measured comes last" '(far)
@@ -278,7 +282,8 @@
 
 (test "a metric that is neither a procedure nor #f is a clear error"
     "pose-task: a metric is a procedure or #f"
-  (error-text (lambda () (pose-task 'bad 1 (list 'idle) (list 'nearest) (list who-am-i)))))
+  (error-text (lambda ()
+                (pose-task 'bad 1 (list 'idle) (list 'nearest) (list who-am-i)))))
 (test "so is a component that is not a procedure"
     "pose-task: a component's procedure is not a procedure"
   (error-text (lambda () (pose-task 'bad 1 (list 'idle) (list #f) (list 42)))))

@@ -48,8 +48,9 @@
 (define (at uid proc . args) (apply remote-apply (uid->aspace uid) proc args))
 (define (status uid topic) (at uid topic-status topic))
 (define (evaluated uid) (at uid (eval '(lambda () *evaluated*) (lab-environment))))
-(define (sorted-uids ls) (list-sort (lambda (x y) (string<? (symbol->string x) (symbol->string y))) ls))
-(define (by-uid answers) (list-sort (lambda (x y) (string<? (symbol->string (car x)) (symbol->string (car y)))) answers))
+(define (uid<? x y) (string<? (symbol->string x) (symbol->string y)))
+(define (sorted-uids ls) (list-sort uid<? ls))
+(define (by-uid answers) (list-sort (lambda (x y) (uid<? (car x) (car y))) answers))
 (define (lab-proc name) (eval name (lab-environment)))
 
 (test-begin (if (null? delivery) "pubsub" "pubsub over multicast"))

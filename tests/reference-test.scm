@@ -16,10 +16,14 @@
 (define (row-names text)
   (filter-map (lambda (line)
                 (and (> (string-length line) 3) (string=? "| `" (substring line 0 3))
-                     (let* ((cell (substring line 3 (string-length line)))
-                            (cell (if (char=? (string-ref cell 0) #\() (substring cell 1 (string-length cell)) cell))
+                     (let* ((cell (string-copy line 3))
+                            (cell (if (char=? (string-ref cell 0) #\()
+                                      (string-copy cell 1)
+                                      cell))
                             (end (let loop ((i 0))
-                                   (if (memv (string-ref cell i) '(#\space #\) #\`)) i (loop (+ i 1))))))
+                                   (if (memv (string-ref cell i) '(#\space #\) #\`))
+                                       i
+                                       (loop (+ i 1))))))
                        (string->symbol (substring cell 0 end)))))
               (text-lines text)))
 
@@ -27,7 +31,8 @@
 (define (undocumented text)
   (row-names (apply string-append
                     (map (lambda (line) (string-append line "\n"))
-                         (filter (lambda (line) (text-contains? line "(no `;;>` comment yet)"))
+                         (filter (lambda (line)
+                                   (text-contains? line "(no `;;>` comment yet)"))
                                  (text-lines text))))))
 
 (test-begin "reference")
@@ -35,7 +40,8 @@
 (test "the generator writes a page" #t
   (text-contains? (file-text generated) "# Reference: the (murdoch) library"))
 
-(test "docs/reference.md is up to date (tools/chibi tools/gen-reference.scm > docs/reference.md)"
+(test (string-append "docs/reference.md is up to date"
+                     " (tools/chibi tools/gen-reference.scm > docs/reference.md)")
     #t
   (string=? (file-text generated) (file-text (tool-path "docs/reference.md"))))
 
@@ -46,8 +52,9 @@
   (let ((rows (row-names (file-text generated))))
     (remove (lambda (name) (memq name rows))
             (map (lambda (e) (if (pair? e) (car (cddr e)) e))
-                 (cdr (assq 'export (cddr (call-with-input-file (tool-path "lib/murdoch.sld")
-                                            read))))))))
+                 (cdr (assq 'export
+                            (cddr (call-with-input-file (tool-path "lib/murdoch.sld")
+                                    read))))))))
 
 (test-end)
 (system? "rm" "-rf" dir)

@@ -5,7 +5,8 @@
         (only (chibi filesystem) open-input-file-descriptor
               open-output-file-descriptor)
         (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
-        (murdoch wire netstring) (murdoch wire hmac) (murdoch wire connect) (murdoch testing harness)
+        (murdoch wire netstring) (murdoch wire hmac) (murdoch wire connect)
+        (murdoch testing harness)
         (murdoch testing raw)
         (only (murdoch sys wait) make-mailbox mailbox-put! mailbox-take)
         (only (murdoch sys scheduler) monotonic-seconds))

@@ -356,7 +356,8 @@
           (list k sum)
           (loop (+ i 1)
                 (+ sum ((eval `(lambda (x)
-                                 (let spin ((j 0)) (if (< j 300) (spin (+ j 1)) (+ x ,k))))
+                                 (let spin ((j 0))
+                                   (if (< j 300) (spin (+ j 1)) (+ x ,k))))
                               (environment '(scheme base)))
                         i)))))))
 

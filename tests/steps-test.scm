@@ -35,7 +35,10 @@
       'left))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
-         (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects)))))
+         (request 'all (lambda ()
+                         (filter-map (lambda (t)
+                                       (let ((s (topic-status t))) (and s (list t s))))
+                                     subjects)))))
 ")
 
 (define lab
@@ -56,7 +59,8 @@
 (define (record) (reverse (remote-apply (uid->aspace 'quiet)
                                         (eval '(lambda () record) (lab-environment)))))
 (define (clear-record!)
-  (remote-apply (uid->aspace 'quiet) (eval '(lambda () (set! record '())) (lab-environment))))
+  (remote-apply (uid->aspace 'quiet)
+                (eval '(lambda () (set! record '())) (lab-environment))))
 (define (all-free?) ((lab-proc 'free-everywhere?) '(mobile near far)))
 (define near-first (location-metric-maker '(0 0 0 0)))
 (define far-first (location-metric-maker '(3000 3000 0 0)))
@@ -124,10 +128,12 @@
 ;; freezing its process (SIGSTOP) until its silence is noticed.
 (test-group "a robot twice in a team is replaced only where it was lost"
   (let* ((hold (lambda (previous)
-                 (let loop ((n 40)) (if (> n 0) (begin (thread-sleep! 0.1) (loop (- n 1)))))
+                 (let loop ((n 40))
+                   (if (> n 0) (begin (thread-sleep! 0.1) (loop (- n 1)))))
                  (local-aspace-uid)))
          (t (start-steps 'twice
-                         (task-step '(((wheels) ()) ((wheels) ())) (list near-first far-first)
+                         (task-step '(((wheels) ()) ((wheels) ()))
+                                    (list near-first far-first)
                                     (list hold (lambda (previous) (local-aspace-uid)))
                                     '(2 1) '(#t #f))
                          (task-step '((same 1 1) (same 1 2)) '(#f #f)
@@ -143,11 +149,13 @@
           (lambda (uid)
             (wait-until 10 (lambda () (eq? uid (runs-1))))
             (kill (cdr (assq uid pids)) signal/stop)
-            (wait-until 10 (lambda () (let ((now (runs-1))) (and now (not (eq? uid now))))))
+            (wait-until 10 (lambda ()
+                             (let ((now (runs-1))) (and now (not (eq? uid now))))))
             (kill (cdr (assq uid pids)) signal/continue))))
     (freeze-until-moved! 'near)
     (freeze-until-moved! 'far)
-    (test "step 2 runs on the robots step 1 ended with: spare, and far" '((spare far) (spare far))
+    (test "step 2 runs on the robots step 1 ended with: spare, and far"
+        '((spare far) (spare far))
       (let ((r (task-wait t 60))) (list (car r) (cadr r))))))
 
 (test-group "wrong arguments"

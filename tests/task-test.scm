@@ -46,7 +46,10 @@
 (define (spin-long) (spin-for 1000))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
-         (request 'all (lambda () (filter-map (lambda (t) (let ((s (topic-status t))) (and s (list t s)))) subjects)))))
+         (request 'all (lambda ()
+                         (filter-map (lambda (t)
+                                       (let ((s (topic-status t))) (and s (list t s))))
+                                     subjects)))))
 ;; Run by the poser address space: starts a task that spins long on one
 ;; mobile robot.
 (define (start-spinning)
@@ -102,7 +105,8 @@
     (wait-until 10 (lambda ()
                      (and (equal? (list-head (state-of task k) 2) (list 'running uid))
                           (> (spins-at uid) before))))))
-(define (list-head ls n) (if (or (zero? n) (null? ls)) '() (cons (car ls) (list-head (cdr ls) (- n 1)))))
+(define (list-head ls n)
+  (if (or (zero? n) (null? ls)) '() (cons (car ls) (list-head (cdr ls) (- n 1)))))
 
 (test-begin "task life cycle")
 

@@ -108,7 +108,8 @@ LAB
   (test "lights read back" '(1 0 1 0) (lights))
   (test-assert "say" (say "moving to" '(300 200)))
   (let ((v (battery-voltage)))
-    (test-assert "battery-voltage in tenths of a volt" (and (exact-integer? v) (<= 130 v 137))))
+    (test-assert "battery-voltage in tenths of a volt"
+      (and (exact-integer? v) (<= 130 v 137))))
   (trip-request ernst 'buttons 'press 1)
   (test "a button pressed by another client" '(0 0 0 0) (buttons-read))
   (trip-request moseley 'buttons 'press 1)
@@ -156,7 +157,8 @@ LAB
     (set-current-robot! second)))
 
 (test-group "errors"
-  (test "bad arguments" '(args "x is not a number") (error-of (lambda () (rotate 'by 'x))))
+  (test "bad arguments" '(args "x is not a number")
+    (error-of (lambda () (rotate 'by 'x))))
   (test "unknown command" 'unknown
         (car (error-of (lambda () (trip-request moseley 'base 'fly)))))
   (test-error "rotate needs 'by or 'to" (rotate 'sideways 10))
@@ -228,7 +230,8 @@ LAB
               (map round (reckon)) (map round end))
         (test-assert "two whole turns" (< (turned-from start (car (cddr end))) 2)))))
   (test "a motion over its time is stopped, and says so" '(timeout "motion took too long")
-        (parameterize ((trip-motion-timeout 0.2)) (error-of (lambda () (rotate 'by 720)))))
+        (parameterize ((trip-motion-timeout 0.2))
+          (error-of (lambda () (rotate 'by 720)))))
   (test "and the base stands still" 0 (list-ref (trip-request moseley 'base 'status) 5)))
 
 (test-group "safe.scm"

@@ -31,7 +31,8 @@
 (test-group "the room: the trace's first line"
   (let ((header (string->json (json-text (lab-header (read-lab (test-lab-file lab)))))))
     (test "the lab's name" "test" (assq-ref 'lab header))
-    (test "walls, 50 mm thick unless said" '(#(-3000 -3000 3000 -3000 50) #(3000 3000 -3000 3000 80))
+    (test "walls, 50 mm thick unless said"
+        '(#(-3000 -3000 3000 -3000 50) #(3000 3000 -3000 3000 80))
       (let ((walls (vector->list (assq-ref 'walls header))))
         (list (first walls) (third walls))))
     (test "boxes" '#(#(1500 1500 400 400 30)) (assq-ref 'boxes header))
@@ -41,7 +42,8 @@
       (< (abs (- (assq-ref 'started header)
                  (string->number (command-output (list "date" "+%s")))))
          10))
-    (test "which address spaces are robots" '(("moseley" . #t) ("ernst" . #t) ("troy" . #f))
+    (test "which address spaces are robots"
+        '(("moseley" . #t) ("ernst" . #t) ("troy" . #f))
       (map (lambda (a) (cons (assq-ref 'name a) (assq-ref 'robot a)))
            (vector->list (assq-ref 'aspaces header))))))
 
@@ -70,7 +72,9 @@
       (take (hex-colours (file-text (tool-path "web/view.js"))) 10)
     (let* ((c (file-text (tool-path "sim/trace.c")))
            (from (let loop ((i 0))
-                   (if (string=? "colour(const world" (substring c i (+ i 18))) i (loop (+ i 1))))))
+                   (if (string=? "colour(const world" (substring c i (+ i 18)))
+                       i
+                       (loop (+ i 1))))))
       (take (hex-colours (substring c from (string-length c))) 10)))
   (let* ((svg (in-dir "sim.svg"))
          (log (in-dir "b14.log"))
@@ -86,7 +90,8 @@
              '("moseley" "ernst")))
       (test "each in its view colour: moseley first, ernst second" '(#t #t)
         (map (lambda (colour)
-               (text-contains? text (string-append "<circle r=\"180\" fill=\"" colour "\"")))
+               (text-contains? text
+                               (string-append "<circle r=\"180\" fill=\"" colour "\"")))
              '("#1565c0" "#c62828"))))))
 
 (test-group "a box where a robot's fiducial finder sees it"
@@ -114,11 +119,14 @@
                             (vector->list (assq-ref 'subjects c))
                             (assq-ref 'until c) (assq-ref 'end c) (assq-ref 'from c)))
                     (vector->list (assq-ref 'components t)))))
-       (vector->list (string->json (json-text (task-table->json table 10))))))
+       (table-tasks table)))
+
+;; The tasks of the view's task table, as the page reads them.
+(define (table-tasks table)
+  (vector->list (string->json (json-text (task-table->json table 10)))))
 
 ;; The newest task of table, as the JSON reader reads it, and its state.
-(define (newest-task table)
-  (vector-ref (string->json (json-text (task-table->json table 10))) 0))
+(define (newest-task table) (car (table-tasks table)))
 (define (task-state table) (assq-ref 'state (newest-task table)))
 
 ;; A look at time t that finds each robot of robot-reports, (UID REPORT).
@@ -128,8 +136,12 @@
 (test-group "the task table"
   (let ((table (make-task-table)))
     ;; pose-task negotiating: the candidates hold their exclusive subjects.
-    (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile t@pose-1/1) (sonar t@pose-1/1)) '()))
-                                      (list 'ernst (report 'ernst '((mobile t@pose-1/1)) '()))))
+    (task-table-update! table 1
+                        (list (list 'moseley
+                                    (report 'moseley
+                                            '((mobile t@pose-1/1) (sonar t@pose-1/1))
+                                            '()))
+                              (list 'ernst (report 'ernst '((mobile t@pose-1/1)) '()))))
     (test "a subject held for a task that runs nothing there is a reservation, unnumbered"
         '(("t" (null "moseley" ("mobile" "sonar") null null null)
                (null "ernst" ("mobile") null null null)))
@@ -149,21 +161,28 @@
     (test "the task's state" "failed" (task-state table))
     ;; A robot killed and started again answers at once, holding nothing.
     (let ((table (make-task-table)))
-      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile u@pose-3/1))
-                                                              '()))))
-      (task-table-update! table 2 (list (list 'moseley (cons 'moseley
-                                                             (cons 99 (cddr (report 'moseley '() '())))))))
+      (task-table-update! table 1
+                          (list (list 'moseley
+                                      (report 'moseley '((mobile u@pose-3/1)) '()))))
+      (task-table-update! table 2
+                          (list (list 'moseley
+                                      (cons* 'moseley 99
+                                             (cddr (report 'moseley '() '()))))))
       (test "one that started again lost what it ran"
           '(("u" (null "moseley" ("mobile") 2 "lost: moseley started again" null)))
         (components table)))
     ;; start-task: components by index, and a reassignment.
     (let ((table (make-task-table)))
-      (task-table-update! table 1 (list (list 'moseley (report 'moseley '((mobile |s@tester/4|))
-                                                               '((running |s@tester/1| 1 tester))))
-                                        (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
-      (task-table-update! table 2 (list (list 'moseley (report 'moseley '() '()))
-                                        (list 'ernst (report 'ernst '() '((running |s@tester/1| 1 tester))))
-                                        (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
+      (task-table-update!
+       table 1
+       (list (list 'moseley (report 'moseley '((mobile |s@tester/4|))
+                                    '((running |s@tester/1| 1 tester))))
+             (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
+      (task-table-update!
+       table 2
+       (list (list 'moseley (report 'moseley '() '()))
+             (list 'ernst (report 'ernst '() '((running |s@tester/1| 1 tester))))
+             (list 'tester (report 'tester '() '((posed |s@tester/1| running))))))
       (test "a component that moves to another robot was reassigned from the first"
           '(("s" (1 "moseley" ("mobile") 2 "moved to ernst" null)
                  (1 "ernst" () null null "moseley")))
@@ -220,7 +239,8 @@
           (robot 'moseley '() '())
           (robot 'ernst '() '() '((r@guest-3/1 1 guest-3 1.5 0.5 (done)))))
     (test "a component lost on one robot and done on the next is done, and so its task"
-        '(("r" (1 "moseley" () 1.5 "lost: stalled" null) (1 "ernst" () 2.5 "done" "moseley"))
+        '(("r" (1 "moseley" () 1.5 "lost: stalled" null)
+               (1 "ernst" () 2.5 "done" "moseley"))
           "done")
       (list (car (components table)) (task-state table))))
   (let ((table (make-task-table)))
@@ -247,12 +267,15 @@
         (assq-ref 'sonar-at (moseley s)))
       (test "a box a robot sees is where it sees it" '#(1500 0 400 400 0)
         (vector-ref (assq-ref 'boxes s) 0)))
-    (let ((s (snap 2 (list (answer 'moseley '(800 0 0 0) (make-list 16 900) #f '(900 50))))))
+    (let ((s (snap 2 (list (answer 'moseley '(800 0 0 0) (make-list 16 900) #f
+                                   '(900 50))))))
       (test "a new ring is drawn from the pose it came with" '#(800 0 0)
         (assq-ref 'sonar-at (moseley s)))
       (test "a robot's goto target is drawn" '#(900 50) (assq-ref 'goal (moseley s))))
     (test "an address space that did not answer is away, and why" '(#t "no answer")
-      (let ((a (vector-ref (assq-ref 'aspaces (snap 3 (list (list 'ernst #f "no answer")))) 0)))
+      (let ((a (vector-ref (assq-ref 'aspaces
+                                     (snap 3 (list (list 'ernst #f "no answer"))))
+                           0)))
         (list (assq-ref 'away a) (assq-ref 'why a))))))
 
 ;;; A real lab
@@ -262,7 +285,9 @@
   (let ((io (open-connection "127.0.0.1" port 5)))
     (and (pair? io)
          (let ((in (car io)) (out (cadr io)))
-           (write-string (string-append "GET " path " HTTP/1.0\r\nHost: localhost\r\n\r\n") out)
+           (write-string (string-append "GET " path
+                                        " HTTP/1.0\r\nHost: localhost\r\n\r\n")
+                         out)
            (flush-output-port out)
            (let loop ((acc '()))
              (let ((s (read-string 65536 in)))
@@ -286,7 +311,8 @@
             (lambda ()
               (let* ((io (open-connection "127.0.0.1" port 5))
                      (in (car io)) (out (cadr io)))
-                (write-string "GET /events?from=0 HTTP/1.1\r\nHost: localhost\r\n\r\n" out)
+                (write-string "GET /events?from=0 HTTP/1.1\r\nHost: localhost\r\n\r\n"
+                              out)
                 (flush-output-port out)
                 (let loop ((events '()) (id #f))
                   (if (= (length events) n)
@@ -294,9 +320,9 @@
                       (let ((line (read-line in)))
                         (cond ((eof-object? line) (reverse events))
                               ((string-prefix? "id: " line)
-                               (loop events (string->number (substring line 4 (string-length line)))))
+                               (loop events (string->number (string-copy line 4))))
                               ((string-prefix? "data: " line)
-                               (loop (cons (cons id (substring line 6 (string-length line))) events) #f))
+                               (loop (cons (cons id (string-copy line 6)) events) #f))
                               (else (loop events id)))))))))))
     (thread-start! t)
     (thread-join! t 20 'timeout)))
@@ -309,16 +335,25 @@
   (find (lambda (c) (system? "sh" "-c" (string-append "command -v " c " >/dev/null")))
         '("chromium" "chromium-browser" "google-chrome")))
 
+;; $1 is a folder of chromium's own.
+(define chromium-flags
+  "--headless --no-sandbox --disable-gpu --user-data-dir=\"$1\"")
+
 ;; The page's DOM once its scripts ran, as headless chromium dumps it.
 (define (browser-dom url file)
   (system? "sh" "-c"
-           "timeout 120 \"$0\" --headless --no-sandbox --disable-gpu --user-data-dir=\"$1\" --virtual-time-budget=4000 --dump-dom \"$2\" >\"$3\" 2>/dev/null"
+           (string-append "timeout 120 \"$0\" " chromium-flags
+                          " --virtual-time-budget=4000 --dump-dom \"$2\""
+                          " >\"$3\" 2>/dev/null")
            chromium (in-dir "chromium") url file)
   (file-text file))
 
 (define (screenshot url file)
   (system? "sh" "-c"
-           "timeout 120 \"$0\" --headless --no-sandbox --disable-gpu --user-data-dir=\"$1\" --hide-scrollbars --window-size=1400,900 --virtual-time-budget=4000 --screenshot=\"$3\" \"$2\" >/dev/null 2>&1"
+           (string-append "timeout 120 \"$0\" " chromium-flags
+                          " --hide-scrollbars --window-size=1400,900"
+                          " --virtual-time-budget=4000 --screenshot=\"$3\" \"$2\""
+                          " >/dev/null 2>&1")
            chromium (in-dir "chromium") url file))
 
 ;; The points of the path of robot name the page drew.
@@ -327,7 +362,7 @@
          (at (string-search tag dom)))
     (if at
         (let* ((start (+ at (string-length tag)))
-               (end (+ start (string-search "\"" (substring dom start (string-length dom))))))
+               (end (+ start (string-search "\"" (string-copy dom start)))))
           (delete-duplicates (text-words (substring dom start end))))
         '())))
 
@@ -336,7 +371,8 @@
     (cond ((null? chars)
            (reverse (if (null? word) acc (cons (list->string (reverse word)) acc))))
           ((char=? (car chars) #\space)
-           (loop (cdr chars) '() (if (null? word) acc (cons (list->string (reverse word)) acc))))
+           (loop (cdr chars) '()
+                 (if (null? word) acc (cons (list->string (reverse word)) acc))))
           (else (loop (cdr chars) (cons (car chars) word) acc)))))
 
 (define view-port (+ (test-lab-port-base lab) 148))
@@ -443,11 +479,13 @@
 
 (if (not (file-exists? (tool-path "sim/b14")))
     (begin (display "no simulator (make -C sim): the lab part is left out\n"))
-    (let ((pid (start-murdoch-lab! (list (test-lab-file lab) "--logs" (in-dir "logs") "--view")
-                                   (in-dir "lab.out"))))
+    (let ((pid (start-murdoch-lab!
+                (list (test-lab-file lab) "--logs" (in-dir "logs") "--view")
+                (in-dir "lab.out"))))
       (test "the lab says where the view is" #t
         (text-contains? (file-text (in-dir "lab.out"))
-                        (string-append "lab: view at http://127.0.0.1:" (number->string view-port) "/")))
+                        (string-append "lab: view at http://127.0.0.1:"
+                                       (number->string view-port) "/")))
       (test "ps names it murdoch-view" #t
         (not (equal? "0" (command-output
                           (list "sh" "-c" "ps -eo comm | grep -c '^murdoch-view$'")))))
@@ -465,24 +503,32 @@
       ;; A task that drives one robot for a while.
       (call-with-output-file (in-dir "task.scm")
         (lambda (out)
-          (write-string "(start-task 'drive-a-while 1 (list (list (list 'mobile) '())) (list #f)
-                          (list (lambda () (goto-xy '(0 -1000)) (thread-sleep! 1) (local-aspace-uid))))\n"
+          (write-string "(start-task 'drive-a-while 1
+                          (list (list (list 'mobile) '())) (list #f)
+                          (list (lambda ()
+                                  (goto-xy '(0 -1000))
+                                  (thread-sleep! 1)
+                                  (local-aspace-uid))))\n"
                         out)))
       (system? "sh" "-c" "timeout 60 \"$0\" pose \"$1\" \"$2\" >\"$3\" 2>&1"
-               (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "task.scm") (in-dir "pose.out"))
+               (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "task.scm")
+               (in-dir "pose.out"))
       (let ((winner (let ((lines (read-lines (in-dir "pose.out"))))
                       (if (pair? lines) (last lines) "")))
             (state (lambda () (string->json (http-get view-port "/state")))))
-        (test "the task ran on a robot" #t (and (member winner '("(moseley)" "(ernst)")) #t))
+        (test "the task ran on a robot" #t
+          (and (member winner '("(moseley)" "(ernst)")) #t))
         (let ((winner (if (> (string-length winner) 2)
                           (substring winner 1 (- (string-length winner) 1))
                           winner)))
-          (test "the view's state has the task, and who won it" (list "drive-a-while" winner)
+          (test "the view's state has the task, and who won it"
+              (list "drive-a-while" winner)
             (let ((tasks (vector->list (assq-ref 'tasks (state)))))
               (if (null? tasks)
                   tasks
                   (list (assq-ref 'name (car tasks))
-                        (assq-ref 'robot (vector-ref (assq-ref 'components (car tasks)) 0))))))
+                        (assq-ref 'robot
+                                  (vector-ref (assq-ref 'components (car tasks)) 0))))))
           (test "while it drove, the trace has its goto target" #t
             (any (lambda (line)
                    (let ((s (string->json line)))
@@ -494,16 +540,20 @@
           (posed-from-a-guest pid state)
           (posed-in-the-lab state)
           (if (not chromium)
-              (display "skipped: no chromium on this machine, so the page is not tried in a browser\n")
-              (let ((dom (browser-dom (string-append "http://127.0.0.1:" (number->string view-port)
-                                                     "/?poll=300")
-                                      (in-dir "live.html"))))
+              (display (string-append "skipped: no chromium on this machine, so the page"
+                                      " is not tried in a browser\n"))
+              (let ((dom (browser-dom
+                          (string-append "http://127.0.0.1:" (number->string view-port)
+                                         "/?poll=300")
+                          (in-dir "live.html"))))
                 (test "in the browser: the lab's name" #t (text-contains? dom "lab test"))
-                (test "each name drawn in the room, robots' and the workstation's" '(#t #t #t)
+                (test "each name drawn in the room, robots' and the workstation's"
+                    '(#t #t #t)
                   (map (lambda (n) (text-contains? dom (string-append ">" n "</text>")))
                        '("moseley" "ernst" "troy")))
                 (test "each name in the table of address spaces" '(#t #t #t)
-                  (map (lambda (n) (text-contains? dom (string-append "<tr data-name=\"" n "\"")))
+                  (map (lambda (n)
+                         (text-contains? dom (string-append "<tr data-name=\"" n "\"")))
                        '("moseley" "ernst" "troy")))
                 (test "the task panel names the task" #t
                   (text-contains? dom "<span class=\"task-name\">drive-a-while</span>"))
@@ -522,10 +572,11 @@
                   (text-contains? dom "<td>failed: car: not a pair ()</td>"))
                 (let ((shot (string-append (or (get-environment-variable "TMPDIR") "/tmp")
                                            "/murdoch-view-test.png")))
-                  (screenshot (string-append "http://127.0.0.1:" (number->string view-port)
-                                             "/?poll=300")
+                  (screenshot (string-append "http://127.0.0.1:"
+                                             (number->string view-port) "/?poll=300")
                               shot)
-                  (test "a screenshot" #t (and (file-exists? shot) (> (file-size shot) 1000)))
+                  (test "a screenshot" #t
+                    (and (file-exists? shot) (> (file-size shot) 1000)))
                   (display (string-append "screenshot: " shot "\n")))))
           (test "SIGTERM: the lab and its view stop" 0 (stop-process! pid))
           (let* ((trace (in-dir "logs/view.jsonl"))
@@ -551,9 +602,10 @@
 ;; runs/ of the folder it was started from.
 (if (file-exists? (tool-path "sim/b14"))
     (let* ((out (in-dir "lab-runs.out"))
-           (pid (start-process! (list "sh" "-c" "cd \"$0\" && exec \"$1\" lab \"$2\" --view"
-                                      dir (tool-path "bin/murdoch") (test-lab-file lab))
-                                out)))
+           (pid (start-process!
+                 (list "sh" "-c" "cd \"$0\" && exec \"$1\" lab \"$2\" --view"
+                       dir (tool-path "bin/murdoch") (test-lab-file lab))
+                 out)))
       (wait-until 90 (lambda () (text-contains? (file-text out) "lab: ready")))
       (test "without --logs, the lab names a trace in runs/" #t
         (text-contains? (file-text out) "lab: the view's trace: runs/test-"))

@@ -71,7 +71,8 @@
 (define (job label gate) ((lab-proc 'job) label gate))
 (define (robot-value uid name)
   (remote-apply (uid->aspace uid) (eval `(lambda () ,name) (lab-environment))))
-(define (open-gate! uid gate) (remote-apply (uid->aspace uid) (lab-proc 'open-gate!) gate))
+(define (open-gate! uid gate)
+  (remote-apply (uid->aspace uid) (lab-proc 'open-gate!) gate))
 (define (state-of task k) (cadr (list-ref (task-status task) (- k 1))))
 (define (all-free?)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
@@ -79,7 +80,8 @@
 
 ;; Holds robot uid with a task until gate is opened there.
 (define (block! uid gate)
-  (let ((t (start-task 'block 1 (list `((arm ,uid) ())) (list #f) (list (job gate gate)))))
+  (let ((t (start-task 'block 1 (list `((arm ,uid) ())) (list #f)
+                       (list (job gate gate)))))
     (wait-until 10 (lambda () (eq? (car (state-of t 1)) 'running)))
     t))
 
@@ -180,7 +182,8 @@
       (if (eq? where 'tester)
           (set! mine (cons (wait-job label) mine))
           (remote-apply (uid->aspace where) (lab-proc 'pose-job) label))
-      (wait-until 10 (lambda () (>= (waiting-count) (length (memq label '(f5 f4 f3 f2 f1)))))))
+      (wait-until 10 (lambda ()
+                       (>= (waiting-count) (length (memq label '(f5 f4 f3 f2 f1)))))))
     (for-each pose! '(p1 tester p2 p1 tester) '(f1 f2 f3 f4 f5))
     (test "five wait, lab-wide" 5 (waiting-count))
     (open-gate! 'r3 'k3)
@@ -245,7 +248,8 @@
                                (start-task 'high 1 (list '((arm) ())) (list #f)
                                            (list ((lab-proc 'slow-job)
                                                   (string->symbol
-                                                   (string-append "high" (number->string i)))
+                                                   (string-append "high"
+                                                                  (number->string i)))
                                                   0.3))
                                            'wait #t 'priority 1))))
                      (iota 16)))
@@ -297,11 +301,13 @@
          (mover (start-task 'mover 1 (list '((arm) ())) (list #f) (list (job 'mover 'q3))
                             '(1) '(#t) 'wait #t))
          (running (wait-until 10 (lambda () (eq? (car (state-of mover 1)) 'running))))
-         (lifter (start-task 'lift 1 (list '((arm lift) ())) (list #f) (list (job 'lift #f))
+         (lifter (start-task 'lift 1 (list '((arm lift) ())) (list #f)
+                             (list (job 'lift #f))
                              'wait #t))
          (armer (wait-job 'armer)))
     (for-each (lambda (uid) (open-gate! uid 'q3)) '(r1 r2))
-    (test "both wait" #t (wait-until 10 (lambda () (and (waiting? lifter) (waiting? armer)))))
+    (test "both wait" #t
+      (wait-until 10 (lambda () (and (waiting? lifter) (waiting? armer)))))
     (kill-process! (cdr (assq 'r3 pids)))
     (test "the one only r3 could take fails, saying so" 'not-enough-takers
       (task-wait lifter 10))
@@ -312,7 +318,8 @@
     (test "the lost component runs when a robot frees" '(mover) (task-wait mover 10))
     (test "its attempts: lost on r3, done on r1" '((r3 lost) (r1 done))
       (map (lambda (a) (list (car a) (cadr a))) (car (cddr (car (task-status mover))))))
-    (test "and the other after it: it ranks first, posed first" '(armer) (task-wait armer 10))
+    (test "and the other after it: it ranks first, posed first" '(armer)
+      (task-wait armer 10))
     (test "in that order (r3's notes died with it)" '(mover armer)
       (start-order '(mover armer)))
     (open-gate! 'r2 'q2)

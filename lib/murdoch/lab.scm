@@ -44,22 +44,36 @@
 ;;; Settings
 ;;
 ;; Every setting a lab file may give, in one table: its name, its
-;; default, and its reader, which answers the value to use for what the
-;; file wrote, or #f when that will not do, and what will.  Most take one
-;; value; code and delivery take the rest of their clause.  read-lab reads
-;; each once, and every place that needs one asks lab-setting.
+;; default, and its reader.  Most take one value; code and delivery take
+;; the rest of their clause.  read-lab reads each once, and every place
+;; that needs one asks lab-setting.
+
+(define-record-type setting
+  (make-setting name default reader)
+  setting?
+  (name setting-name)
+  (default setting-default)
+  (reader setting-reader))
+
+;; What a clause's value may be: read answers the value to use for what
+;; the file wrote, or #f when that will not do, and what says what will.
+(define-record-type reader
+  (make-reader read what)
+  reader?
+  (read reader-read)
+  (what reader-what))
 
 (define (number-over zero what)
-  (cons (lambda (x) (and (real? x) (> x zero) x)) what))
+  (make-reader (lambda (x) (and (real? x) (> x zero) x)) what))
 
 (define (whole-from low high what)
-  (cons (lambda (x) (and (exact-integer? x) (<= low x high) x)) what))
+  (make-reader (lambda (x) (and (exact-integer? x) (<= low x high) x)) what))
 
-(define (text what) (cons (lambda (x) (and (string? x) x)) what))
+(define (text what) (make-reader (lambda (x) (and (string? x) x)) what))
 
 (define seconds (number-over 0 "a positive number of seconds"))
 (define rate
-  (cons (lambda (x) (and (real? x) (>= x 0) x)) "a number, 0 or more, per second"))
+  (make-reader (lambda (x) (and (real? x) (>= x 0) x)) "a number, 0 or more, per second"))
 (define positive-count (whole-from 1 1000000000 "a positive whole number"))
 
 ;; A size: bytes, or a string of a number and K, M or G.
@@ -82,11 +96,13 @@
          args)
         (else #f)))
 
-(define settings-table
+(define setting-entries
   `((port-base 7100 ,(whole-from 1 65535 "a port number"))
     ;; sim/lab.c keeps an interface, and a robot's name, in 64 bytes.
-    (interface "127.0.0.1" (,(lambda (x) (and (string? x) (< (string-length x) 64) x))
-                            . "an IPv4 address, in quotes"))
+    (interface "127.0.0.1"
+               ,(make-reader
+                 (lambda (x) (and (string? x) (< (string-length x) 64) x))
+                 "an IPv4 address, in quotes"))
     (key-file "murdoch.key" ,(text "a file name, in quotes"))
     (max-frame 1048576 ,positive-count)
     ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
@@ -99,24 +115,33 @@
     (lease 30 ,seconds)
     (monitor-period 60 ,seconds)
     ;; A started task's components and their poser hear from each other
-    ;; every heartbeat seconds (task.scm).
+    ;; every heartbeat seconds (task/life-cycle.scm).
     (heartbeat 0.5 ,seconds)
     (max-attempts 3 ,positive-count)
     ;; A started task that finds too few capable robots free waits for
     ;; them or fails with not-enough-takers; its priority rises by aging
     ;; a second while it waits; a poser keeps at most max-waiting such
-    ;; tasks (task.scm, docs/tasks.md).
-    (when-robots-busy fail (,(lambda (x) (and (memq x '(fail wait)) x)) . "fail or wait"))
+    ;; tasks (task/life-cycle.scm, docs/tasks.md).
+    (when-robots-busy fail
+                      ,(make-reader (lambda (x) (and (memq x '(fail wait)) x))
+                                    "fail or wait"))
     (aging 0.1 ,rate)
     (max-waiting 100 ,positive-count)
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
-    (heap-max "512M" (,size-bytes . "bytes, or a size in quotes such as \"512M\""))
+    (heap-max "512M" ,(make-reader size-bytes
+                                   "bytes, or a size in quotes such as \"512M\""))
     ;; Chibi grows its heap by twice one allocation (sandbox.scm).
-    (max-alloc "32M" (,size-bytes . "bytes, or a size in quotes such as \"32M\""))
-    (code () (,(lambda (x) (and (every string? x) x)) . "file names, in quotes"))
+    (max-alloc "32M" ,(make-reader size-bytes
+                                   "bytes, or a size in quotes such as \"32M\""))
+    (code () ,(make-reader (lambda (x) (and (every string? x) x))
+                           "file names, in quotes"))
     (delivery (broadcast)
-              (,delivery-clause . "broadcast, or multicast \"GROUP\" [PORT]"))))
+              ,(make-reader delivery-clause
+                            "broadcast, or multicast \"GROUP\" [PORT]"))))
+
+(define settings-table
+  (map (lambda (entry) (apply make-setting entry)) setting-entries))
 
 ;; The clauses the simulator reads (docs/trip-protocol.md), and address
 ;; spaces.
@@ -125,14 +150,14 @@
 ;;; Within aspace, robot, world, simulator and b14
 ;;
 ;; What each may hold, as the address spaces and sim/lab.c read it: for
-;; each name, a check of the clause's values, the list after its name, and
-;; what will do; a robot's values are clauses of their own, in a table.
+;; each name, a reader of the clause's values, the list after its name;
+;; a robot's values are clauses of their own, in a table.
 
 (define (values-of n check what)
-  (list (lambda (xs) (and (= (length xs) n) (every check xs))) what))
+  (make-reader (lambda (xs) (and (= (length xs) n) (every check xs))) what))
 
 (define (reals low high what)
-  (list (lambda (xs) (and (<= low (length xs) high) (every real? xs))) what))
+  (make-reader (lambda (xs) (and (<= low (length xs) high) (every real? xs))) what))
 
 (define (positive-real? x) (and (real? x) (positive? x)))
 (define (non-negative? x) (and (real? x) (>= x 0)))
@@ -145,48 +170,50 @@
                   x))))
 
 (define robot-table
-  `((pose ,@(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
-    (tethered ,@(values-of 1 boolean? "#t or #f"))
-    (battery ,@(values-of 1 positive-real? "volts, a positive number"))
-    (trip-port ,@(values-of 1 port-number? "a port number"))
-    (trip-host ,@(values-of 1 string? "an IPv4 address, in quotes"))))
+  `((pose . ,(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
+    (tethered . ,(values-of 1 boolean? "#t or #f"))
+    (battery . ,(values-of 1 positive-real? "volts, a positive number"))
+    (trip-port . ,(values-of 1 port-number? "a port number"))
+    (trip-host . ,(values-of 1 string? "an IPv4 address, in quotes"))))
 
 (define aspace-table
-  `((port ,@(values-of 1 port-number? "a port number"))
-    (host ,@(values-of 1 string? "an IPv4 address, in quotes"))
-    (robot ,robot-table)
-    (position ,@(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
-    (capabilities ,(lambda (xs) (every symbol? xs)) "subjects, as names")
-    (load ,@(values-of 1 load-value? "a number, or ((SECONDS LOAD) ...)"))))
+  `((port . ,(values-of 1 port-number? "a port number"))
+    (host . ,(values-of 1 string? "an IPv4 address, in quotes"))
+    (robot . ,robot-table)
+    (position . ,(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
+    (capabilities . ,(make-reader (lambda (xs) (every symbol? xs)) "subjects, as names"))
+    (load . ,(values-of 1 load-value? "a number, or ((SECONDS LOAD) ...)"))))
 
 (define world-table
-  `((wall ,@(reals 4 5 "x1 y1 x2 y2 and a thickness if not 50: four or five numbers"))
-    (box ,@(reals 5 6 "x y width depth heading and a mass if not 5: five or six numbers"))
-    (friction ,@(values-of 1 non-negative? "a number"))))
+  `((wall . ,(reals 4 5 "x1 y1 x2 y2 and a thickness if not 50: four or five numbers"))
+    (box . ,(reals 5 6 (string-append "x y width depth heading and a mass if not 5:"
+                                      " five or six numbers")))
+    (friction . ,(values-of 1 non-negative? "a number"))))
 
 (define simulator-table
-  `((step-hz ,@(values-of 1 (lambda (x) (and (real? x) (>= x 1))) "a number from 1"))
-    (seed ,@(values-of 1 real? "a number"))
-    (speed ,@(values-of 1 (lambda (x) (or (positive-real? x) (eq? x 'fast)))
-                        "a positive number, or fast"))
-    (stall-timeout ,@(values-of 1 positive-real? "a positive number of seconds"))))
+  `((step-hz . ,(values-of 1 (lambda (x) (and (real? x) (>= x 1))) "a number from 1"))
+    (seed . ,(values-of 1 real? "a number"))
+    (speed . ,(values-of 1 (lambda (x) (or (positive-real? x) (eq? x 'fast)))
+                          "a positive number, or fast"))
+    (stall-timeout . ,(values-of 1 positive-real? "a positive number of seconds"))))
 
 (define (increasing-pair)
-  (list (lambda (xs) (and (= (length xs) 2) (every real? xs) (< (car xs) (cadr xs))))
-        "two numbers, the first the smaller"))
+  (make-reader (lambda (xs)
+                 (and (= (length xs) 2) (every real? xs) (< (car xs) (cadr xs))))
+               "two numbers, the first the smaller"))
 
 (define b14-table
-  `(,@(map (lambda (name) `(,name ,@(values-of 1 non-negative? "a number, 0 or more")))
+  `(,@(map (lambda (name) `(,name . ,(values-of 1 non-negative? "a number, 0 or more")))
            '(radius mass max-speed max-turn speed turn-speed sonar-cone sonar-noise
              sonar-hz ir-range fiducial-range battery-drain battery-idle battery-charge))
-    (sonar-range ,@(increasing-pair))
-    (battery-range ,@(increasing-pair))
-    (fiducial-fov ,@(values-of 1 (lambda (x) (and (real? x) (< 0 x) (<= x 360)))
-                               "degrees, above 0 and at most 360"))
-    (sonar-rays ,@(values-of 1 (lambda (x) (and (exact-integer? x) (<= 1 x 16)))
-                             "a whole number from 1 to 16"))
-    (max-frame ,@(values-of 1 (lambda (x) (and (exact-integer? x) (<= 64 x 65536)))
-                            "a whole number from 64 to 65536"))))
+    (sonar-range . ,(increasing-pair))
+    (battery-range . ,(increasing-pair))
+    (fiducial-fov . ,(values-of 1 (lambda (x) (and (real? x) (< 0 x) (<= x 360)))
+                                 "degrees, above 0 and at most 360"))
+    (sonar-rays . ,(values-of 1 (lambda (x) (and (exact-integer? x) (<= 1 x 16)))
+                               "a whole number from 1 to 16"))
+    (max-frame . ,(values-of 1 (lambda (x) (and (exact-integer? x) (<= 64 x 65536)))
+                              "a whole number from 64 to 65536"))))
 
 ;; Each of the items of clause c against table.
 (define (check-within path c items table)
@@ -199,12 +226,12 @@
                                               " (NAME VALUE ...)")))
    ((assq (car item) table)
     => (lambda (entry)
-         (cond ((not (procedure? (cadr entry)))
-                (check-within path item (cdr item) (cadr entry)))
-               ((not ((cadr entry) (cdr item)))
-                (lab-file-error path item
-                                (string-append (symbol->string (car item))
-                                               " takes " (car (cddr entry))))))))
+         (let ((reader (cdr entry)))
+           (cond ((not (reader? reader)) (check-within path item (cdr item) reader))
+                 ((not ((reader-read reader) (cdr item)))
+                  (lab-file-error path item
+                                  (string-append (symbol->string (car item))
+                                                 " takes " (reader-what reader))))))))
    (else
     (lab-file-error path item
                     (string-append "no such clause in " (symbol->string (car outer))
@@ -235,33 +262,36 @@
 ;; error names the file, the clause and what is wrong.
 (define (read-settings path clauses)
   (for-each (lambda (c) (check-clause path c)) clauses)
-  (map (lambda (entry)
-         (let ((c (clause (car entry) clauses)))
-           (cons (car entry)
+  (map (lambda (s)
+         (let ((c (clause (setting-name s) clauses)))
+           (cons (setting-name s)
                  (if c
-                     (setting-value path c entry)
-                     ((car (car (cddr entry))) (cadr entry))))))
+                     (setting-value path c s)
+                     ((reader-read (setting-reader s)) (setting-default s))))))
        settings-table))
 
 (define (check-clause path c)
   (if (not (and (pair? c) (symbol? (car c)) (list? c)))
       (lab-file-error path c "a clause is (NAME VALUE ...)"))
-  (if (not (or (assq (car c) settings-table) (memq (car c) other-clauses)))
+  (if (not (or (setting-named (car c)) (memq (car c) other-clauses)))
       (lab-file-error path c (string-append "no such setting"
                                             (did-you-mean (car c)
-                                                          (append (map car settings-table)
+                                                          (append (map setting-name
+                                                                       settings-table)
                                                                   other-clauses)))))
   (check-inside path c))
 
-(define (setting-value path c entry)
-  (let* ((reader (car (cddr entry)))
-         (multi? (memq (car entry) multi-valued))
-         (value (cond (multi? ((car reader) (cdr c)))
-                      ((and (pair? (cdr c)) (null? (cddr c))) ((car reader) (cadr c)))
+(define (setting-named name)
+  (find (lambda (s) (eq? (setting-name s) name)) settings-table))
+
+(define (setting-value path c s)
+  (let* ((read (reader-read (setting-reader s)))
+         (value (cond ((memq (setting-name s) multi-valued) (read (cdr c)))
+                      ((and (pair? (cdr c)) (null? (cddr c))) (read (cadr c)))
                       (else #f))))
     (or value
         (lab-file-error path c (string-append (symbol->string (car c)) " takes "
-                                              (cdr reader))))))
+                                              (reader-what (setting-reader s)))))))
 
 (define (did-you-mean name names)
   (let ((near (find-nearest-edits (symbol->string name) (map symbol->string names))))
@@ -302,7 +332,8 @@
 ;;> The port base where no lab file is read (murdoch replay):
 ;;> MURDOCH_PORT_BASE, else port-base's default.
 (define (unread-lab-port-base)
-  (settings-port-base (list (cons 'port-base (cadr (assq 'port-base settings-table))))))
+  (settings-port-base
+   (list (cons 'port-base (setting-default (setting-named 'port-base))))))
 
 (define (settings-port-base settings)
   (cond ((get-environment-variable "MURDOCH_PORT_BASE") => string->number)
@@ -340,8 +371,9 @@
 ;;> or left of, as when a clause lacks its ), or else the innermost.
 ;;> Lists are read here, for their lines; other data with read.
 (define (read-source path)
-  (let ((in (guard (e (#t (error (string-append "cannot read " path ": "
-                                                (condition-message e)))))
+  (let ((in (guard (e ((file-error? e)
+                        (error (string-append "cannot read " path
+                                              ": couldn't open input file"))))
               (open-input-file path))))
     (let ((source (read-source-port path in)))
       (close-input-port in)
@@ -380,7 +412,7 @@
          ((char=? c #\)) (read-char in) (fail line "a ) that closes nothing"))
          (else
           (guard (e (#t (fail line (string-append "cannot read this: "
-                                                  (condition-message e)))))
+                                                  (error-message e)))))
             (read in))))))
     (define (read-list line open)
       (let loop ((items '()))
@@ -460,14 +492,16 @@
       (loop (cdr as))))
   (let loop ((ports (lab-ports lab)))
     (when (pair? ports)
-      (cond ((find (lambda (p) (= (car p) (car (car ports)))) (cdr ports))
+      (cond ((find (lambda (p) (= (listener-port p) (listener-port (car ports))))
+                   (cdr ports))
              => (lambda (p)
-                  (lab-file-error path (car (cddr p))
+                  (lab-file-error path (listener-clause p)
                                   (string-append
-                                   "two things on port " (number->string (car p)) ": "
-                                   (cadr (car ports))
-                                   (line-words (car (cddr (car ports))))
-                                   ", and " (cadr p)
+                                   "two things on port "
+                                   (number->string (listener-port p)) ": "
+                                   (listener-what (car ports))
+                                   (line-words (listener-clause (car ports)))
+                                   ", and " (listener-what p)
                                    " (address spaces listen at port-base + i, robots'"
                                    " trip servers at port-base + 100 + i)")))))
       (loop (cdr ports))))
@@ -481,22 +515,28 @@
   (cond ((clause-line c) => (lambda (n) (string-append " on line " (number->string n))))
         (else "")))
 
-;; Every port the lab's address spaces and robots listen on, in file
-;; order: (PORT WHAT CLAUSE) for each.
+;; What listens on a port of the lab, and the clause that puts it there.
+(define-record-type listener
+  (make-listener port what clause)
+  listener?
+  (port listener-port)
+  (what listener-what)
+  (clause listener-clause))
+
+;; Every listener of the lab's address spaces and robots, in file order.
 (define (lab-ports lab)
   (append-map
    (lambda (a)
      (let ((name (symbol->string (lab-aspace-uid a)))
            (form (lab-aspace-form a)))
-       (cons (list (lab-aspace-port a) (string-append "the address space " name) form)
+       (cons (make-listener (lab-aspace-port a) (string-append "the address space " name)
+                            form)
              (if (lab-aspace-clause a 'robot)
-                 (list (list (lab-trip-port lab a)
-                             (string-append "the trip server of the robot " name) form))
+                 (list (make-listener (lab-trip-port lab a)
+                                      (string-append "the trip server of the robot " name)
+                                      form))
                  '()))))
    (lab-aspaces lab)))
-
-(define (condition-message e)
-  (if (error-object? e) (error-object-message e) e))
 
 ;; form was checked by check-inside.
 (define (parse-aspace path form index base interface)
@@ -560,7 +600,7 @@
         (make-key-file file))
     (let ((hex (call-with-input-file file read-line)))
       (if (or (eof-object? hex) (< (string-length hex) 32))
-          (error "the lab's key file is too short" file))
+          (error (string-append "the lab's key file is too short " file)))
       (string->utf8 hex))))
 
 (define (make-key-file file)
@@ -568,7 +608,7 @@
                              ".new")))
     (let ((fd (open temp (bitwise-ior open/write open/create open/exclusive)
                     #o600)))
-      (if (not fd) (error "cannot create the key file" temp))
+      (if (not fd) (error (string-append "cannot create the key file " temp)))
       (let ((out (open-output-file-descriptor fd)))
         (write-string (random-hex key-bytes) out)
         (newline out)

@@ -23,12 +23,28 @@
                   (subscription-statuses '>))
           not-over (goto-goal) ended)))
 
+;;> The parts of an aspace-report \var{r}, by name.
+(define (report-uid r) (car r))
+(define (report-since r) (cadr r))
+(define (report-pose r) (list-ref r 2))
+(define (report-battery r) (list-ref r 3))
+(define (report-held r) (list-ref r 4))
+(define (report-tasks r) (list-ref r 5))
+;; A report from a peer older than GOAL, or ENDED, has none.
+(define (report-goal r) (and (> (length r) 6) (list-ref r 6)))
+(define (report-ended r) (if (> (length r) 7) (list-ref r 7) '()))
+
+;; lab-status's entry for an address space that did not answer.
+(define (make-away uid why) (list uid 'away why))
+(define (away? r) (eq? (cadr r) 'away))
+(define (away-why r) (car (cddr r)))
+
 ;;> The lab's status: for each address space of \var{lab}, in file order,
 ;;> its report (see aspace-report) when it answered within
 ;;> (remote-timeout) seconds, else (UID away WHY).
 (define (lab-status lab)
   (map (lambda (r)
-         (if (cadr r) (car (cddr r)) (list (car r) 'away (car (cddr r)))))
+         (if (cadr r) (car (cddr r)) (make-away (car r) (car (cddr r)))))
        (remote-apply-all (map (lambda (a) (uid->aspace (lab-aspace-uid a)))
                               (lab-aspaces lab))
                          aspace-report)))
@@ -46,26 +62,26 @@
   (let ((status (lab-status (current-lab))))
     (display-lab-status status (utc-seconds)
                         (if (pair? port) (car port) (current-output-port)))
-    (count (lambda (r) (not (eq? (cadr r) 'away))) status)))
+    (count (lambda (r) (not (away? r))) status)))
 
 (define (display-lab-status status now out)
   (for-each (lambda (r) (write-report r now out)) status))
 
 (define (write-report r now out)
-  (let ((uid (symbol->string (car r))))
+  (let ((uid (symbol->string (report-uid r))))
     (cond
-     ((eq? (cadr r) 'away)
-      (write-line out uid "  away: " (car (cddr r))))
+     ((away? r)
+      (write-line out uid "  away: " (away-why r)))
      (else
-      (write-line out uid "  up " (seconds-text (- now (cadr r))) " s"
-                  (pose-text (car (cddr r)))
-                  "  battery " (tenths-text (cadr (cddr r))))
+      (write-line out uid "  up " (seconds-text (- now (report-since r))) " s"
+                  (pose-text (report-pose r))
+                  "  battery " (tenths-text (report-battery r)))
       (for-each (lambda (held)
                   (write-line out "    " (symbol->string (car held))
                               " held by " (held-text (cadr held))))
-                (list-ref r 4))
+                (report-held r))
       (for-each (lambda (t) (write-line out "    " (task-text t)))
-                (list-ref r 5))))))
+                (report-tasks r))))))
 
 ;; (posed ID STATE), (posed ID waiting POSITION WHY) or (running ID INDEX
 ;; POSER), as a line.

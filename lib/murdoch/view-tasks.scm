@@ -6,7 +6,7 @@
 ;; A robot tells the subjects it holds and for whom -- a reservation
 ;; name, NAME@POSER/N (pose-task.scm) -- the components it runs, (running
 ;; ID INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed
-;; task's reservation name (component.scm), and the components that ended
+;; task's reservation name (running.scm), and the components that ended
 ;; there lately, each with how it ended, which its poser was told.  The
 ;; table remembers each component from when it is first seen on a robot
 ;; to when it ended there, and how; one that ended between two looks is
@@ -69,12 +69,12 @@
 ;; SUBJECTS) for each component, INDEX #f when only held subjects show it.
 (define (report-components report)
   (let* ((held (map (lambda (h) (cons (text (car h)) (text (cadr h))))
-                    (list-ref report 4)))
+                    (report-held report)))
          (running (filter-map (lambda (t)
                                 (and (pair? t) (eq? (car t) 'running)
                                      (>= (length t) 3)
                                      (list (text (cadr t)) (list-ref t 2))))
-                              (list-ref report 5)))
+                              (report-tasks report)))
          (subjects-of (lambda (pred)
                         (map car (filter (lambda (h) (pred (cdr h))) held))))
          (covered? (lambda (holder)
@@ -111,14 +111,14 @@
 ;; (KEY INDEX SINCE UNTIL END) for each component the report says ended
 ;; there (components-ended): SINCE and UNTIL in seconds before the
 ;; report, END as the table shows it.
-(define (report-ended report)
+(define (ended-entries report)
   (filter-map (lambda (e)
                 (and (list? e) (= (length e) 6) (exact-integer? (cadr e))
                      (real? (list-ref e 3)) (real? (list-ref e 4))
                      (pair? (list-ref e 5))
                      (list (text (car e)) (cadr e) (list-ref e 3) (list-ref e 4)
                            (end-text (list-ref e 5)))))
-              (if (> (length report) 7) (list-ref report 7) '())))
+              (report-ended report)))
 
 ;; (done), (failed WHY) or (lost WHY), as "done", "failed: WHY" ...; a
 ;; long WHY cut short.
@@ -188,7 +188,7 @@
                                                 (cadr posed))))
                    (posed-states (if (pair? (cddr uid+report))
                                      (car (cddr uid+report))
-                                     (list-ref report 5))))
+                                     (report-tasks report))))
          (for-each
           (lambda (obs)
             (set! seen (cons (observe! table (task-named table (car obs)) t robot
@@ -196,7 +196,7 @@
                              seen)))
           (report-components report))
          (for-each (lambda (e) (note-ended! table t robot e))
-                   (report-ended report))))
+                   (ended-entries report))))
      reports)
     (let* ((answered (map (lambda (r) (text (car r))) reports))
            (gone (note-robots! table t reports)))
@@ -304,7 +304,7 @@
                             (table-tasks table)))
     since))
 
-;; Brings robot's component that e, an entry of report-ended, tells of to
+;; Brings robot's component that e, an entry of ended-entries, tells of to
 ;; its end: the open entry seen before, or a new one when it ended since
 ;; the view started and the table has none.
 (define (note-ended! table t robot e)

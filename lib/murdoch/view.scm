@@ -42,12 +42,7 @@
 (define (text x)
   (cond ((string? x) x)
         ((symbol? x) (symbol->string x))
-        ((error-object? x)
-         (let ((out (open-output-string)))
-           (display (error-object-message x) out)
-           (for-each (lambda (i) (write-char #\space out) (display i out))
-                     (error-object-irritants x))
-           (get-output-string out)))
+        ((error-object? x) (error-message x))
         (else (let ((out (open-output-string)))
                 (display x out)
                 (get-output-string out)))))
@@ -159,7 +154,7 @@
 ;; Remembers uid's sonar ring, with its pose now when the ring is new.
 (define (note-sonar! state uid answer)
   (let ((ranges (cadr answer))
-        (pose (list-ref (car answer) 2))
+        (pose (report-pose (car answer)))
         (old (assq uid (view-state-sonars state))))
     (if (and (list? ranges) (pair? ranges) (every real? ranges) (list? pose)
              (>= (length pose) 3)
@@ -170,7 +165,7 @@
                              (view-state-sonars state)))))))
 
 (define (move-boxes! boxes answer)
-  (let ((pose (list-ref (car answer) 2))
+  (let ((pose (report-pose (car answer)))
         (seen (car (cddr answer))))
     (if (and pose (list? seen))
         (for-each
@@ -191,18 +186,18 @@
         `((name . ,name) (away . #t) (why . ,(text (car (cddr answer)))))
         (let* ((value (car (cddr answer)))
                (report (car value))
-               (pose (list-ref report 2))
-               (battery (list-ref report 3)))
+               (pose (report-pose report))
+               (battery (report-battery report)))
           `((name . ,name)
             (away . #f)
-            (since . ,(num (list-ref report 1)))
+            (since . ,(num (report-since report)))
             (pose . ,(if (and (list? pose) (>= (length pose) 3))
                          (numbers (take pose 3))
                          'null))
             (battery . ,(if (real? battery) (num (/ battery 10)) 'null))
             (held . ,(list->vector (map (lambda (h)
                                           (vector (text (car h)) (text (cadr h))))
-                                        (list-ref report 4))))
+                                        (report-held report))))
             ;; The last sonar ring, and the pose it was read at.
             (sonar . ,(cond ((assq (car answer) (view-state-sonars state))
                              => (lambda (s) (numbers (cadr s))))
@@ -211,7 +206,7 @@
                                 => (lambda (s) (numbers (car (cddr s)))))
                                (else 'null)))
             ;; Where the robot's goto-xy is going (aspace-report's GOAL).
-            (goal . ,(let ((goal (and (> (length report) 6) (list-ref report 6))))
+            (goal . ,(let ((goal (report-goal report)))
                        (if (and (list? goal) (>= (length goal) 2)
                                 (every real? (take goal 2)))
                            (numbers (take goal 2))
@@ -452,13 +447,13 @@
              (fd (open name (bitwise-ior open/write open/create open/exclusive) #o644)))
         (cond (fd (close-port (open-output-file-descriptor fd)) name)
               ((file-exists? name) (claim (+ n 1)))
-              (else (error "cannot make the trace" name)))))))
+              (else (error (string-append "cannot make the trace " name))))))))
 
 ;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
 ;;> (default: port-base + 148, MURDOCH_PORT_BASE's or else 7100's, as the
 ;;> view's) to play the run that \var{trace} holds.
 (define (run-replay web trace port)
-  (if (not (file-exists? trace)) (error "no such trace" trace))
+  (if (not (file-exists? trace)) (error (string-append "no such trace " trace)))
   (let ((header (trace-header trace)))
     (if (not (and (list? header) (equal? (assq 'kind header) '(kind . "lab"))))
         (error (string-append "not a trace of the view: " trace " (a trace's first"

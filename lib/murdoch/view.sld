@@ -8,7 +8,10 @@
           lab-header default-trace view-snapshot new-view-state make-task-table
           task-table-update!
           task-table->json reservation-task json-text box-seen)
-  (import (only (murdoch code) make-logged-thread) (only (murdoch task) task-key-parts)
+  (import (only (murdoch code) make-logged-thread) (only (murdoch wire) error-message)
+          (only (murdoch task) task-key-parts)
+          (only (murdoch status) report-since report-pose report-battery report-held
+                report-tasks report-goal report-ended)
           (scheme base) (scheme write)
           (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)
           (chibi net) (chibi net http-server) (chibi net servlet)

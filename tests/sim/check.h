@@ -10,7 +10,8 @@ static int check_passed, check_failed;
 #define CHECK(name, cond) do { \
         if (cond) { check_passed++; } \
         else { check_failed++; \
-               fprintf(stderr, "FAIL %s (%s:%d): %s\n", name, __FILE__, __LINE__, #cond); } \
+               fprintf(stderr, "FAIL %s (%s:%d): %s\n", \
+                       name, __FILE__, __LINE__, #cond); } \
     } while (0)
 
 static int check_summary(void)

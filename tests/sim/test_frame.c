@@ -55,7 +55,8 @@ static void test_each_special_byte(void)
     for (i = 0; i < 3; i++) {
         unsigned char enc[8];
         size_t n = frame_encode(&special[i], 1, enc);
-        CHECK("special byte stuffed as DLE x^0x40", n == 4 && memcmp(enc, want[i], 4) == 0);
+        CHECK("special byte stuffed as DLE x^0x40",
+              n == 4 && memcmp(enc, want[i], 4) == 0);
     }
 }
 
@@ -128,7 +129,8 @@ static void test_errors(void)
 
     frame_init(&p, buf, sizeof buf);
     k = run_str(&p, "\00212345678\003", evs);
-    CHECK("frame of exactly the limit accepted", k == 1 && evs[0] == FRAME_OK && p.len == 8);
+    CHECK("frame of exactly the limit accepted",
+          k == 1 && evs[0] == FRAME_OK && p.len == 8);
 
     frame_init(&p, buf, sizeof buf);
     k = run_str(&p, "\002\003", evs);

@@ -33,7 +33,8 @@ typedef struct {
 
 static int dial(conn *c, int robot)
 {
-    struct sockaddr_in sa = { .sin_family = AF_INET, .sin_port = htons(port_base + 100 + robot) };
+    struct sockaddr_in sa = { .sin_family = AF_INET,
+                              .sin_port = htons(port_base + 100 + robot) };
     inet_pton(AF_INET, "127.0.0.1", &sa.sin_addr);
     c->fd = socket(AF_INET, SOCK_STREAM, 0);
     frame_init(&c->p, c->buf, sizeof c->buf - 1);
@@ -107,17 +108,21 @@ static void test_basics(void)
         int spaces = 0;
         for (; *r; r++)
             spaces += *r == ' ';
-        CHECK("sonar read gives 16 ranges", starts((char *)c.buf, "6 ok ") && spaces == 17);
+        CHECK("sonar read gives 16 ranges",
+              starts((char *)c.buf, "6 ok ") && spaces == 17);
     }
     CHECK("open speech", strcmp(ask(&c, "7 open speech"), "7 ok") == 0);
     {
         const char say[] = "8 speech say stx\002 etx\003 dle\020 end";
         send_frame(&c, say, sizeof say - 1);
-        CHECK("every special byte survives stuffing in a request", strcmp(next_reply(&c), "8 ok") == 0);
+        CHECK("every special byte survives stuffing in a request",
+              strcmp(next_reply(&c), "8 ok") == 0);
     }
-    CHECK("buttons press needs no open", strcmp(ask(&c, "9 buttons press 2"), "9 ok") == 0);
+    CHECK("buttons press needs no open",
+          strcmp(ask(&c, "9 buttons press 2"), "9 ok") == 0);
     ask(&c, "10 open buttons");
-    CHECK("buttons read shows the press", strcmp(ask(&c, "11 buttons read"), "11 ok 0 0 1 0") == 0);
+    CHECK("buttons read shows the press",
+          strcmp(ask(&c, "11 buttons read"), "11 ok 0 0 1 0") == 0);
     CHECK("and clears it", strcmp(ask(&c, "12 buttons read"), "12 ok 0 0 0 0") == 0);
     ask(&c, "13 open lights");
     CHECK("lights set", strcmp(ask(&c, "14 lights set 1 0 1 1"), "14 ok") == 0);
@@ -153,15 +158,18 @@ static void test_fiducial(void)
     CHECK("fiducial read needs the device open",
           starts(ask(&c, "1 fiducial read"), "1 err not-open open fiducial first"));
     CHECK("open fiducial", strcmp(ask(&c, "2 open fiducial"), "2 ok") == 0);
-    CHECK("fiducial read takes no arguments", starts(ask(&c, "3 fiducial read 1"), "3 err args"));
-    sscanf(ask(&c, "4 fiducial read"), "4 ok %d %d %lf %lf %lf", &n, &id, &range, &bearing, &orientation);
+    CHECK("fiducial read takes no arguments",
+          starts(ask(&c, "3 fiducial read 1"), "3 err args"));
+    sscanf(ask(&c, "4 fiducial read"), "4 ok %d %d %lf %lf %lf",
+           &n, &id, &range, &bearing, &orientation);
     CHECK("fiducial read: the box ahead, its range, bearing and orientation",
           n == 1 && id == 0 && range == 1500 && bearing == 0 && orientation == 0);
     CHECK("no angle is answered as -0.0", strstr((char *)c.buf, "-0.0") == NULL);
     ask(&c, "5 open base");
     ask(&c, "6 base rotate 180");
     CHECK("fiducial test: the robot turns round", fabs(fabs(await_still(&c)) - 180) < 1);
-    CHECK("turned away it sees nothing", strcmp(ask(&c, "8 fiducial read"), "8 ok 0") == 0);
+    CHECK("turned away it sees nothing",
+          strcmp(ask(&c, "8 fiducial read"), "8 ok 0") == 0);
     ask(&c, "9 base rotate -180");
     CHECK("fiducial test: and back", fabs(await_still(&c)) < 1);
     close(c.fd);
@@ -172,25 +180,32 @@ static void test_errors(void)
     conn c;
     char big[3000];
     dial(&c, 0);
-    CHECK("unknown command", strcmp(ask(&c, "1 dance"), "1 err unknown no command or device dance") == 0);
-    CHECK("unknown command of a device", strcmp(ask(&c, "2 base fly"), "2 err unknown base has no command fly") == 0);
+    CHECK("unknown command",
+          strcmp(ask(&c, "1 dance"), "1 err unknown no command or device dance") == 0);
+    CHECK("unknown command of a device",
+          strcmp(ask(&c, "2 base fly"), "2 err unknown base has no command fly") == 0);
     ask(&c, "3 open base");
-    CHECK("unknown base command", starts(ask(&c, "4 base fly"), "4 err unknown base has no command fly"));
+    CHECK("unknown base command",
+          starts(ask(&c, "4 base fly"), "4 err unknown base has no command fly"));
     CHECK("too few arguments", starts(ask(&c, "5 base goto 1"), "5 err args"));
     CHECK("too many arguments", starts(ask(&c, "6 base stop now"), "6 err args"));
-    CHECK("not a number", starts(ask(&c, "7 base rotate left"), "7 err args left is not a number"));
+    CHECK("not a number",
+          starts(ask(&c, "7 base rotate left"), "7 err args left is not a number"));
     CHECK("not finite", starts(ask(&c, "8 base rotate inf"), "8 err args"));
-    CHECK("device not open", starts(ask(&c, "9 ir read"), "9 err not-open open ir first"));
+    CHECK("device not open",
+          starts(ask(&c, "9 ir read"), "9 err not-open open ir first"));
     CHECK("open of no device", starts(ask(&c, "10 open wings"), "10 err unknown"));
     CHECK("no tag", starts(ask(&c, "ping"), "0 err syntax"));
     CHECK("tag 0 is the server's", starts(ask(&c, "0 ping"), "0 err syntax"));
     CHECK("empty frame", starts(ask(&c, ""), "0 err syntax"));
     CHECK("bad button", starts(ask(&c, "11 buttons press 7"), "11 err args"));
     send_raw(&c, "garbage", 7);
-    CHECK("bytes outside a frame", starts(ask(&c, "12 ping"), "0 err framing byte outside"));
+    CHECK("bytes outside a frame",
+          starts(ask(&c, "12 ping"), "0 err framing byte outside"));
     CHECK("and the next frame is fine", strcmp(next_reply(&c), "12 ok pong") == 0);
     send_raw(&c, "\0021 pi\0022 ping\003", 13);
-    CHECK("STX inside a frame", starts(next_reply(&c), "0 err framing frame interrupted"));
+    CHECK("STX inside a frame",
+          starts(next_reply(&c), "0 err framing frame interrupted"));
     CHECK("the frame after it is answered", strcmp(next_reply(&c), "2 ok pong") == 0);
     send_raw(&c, "\0023 \020Zping\003", 10);
     CHECK("bad escape", starts(next_reply(&c), "0 err framing bad escape"));
@@ -236,7 +251,8 @@ static void test_flood(void)
             break;
     }
     dial(&d, 1);
-    CHECK("others are served during a flood", strcmp(ask(&d, "1 ping"), "1 ok pong") == 0);
+    CHECK("others are served during a flood",
+          strcmp(ask(&d, "1 ping"), "1 ok pong") == 0);
     CHECK("a flooding client that never reads is dropped", i < 4096);
     close(c.fd);
     close(d.fd);
@@ -248,7 +264,8 @@ static void test_stall(void)
     dial(&c, 0);
     send_raw(&c, "\0021 pi", 5);
     dial(&d, 0);
-    CHECK("others are served while one stalls", strcmp(ask(&d, "1 ping"), "1 ok pong") == 0);
+    CHECK("others are served while one stalls",
+          strcmp(ask(&d, "1 ping"), "1 ok pong") == 0);
     CHECK("a stalled frame gets its error", starts(next_reply(&c), "0 err stalled"));
     CHECK("and the connection is closed", closed(&c));
     close(c.fd);
@@ -262,9 +279,11 @@ static void test_exclusion(void)
     dial(&b, 0);
     CHECK("first client opens base", strcmp(ask(&a, "1 open base"), "1 ok") == 0);
     CHECK("second is refused, naming the device",
-          strcmp(ask(&b, "1 open base"), "1 err held base is held by another client") == 0);
+          strcmp(ask(&b, "1 open base"),
+                 "1 err held base is held by another client") == 0);
     CHECK("second may open another device", strcmp(ask(&b, "2 open sonar"), "2 ok") == 0);
-    CHECK("first may not have sonar now", starts(ask(&a, "2 open sonar"), "2 err held sonar"));
+    CHECK("first may not have sonar now",
+          starts(ask(&a, "2 open sonar"), "2 err held sonar"));
     CHECK("close releases", strcmp(ask(&a, "3 close base"), "3 ok") == 0);
     CHECK("then the second gets it", strcmp(ask(&b, "3 open base"), "3 ok") == 0);
     close(a.fd);
@@ -273,7 +292,8 @@ static void test_exclusion(void)
         conn e;
         int k, ok = 0;
         dial(&e, 1);
-        CHECK("ernst's base is a different lock", strcmp(ask(&e, "1 open base"), "1 ok") == 0);
+        CHECK("ernst's base is a different lock",
+              strcmp(ask(&e, "1 open base"), "1 ok") == 0);
         close(e.fd);
         /* b's locks go when its connection does */
         dial(&e, 0);
@@ -377,9 +397,11 @@ static void test_motion(void)
         int tv, st;
         double rv;
         usleep(20000);
-        sscanf(ask(&c, "3 base status"), "3 ok %lf %lf %lf %d %lf %d %d", &x, &y, &h, &tv, &rv, &moving, &st);
+        sscanf(ask(&c, "3 base status"), "3 ok %lf %lf %lf %d %lf %d %d",
+               &x, &y, &h, &tv, &rv, &moving, &st);
     }
-    CHECK("goto over trip arrives within 2 cm", (x - 500) * (x - 500) + (y + 300) * (y + 300) < 400);
+    CHECK("goto over trip arrives within 2 cm",
+          (x - 500) * (x - 500) + (y + 300) * (y + 300) < 400);
     close(c.fd);
 }
 
@@ -392,7 +414,8 @@ static void send_frames(conn *c, const char *const *payloads, int n)
     size_t len = 0;
     int i;
     for (i = 0; i < n; i++)
-        len += frame_encode((const unsigned char *)payloads[i], strlen(payloads[i]), out + len);
+        len += frame_encode((const unsigned char *)payloads[i], strlen(payloads[i]),
+                            out + len);
     send_raw(c, out, len);
 }
 
@@ -400,8 +423,10 @@ static void send_frames(conn *c, const char *const *payloads, int n)
  * with other requests answered meanwhile. */
 static void test_await(void)
 {
-    static const char *const turn[] = { "3 base rotate 90", "4 base await", "5 base reckon" };
-    static const char *const spin[] = { "7 base rotate 3600", "8 base await", "9 base stop" };
+    static const char *const turn[] = {
+        "3 base rotate 90", "4 base await", "5 base reckon" };
+    static const char *const spin[] = {
+        "7 base rotate 3600", "8 base await", "9 base stop" };
     conn c;
     char reply[256];
     double x, y, h, h0 = 0;
@@ -411,16 +436,19 @@ static void test_await(void)
     dial(&c, 0);
     ask(&c, "1 open base");
     CHECK("await on an idle base answers at once",
-          sscanf(ask(&c, "2 base await"), "2 ok %lf %lf %lf %d", &x, &y, &h0, &stalled) == 4 && stalled == 0);
+          sscanf(ask(&c, "2 base await"), "2 ok %lf %lf %lf %d",
+                 &x, &y, &h0, &stalled) == 4 && stalled == 0);
     send_frames(&c, turn, 3);
     CHECK("a motion is accepted", strcmp(next_reply(&c), "3 ok") == 0);
     CHECK("a request after an await is answered before the motion ends",
           starts(next_reply(&c), "5 ok "));
     snprintf(reply, sizeof reply, "%s", next_reply(&c));
-    CHECK("the await is answered once it has", sscanf(reply, "4 ok %lf %lf %lf %d", &x, &y, &h, &stalled) == 4
+    CHECK("the await is answered once it has",
+          sscanf(reply, "4 ok %lf %lf %lf %d", &x, &y, &h, &stalled) == 4
           && stalled == 0 && fabs(remainder(h - h0 - 90, 360)) < 1);
     CHECK("and the base is idle then",
-          sscanf(ask(&c, "6 base status"), "6 ok %*f %*f %*f %*f %*f %d", &moving) == 1 && moving == 0);
+          sscanf(ask(&c, "6 base status"), "6 ok %*f %*f %*f %*f %*f %d", &moving) == 1
+          && moving == 0);
     send_frames(&c, spin, 3);
     CHECK("a stop ends the motion an await waits for", strcmp(next_reply(&c), "7 ok") == 0
           && strcmp(next_reply(&c), "9 ok") == 0 && starts(next_reply(&c), "8 ok "));
@@ -523,7 +551,8 @@ int main(int argc, char **argv)
             snprintf(pb, sizeof pb, "%d", port_base);
             dup2(ready[1], 1);
             prctl(PR_SET_PDEATHSIG, SIGTERM);   /* no stray server if we crash */
-            execl(argv[1], argv[1], lab, "--port-base", pb, "--trace", trace, "--lock-dir", locks, (char *)NULL);
+            execl(argv[1], argv[1], lab, "--port-base", pb, "--trace", trace,
+                  "--lock-dir", locks, (char *)NULL);
             _exit(127);
         }
         close(ready[1]);
@@ -545,12 +574,14 @@ int main(int argc, char **argv)
         test_heading_range();
         kill(server, SIGTERM);
         waitpid(server, &status, 0);
-        CHECK("SIGTERM ends the server with status 0", WIFEXITED(status) && WEXITSTATUS(status) == 0);
+        CHECK("SIGTERM ends the server with status 0",
+              WIFEXITED(status) && WEXITSTATUS(status) == 0);
         {
             struct stat st;
             char tmp[520];
             snprintf(tmp, sizeof tmp, "%s.tmp", trace);
-            CHECK("the trace is written whole", stat(trace, &st) == 0 && st.st_size > 1000 && stat(tmp, &st) < 0);
+            CHECK("the trace is written whole",
+                  stat(trace, &st) == 0 && st.st_size > 1000 && stat(tmp, &st) < 0);
         }
         fclose(out);
     }

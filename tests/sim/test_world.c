@@ -51,7 +51,8 @@ static void test_goto(void)
     lab l = room();
     int r = add(&l, "a", -1000, -500, 30);
     world *w = world_new(&l);
-    static const double targets[][3] = { { 300, 200, 0 }, { -1000, 200, 90 }, { 1500, -2000, -135 } };
+    static const double targets[][3] = {
+        { 300, 200, 0 }, { -1000, 200, 90 }, { 1500, -2000, -135 } };
     size_t k;
     for (k = 0; k < 3; k++) {
         pose p;
@@ -86,7 +87,8 @@ static void test_odometry_frame(void)
     p = robot_reckon(w, r);
     CHECK("goto is in the odometry frame", hypot(p.x - 1000, p.y) < 20);
     CHECK("true pose moved along the old heading",
-          hypot(w->robots[r].at.x - (500 + 1000 * M_SQRT1_2), w->robots[r].at.y - (500 + 1000 * M_SQRT1_2)) < 20);
+          hypot(w->robots[r].at.x - (500 + 1000 * M_SQRT1_2),
+                w->robots[r].at.y - (500 + 1000 * M_SQRT1_2)) < 20);
     world_free(w);
     lab_free(&l);
 }
@@ -172,7 +174,8 @@ static void test_steer_box(void)
     CHECK("a push at the middle of a face drives the box straight",
           fabs(box_turned_by_push(0)) < 2);
     CHECK("a push at its left corner turns it clockwise", box_turned_by_push(200) < -5);
-    CHECK("a push at its right corner turns it counter-clockwise", box_turned_by_push(-200) > 5);
+    CHECK("a push at its right corner turns it counter-clockwise",
+          box_turned_by_push(-200) > 5);
 }
 
 /* The stall rule against a pushed box: a base is blocked only when it
@@ -196,7 +199,8 @@ static void test_push_box_stall(void)
         world_step(w);
         stalled |= w->robots[0].m.stalled || w->robots[1].m.stalled;
     }
-    CHECK("two pushers drive a box at their speed", fabs(physics_box_pose(w->phys, 0).x - 1000) < 50);
+    CHECK("two pushers drive a box at their speed",
+          fabs(physics_box_pose(w->phys, 0).x - 1000) < 50);
     CHECK("and neither stalls", !stalled);
     world_free(w);
     lab_free(&l);
@@ -267,8 +271,10 @@ static void test_fiducials(void)
     n = look(&l, 20, f, FIDUCIALS);
     CHECK("a box in view is seen, by its index", n == 1 && f[0].id == 0);
     CHECK("its range, centre to centre, in mm", n == 1 && fabs(f[0].range - 1414.2) < 2);
-    CHECK("its bearing from the robot's heading", n == 1 && fabs(f[0].bearing - 25) < 0.5);
-    CHECK("its heading relative to the robot's", n == 1 && fabs(f[0].orientation - 10) < 0.5);
+    CHECK("its bearing from the robot's heading",
+          n == 1 && fabs(f[0].bearing - 25) < 0.5);
+    CHECK("its heading relative to the robot's",
+          n == 1 && fabs(f[0].orientation - 10) < 0.5);
 
     l = open_room();
     put_box(&l, -1500, 0, 400, 400, 0);
@@ -276,7 +282,8 @@ static void test_fiducials(void)
     l = open_room();
     put_box(&l, -1500, 0, 400, 400, 0);
     n = look(&l, 180, f, FIDUCIALS);
-    CHECK("turned round, the robot sees it dead ahead", n == 1 && fabs(f[0].range - 1500) < 2
+    CHECK("turned round, the robot sees it dead ahead",
+          n == 1 && fabs(f[0].range - 1500) < 2
           && fabs(f[0].bearing) < 0.5 && fabs(fabs(f[0].orientation) - 180) < 0.5);
 
     l = open_room();
@@ -288,7 +295,8 @@ static void test_fiducials(void)
     l = open_room();
     put_box(&l, -347.3, 1969.6, 400, 400, 0);
     l.b14.fiducial_fov = 240;
-    CHECK("a wider field of view (b14 fiducial-fov) takes it in", look(&l, 0, f, FIDUCIALS) == 1);
+    CHECK("a wider field of view (b14 fiducial-fov) takes it in",
+          look(&l, 0, f, FIDUCIALS) == 1);
 
     l = open_room();
     put_box(&l, 4900, 0, 400, 400, 0);
@@ -299,7 +307,8 @@ static void test_fiducials(void)
     l = open_room();
     put_box(&l, 4900, 0, 400, 400, 0);
     l.b14.fiducial_range = 4000;
-    CHECK("a shorter range (b14 fiducial-range) leaves it out", look(&l, 0, f, FIDUCIALS) == 0);
+    CHECK("a shorter range (b14 fiducial-range) leaves it out",
+          look(&l, 0, f, FIDUCIALS) == 0);
 
     l = open_room();
     put_box(&l, 3000, 0, 600, 600, 0);
@@ -352,7 +361,8 @@ static void test_stall(void)
     world *w = world_new(&l);
     robot_translate(w, r, 2000);
     settle(w, r, 30);
-    CHECK("driving into a wall stalls and ends the motion", idle(w, r) && w->robots[r].m.stalled);
+    CHECK("driving into a wall stalls and ends the motion",
+          idle(w, r) && w->robots[r].m.stalled);
     world_free(w);
     lab_free(&l);
 }
@@ -397,7 +407,8 @@ static void test_deterministic(void)
         if (k == 0)
             memcpy(first, w->robots[r].sonar, sizeof first);
         else
-            CHECK("same seed, same sonar readings", memcmp(first, w->robots[r].sonar, sizeof first) == 0);
+            CHECK("same seed, same sonar readings",
+                  memcmp(first, w->robots[r].sonar, sizeof first) == 0);
         at[k] = w->robots[r].at;
         world_free(w);
         lab_free(&l);
@@ -419,7 +430,8 @@ static void test_against_box2d(void)
             lab_add_box(&l, &b);
         }
         for (i = 0; i < 40; i++)
-            add(&l, "r", -2600 + 650 * (i % 9), -2600 + 1250 * (i / 9) + 120 * (i % 2), 37 * i);
+            add(&l, "r", -2600 + 650 * (i % 9), -2600 + 1250 * (i / 9) + 120 * (i % 2),
+                37 * i);
         l.b14.sonar_noise = 0;
         w = world_new(&l);
         w->plain = pass;

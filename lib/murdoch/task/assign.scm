@@ -20,12 +20,11 @@
            (let ((assignment (hungarian (finite-costs costs) n m)))
              (and (allowed? costs assignment) assignment))))))
 
-;; The costs, inexact, with each +inf.0 made the dominant cost, so that
-;; the method's arithmetic stays finite and an assignment with fewer of
-;; them always costs less.  Chibi compares two flonums as an opcode, an
-;; exact number with a flonum by a slow path that took longer than the
-;; method.  Each row gains a column 0, never read, so that the method
-;; indexes it as it counts, from 1.
+;; The costs, inexact (flonums compare fast: docs/speed.md), with each
+;; +inf.0 made the dominant cost, so that the method's arithmetic stays
+;; finite and an assignment with fewer of them always costs less.  Each
+;; row gains a column 0, never read, so that the method indexes it as it
+;; counts, from 1.
 (define (finite-costs costs)
   (let ((forbidden (inexact (dominant-cost costs))))
     (vector-map (lambda (row)
@@ -87,9 +86,7 @@
       (let* ((i0 (vector-ref p j0))
              (row (vector-ref a (- i0 1)))
              (ui0 (vector-ref u i0)))
-        ;; The loop of the method's O(n^2 m).  No let here: in Chibi each
-        ;; is a call, and the loop ran faster computing a reduced cost
-        ;; twice when it improves than binding it once.
+        ;; The loop of the method's O(n^2 m), without let (docs/speed.md).
         (let scan ((j 1) (delta +inf.0) (j1 0))
           (cond
            ((> j m)

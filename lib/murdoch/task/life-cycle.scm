@@ -24,7 +24,7 @@
 ;;     so frees its reservation: no orphans.  The same rule stops the
 ;;     component of a robot cut off from its poser at least one full
 ;;     period before the poser can declare it lost and start the component
-;;     elsewhere: no ghosts (component.scm gives the margin).
+;;     elsewhere: no ghosts (running.scm gives the margin).
 ;;  5. cancel-task stops every component on its robot so, at once, and
 ;;     what is still being negotiated is freed when the negotiation ends.
 ;;
@@ -62,6 +62,7 @@
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
+;; Global, as *waiters* and the offers' below: peers' calls find them by name.
 (define *posed* '())                    ; the tasks started here, newest first
 (define *tasks-lock* (make-mutex 'tasks))
 
@@ -153,20 +154,20 @@
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      ((eq? (task-state t) 'cancelled)
-      (for-each (lambda (winner type) (free-winner! winner type)) (car team) (cadr team))
+      (for-each free-winner! (negotiated-winners team) (negotiated-types team))
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
-      (task-team-set! t (map car (car team)))
+      (task-team-set! t (map winner-uid (negotiated-winners team)))
       (for-each thread-join!
                 (map (lambda (c winner type)
                        (thread-start!
                         (make-logged-thread (inheriting
                                              (lambda ()
-                                               (supervise t c (car winner)
+                                               (supervise t c (winner-uid winner)
                                                           (work-for winner type c)))))))
-                     cs (car team) (cadr team)))
+                     cs (negotiated-winners team) (negotiated-types team)))
       (finish! t (map component-result cs))))))
 
 (define (finish! t results)
@@ -178,12 +179,12 @@
 ;; exclusive component.
 (define (work-for winner type c)
   (if (eq? type 'exclusive)
-      (list (cadr winner) #t)
+      (list (winner-promise winner) #t)
       (list (component-proc c))))
 
 (define (free-winner! winner type)
   (if (eq? type 'exclusive)
-      (guard (e (#t #f)) ((cadr winner) #f))))
+      (guard (e (#t #f)) ((winner-promise winner) #f))))
 
 ;; Runs component c on uid, and again elsewhere while its robot is lost
 ;; and it may be restarted.
@@ -244,7 +245,9 @@
                               (list (component-metric c))
                               (list (component-proc c)))))))
       (and (pair? team)
-           (cons (car (caar team)) (work-for (caar team) (caadr team) c))))))
+           (let ((winner (car (negotiated-winners team))))
+             (cons (winner-uid winner)
+                   (work-for winner (car (negotiated-types team)) c)))))))
 
 ;; One run of c on uid, watched by heartbeats: (done VALUE), (failed WHY)
 ;; or (lost WHY).
@@ -297,8 +300,7 @@
           (list 'lost (cadr what))
           (list 'done what)))
      ((remote-unreachable-error? what) (list 'lost (remote-error-message what)))
-     ((remote-error? what) (list 'failed (remote-error-message what)))
-     (else (list 'failed (error-message what))))))
+     (else (list 'failed (error-why what))))))
 
 ;; A component's result, as pose-task gives it: its value, or (error UID
 ;; WHY) with the last robot it had.
@@ -519,7 +521,7 @@
   (hold? turn-hold?)
   (priority turn-priority)
   (deadline turn-deadline)              ; monotonic-seconds, or #f
-  (posed turn-posed))                   ; current-second
+  (posed turn-posed))                   ; utc-seconds
 
 ;; A turn from start-task's keywords and their values.
 (define (read-turn who options)
@@ -537,7 +539,7 @@
     (cond
      ((null? kv)
       (make-turn (or wait hold) hold priority
-                 (and deadline (+ (monotonic-seconds) deadline)) (current-second)))
+                 (and deadline (+ (monotonic-seconds) deadline)) (utc-seconds)))
      ((not (and (symbol? (car kv)) (pair? (cdr kv))))
       (bad (string-append "after the lists come keywords, each with its value: "
                           "wait, hold, priority, deadline")))
@@ -723,32 +725,38 @@
                                     (list (component-metric c))
                                     (list (component-proc c))))))
              (if (pair? team)
-                 (waiter-held-set! w (cons (list (component-index c) (caar team)
-                                                 (caadr team))
+                 (waiter-held-set! w (cons (list (component-index c)
+                                                 (car (negotiated-winners team))
+                                                 (car (negotiated-types team)))
                                            (waiter-held w)))))))
      (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
       (cond ((every pair? held)
              (waiter-held-set! w '())
-             (list (map cadr held) (map (lambda (h) (car (cddr h))) held)))
+             (list (map held-winner held) (map held-type held)))
             (else 'not-enough-takers)))))
 
-(define (held-uids w) (map (lambda (h) (car (cadr h))) (waiter-held w)))
+;; What w holds of a component, (INDEX WINNER TYPE), read by name.
+(define (held-winner h) (cadr h))
+(define (held-type h) (car (cddr h)))
+(define (held-uid h) (winner-uid (held-winner h)))
+
+(define (held-uids w) (map held-uid (waiter-held w)))
 
 ;; Frees what w holds on robot uid, or on every robot.
 (define (let-go-held! w . uid)
-  (let ((out (filter (lambda (h) (or (null? uid) (eq? (car (cadr h)) (car uid))))
+  (let ((out (filter (lambda (h) (or (null? uid) (eq? (held-uid h) (car uid))))
                      (waiter-held w))))
-    (for-each (lambda (h) (free-winner! (cadr h) (car (cddr h)))) out)
+    (for-each (lambda (h) (free-winner! (held-winner h) (held-type h))) out)
     (waiter-held-set! w (remove (lambda (h) (memq h out)) (waiter-held w)))))
 
 ;; Holds what w holds for another lease.
 (define (keep-held! w)
   (waiter-kept-set! w (monotonic-seconds))
   (for-each (lambda (h)
-              (if (eq? (car (cddr h)) 'exclusive)
-                  (if (not (guard (e (#t #f)) ((cadr (cadr h)) 'keep)))
-                      (let-go-held! w (car (cadr h))))))
+              (if (eq? (held-type h) 'exclusive)
+                  (if (not (guard (e (#t #f)) ((winner-promise (held-winner h)) 'keep)))
+                      (let-go-held! w (held-uid h)))))
             (waiter-held w)))
 
 ;; Acts on the news: gives way on each robot a better-ranked task asked

@@ -7,10 +7,10 @@
   (export start-task task? task-id task-name task-status task-wait cancel-task
           tasks task-step start-steps pose-steps
           waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
-  (import (scheme base) (scheme char) (scheme cxr) (scheme time) (srfi 1) (srfi 18)
+  (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
           (srfi 132) (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
           (murdoch wire) (murdoch lab) (murdoch remote) (murdoch task progress)
-          (murdoch task team) (murdoch task pose-task) (murdoch task component)
+          (murdoch task team) (murdoch task pose-task) (murdoch task running)
           (only (murdoch pubsub) subscribe unsubscribe publish request
                 capability-layout subscription-statuses on-free! offer-subjects!)
           (only (murdoch task takers) explain-components))

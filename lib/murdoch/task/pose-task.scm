@@ -36,7 +36,7 @@
 (define pose-task-backoff (make-parameter 0.1))
 
 ;;> Robots that pose-task gives no component to: a task that lost a
-;;> robot renegotiates without it (task.scm).
+;;> robot renegotiates without it (life-cycle.scm).
 (define pose-task-excluded (make-parameter '()))
 
 (for-each sandbox-parameter!
@@ -50,6 +50,7 @@
 ;; The poses made here, counted, and those negotiating, each as
 ;; (name rank rival-rank ...): the ranks of the other tasks that said
 ;; they want robots it holds.  Threads and received calls pose at once.
+;; Global: a rival's call (receive-rival) finds them by name.
 (define *poses* 0)
 (define *negotiating* '())
 (define *poses-lock* (make-mutex 'poses))
@@ -99,15 +100,18 @@
                      procs priorities)))
     (if (symbol? team)
         team
-        (let ((uids (map car (car team))))
+        (let ((uids (map winner-uid (negotiated-winners team))))
           (for-each (lambda (i uid) (progress "  component " i " starts on " uid))
                     (iota (length uids) 1) uids)
-          (let ((results ((with-team-proc-maker (car team) (cadr team) procs
-                                                (posed-component (car (cddr team)))))))
+          (let ((results ((with-team-proc-maker (negotiated-winners team)
+                                                (negotiated-types team) procs
+                                                (posed-component
+                                                 (negotiated-name team))))))
             ;; Applied promises are of no more use here.
             (for-each (lambda (winner type)
-                        (if (eq? type 'exclusive) (release-proxy! (cadr winner))))
-                      (car team) (cadr team))
+                        (if (eq? type 'exclusive)
+                            (release-proxy! (winner-promise winner))))
+                      (negotiated-winners team) (negotiated-types team))
             (for-each (lambda (i uid result)
                         (progress "  component " i " done on " uid ": "
                                   (abridged result 50)))
@@ -140,6 +144,15 @@
                             procs priorities)))
       (progress task-name ": " (length procs) " components")
       (while-negotiating name (lambda () (negotiate-by-tries task 1))))))
+
+;;> The parts of negotiate's answer, (WINNERS TYPES NAME), by name: its
+;;> winners and their types, in component order, the reservation's name,
+;;> and a winner's uid and promise (#t for a non-exclusive component).
+(define (negotiated-winners answer) (car answer))
+(define (negotiated-types answer) (cadr answer))
+(define (negotiated-name answer) (car (cddr answer)))
+(define (winner-uid winner) (car winner))
+(define (winner-promise winner) (cadr winner))
 
 ;; A task being negotiated, as negotiate has checked it.
 (define-record-type pose

@@ -4,7 +4,8 @@
 ;;> new-task.scm had them.
 
 (define-library (murdoch task pose-task)
-  (export pose-task negotiate check-task pose-task-progress task-timeout
+  (export pose-task negotiate negotiated-winners negotiated-types negotiated-name
+          winner-uid winner-promise check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
           pose-task-backoff pose-task-excluded receive-rival pose-negotiations
           reservation-aspace-uid task-key task-key-parts
@@ -21,5 +22,5 @@
           (only (chibi process) current-process-id) (murdoch sys) (murdoch code)
           (murdoch remote) (murdoch pubsub) (murdoch task assign)
           (murdoch task progress) (murdoch task metric) (murdoch task takers)
-          (murdoch task team) (only (murdoch task component) run-posed-component))
+          (murdoch task team) (only (murdoch task running) run-posed-component))
   (include "pose-task.scm"))

@@ -5,8 +5,9 @@
   (export with-team on-list current-team with-team-proc-maker exec-on
           task-timeout t sort-list make-maxrandom
           with-coordinator team-barrier team-send! team-receive step-team
-          make-coordinator)
+          make-coordinator error-why)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
-          (murdoch remote) (murdoch task progress) (murdoch task metric))
+          (only (murdoch wire) error-message) (murdoch remote) (murdoch task progress)
+          (murdoch task metric))
   (include "team.scm"))

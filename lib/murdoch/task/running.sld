@@ -2,13 +2,13 @@
 ;;> task's component here and stops it when its poser falls silent;
 ;;> component-heartbeat! and stop-component! are what the poser calls, and
 ;;> lost-periods how many silent heartbeat periods it waits before it
-;;> declares a robot lost (component.scm says why).  run-posed-component
+;;> declares a robot lost (running.scm says why).  run-posed-component
 ;;> runs a component of pose-task's; components-running and
 ;;> components-ended list them all, for the status and the live view.
 
-(define-library (murdoch task component)
+(define-library (murdoch task running)
   (export run-component run-posed-component component-heartbeat! stop-component!
           components-running components-ended lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
           (murdoch robot) (only (murdoch remote) hand-over-connection!))
-  (include "component.scm"))
+  (include "running.scm"))

@@ -1,4 +1,4 @@
-;;;; The robot's side of the task life cycle (task.scm): the components
+;;;; The robot's side of the task life cycle (life-cycle.scm): the components
 ;;;; of started tasks that run here, each watched for its poser's
 ;;;; heartbeats; and pose-task's components, which have no heartbeats.
 ;;;; Each is listed while it runs, and remembered for a while once it has
@@ -18,6 +18,7 @@
   (heard running-heard running-heard-set!)    ; monotonic-seconds
   (over? running-over? running-over?-set!))
 
+;; Global: the poser's calls (component-heartbeat! ...) find them by name.
 (define *running* '())
 (define *running-lock* (make-mutex 'running))
 
@@ -83,7 +84,7 @@
 ;; poser has been silent for orphan-periods heartbeat periods, looked at
 ;; every quarter period, so by 2.25 periods after the last heartbeat the
 ;; robot heard; its poser declares the robot lost only when no heartbeat
-;; was answered for lost-periods (task.scm), and the robot heard that
+;; was answered for lost-periods (life-cycle.scm), and the robot heard that
 ;; heartbeat before its answer reached the poser.  The stale copy has
 ;; stopped 1.75 periods before the poser can start another: one full
 ;; period, and more, for a loaded robot that is late to look.
