@@ -16,45 +16,45 @@
          (robots (filter-map robot-place clauses)))
     (let loop ((robots robots) (before '()))
       (when (pair? robots)
-        (let ((r (car robots)))
-          (if (outside? (cdr r) walls)
+        (let* ((r (car robots)) (at (place-point r)))
+          (if (outside? at walls)
               (room-error path r "outside the walls of the room" ""))
           (for-each (lambda (w)
-                      (if (< (wall-distance (cadr r) (car (cddr r)) w)
-                             (+ radius (/ (wall-thickness w) 2)))
+                      (if (< (wall-distance at w) (+ radius (/ (wall-thickness w) 2)))
                           (room-error path r "inside or against " w)))
                     walls)
           (for-each (lambda (b)
-                      (if (< (box-distance (cadr r) (car (cddr r)) b) radius)
+                      (if (< (box-distance at b) radius)
                           (room-error path r "on " b)))
                     boxes)
           (for-each (lambda (other)
-                      (if (< (distance (cdr r) (cdr other)) (* 2 radius))
+                      (if (< (distance at (place-point other)) (* 2 radius))
                           (room-error path r "on the robot "
-                                      (string-append (symbol->string (cadr (car other)))
-                                                     (line-words (car other))))))
+                                      (string-append
+                                       (symbol->string (place-uid other))
+                                       (line-words (place-aspace other))))))
                     before)
           (loop (cdr robots) (cons r before)))))))
 
-;; Whether (x y) is outside the bounding box of walls that enclose it: a
-;; wall along each of its four sides.
-(define (outside? p walls)
+;; Whether point is outside the bounding box of walls that enclose it:
+;; a wall along each of its four sides.
+(define (outside? point walls)
   (and (pair? walls)
-       (let* ((xs (append-map (lambda (w) (list (list-ref w 1) (list-ref w 3))) walls))
-              (ys (append-map (lambda (w) (list (list-ref w 2) (list-ref w 4))) walls))
+       (let* ((ends (append (map wall-from walls) (map wall-to walls)))
+              (xs (map car ends)) (ys (map cadr ends))
               (x0 (apply min xs)) (x1 (apply max xs))
               (y0 (apply min ys)) (y1 (apply max ys)))
-         (define (side? at x-or-y)
-           (any (lambda (w) (and (= (list-ref w x-or-y) at)
-                                 (= (list-ref w (+ x-or-y 2)) at)))
+         ;; A wall whose two ends have coordinate at, x (car) or y (cadr).
+         (define (side? at coordinate)
+           (any (lambda (w) (= at (coordinate (wall-from w)) (coordinate (wall-to w))))
                 walls))
-         (and (side? x0 1) (side? x1 1) (side? y0 2) (side? y1 2)
-              (not (and (<= x0 (car p) x1) (<= y0 (cadr p) y1)))))))
+         (and (side? x0 car) (side? x1 car) (side? y0 cadr) (side? y1 cadr)
+              (not (and (<= x0 (car point) x1) (<= y0 (cadr point) y1)))))))
 
 (define (room-error path r where thing)
-  (let ((aspace (car r)))
+  (let ((aspace (place-aspace r)))
     (lab-file-error path aspace
-                    (string-append "the robot " (symbol->string (cadr aspace))
+                    (string-append "the robot " (symbol->string (place-uid r))
                                    " stands " where
                                    (if (string? thing)
                                        thing
@@ -75,7 +75,16 @@
            => cadr)
           (else default-robot-radius))))
 
-;; (ASPACE-CLAUSE X Y) of an address space with a robot at a pose, or #f.
+;; Where the robot of an address space clause stands: its pose's point.
+(define-record-type place
+  (make-place aspace point)
+  place?
+  (aspace place-aspace)
+  (point place-point))
+
+(define (place-uid p) (cadr (place-aspace p)))
+
+;; The place of an address space with a robot at a pose, or #f.
 (define (robot-place c)
   (and (pair? c) (eq? (car c) 'aspace) (list? c) (pair? (cdr c))
        (let* ((robot (clause 'robot (cddr c)))
@@ -84,30 +93,41 @@
                                (cdr robot)))))
          (and pose (list? pose) (>= (length pose) 3)
               (real? (cadr pose)) (real? (car (cddr pose)))
-              (list c (cadr pose) (car (cddr pose)))))))
+              (make-place c (list (cadr pose) (car (cddr pose))))))))
 
+;; The fields of the world's clauses (wall X1 Y1 X2 Y2 [THICK]) and
+;; (box X Y W D HEADING [MASS]), by name.
+(define (wall-from w) (list (list-ref w 1) (list-ref w 2)))
+(define (wall-to w) (list (list-ref w 3) (list-ref w 4)))
 (define (wall-thickness w)
   (if (> (length w) 5) (list-ref w 5) default-wall-thickness))
+(define (box-centre b) (list (list-ref b 1) (list-ref b 2)))
+(define (box-width b) (list-ref b 3))
+(define (box-depth b) (list-ref b 4))
+(define (box-heading b) (list-ref b 5))
 
 (define (distance p q)
   (sqrt (+ (square (- (car p) (car q))) (square (- (cadr p) (cadr q))))))
 
-;; From (x y) to the wall's centre line.
-(define (wall-distance x y w)
-  (let* ((x1 (list-ref w 1)) (y1 (list-ref w 2)) (x2 (list-ref w 3)) (y2 (list-ref w 4))
-         (dx (- x2 x1)) (dy (- y2 y1))
+;; From point to the wall's centre line.
+(define (wall-distance point w)
+  (let* ((from (wall-from w)) (to (wall-to w))
+         (dx (- (car to) (car from))) (dy (- (cadr to) (cadr from)))
          (len2 (+ (square dx) (square dy)))
-         (t (if (zero? len2) 0
-                (max 0 (min 1 (/ (+ (* (- x x1) dx) (* (- y y1) dy)) len2))))))
-    (distance (list x y) (list (+ x1 (* t dx)) (+ y1 (* t dy))))))
+         (t (if (zero? len2)
+                0
+                (max 0 (min 1 (/ (+ (* (- (car point) (car from)) dx)
+                                    (* (- (cadr point) (cadr from)) dy))
+                                 len2))))))
+    (distance point (list (+ (car from) (* t dx)) (+ (cadr from) (* t dy))))))
 
-;; From (x y) to the nearest point of the box: 0 inside it.
-(define (box-distance x y b)
-  (let* ((cx (list-ref b 1)) (cy (list-ref b 2))
-         (hw (/ (list-ref b 3) 2)) (hd (list-ref b 4))
-         (a (* (list-ref b 5) (/ (acos -1) 180)))
-         ;; (x y) in the box's frame
-         (u (+ (* (- x cx) (cos a)) (* (- y cy) (sin a))))
-         (v (- (* (- y cy) (cos a)) (* (- x cx) (sin a)))))
-    (distance (list u v) (list (max (- hw) (min hw u))
-                               (max (- (/ hd 2)) (min (/ hd 2) v))))))
+;; From point to the nearest point of the box: 0 inside it.
+(define (box-distance point b)
+  (let* ((x (- (car point) (car (box-centre b))))
+         (y (- (cadr point) (cadr (box-centre b))))
+         (hw (/ (box-width b) 2)) (hd (/ (box-depth b) 2))
+         (a (* (box-heading b) (/ (acos -1) 180)))
+         ;; point in the box's frame
+         (u (+ (* x (cos a)) (* y (sin a))))
+         (v (- (* y (cos a)) (* x (sin a)))))
+    (distance (list u v) (list (max (- hw) (min hw u)) (max (- hd) (min hd v))))))
