@@ -232,11 +232,16 @@
                   (thread-sleep! 0.1)
                   (loop (or (see-box) box) (+ n 1)))))))
 
-;; Whether this robot stands at its place, against the box's face.
-(define (at-place? box side)
-  (let ((off (offsets-to box (place-axis box) (* side pusher-offset))))
-    (and (< -120 (car off) 30) (< (abs (cadr off)) 70)
-         (< (abs (wrap (- (place-axis box) (list-ref (reckon) 2)))) 20))))
+;; Whether this robot stands at its place, against the box's face; with
+;; was? (it stood there the round before), whether it is still near enough
+;; to push from there: a pusher that has fallen further behind or aside
+;; comes up again as a spare does (approach!), never sideways along the face.
+(define (at-place? box side . was?)
+  (let ((off (offsets-to box (place-axis box) (* side pusher-offset)))
+        (turn (abs (wrap (- (place-axis box) (list-ref (reckon) 2))))))
+    (if (and (pair? was?) (car was?))
+        (and (< -150 (car off) 250) (< (abs (cadr off)) 200) (< turn 35))
+        (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
 ;; What the pusher hears: the round its partner last said it was at the
 ;; face ('here), and the last round it said how far it still had to come
@@ -286,8 +291,7 @@
           (team-send! watcher 'done)
           (error "push: the box did not reach the goal" box))
          ((not box) (stop-base) (loop (latest view) at-face? (+ n 1)))
-         ((or (and at-face? (< (distance (reckon) (place-of box side)) 600))
-              (at-place? box side))
+         ((at-place? box side at-face?)
           (team-send! (partner) 'here)
           (steer! view side)
           (loop (latest view) #t (+ n 1)))
@@ -342,18 +346,11 @@
            bodies)))
 
 ;; Pushes at share of push-speed at the place offset mm left of the middle
-;; of the box's rear face, hurrying when it has fallen behind it.  A pusher
-;; far to the side of that place backs off the face to cross it: one
-;; sliding across a face while it pushes turns the box the wrong way.
+;; of the box's rear face, hurrying when it has fallen behind it.
 (define (push-at! box axis offset share)
-  (let* ((off (offsets-to box axis offset)) (ahead (car off)) (left (cadr off)))
-    (cond ((<= (abs left) 100)
-           (drive-along! axis ahead left
-                         (* push-speed (slowing box) (+ share (clip (/ ahead 100) 0 1)))))
-          ((< ahead 190)                        ; back off straight
-           (set-velocity -150 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
-          (else (drive-to! (behind-at box axis offset
-                                      (+ box-half body-radius face-gap 250)))))))
+  (let ((off (offsets-to box axis offset)))
+    (drive-along! axis (car off) (cadr off)
+                  (* push-speed (slowing box) (+ share (clip (/ (car off) 100) 0 1))))))
 
 
 ;; Sets the velocities that bring the robot, heading along axis, to a
@@ -385,10 +382,10 @@
   (let* ((box (car view)) (axis (place-axis box)) (offset (* side pusher-offset))
          (off (offsets-to box axis offset)) (place (behind-at box axis offset))
          (stage (staging box axis offset (cadr view))))
-    (if (and stage (< (distance (reckon) (car stage)) 150))
+    (if (and stage (or (< (distance (reckon) (car stage)) 150)
+                       (and (eq? (cdr stage) 'behind) (in-corridor? off))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (< -150 (car off) (+ stage-back 200))
-                (< (abs (cadr off)) 400))
+    (cond ((and (eq? docking 'behind) (in-corridor? off))
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
            (if (> (distance (reckon) place) 40)
@@ -399,6 +396,13 @@
            (if (or (not waypoint) (= 0 (modulo n 5)))
                (set! waypoint (and stage (plan-way (car stage) box (cadr view)))))
            (if waypoint (drive-to! waypoint) (stop-base))))))
+
+;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
+;; it along the box's axis: behind it, and the nearer the face the nearer
+;; the place's line, lest it come sideways into the face or its corner.
+(define (in-corridor? off)
+  (and (< -150 (car off) (+ stage-back 200))
+       (< (abs (cadr off)) (+ 80 (* 1/2 (max 0 (car off)))))))
 
 ;; Where to come up to the place offset mm left of the middle from, as
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
@@ -430,7 +434,7 @@
          (blocked (make-vector (* nx ny) #f))
          (cell-of (lambda (p) (+ (exact (round (/ (- (car p) x0) cell)))
                                  (* nx (exact (round (/ (- (cadr p) y0) cell))))))))
-    (define (paint! p r)
+    (define (paint! p r . free)
       (let ((i0 (exact (round (/ (- (car p) x0) cell))))
             (j0 (exact (round (/ (- (cadr p) y0) cell))))
             (k (exact (ceiling (/ r cell)))))
@@ -438,10 +442,13 @@
           (do ((j (- j0 k) (+ j 1))) ((> j (+ j0 k)))
             (if (and (< -1 i nx) (< -1 j ny)
                      (<= (* cell cell (+ (square (- i i0)) (square (- j j0)))) (* r r)))
-                (vector-set! blocked (+ i (* nx j)) #t))))))
+                (vector-set! blocked (+ i (* nx j)) (null? free)))))))
     (paint-box! paint! box)
     (for-each (lambda (b) (paint! b (+ body-radius body-radius))) bodies)
     (for-each (lambda (e) (paint! e (+ body-radius 80))) (echoes me box))
+    ;; A robot hemmed in, by the box's grown edge or a robot beside it, may
+    ;; still step out.
+    (paint! me 150 'free)
     (let ((start (cell-of me)) (end (cell-of goal)))
       (let ((from (breadth-first blocked nx ny end start)))
         (and from
