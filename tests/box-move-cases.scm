@@ -68,7 +68,7 @@
                (let ((mm (bench text "box-move-spare-push-mm")))
                  (and (real? mm) (> mm 0)))))
             (else
-             (test-assert "the task says the lost pusher's component failed, no robot left"
+             (test-assert "the task says the lost pusher's part failed, no robot left"
                (text-contains? text "connection lost; no other capable robot is free"))
              (test-assert "the other pusher finished its part of step 2"
                (let ((done (find (lambda (line) (text-contains? line ": step 2 done: "))
