@@ -407,10 +407,10 @@
 ;;; Finding a way to the place
 
 ;; Comes to the place offset mm left of the middle of the rear face of the
-;; box of view, (BOX BODIES): along a
-;; planned way (plan-way) to a staging point, then into the place: along
-;; the box's axis from a point behind it, or, when a body lies right behind
-;; the place, along the face from a point beside it, turning in place there.
+;; box of view, (BOX BODIES): along a planned way (plan-way) to a staging
+;; point, then into the place: along the box's axis from a point behind it,
+;; or, when a body lies right behind the place, along the face from a point
+;; beside it, turning in place there.
 (define stage-back 450)
 (define docking #f)             ; the staging point reached, while docking
 (define waypoint #f)
