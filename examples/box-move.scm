@@ -163,7 +163,7 @@
 (define (watch previous)
   (team-barrier 'push 120)
   (let loop ((last #f) (where '()) (done 0) (n 0))
-    (let ((box (see-box)) (bodies (lost-bodies where)))
+    (let ((box (see-box)) (bodies (lost-bodies where n)))
       (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
@@ -171,7 +171,7 @@
                     (step-team)))
       (thread-sleep! 0.15)
       (let* ((heard (all-heard)) (box (or box last))
-             (where (fold-at heard where))
+             (where (fold-at heard where n))
              (done (+ done (count (lambda (h) (eq? (cdr h) 'done)) heard))))
         (cond ((or (>= done 2) (and (>= done 1) box (arrived? box))) (or box 'lost-sight))
               ((> n 3000) (error "watch: the pushers did not finish" done))
@@ -182,19 +182,25 @@
   (let ((heard (guard (e (#t #f)) (team-receive 0.01))))
     (if heard (cons heard (all-heard)) '())))
 
-;; where, a list of (UID X Y), with each pusher's newest (at X Y).
-(define (fold-at heard where)
+;; where, a list of (UID X Y N), with each pusher's newest (at X Y), heard
+;; in the watcher's round N.
+(define (fold-at heard where n)
   (fold (lambda (h where)
           (if (and (pair? (cdr h)) (eq? (car (cdr h)) 'at))
-              (cons (cons (car h) (cdr (cdr h)))
+              (cons (append (cons (car h) (cdr (cdr h))) (list n))
                     (remove (lambda (w) (eq? (car w) (car h))) where))
               where))
         where heard))
 
-;; Where the pushers that left the team were last.
-(define (lost-bodies where)
+;; Where the pushers that left the team, or have not said where they are
+;; for 15 rounds (some 3 s; a pusher says it every quarter second or so),
+;; were last: a pusher lost with no spare to take its part stays in the
+;; team.
+(define (lost-bodies where n)
   (let ((team (step-team)))
-    (map cdr (remove (lambda (w) (memq (car w) team)) where))))
+    (map (lambda (w) (list (list-ref w 1) (list-ref w 2)))
+         (filter (lambda (w) (or (not (memq (car w) team)) (> (- n (list-ref w 3)) 15)))
+                 where))))
 
 ;; Turns toward the box when it nears the edge of the finder's view.
 (define (keep-in-view box)
@@ -220,7 +226,7 @@
                (local-aspace-uid) (reckon)))
     (sonar-start)
     (let loop ((box first) (n 0))
-      (cond ((at-place? box side)
+      (cond ((at-place? box (* side pusher-offset))
              (stop-base)
              (rotate 'to (place-axis box))
              (list (local-aspace-uid) (role side)))
@@ -228,15 +234,21 @@
              (stop-base)
              (error "take-place: found no way to its place behind the box"
                     (local-aspace-uid) (place-of box side)))
-            (else (approach! (list box '()) side n)
+            (else (approach! (list box '()) (* side pusher-offset) n)
                   (thread-sleep! 0.1)
                   (loop (or (see-box) box) (+ n 1)))))))
 
-;; Whether this robot stands at its place, against the box's face.
-(define (at-place? box side)
-  (let ((off (offsets-to box (place-axis box) (* side pusher-offset))))
-    (and (< -120 (car off) 30) (< (abs (cadr off)) 70)
-         (< (abs (wrap (- (place-axis box) (list-ref (reckon) 2)))) 20))))
+;; Whether this robot stands at the place offset mm left of the middle of
+;; the box's rear face, against it; with slack (mm: it stood there the
+;; round before), whether it is still near enough to push from there, at
+;; most slack aside: a pusher that has fallen further behind or aside comes
+;; up again as a spare does (approach!), never sideways along the face.
+(define (at-place? box offset . slack)
+  (let ((off (offsets-to box (place-axis box) offset))
+        (turn (abs (wrap (- (place-axis box) (list-ref (reckon) 2))))))
+    (if (and (pair? slack) (car slack))
+        (and (< -150 (car off) 250) (< (abs (cadr off)) (car slack)) (< turn 35))
+        (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
 ;; What the pusher hears: the round its partner last said it was at the
 ;; face ('here), and the last round it said how far it still had to come
@@ -286,53 +298,81 @@
           (team-send! watcher 'done)
           (error "push: the box did not reach the goal" box))
          ((not box) (stop-base) (loop (latest view) at-face? (+ n 1)))
-         ((or (and at-face? (< (distance (reckon) (place-of box side)) 600))
-              (at-place? box side))
-          (team-send! (partner) 'here)
-          (steer! view side)
-          (loop (latest view) #t (+ n 1)))
          (else
-          (team-send! (partner) (list 'coming (if waypoint
-                                                  (distance (reckon) (place-of box side))
-                                                  1e9)))
-          (approach! view side n)
-          (loop (latest view) #f (+ n 1))))))))
+          (let ((offset (push-offset view side)))
+            (cond ((at-place? box offset (and at-face? (if (alone?) 75 200)))
+                   (team-send! (partner) 'here)
+                   (steer! view side offset)
+                   (loop (latest view) #t (+ n 1)))
+                  (else
+                   (team-send! (partner)
+                               (list 'coming (if waypoint
+                                                 (distance (reckon) (place-of box side))
+                                                 1e9)))
+                   (approach! view offset n)
+                   (loop (latest view) #f (+ n 1)))))))))))
+
+;; How many degrees left the box must turn to head for the path.
+(define (turn-error box)
+  (wrap (- (heading-to box (aim-point box)) (place-axis box))))
+
+;; Where on the rear face this pusher pushes from, mm left of its middle:
+;; its own place while its partner is at the face or coming with a way to
+;; it; while a spare waits for a body to clear its place, where lone-offset
+;; says, sliding there along its own half; with no partner at all, where
+;; lone-offset says, kept until that has moved by more than 80 mm, for a
+;; pusher that slides far along a face it pushes drags the box round the
+;; wrong way: it comes up afresh to each new spot (approach!).
+(define lone-at #f)
+(define (push-offset view side)
+  (if (or (< (- tick partner-here) 4) (spare-on-its-way?))
+      (begin (set! lone-at #f) (* side pusher-offset))
+      (let ((want (lone-offset (car view) (cadr view) side)))
+        (cond ((not lone-at) (set! lone-at (* side pusher-offset)))
+              ((or (not (alone?)) (> (abs (- want lone-at)) 80)) (set! lone-at want)))
+        lone-at)))
+
+;; Whether this pusher has heard nothing from a partner for 60 rounds (some
+;; six seconds, long enough for a spare to be found and the watcher to
+;; know where the lost one lies): its partner was lost and no spare took
+;; its part.
+(define (alone?) (and (>= (- tick partner-here) 60) (>= (- tick partner-coming) 60)))
 
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
 ;; pushes harder.  A pusher alone (its partner has not said it is at the
-;; face for three rounds) turns the box by where it pushes on its own half
-;; (lone-offset).  A spare coming turns the box the most: once the spare
-;; has a way to its place, the lone pusher holds at its own, leaving the
-;; spare's free.
-(define (steer! view side)
-  (let* ((box (car view)) (bodies (cadr view))
-         (d (heading-to box (aim-point box)))
-         (axis (place-axis box))
-         (err (wrap (- d axis))))               ; > 0: the box must turn left
-    (cond ((< (- tick partner-here) 4)
-           (push-at! box axis (* side pusher-offset)
-                     (clip (- 1 (* 0.05 side err)) 0.3 1.7)))
-          ((spare-on-its-way?) (push-at! box axis (* side pusher-offset) 0))
-          (else (push-at! box axis (lone-offset box axis side err bodies) 0.5)))))
+;; face for three rounds) turns the box by where it pushes (push-offset).
+;; A spare coming turns the box the most: once the spare has a way to its
+;; place, the lone pusher holds at its own, leaving the spare's free.
+(define (steer! view side offset)
+  (let ((box (car view)))
+    (push-at! box (place-axis box) offset
+              (cond ((< (- tick partner-here) 4)
+                     (clip (- 1 (* 0.05 side (turn-error box))) 0.3 1.7))
+                    ((spare-on-its-way?) 0)
+                    (else 0.5)))))
 
 ;; Whether a spare said lately that it has a way to its place.
 (define (spare-on-its-way?)
   (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
 
-;; Where a pusher alone on side pushes, mm left of the middle, for a box
-;; that must turn err degrees left: the middle, within 4 degrees, else to
-;; the side that turns it, as far as its own half of the face goes: it
-;; never crosses the middle, and it keeps its distance from a lost
-;; pusher's body, which would stop it.
-(define (lone-offset box axis side err bodies)
-  (let loop ((offset (* side (max 0 (* side (if (< (abs err) 4)
-                                                 0
-                                                 (clip (* -8 err) pusher-offset)))))))
-    (if (or (>= (* side offset) pusher-offset)
-            (clear-of? bodies (list (behind-at box axis offset))))
-        offset
-        (loop (+ offset (* side 20))))))
+;; Where a pusher alone pushes, mm left of the middle of the rear face:
+;; 10 mm aside a degree the box must turn, to the right of the middle to
+;; turn it left, anywhere along the face, or only on its own half while a
+;; spare is on its way to the other; or the spot nearest that, its own side
+;; first, that is clear of the lost pushers' bodies as a place must be
+;; (staging), else its own place.
+(define (lone-offset box bodies side)
+  (let* ((axis (place-axis box))
+         (want (clip (* -10 (turn-error box)) pusher-offset))
+         (half? (not (alone?)))
+         (clear? (lambda (o)
+                   (and (<= (abs o) pusher-offset) (or (not half?) (>= (* side o) 0))
+                        (clear-of? bodies (list (behind-at box axis o)) -40)))))
+    (let loop ((k 0))
+      (cond ((> k (* 2 pusher-offset)) (* side pusher-offset))
+            ((find clear? (list (+ want (* side k)) (- want (* side k)))))
+            (else (loop (+ k 20)))))))
 
 ;; Whether every point is a robot's width and a margin (20 mm, or the one
 ;; given: a spare may nudge a body at its place) from every body.
@@ -342,18 +382,11 @@
            bodies)))
 
 ;; Pushes at share of push-speed at the place offset mm left of the middle
-;; of the box's rear face, hurrying when it has fallen behind it.  A pusher
-;; far to the side of that place backs off the face to cross it: one
-;; sliding across a face while it pushes turns the box the wrong way.
+;; of the box's rear face, hurrying when it has fallen behind it.
 (define (push-at! box axis offset share)
-  (let* ((off (offsets-to box axis offset)) (ahead (car off)) (left (cadr off)))
-    (cond ((<= (abs left) 100)
-           (drive-along! axis ahead left
-                         (* push-speed (slowing box) (+ share (clip (/ ahead 100) 0 1)))))
-          ((< ahead 190)                        ; back off straight
-           (set-velocity -150 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
-          (else (drive-to! (behind-at box axis offset
-                                      (+ box-half body-radius face-gap 250)))))))
+  (let ((off (offsets-to box axis offset)))
+    (drive-along! axis (car off) (cadr off)
+                  (* push-speed (slowing box) (+ share (clip (/ (car off) 100) 0 1))))))
 
 
 ;; Sets the velocities that bring the robot, heading along axis, to a
@@ -373,22 +406,23 @@
 
 ;;; Finding a way to the place
 
-;; Comes to the place on side at the box of view, (BOX BODIES): along a
-;; planned way (plan-way) to a staging point, then into the place: along
-;; the box's axis from a point behind it, or, when a body lies right behind
-;; the place, along the face from a point beside it, turning in place there.
+;; Comes to the place offset mm left of the middle of the rear face of the
+;; box of view, (BOX BODIES): along a planned way (plan-way) to a staging
+;; point, then into the place: along the box's axis from a point behind it,
+;; or, when a body lies right behind the place, along the face from a point
+;; beside it, turning in place there.
 (define stage-back 450)
 (define docking #f)             ; the staging point reached, while docking
 (define waypoint #f)
 
-(define (approach! view side n)
-  (let* ((box (car view)) (axis (place-axis box)) (offset (* side pusher-offset))
+(define (approach! view offset n)
+  (let* ((box (car view)) (axis (place-axis box))
          (off (offsets-to box axis offset)) (place (behind-at box axis offset))
          (stage (staging box axis offset (cadr view))))
-    (if (and stage (< (distance (reckon) (car stage)) 150))
+    (if (and stage (or (< (distance (reckon) (car stage)) 150)
+                       (and (eq? (cdr stage) 'behind) (in-corridor? off))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (< -150 (car off) (+ stage-back 200))
-                (< (abs (cadr off)) 400))
+    (cond ((and (eq? docking 'behind) (in-corridor? off))
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
            (if (> (distance (reckon) place) 40)
@@ -399,6 +433,13 @@
            (if (or (not waypoint) (= 0 (modulo n 5)))
                (set! waypoint (and stage (plan-way (car stage) box (cadr view)))))
            (if waypoint (drive-to! waypoint) (stop-base))))))
+
+;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
+;; it along the box's axis: behind it, and the nearer the face the nearer
+;; the place's line, lest it come sideways into the face or its corner.
+(define (in-corridor? off)
+  (and (< -150 (car off) (+ stage-back 200))
+       (< (abs (cadr off)) (+ 50 (* 1/3 (max 0 (car off)))))))
 
 ;; Where to come up to the place offset mm left of the middle from, as
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
@@ -430,7 +471,7 @@
          (blocked (make-vector (* nx ny) #f))
          (cell-of (lambda (p) (+ (exact (round (/ (- (car p) x0) cell)))
                                  (* nx (exact (round (/ (- (cadr p) y0) cell))))))))
-    (define (paint! p r)
+    (define (paint! p r . free)
       (let ((i0 (exact (round (/ (- (car p) x0) cell))))
             (j0 (exact (round (/ (- (cadr p) y0) cell))))
             (k (exact (ceiling (/ r cell)))))
@@ -438,10 +479,16 @@
           (do ((j (- j0 k) (+ j 1))) ((> j (+ j0 k)))
             (if (and (< -1 i nx) (< -1 j ny)
                      (<= (* cell cell (+ (square (- i i0)) (square (- j j0)))) (* r r)))
-                (vector-set! blocked (+ i (* nx j)) #t))))))
+                (vector-set! blocked (+ i (* nx j)) (null? free)))))))
     (paint-box! paint! box)
-    (for-each (lambda (b) (paint! b (+ body-radius body-radius))) bodies)
+    ;; A body said to lie where this robot stands has been pushed away.
+    (for-each (lambda (b) (if (> (distance b me) (+ body-radius body-radius))
+                              (paint! b (+ body-radius body-radius))))
+              bodies)
     (for-each (lambda (e) (paint! e (+ body-radius 80))) (echoes me box))
+    ;; A robot hemmed in, by the box's grown edge or a robot beside it, may
+    ;; still step out.
+    (paint! me 150 'free)
     (let ((start (cell-of me)) (end (cell-of goal)))
       (let ((from (breadth-first blocked nx ny end start)))
         (and from

@@ -172,9 +172,9 @@
                           " lights mobile camera)))")
            (string-append "(capabilites sonar ir bumpers speech buttons lights mobi ...:"
                           " no such clause")))
-  (test "every example lab passes" '(#t #t)
+  (test "every example lab passes" '(#t #t #t #t)
     (map (lambda (f) (lab? (read-lab (tool-path (string-append "examples/" f)))))
-         '("tulane-lab.scm" "box-lab.scm"))))
+         '("tulane-lab.scm" "box-lab.scm" "box-lab-right.scm" "box-lab-alone.scm"))))
 
 (test-end)
 (delete-file-hierarchy dir)
