@@ -585,7 +585,6 @@
   (rank waiter-rank)
   (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
   (looked waiter-looked waiter-looked-set!)      ; monotonic-seconds
-  (free-seen? waiter-free-seen? waiter-free-seen?-set!) ; at its last look
   (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
@@ -599,7 +598,6 @@
 (define (enlist! w)
   (waiter-held-set! w '())
   (waiter-looked-set! w #f)
-  (waiter-free-seen?-set! w #f)
   (waiter-kept-set! w (monotonic-seconds))
   (waiter-yielded-set! w '())
   (waiter-capable-set! w #t)            ; any robot, until it has looked
@@ -659,11 +657,12 @@
          (lambda () (let-go-held! w) (delist! w))))))
 
 ;; Tries, answers the offers that woke it, and waits for the next.  It
-;; tries only when news came (it was posed, offered a robot, asked to give
-;; way), and looks at the lab again when what it holds changed, or a
-;; second after its last look: an offer is answered by one try.  Newly
-;; posed behind a better-ranked waiting task, it does not try but waits
-;; for the free robots' offers, which come in rank order.
+;; tries only when a robot offered itself, or when it was posed with no
+;; better-ranked task waiting for a robot it may use: a robot's offers
+;; come in rank order, and a try out of turn could take a robot freed for
+;; a better-ranked task.  It looks at the lab again when what it holds
+;; changed, or a second after its last look: an offer is answered by one
+;; try.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
         (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
@@ -673,14 +672,10 @@
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (if (or (null? news)
-                          (and (equal? news '((posed))) (behind-others? w)))
-                      'not-enough-takers
-                      (quiet-try (lambda ()
-                                   (parameterize ((pose-task-excluded
-                                                   (append (offered-to-others w)
-                                                           (pose-task-excluded))))
-                                     (try w)))))))
+      (let ((team (if (or (pair? offers)
+                          (and (equal? news '((posed))) (not (behind-others? w))))
+                      (try-in-turn w try)
+                      'not-enough-takers)))
         (answer-offers! offers (pair? team))
         (cond
          ((pair? team) team)
@@ -693,10 +688,22 @@
           (if (> (- (monotonic-seconds) (waiter-kept w))
                  (/ (lab-setting (current-lab) 'lease) 4))
               (keep-held! w))
-          (wait-turn w try
-                     (if (and (null? news) (waiter-free-seen? w))
-                         '((free))     ; an offer it missed: a robot is free
-                         (take-news! w (next-look (turn-deadline (task-turn t)))))))))))))
+          (wait-turn w try (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+
+;; One try of w's, after the tries of this address space's other waiting
+;; tasks: two at once, each offered a robot, each reserved the other's
+;; robot as a candidate of its negotiation, and the one that lost its
+;; robot so, for a moment, found none and declined it.  The robots offered
+;; to the others are left alone.
+(define *try-lock* (make-mutex 'tries))
+
+(define (try-in-turn w try)
+  (with-lock *try-lock*
+    (lambda ()
+      (quiet-try (lambda ()
+                   (parameterize ((pose-task-excluded (append (offered-to-others w)
+                                                              (pose-task-excluded))))
+                     (try w)))))))
 
 ;;; Holding what it has (the thesis's chapter 6 wish)
 ;;
@@ -852,7 +859,7 @@
       "fewer live robots of the lab are capable of it than it has components")
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
-      (waiter-free-seen?-set! w (any pair? (map cadr lines)))
+      (remind-free! (delete-duplicates (append-map cadr lines)))
       (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
       (waiter-position-set! w (place-in-line w (map cadr others)))
       (ask-way! w lines others)
@@ -866,6 +873,16 @@
       (progress (task-id (waiter-task w)) ": waiting, " (waiter-position w)
                 " in line")
       #f))))
+
+;; Robots that a look finds free may have made their offers before this
+;; task waited, or be making them: each is asked to offer itself (again),
+;; best rank first, rather than taken by a try out of turn.
+(define (remind-free! uids)
+  (for-each (lambda (uid)
+              (guard (e (#t (log-warn "reminding " uid ": " (error-message e))))
+                (parameterize ((remote-timeout 1))
+                  (remote-apply (uid->aspace uid) note-waiters!))))
+            uids))
 
 (define (trimmed line)
   (let loop ((s line))
