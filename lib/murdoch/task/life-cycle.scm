@@ -688,7 +688,8 @@
           (if (> (- (monotonic-seconds) (waiter-kept w))
                  (/ (lab-setting (current-lab) 'lease) 4))
               (keep-held! w))
-          (wait-turn w try (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+          (wait-turn w try
+                     (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
 ;; One try of w's, after the tries of this address space's other waiting
 ;; tasks: two at once, each offered a robot, each reserved the other's
@@ -966,11 +967,13 @@
 ;; Whether w is offered a robot for each component it does not hold: two
 ;; robots freed together offer themselves to one task, and the second
 ;; goes on to the next task at once rather than after the first's try.
+;; A robot that w won, holding, in the try its offer began is no longer
+;; one of them, though its offer is answered only when that try ends.
 ;; Under *tasks-lock*.
 (define (offered-enough? w)
-  (let ((id (task-id (waiter-task w))))
-    (>= (count (lambda (o) (eq? (cdr o) id)) *offers*)
-        (- (length (waiter-components w)) (length (waiter-held w))))))
+  (let ((id (task-id (waiter-task w))) (held (held-uids w)))
+    (>= (count (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held)))) *offers*)
+        (- (length (waiter-components w)) (length held)))))
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
