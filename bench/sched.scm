@@ -161,6 +161,19 @@
    tasks))
 
 (define (span-of id) (assv id spans))
+
+;; The last release among the robots that task span sp started on, before
+;; it started, or #f when none of them had run anything before.
+(define (ready-at sp)
+  (let ((releases
+         (filter-map
+          (lambda (s)
+            (let ((before (filter (lambda (e) (and (eq? (list-ref e 4) (list-ref s 4))
+                                                   (<= (car e) (cadr sp))))
+                                  ends)))
+              (and (pair? before) (apply max (map car before)))))
+          (filter (lambda (s) (= (list-ref s 2) (car sp))) starts))))
+    (and (pair? releases) (apply max releases))))
 (define (work-of t) (let ((s (span-of (car t)))) (and s (- (car (cddr s)) (cadr s)))))
 
 (define (del uid alist) (remove (lambda (x) (eq? (car x) uid)) alist))
@@ -194,21 +207,29 @@
              (< (vector-ref posed-by (car a)) (vector-ref posed-at (car b)))))))
 
 ;; The inversions: a task x starting while y, which surely ranks before
-;; it, waited.  y waited from 0.2 s after its posing call, and until 0.2 s
-;; before its start: a task that has won its robots takes a moment to
-;; tell this address space it started.  Every task here holds what it
-;; wins, and any robot serves any task, so a task that waits could have
-;; used any robot freed, if only to hold it.  (x y) for each x and the
-;; best-ranked such y.
+;; it, waited for a robot.  y waited from 0.2 s after its posing call
+;; until the last of the robots it started on was released, if that was
+;; after x started, and it had not started 0.2 s after x: a task that
+;; has won its robots takes a moment to tell this address space it
+;; started, and one whose robots were all free when x started was being
+;; served, and needed none more.  Every task here holds what it wins,
+;; and any robot serves any task, so a task that waits for a robot could
+;; have used any robot freed, if only to hold it.  (x y) for each x and
+;; the best-ranked such y.
+(define (waited-for-robot? y sx)
+  (let ((sy (span-of (car y))))
+    (and (< (+ (vector-ref posed-by (car y)) 0.2) sx)
+         (or (not sy)
+             (and (> (cadr sy) (+ sx 0.2))
+                  (> (or (ready-at sy) 0) sx))))))
+
 (define inversions
   (filter-map
    (lambda (x)
      (let* ((sx (span-of (car x)))
             (ys (filter (lambda (y)
-                          (let ((sy (span-of (car y))))
-                            (and sx (surely-ranks-before? y x)
-                                 (< (+ (vector-ref posed-by (car y)) 0.2) (cadr sx))
-                                 (or (not sy) (> (cadr sy) (+ (cadr sx) 0.2))))))
+                          (and sx (surely-ranks-before? y x)
+                               (waited-for-robot? y (cadr sx))))
                         tasks)))
        (and (pair? ys) (list x (car (list-sort ranks-before? ys))))))
    tasks))
@@ -222,7 +243,9 @@
                        (number->string (task-priority t)) ", posed at "
                        (number->string (round-to (vector-ref posed-at (car t)) 3))
                        " s, started at "
-                       (if s (string-append (number->string (round-to (cadr s) 3)) " s") "never"))))
+                       (if s
+                           (string-append (number->string (round-to (cadr s) 3)) " s")
+                           "never"))))
     (write-string (string-append "sched: inversion: " (task-line x) "\n"
                                  "  while this better-ranked one waited: "
                                  (task-line y) "\n")
@@ -271,16 +294,7 @@
 (define last-release-latencies
   (filter-map
    (lambda (sp)
-     (let* ((mine (filter (lambda (s) (= (list-ref s 2) (car sp))) starts))
-            (releases (filter-map
-                       (lambda (s)
-                         (let ((before (filter (lambda (e) (and (eq? (list-ref e 4)
-                                                                     (list-ref s 4))
-                                                                (<= (car e) (cadr sp))))
-                                               ends)))
-                           (and (pair? before) (apply max (map car before)))))
-                       mine))
-            (last (and (pair? releases) (apply max releases))))
+     (let ((last (ready-at sp)))
        (and last (< (vector-ref posed-at (car sp)) last)
             (* 1000 (- (cadr sp) last)))))
    spans))
