@@ -1001,7 +1001,15 @@
 ;;> once, since a task posed behind others waits for the offers.
 (define (note-waiters!)
   (set! *waiters-here?* #t)
+  (set! *new-waiters* #t)
   (if (and (robot-here?) (free-here?)) (robot-freed!)))
+
+;; Whether a task started to wait, or was reminded of, since this robot's
+;; offer round asked who waits: the round's list may lack a better-ranked
+;; task, and it asks again before its next offer (forty tasks posed at
+;; once: a round that had asked before the best of them waited went on
+;; down its list to a worse one).
+(define *new-waiters* #f)
 
 (define (robot-here?)
   (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
@@ -1048,6 +1056,7 @@
 (define (offer-round)
   (let ((me (local-aspace-uid)))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
+    (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                               (guard (e (#t '()))
@@ -1065,7 +1074,9 @@
         (parameterize ((remote-timeout 3))
           (remote-apply (uid->aspace poser) receive-offer
                         (car (cddr (car waiting))) me)))
-      (offer-to me (cdr waiting)))))
+      (if (and *new-waiters* (free-here?))
+          (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
+          (offer-to me (cdr waiting))))))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
