@@ -674,7 +674,7 @@
      (else
       (let ((team (if (or (pair? offers)
                           (and (equal? news '((posed))) (not (behind-others? w))))
-                      (try-in-turn w try)
+                      (try-in-turn w try (map (lambda (o) (car (cddr o))) offers))
                       'not-enough-takers)))
         (answer-offers! offers (pair? team))
         (cond
@@ -695,16 +695,27 @@
 ;; tasks: two at once, each offered a robot, each reserved the other's
 ;; robot as a candidate of its negotiation, and the one that lost its
 ;; robot so, for a moment, found none and declined it.  The robots offered
-;; to the others are left alone.
+;; to the others are left alone, and so are all but those offered to w,
+;; the uids offered, when w can take robots one at a time (it holds, or
+;; needs one): a robot may be kept for this poser on its way to offer
+;; itself to another of its tasks.
 (define *try-lock* (make-mutex 'tries))
 
-(define (try-in-turn w try)
+(define (try-in-turn w try offered)
   (with-lock *try-lock*
     (lambda ()
       (quiet-try (lambda ()
                    (parameterize ((pose-task-excluded (append (offered-to-others w)
+                                                              (not-offered w offered)
                                                               (pose-task-excluded))))
                      (try w)))))))
+
+(define (not-offered w offered)
+  (let ((t (waiter-task w)))
+    (if (and (pair? offered) (list? (waiter-capable w))
+             (or (turn-hold? (task-turn t)) (= 1 (length (waiter-components w)))))
+        (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
+        '())))
 
 ;;; Holding what it has (the thesis's chapter 6 wish)
 ;;
