@@ -39,6 +39,8 @@
 ;; A component that keeps its robot for seconds.
 (define (slow-job label seconds)
   (lambda () ((job label #f)) (thread-sleep! seconds) label))
+;; A step's procedure: the same, applied to the step before's results.
+(define (step-job label) (lambda (previous) ((job label #f))))
 ;; What the posers p1 and p2 run: a one-robot task that waits.
 (define posed-here '())
 (define (pose-job label)
@@ -182,8 +184,8 @@
       (if (eq? where 'tester)
           (set! mine (cons (wait-job label) mine))
           (remote-apply (uid->aspace where) (lab-proc 'pose-job) label))
-      (wait-until 10 (lambda ()
-                       (>= (waiting-count) (length (memq label '(f5 f4 f3 f2 f1)))))))
+      (wait-until 10 (lambda () (>= (waiting-count)
+                                    (length (memq label '(f5 f4 f3 f2 f1)))))))
     (for-each pose! '(p1 tester p2 p1 tester) '(f1 f2 f3 f4 f5))
     (test "five wait, lab-wide" 5 (waiting-count))
     (open-gate! 'r3 'k3)
@@ -269,6 +271,12 @@
 (define (holder-of uid)
   (cadr (find (lambda (s) (eq? (car s) 'arm)) (cadr (assq uid (request-status 'arm))))))
 
+;; Whether robot uid is held by a reservation of a task named name.
+(define (held-for? uid name)
+  (let ((holder (holder-of uid)))
+    (and (symbol? holder)
+         (text-contains? (symbol->string holder) (string-append name "@")))))
+
 (define (pair-job label)
   (lambda options
     (apply start-task 'pair 2 (list '((arm) ()) '((arm) ())) (list #f #f)
@@ -282,9 +290,7 @@
          (x1 (block! 'r1 'x1))
          (low ((pair-job 'low) 'priority 0)))
     (test "the lower-ranked one waits, holding the free robot" #t
-      (wait-until 10 (lambda () (and (waiting? low) (symbol? (holder-of 'r2))
-                                     (text-contains? (symbol->string (holder-of 'r2))
-                                                     "pair@")))))
+      (wait-until 10 (lambda () (and (waiting? low) (held-for? 'r2 "pair")))))
     (let ((high ((pair-job 'high) 'priority 5)))
       (test "the better-ranked one waits" #t (wait-until 10 (lambda () (waiting? high))))
       (open-gate! 'r1 'x1)
@@ -294,6 +300,54 @@
       (open-gate! 'r3 'x3)
       (for-each (lambda (t) (task-wait t 10)) (list x1 x3)))))
 
+(test-group "a task of steps takes start-task's keywords"
+  ;; other, posed first at priority 0, waits for any robot; the task of
+  ;; steps, posed after it at priority 5, holds r1 as it frees and waits
+  ;; for a second robot: without priority it would rank after other, and
+  ;; without hold it would not keep r1.
+  (let* ((blocks (map block! '(r1 r2 r3) '(v1 v2 v3)))
+         (other (wait-job 'other))
+         (step-job (lab-proc 'step-job))
+         (one-arm (lambda (label)
+                    (task-step (list '((arm) ())) (list #f) (list (step-job label)))))
+         (stepped (start-steps 'stepped
+                               (task-step (list '((arm) ()) '((arm) ())) (list #f #f)
+                                          (list (step-job 'step1) (step-job 'step1)))
+                               (one-arm 'step2)
+                               'wait #t 'hold #t 'priority 5))
+         (first-state (lambda ()
+                        (let ((steps (task-status stepped)))
+                          (if (null? steps)
+                              '(not-started)
+                              (cadr (car (car (cddr (car steps))))))))))
+    (test "its first step waits" 'waiting
+      (begin (wait-until 10 (lambda () (eq? (car (first-state)) 'waiting)))
+             (car (first-state))))
+    (test "first in line, ahead of a task posed before it" '(1 2)
+      (begin (wait-until 10 (lambda () (waiting? other)))
+             (task-status stepped)
+             (list (cadr (first-state)) (cadr (state-of other 1)))))
+    (open-gate! 'r1 'v1)
+    (test "it holds the robot that freed, and waits for another" #t
+      (wait-until 10 (lambda () (held-for? 'r1 "stepped"))))
+    (test "the other task still waits" #t (waiting? other))
+    (open-gate! 'r2 'v2)
+    (test "both steps run" '((step1 step1) (step2)) (task-wait stepped 20))
+    (test "the other task runs after the first step started" 'other
+      (begin (task-wait other 20) (last (start-order '(step1 other)))))
+    (open-gate! 'r3 'v3)
+    (for-each (lambda (t) (task-wait t 10)) blocks)
+    (let* ((blocks (map block! '(r1 r2 r3) '(u1 u2 u3)))
+           (late (start-steps 'late (one-arm 'late) 'wait #t 'deadline 0.5)))
+      (test "one past its deadline fails with deadline" '(deadline) (task-wait late 10))
+      (test "and never started" '() (start-order '(late)))
+      (for-each open-gate! '(r1 r2 r3) '(u1 u2 u3))
+      (for-each (lambda (t) (task-wait t 10)) blocks))
+    (test-assert "a bad keyword gets one clear error"
+      (text-contains? (error-text (lambda ()
+                                    (start-steps 'bad (one-arm 'bad) 'priority -1)))
+                      "priority"))))
+
 (test-group "a robot killed while tasks wait"
   ;; mover, restartable, runs on r3 while r1 and r2 are busy; lifter can
   ;; only have r3, armer any robot.
@@ -302,8 +356,7 @@
                             '(1) '(#t) 'wait #t))
          (running (wait-until 10 (lambda () (eq? (car (state-of mover 1)) 'running))))
          (lifter (start-task 'lift 1 (list '((arm lift) ())) (list #f)
-                             (list (job 'lift #f))
-                             'wait #t))
+                             (list (job 'lift #f)) 'wait #t))
          (armer (wait-job 'armer)))
     (for-each (lambda (uid) (open-gate! uid 'q3)) '(r1 r2))
     (test "both wait" #t

@@ -587,7 +587,6 @@
   (rank waiter-rank)
   (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
   (looked waiter-looked waiter-looked-set!)      ; monotonic-seconds
-  (free-seen? waiter-free-seen? waiter-free-seen?-set!) ; at its last look
   (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
@@ -601,7 +600,6 @@
 (define (enlist! w)
   (waiter-held-set! w '())
   (waiter-looked-set! w #f)
-  (waiter-free-seen?-set! w #f)
   (waiter-kept-set! w (monotonic-seconds))
   (waiter-yielded-set! w '())
   (waiter-capable-set! w #t)            ; any robot, until it has looked
@@ -661,11 +659,12 @@
          (lambda () (let-go-held! w) (delist! w))))))
 
 ;; Tries, answers the offers that woke it, and waits for the next.  It
-;; tries only when news came (it was posed, offered a robot, asked to give
-;; way), and looks at the lab again when what it holds changed, or a
-;; second after its last look: an offer is answered by one try.  Newly
-;; posed behind a better-ranked waiting task, it does not try but waits
-;; for the free robots' offers, which come in rank order.
+;; tries only when a robot offered itself, or when it was posed with no
+;; better-ranked task waiting for a robot it may use: a robot's offers
+;; come in rank order, and a try out of turn could take a robot freed for
+;; a better-ranked task.  It looks at the lab again when what it holds
+;; changed, or a second after its last look: an offer is answered by one
+;; try.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
         (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
@@ -675,14 +674,10 @@
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
-      (let ((team (if (or (null? news)
-                          (and (equal? news '((posed))) (behind-others? w)))
-                      'not-enough-takers
-                      (quiet-try (lambda ()
-                                   (parameterize ((pose-task-excluded
-                                                   (append (offered-to-others w)
-                                                           (pose-task-excluded))))
-                                     (try w)))))))
+      (let ((team (if (or (pair? offers)
+                          (and (equal? news '((posed))) (not (behind-others? w))))
+                      (try-in-turn w try (map (lambda (o) (car (cddr o))) offers))
+                      'not-enough-takers)))
         (answer-offers! offers (pair? team))
         (cond
          ((pair? team) team)
@@ -696,9 +691,33 @@
                  (/ (lab-setting (current-lab) 'lease) 4))
               (keep-held! w))
           (wait-turn w try
-                     (if (and (null? news) (waiter-free-seen? w))
-                         '((free))     ; an offer it missed: a robot is free
-                         (take-news! w (next-look (turn-deadline (task-turn t)))))))))))))
+                     (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+
+;; One try of w's, after the tries of this address space's other waiting
+;; tasks: two at once, each offered a robot, each reserved the other's
+;; robot as a candidate of its negotiation, and the one that lost its
+;; robot so, for a moment, found none and declined it.  The robots offered
+;; to the others are left alone, and so are all but those offered to w,
+;; the uids offered, when w can take robots one at a time (it holds, or
+;; needs one): a robot may be kept for this poser on its way to offer
+;; itself to another of its tasks.
+(define *try-lock* (make-mutex 'tries))
+
+(define (try-in-turn w try offered)
+  (with-lock *try-lock*
+    (lambda ()
+      (quiet-try (lambda ()
+                   (parameterize ((pose-task-excluded (append (offered-to-others w)
+                                                              (not-offered w offered)
+                                                              (pose-task-excluded))))
+                     (try w)))))))
+
+(define (not-offered w offered)
+  (let ((t (waiter-task w)))
+    (if (and (pair? offered) (list? (waiter-capable w))
+             (or (turn-hold? (task-turn t)) (= 1 (length (waiter-components w)))))
+        (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
+        '())))
 
 ;;; Holding what it has (the thesis's chapter 6 wish)
 ;;
@@ -860,7 +879,7 @@
       "fewer live robots of the lab are capable of it than it has components")
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
-      (waiter-free-seen?-set! w (any pair? (map cadr lines)))
+      (remind-free! (delete-duplicates (append-map cadr lines)))
       (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
       (waiter-position-set! w (place-in-line w (map cadr others)))
       (ask-way! w lines others)
@@ -874,6 +893,16 @@
       (progress (task-id (waiter-task w)) ": waiting, " (waiter-position w)
                 " in line")
       #f))))
+
+;; Robots that a look finds free may have made their offers before this
+;; task waited, or be making them: each is asked to offer itself (again),
+;; best rank first, rather than taken by a try out of turn.
+(define (remind-free! uids)
+  (for-each (lambda (uid)
+              (guard (e (#t (log-warn "reminding " uid ": " (error-message e))))
+                (parameterize ((remote-timeout 1))
+                  (remote-apply (uid->aspace uid) note-waiters!))))
+            uids))
 
 (define (trimmed line)
   (let loop ((s line))
@@ -957,11 +986,13 @@
 ;; Whether w is offered a robot for each component it does not hold: two
 ;; robots freed together offer themselves to one task, and the second
 ;; goes on to the next task at once rather than after the first's try.
+;; A robot that w won, holding, in the try its offer began is no longer
+;; one of them, though its offer is answered only when that try ends.
 ;; Under *tasks-lock*.
 (define (offered-enough? w)
-  (let ((id (task-id (waiter-task w))))
-    (>= (count (lambda (o) (eq? (cdr o) id)) *offers*)
-        (- (length (waiter-components w)) (length (waiter-held w))))))
+  (let ((id (task-id (waiter-task w))) (held (held-uids w)))
+    (>= (count (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held)))) *offers*)
+        (- (length (waiter-components w)) (length held)))))
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
@@ -989,7 +1020,15 @@
 ;;> once, since a task posed behind others waits for the offers.
 (define (note-waiters!)
   (set! *waiters-here?* #t)
+  (set! *new-waiters* #t)
   (if (and (robot-here?) (free-here?)) (robot-freed!)))
+
+;; Whether a task started to wait, or was reminded of, since this robot's
+;; offer round asked who waits: the round's list may lack a better-ranked
+;; task, and it asks again before its next offer (forty tasks posed at
+;; once: a round that had asked before the best of them waited went on
+;; down its list to a worse one).
+(define *new-waiters* #f)
 
 (define (robot-here?)
   (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
@@ -1036,6 +1075,7 @@
 (define (offer-round)
   (let ((me (local-aspace-uid)))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
+    (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
                               (guard (e (#t '()))
@@ -1053,7 +1093,9 @@
         (parameterize ((remote-timeout 3))
           (remote-apply (uid->aspace poser) receive-offer
                         (car (cddr (car waiting))) me)))
-      (offer-to me (cdr waiting)))))
+      (if (and *new-waiters* (free-here?))
+          (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
+          (offer-to me (cdr waiting))))))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
