@@ -3,6 +3,7 @@
 ;; A proxy travels as its maker's uid and an id (sendable.scm); applied
 ;; elsewhere, it is a remote-apply back to its maker.
 
+;; Global: a proxy made in any thread is applied from any connection.
 (define *proxies* (make-hash-table eqv?))        ; id -> procedure
 (define *proxy-stubs* (make-hash-table equal?))  ; (uid . id) -> proxy
 (define *proxies-lock* (make-mutex 'proxies))
