@@ -113,9 +113,9 @@
              (loop (+ i 1) (+ i 1) (cons (substring s start i) acc)))
             (else (loop start (+ i 1) acc))))))
 
-;; A predicate true of the topics the address subject pattern reaches.
-;; Made once per message: splitting a subject into its levels copies its
-;; name (Chibi's symbol->string), and most subjects have no wildcard.
+;; A predicate true of the topics the address subject pattern reaches,
+;; made once per message: most subjects have no wildcard, and splitting
+;; one into its levels copies its name (docs/speed.md).
 (define (subject-matcher pattern)
   (let ((levels (subject-levels pattern)))
     (if (or (member "*" levels) (member ">" levels))
@@ -134,8 +134,7 @@
 ;; (the thesis says "proper subset"; it means subset).  It takes no lock:
 ;; it reads the list once, and then only the topics, which never change.
 ;; A subject subscribed as it is matches itself, wildcards included, and
-;; is the common case (all, a uid): found so, it costs no matcher, whose
-;; splitting of the subject was most of a receiver's work on a request.
+;; is the common case (all, a uid): found so, it costs no matcher.
 (define (addressed-here? topic)
   (let ((subscriptions *subscriptions*))
     (every (lambda (pattern)
