@@ -166,13 +166,10 @@
   (or (hmac-sha256-open (wire-key *wire*) bytes end parts)
       (frame-fail "bad MAC")))
 
-;; Chibi's own reader, in C (docs/speed.md, What Chibi charges), which
-;; recurses without bound and reads datum labels, which make cycles, so
-;; the text is first scanned for both (nests-within?): a message may nest
-;; twice max-depth, room for its envelope and for a value one level too
-;; deep, which decoding then refuses with an error answer; deeper, or with
-;; a label, it is a protocol violation.  Text that is no datum raises a
-;; read error; our writer puts nothing after the datum.
+;; Read by Chibi's own reader (docs/speed.md), which recurses without
+;; bound and makes cycles of datum labels: so a message that nests deeper
+;; than twice max-depth (its envelope, and a value one level too deep for
+;; decoding to refuse), or has a label, is a protocol violation.
 (define (parse-message text)
   (if (not (nests-within? text (* 2 (wire-max-depth *wire*))))
       (frame-fail "nests deeper than twice max-depth, or has a datum label"))
