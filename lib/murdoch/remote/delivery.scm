@@ -72,18 +72,18 @@
 ;; Serves the group's calls while this thread is its listener (see
 ;; read-calls).  A call is answered to its sender over TCP.
 (define (serve-group-calls s receive-call)
+  (define (answer c kind value)
+    (send-datagram-answer! (served-call-caller c) (served-call-id c) kind value))
   (define (read-on r)
     (match (receive-call)
       ((sender id kind proc-code args-code)
-       (let ((to (uid->aspace sender)))
-         (serve-call r (make-served-call id kind proc-code args-code
-                                         (lambda (kind value)
-                                           (send-datagram-answer! to id kind value))))))
+       (serve-call r (make-served-call (uid->aspace sender) id kind proc-code
+                                       args-code answer)))
       (#f #f))
     (if (reader? s) (read-on r)))
   (read-calls s read-on
               (lambda (c e)
                 (guard (e2 (#t (log-warn "an answer was lost: "
                                          (fault-message e2))))
-                  ((served-call-reply c) 'error (error-message e))))
+                  (reply! c 'error (error-message e))))
               (lambda (e) (log-warn "datagram dropped: " (fault-message e)))))

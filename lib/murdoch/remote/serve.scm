@@ -204,17 +204,22 @@
                 " it stops at its next remote call or robot command")
       (abandon-thread! (cdr a)))))
 
-;; A call that a reader has read, from a connection or the group: its id,
-;; what it applies, and (reply KIND VALUE), KIND ack, value or error, which
-;; answers it.
+;; A call that a reader has read, from a connection or the group: who
+;; sent it, its id, what it applies, and how it is answered, a procedure
+;; of the connection's or the group's (see reply!).
 (define-record-type served-call
-  (make-served-call id kind proc-code args-code reply)
+  (make-served-call caller id kind proc-code args-code answer)
   served-call?
+  (caller served-call-caller)           ; its uid, or for the group its aspace
   (id served-call-id)
   (kind served-call-kind)               ; run or apply
   (proc-code served-call-proc-code)
   (args-code served-call-args-code)
-  (reply served-call-reply))
+  (answer served-call-answer))          ; (answer C KIND VALUE)
+
+;;> Answers served call \var{c}: \var{kind} ack, value or error, and
+;;> \var{value}, the encoded value or the error's message.
+(define (reply! c kind value) ((served-call-answer c) c kind value))
 
 ;; A thread reading s's calls: the call it runs, until its answer is made,
 ;; for read-calls to answer an error to.
@@ -250,13 +255,13 @@
   (if (eq? (served-call-kind c) 'run)
       (let ((thunk (decode-call c)))
         (reading-call-set! r #f)
-        ((served-call-reply c) 'ack #t)
+        (reply! c 'ack #t)
         (run-in-worker thunk))
       (let ((s (reading-serving r)))
         (inline-apply-begins! s (served-call-id c))
         ;; Answered while the call is r's: a value that cannot go back
         ;; (too large, say) is answered with the error instead.
-        ((served-call-reply c) 'value (encoded-result c))
+        (reply! c 'value (encoded-result c))
         (reading-call-set! r #f)
         (inline-apply-ends! s))))
 
@@ -289,12 +294,17 @@
     (define (flush-if-idle!)
       (if (zero? (buffered-byte-count (serving-in s)))
           (with-lock write-lock (lambda () (flush-output-port out)))))
+    (define (answer c kind value)
+      (let ((id (served-call-id c)))
+        (answer! (if (eq? kind 'ack)
+                     (make-message 'ack id)
+                     (make-message kind id value)))))
     ;; Serves frames while this thread is the reader; see read-calls.
     (define (read-on r)
       (let ((message (read-served-frame s nonce (+ count 1))))
         (unless (eof-object? message)
           (set! count (+ count 1))
-          (serve-frame r uid answer!
+          (serve-frame r uid answer
                        (check-message message '(run apply answer abandon)
                                       "a call"))
           (flush-if-idle!)
@@ -302,7 +312,7 @@
     (define (serve)
       (read-calls s read-on
                   (lambda (c e)
-                    ((served-call-reply c) 'error (error-message e))
+                    (reply! c 'error (error-message e))
                     (flush-if-idle!))
                   raise))
     (send-frame! out text caller-nonce 0
@@ -310,19 +320,14 @@
     (serving-read-on-set! s serve)
     (serve)))
 
-;; Serves one frame from the caller uid, read by r: a call, whose answer
-;; goes back by answer!; the answer to one of our datagram calls; or an
-;; abandon.
-(define (serve-frame r uid answer! message)
+;; Serves one frame from the caller uid, read by r: a call, which answer
+;; answers; the answer to one of our datagram calls; or an abandon.
+(define (serve-frame r uid answer message)
   (match message
     (('answer . _) (take-datagram-answer! uid message))
     (('abandon id) (abandon-call! (reading-serving r) id))
     ((kind id proc-code args-code)
-     (serve-call r (make-served-call id kind proc-code args-code
-                                     (lambda (kind value)
-                                       (answer! (if (eq? kind 'ack)
-                                                    (make-message 'ack id)
-                                                    (make-message kind id value)))))))))
+     (serve-call r (make-served-call uid id kind proc-code args-code answer)))))
 
 ;; The application call c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
