@@ -42,8 +42,6 @@
 
 (define *server* #f)
 
-(define (serving-lock) (server-lock *server*))
-
 (define janitor-seconds 0.1)
 (define takeover-seconds 0.1)
 
@@ -69,7 +67,7 @@
     (serving-deadline-set! s #f)
     (serving-busy-since-set! s #f)
     (serving-applying-set! s '())
-    (with-lock (serving-lock)
+    (with-lock (server-lock *server*)
       (lambda () (server-servings-set! *server* (cons s (server-servings *server*)))))
     s))
 
@@ -83,7 +81,7 @@
 (define (reader? s) (eq? (current-thread) (serving-thread s)))
 
 (define (end-serving! s)
-  (with-lock (serving-lock)
+  (with-lock (server-lock *server*)
     (lambda ()
       (server-servings-set! *server* (remove (lambda (x) (eq? x s))
                                              (server-servings *server*)))))
@@ -116,7 +114,7 @@
 
 ;; The connections whose (moment s) is before time.
 (define (serving-where moment time)
-  (with-lock (serving-lock)
+  (with-lock (server-lock *server*)
     (lambda ()
       (filter (lambda (s) (let ((t (moment s))) (and t (< t time))))
               (server-servings *server*)))))
@@ -153,7 +151,7 @@
   (end-serving! s))
 
 (define (take-over! s)
-  (mutex-lock! (serving-lock))
+  (mutex-lock! (server-lock *server*))
   (when (serving-busy-since s)          ; its apply may just have ended
     (let ((t (make-guarded-thread
               (lambda () (read-as-reader s (serving-read-on s)))
@@ -161,44 +159,44 @@
       (serving-busy-since-set! s #f)
       (serving-thread-set! s t)
       (thread-start! t)))
-  (mutex-unlock! (serving-lock)))
+  (mutex-unlock! (server-lock *server*)))
 
 ;;> Run by an apply served here that runs long, a task's component say:
 ;;> its connection gets a new reader at once, so that the caller's next
 ;;> calls do not wait behind it for the janitor's takeover.
 (define (hand-over-connection!)
-  (mutex-lock! (serving-lock))
+  (mutex-lock! (server-lock *server*))
   (let ((s (find (lambda (s) (and (eq? (serving-thread s) (current-thread))
                                   (serving-busy-since s)))
                  (server-servings *server*))))
-    (mutex-unlock! (serving-lock))
+    (mutex-unlock! (server-lock *server*))
     (if s (take-over! s))))
 
 ;; Marks the start and the end of the reader's inline apply of call id;
 ;; ending answers whether this thread is still the reader.  Until it ends,
 ;; the thread is found by id when its caller gives up.
 (define (inline-apply-begins! s id)
-  (mutex-lock! (serving-lock))
+  (mutex-lock! (server-lock *server*))
   (serving-applying-set! s (cons (cons id (current-thread))
                                  (serving-applying s)))
   (serving-busy-since-set! s (monotonic-seconds))
-  (mutex-unlock! (serving-lock))
+  (mutex-unlock! (server-lock *server*))
   (janitor-wanted!))
 
 (define (inline-apply-ends! s)
-  (mutex-lock! (serving-lock))
+  (mutex-lock! (server-lock *server*))
   (let ((still (reader? s)))
     (serving-applying-set! s (remove (lambda (a) (eq? (cdr a) (current-thread)))
                                      (serving-applying s)))
     (if still (serving-busy-since-set! s #f))
-    (mutex-unlock! (serving-lock))
+    (mutex-unlock! (server-lock *server*))
     (if (abandoned?) (forget-abandoned! (current-thread)))
     still))
 
 ;; The caller of apply id gave up on it: its thread is marked, to stop
 ;; where it next calls out (abandon.scm).  An apply already done is let be.
 (define (abandon-call! s id)
-  (let ((a (with-lock (serving-lock) (lambda () (assv id (serving-applying s))))))
+  (let ((a (with-lock (server-lock *server*) (lambda () (assv id (serving-applying s))))))
     (when a
       (log-note "call " id " from " (serving-peer s) " abandoned by its caller;"
                 " it stops at its next remote call or robot command")
@@ -360,7 +358,7 @@
 ;; from one host: past them, connections that never say hello could take
 ;; every descriptor the process has.
 (define (room-for? host)
-  (with-lock (serving-lock)
+  (with-lock (server-lock *server*)
     (lambda ()
       (let* ((servings (server-servings *server*))
              (from-host (count (lambda (s) (equal? (serving-host s) host))

@@ -123,7 +123,7 @@
   (let ((text (get-output-string text-port)))
     ;; The receiver would refuse it and close the connection, failing the
     ;; calls on it that had nothing to do with this one.
-    (if (> (+ 64 (string-size text)) (max-frame))
+    (if (> (+ 64 (string-size text)) (wire-max-frame *wire*))
         (error (string-append "the message is larger than the lab's max-frame, "
                               (number->string (max-frame)) " bytes")))
     text))
@@ -145,7 +145,7 @@
 ;; bad frame raises (see fault-message), and the connection's one handler
 ;; closes it (no handler per frame: docs/speed.md, What Chibi charges).
 (define (read-frame in nonce count)
-  (let ((payload (read-netstring in (max-frame))))
+  (let ((payload (read-netstring in (wire-max-frame *wire*))))
     (if (eof-object? payload)
         payload
         (open-frame payload nonce count))))
