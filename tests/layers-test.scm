@@ -13,7 +13,7 @@
 ;; any order will do, but where one is given, (FOLDER SUBLAYER ...), bottom
 ;; to top; a family's umbrella, (murdoch FOLDER), is above all its members.
 (define layers
-  '(sys wire lab code robot
+  '(sys lab wire code robot
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
     (task (assign progress metric takers) team (pose-task running) life-cycle)

@@ -3,7 +3,17 @@
         (scheme write) (scheme cxr) (srfi 1) (chibi test)
         (only (meta) mutable-environment)
         (rename (murdoch code sendable) (sendable-lambda lambda)
-                (sendable-define define)))
+                (sendable-define define))
+        (murdoch lab) (murdoch testing harness))
+
+;; The lab of clauses (max-depth, max-frame), read from a file of its own.
+(define (limits-of clauses)
+  (let* ((lab (make-test-lab clauses))
+         (limits (read-lab (test-lab-file lab))))
+    (remove-test-lab! lab)
+    limits))
+
+(set-value-limits! (limits-of '()))
 
 (define env (environment '(scheme base)))
 (define (round-trip x)
@@ -44,7 +54,7 @@
   (guard (e ((send-error? e) (error-object-message e))) (thunk) 'sent))
 (define (nested n) (if (= n 0) '() (list (nested (- n 1)))))
 (test-group "the limits, through the look that passes plain data as it is"
-  (set-value-limits! 50 1000)
+  (set-value-limits! (limits-of '((max-depth 50) (max-frame 2000))))
   (test "plain data nested to the limit goes as it is" (nested 49)
     (encode (nested 49) env "it"))
   (test "deeper is refused" "it nests deeper than the lab's max-depth, 50"
@@ -60,7 +70,7 @@
       '(1 (2 "three") four)
     (let ((p (round-trip (list '(1 (2 "three")) (lambda () 'four)))))
       (list (caar p) (cadr (car p)) ((cadr p)))))
-  (set-value-limits! 4000 524288))
+  (set-value-limits! (limits-of '())))
 (test "a receiver's table of compiled sources, emptied when full, compiles again"
     '(0 4100 0)
   ;; 4,101 sources, more than the table holds, through one decoder.

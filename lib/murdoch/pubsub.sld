@@ -8,7 +8,7 @@
           request-non-exclusive request-components capability-layout check-subjects
           request-status subscription-statuses receive-publication receive-request
           receive-request-exclusive receive-request-non-exclusive receive-components
-          set-lease! start-leases! on-free! offer-subjects! get-system-load load-monitor
+          start-leases! on-free! offer-subjects! get-system-load load-monitor
           battery-monitor *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)

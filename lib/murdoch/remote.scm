@@ -12,9 +12,7 @@
 ;;> received code runs in, and starts answering calls.  \var{port} may
 ;;> override the lab's port for uid.
 (define (start-aspace! lab uid environment . port)
-  (let ((entry (lab-aspace-by-uid lab uid))
-        (max-frame (lab-setting lab 'max-frame))
-        (max-depth (lab-setting lab 'max-depth)))
+  (let ((entry (lab-aspace-by-uid lab uid)))
     (join-lab! lab uid
                (if entry (lab-aspace-host entry) (lab-setting lab 'interface))
                (cond ((pair? port) (car port))
@@ -23,8 +21,8 @@
                environment
                (make-decoder environment decode-proxy))
     (set-log-name! (string-append "murdoch " (symbol->string uid)))
-    (configure-wire! (lab-key lab) max-frame max-depth)
-    (set-value-limits! max-depth (quotient max-frame 2))
+    (start-wire! lab)
+    (set-value-limits! lab)
     (set-sandbox-ports! (current-output-port) (current-error-port))
     (start-serving! lab)
     (spawn prober 'prober)

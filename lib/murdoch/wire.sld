@@ -4,7 +4,7 @@
 
 (define-library (murdoch wire)
   (export open-connection socket-port message-kinds make-message check-message
-          check-datagram configure-wire! frame-text write-frame! send-frame! read-frame
+          check-datagram start-wire! frame-text write-frame! send-frame! read-frame
           open-frame max-frame frame-fail parse-message protocol-fault? fault-message
           log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign
           hmac-sha256-open open-multicast-socket read-netstring write-netstring

@@ -10,6 +10,8 @@
 ;; (a robot's motion) is woken when it is marked, by the procedure it gave
 ;; with-wake-on-abandon, rather than look at its mark again and again.
 
+;; Global: a caller gives up from its connection's thread, and the mark
+;; is read in the thread it stops.
 (define *abandoned* '())                ; the marked threads
 (define *wakers* '())                   ; ((thread . wake) ...), innermost first
 (define *abandoned-lock* (make-mutex 'abandoned))

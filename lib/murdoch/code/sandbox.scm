@@ -55,7 +55,7 @@
 
 ;; The environments whose imports are guarded: their parents hold the
 ;; imported cells (a mutable environment's own frame holds what is
-;; defined in it).
+;; defined in it).  Global: guarded-set! reads it as code is compiled.
 (define *guarded* '())
 
 ;;> Murdoch's set! inside the sandbox: an ordinary set! of a local
@@ -79,7 +79,7 @@
 ;;; Threads
 
 ;; The threads that serve calls: a reader, a worker, the multicast
-;; listener, the janitor.
+;; listener, the janitor.  Global: any layer's thread may be one.
 (define *protected* (make-hash-table eq?))
 (define *protected-lock* (make-mutex 'protected))
 
@@ -114,7 +114,7 @@
 ;; thread's last binding of that port is made a sink, so that the line
 ;; logged here is the only one.
 (define (log-thread-death e)
-  (parameterize ((current-error-port (or *err* (current-error-port))))
+  (parameterize ((current-error-port (process-port sandbox-err (current-error-port))))
     (log-warn "thread " (thread-label (current-thread)) " died: " (error-message e)))
   (thread-parameters-set! (cons (cons current-error-port (open-output-string))
                                 (thread-parameters))))
@@ -127,14 +127,26 @@
 
 ;;; Allocation
 
-(define *max-alloc* #f)                 ; the lab's max-alloc, in bytes
+;; The sandbox of this process: the lab's max-alloc, read by
+;; make-lab-environment, and the process's ports that received code
+;; writes through to, given by set-sandbox-ports!.  Global: every call
+;; received runs in it.
+(define-record-type sandbox
+  (make-sandbox max-alloc out err)
+  sandbox?
+  (max-alloc sandbox-max-alloc)         ; bytes
+  (out sandbox-out sandbox-out-set!)
+  (err sandbox-err sandbox-err-set!))
+
+(define *sandbox* #f)
 
 ;; Refuses count items of unit bytes each, past the lab's max-alloc.
 (define (check-alloc! who count unit)
-  (if (and *max-alloc* (real? count) (> (* count unit) *max-alloc*))
-      (error (string-append who ": " (number->string count)
-                            " would take more than the lab's max-alloc, "
-                            (number->string *max-alloc*) " bytes"))))
+  (let ((most (and *sandbox* (sandbox-max-alloc *sandbox*))))
+    (if (and most (real? count) (> (* count unit) most))
+        (error (string-append who ": " (number->string count)
+                              " would take more than the lab's max-alloc, "
+                              (number->string most) " bytes")))))
 
 ;; A constructor whose first argument is a count of unit bytes each.
 (define (sized who unit make)
@@ -175,14 +187,17 @@
 
 ;;; Each call's own ports and parameters
 
-(define *out* #f)                       ; the process's output ports
-(define *err* #f)
-
 ;;> Gives the ports that received code writes through to: the process's
-;;> standard output and error, taken at start-up.
+;;> standard output and error, taken at start-up, after
+;;> make-lab-environment.
 (define (set-sandbox-ports! out err)
-  (set! *out* out)
-  (set! *err* err))
+  (sandbox-out-set! *sandbox* out)
+  (sandbox-err-set! *sandbox* err))
+
+;; The process's port that received code writes through to, by
+;; which, sandbox-out or sandbox-err, else the current one.
+(define (process-port which current)
+  (or (and *sandbox* (which *sandbox*)) current))
 
 ;; A port that writes through to port, and can be closed without closing
 ;; it.  It holds what is written until it is flushed, as any port, and at
@@ -210,15 +225,17 @@
     (if (and (call-ports? p) (port-open? (call-ports-in p))
              (port-open? (call-ports-out p)) (port-open? (call-ports-err p)))
         p
-        (let ((new (make-call-ports (make-null-input-port)
-                                    (through-port (or *out* (current-output-port)))
-                                    (through-port (or *err* (current-error-port))))))
+        (let ((new (make-call-ports
+                    (make-null-input-port)
+                    (through-port (process-port sandbox-out (current-output-port)))
+                    (through-port (process-port sandbox-err (current-error-port))))))
           (thread-specific-set! (current-thread) new)
           new))))
 
 (define (flush-if-open port)
   (if (port-open? port) (flush-output-port port)))
 
+;; Global: each layer adds its own as it loads (sandbox-parameter!).
 (define *parameters* '())
 
 ;;> Gives each received call a binding of \var{parameter} of its own, so
@@ -255,7 +272,7 @@
 ;;> loaded.  Each file is read here and evaluated in the environment, so
 ;;> the files themselves can use no more than received code can.
 (define (make-lab-environment lab)
-  (set! *max-alloc* (lab-setting lab 'max-alloc))
+  (set! *sandbox* (make-sandbox (lab-setting lab 'max-alloc) #f #f))
   (let ((env (apply mutable-environment sandbox-libraries)))
     (set! *guarded* (cons env *guarded*))
     (for-each (lambda (file) (load-into (lab-path lab file) env))

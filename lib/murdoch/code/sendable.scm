@@ -179,19 +179,28 @@
 ;; and encoding counts the pairs it meets: more than a frame could hold is
 ;; an error, which a circular value reaches too.
 
-(define *max-depth* 4000)               ; the lab's max-depth
-(define *max-pairs* 524288)             ; a frame of max-frame bytes holds fewer
+;; The limits of the lab this process joined, read once by
+;; set-value-limits!, since every pair walked reads them.  Global: every
+;; value sent or received is that lab's.
+(define-record-type value-limits
+  (make-value-limits depth pairs)
+  value-limits?
+  (depth limits-depth)                  ; the lab's max-depth
+  (pairs limits-pairs))                 ; a frame of max-frame bytes holds fewer
 
-;;> Sets the deepest nesting a value may have, and the most pairs one may
-;;> hold (half the largest frame: a pair is written in two bytes or more).
-(define (set-value-limits! depth pairs)
-  (set! *max-depth* depth)
-  (set! *max-pairs* pairs))
+(define *limits* #f)
+
+;;> Takes the limits of values from \var{lab}: the deepest nesting a value
+;;> may have, its max-depth, and the most pairs one may hold, half its
+;;> max-frame (a pair is written in two bytes or more).
+(define (set-value-limits! lab)
+  (set! *limits* (make-value-limits (lab-setting lab 'max-depth)
+                                    (quotient (lab-setting lab 'max-frame) 2))))
 
 (define (check-depth depth what)
-  (if (> depth *max-depth*)
+  (if (> depth (limits-depth *limits*))
       (send-fail (what-string what) " nests deeper than the lab's max-depth, "
-                 (number->string *max-depth*))))
+                 (number->string (limits-depth *limits*)))))
 
 ;; (map f ls) for a list that may be improper, by iteration: f takes each
 ;; element, and the tail that is not a pair.
@@ -214,7 +223,7 @@
 ;; in plain.c, beside plain-atom?, the atoms that do) stops after a
 ;; budget of pairs, or at the depth limit, so that a long, deep or
 ;; circular value goes the general way, which says what is wrong with it.
-(define (plain? x) (plain-within? x 100000 *max-depth*))
+(define (plain? x) (plain-within? x 100000 (limits-depth *limits*)))
 
 ;;> The S-expression that stands for \var{x} on the wire.  \var{env} is the
 ;;> environment whose procedures travel by name; \var{what} names \var{x}
@@ -225,11 +234,10 @@
         (else (encode-compound x env what))))
 
 ;; The walk's procedures are defined at the top, not inside
-;; encode-compound: Chibi would make each of them anew for every value
-;; sent, a microsecond of every call.  left is a one-element vector, the
-;; pairs the value may still hold.
+;; encode-compound (docs/speed.md, What Chibi charges).  left is a
+;; one-element vector, the pairs the value may still hold.
 (define (encode-compound x env what)
-  (enc x env what 0 (make-vector 1 *max-pairs*)))
+  (enc x env what 0 (make-vector 1 (limits-pairs *limits*))))
 
 (define (spend! left n what)
   (vector-set! left 0 (- (vector-ref left 0) n))
@@ -280,17 +288,13 @@
 ;; global's, while its name is bound to it, and a closure's that captures
 ;; no variable (and was not a global when first sent: one bound to a
 ;; global name afterwards still goes as its source, which means the same
-;; there).  The same procedures are sent again and again (a
-;; request's, its user's closure), and finding a global's name, or that a
-;; closure is one, was most of the 4 us their encoding took.  At most
-;; max-known are kept, so that closures made and sent once are let go.
+;; there).  The same procedures are sent again and again (a request's,
+;; its user's closure).  At most max-known are kept, so that closures
+;; made and sent once are let go.  Global: a cache for every thread.
 (define max-known 4096)
 (define *known* (make-hash-table eq?))  ; procedure -> (env cell . code)
 
-;; Looked up with hash-table-cell, srfi 69's lookup in C itself, which
-;; hash-table-ref/default wraps in Scheme for 0.15 us more a call; and
-;; checked by a procedure of its own, since Chibi makes a closure for
-;; each let that uses the variables around it, 0.08 us apiece.
+;; hash-table-cell, and no let: docs/speed.md, What Chibi charges.
 (define (known-encoding p env)
   (known-code (hash-table-cell *known* p #f) p env))
 
@@ -344,11 +348,8 @@
 ;; closure is sent again and again, so makers are kept by source.  A peer
 ;; could send sources without end, so the table is emptied when it holds
 ;; max-makers: a program sends far fewer lambdas than that.  The table
-;; compares keys with Chibi's own equal?, which srfi 69 runs in C: R7RS's,
-;; which (scheme base) gives, is Chibi's cycle-safe equiv?, written in
-;; Scheme, and a table called it from C, a fresh run of the VM, for 2 us a
-;; lookup.  A source nests no deeper than max-depth, below where Chibi's
-;; stops looking.
+;; compares keys with Chibi's own equal? (docs/speed.md); a source nests
+;; no deeper than max-depth, below where it stops looking.
 (define max-makers 4096)
 
 (define (make-closure-compiler env)

@@ -14,6 +14,6 @@
                 strip-syntactic-closures
                 make-exception exception? exception-kind)
           (chibi ast)
-          (srfi 1) (srfi 18) (srfi 69))
+          (srfi 1) (srfi 18) (srfi 69) (murdoch lab))
   (include-shared "sendable")
   (include "sendable.scm"))

@@ -22,8 +22,9 @@
   (status subscription-status subscription-status-set!) ; (), task, shared
   (holds subscription-holds subscription-holds-set!))   ; live reservations
 
-;; Guarded by *subscriptions-lock*, as in the thesis: monitor threads
-;; change the list while messages read it.  The list itself is never
+;; The thesis's names (A.8), global as there.  Guarded by
+;; *subscriptions-lock*, as in the thesis: monitor threads change the
+;; list while messages read it.  The list itself is never
 ;; changed, only replaced (add-subscription!, remove-subscription!), so
 ;; that addressed-here?, on every message, can read it without the lock.
 (define *subscriptions* '())
@@ -112,9 +113,9 @@
              (loop (+ i 1) (+ i 1) (cons (substring s start i) acc)))
             (else (loop start (+ i 1) acc))))))
 
-;; A predicate true of the topics the address subject pattern reaches.
-;; Made once per message: splitting a subject into its levels copies its
-;; name (Chibi's symbol->string), and most subjects have no wildcard.
+;; A predicate true of the topics the address subject pattern reaches,
+;; made once per message: most subjects have no wildcard, and splitting
+;; one into its levels copies its name (docs/speed.md).
 (define (subject-matcher pattern)
   (let ((levels (subject-levels pattern)))
     (if (or (member "*" levels) (member ">" levels))
@@ -133,8 +134,7 @@
 ;; (the thesis says "proper subset"; it means subset).  It takes no lock:
 ;; it reads the list once, and then only the topics, which never change.
 ;; A subject subscribed as it is matches itself, wildcards included, and
-;; is the common case (all, a uid): found so, it costs no matcher, whose
-;; splitting of the subject was most of a receiver's work on a request.
+;; is the common case (all, a uid): found so, it costs no matcher.
 (define (addressed-here? topic)
   (let ((subscriptions *subscriptions*))
     (every (lambda (pattern)
@@ -146,15 +146,14 @@
 
 ;;; Sending
 
-;; Sends a message to the lab (remote-apply-all's answers).  An address
-;; that is one address space's uid reaches that address space alone (each
-;; subscribes to its own uid and to no other's), so it is sent there only:
-;; metrics ask each candidate point to point, and would otherwise cost N
-;; messages each.
+;; Sends a message to the lab: a result (call.scm) of each address space
+;; that it reached.  An address that is one address space's uid reaches
+;; that address space alone (each subscribes to its own uid and to no
+;; other's), so it is sent there only: metrics ask each candidate point to
+;; point, and would otherwise cost N messages each.
 (define (deliver kind topic proc . args)
   (if (and (symbol? topic) (memq topic (live-uids)))
-      (apply (if (eq? kind 'run) remote-run-all! remote-apply-all)
-             (list (uid->aspace topic)) proc args)
+      (call-all (list (uid->aspace topic)) kind proc args)
       (apply (if (eq? kind 'run) broadcast-run! broadcast-apply) proc args)))
 
 ;;> Publishes a message (asynchronous, Figure 4.1): each live address
@@ -163,7 +162,7 @@
 ;;> which says nothing of who evaluated it.
 (define (publish topic proc . args)
   (check-subjects-and-procedure "publish" (subject-list topic) proc)
-  (filter-map (lambda (r) (and (cadr r) (car r)))
+  (filter-map (lambda (r) (and (result-ok? r) (result-uid r)))
               (told-failures 'publish
                              (deliver 'run topic receive-publication topic
                                       (local-aspace-uid) proc args))))
@@ -178,12 +177,13 @@
   (answers 'request (deliver 'apply topic receive-request topic
                              (local-aspace-uid) proc args)))
 
-;; The evaluators' (uid value) from the receivers' (#t uid value) and
-;; (#f uid) answers; the failures are told (see told-failures).
+;; The evaluators' (uid value) from results whose values are receivers'
+;; answers (see receive-request); the failures are told (see
+;; told-failures).
 (define (answers what results)
   (filter-map (lambda (r)
-                (and (cadr r) (car (car (cddr r)))
-                     (cdr (car (cddr r)))))
+                (and (result-ok? r) (evaluated? (result-value r))
+                     (evaluation (result-value r))))
               (told-failures what results)))
 
 ;; A receiver whose evaluation raised, or that did not answer, is left out
@@ -192,8 +192,8 @@
 ;; subscribed.  Answers results.
 (define (told-failures what results)
   (for-each (lambda (r)
-              (if (not (cadr r))
-                  (log-warn what " on " (car r) " failed: " (car (cddr r)))))
+              (if (not (result-ok? r))
+                  (log-warn what " on " (result-uid r) " failed: " (result-value r))))
             results)
   results)
 
@@ -251,24 +251,30 @@
     (map (lambda (c i)
            (let ((entries (map (lambda (row) (component-entry row i n)) rows)))
              (list (answers (if (eq? (car c) 'exclusive) 'request-exclusive 'request)
-                            entries)
+                            (map (lambda (e)
+                                   (if (result-ok? e)
+                                       (make-result (result-uid e) #t
+                                                    (component-answer (result-value e)))
+                                       e))
+                                 entries))
                    (filter-map (lambda (e)
-                                 (and (cadr e) (car (car (cddr e)))
-                                      (cons (car e) (cadr (cddr e)))))
+                                 (and (result-ok? e)
+                                      (evaluated? (component-answer (result-value e)))
+                                      (cons (result-uid e)
+                                            (component-asked (result-value e)))))
                                entries))))
          components (iota n))))
 
-;; Receiver row's entry for component i of n, as remote-apply-all gives
-;; request its entries, with the askings' answers after the answer:
-;; (uid #t answer asked) or (uid #f message).
+;; Receiver row's result for component i of n: its value that
+;; component's (answer asked), or what was wrong with the row.
 (define (component-entry row i n)
-  (let ((value (and (cadr row) (car (cddr row)))))
-    (cond ((not (cadr row)) row)
+  (let ((value (and (result-ok? row) (result-value row))))
+    (cond ((not (result-ok? row)) row)
           ((not (and (list? value) (= (length value) n)
                      (every (lambda (c) (and (list? c) (= (length c) 2) (pair? (car c))))
                             value)))
-           (list (car row) #f "a malformed answer to request-components"))
-          (else (cons* (car row) #t (list-ref value i))))))
+           (make-result (result-uid row) #f "a malformed answer to request-components"))
+          (else (make-result (result-uid row) #t (list-ref value i))))))
 
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).
@@ -289,6 +295,15 @@
                     *subscriptions*)))))
 
 ;;; Receiving: what the senders above run in each address space
+;;
+;; What a receiver answers travels back as a list: (#t UID VALUE) when it
+;; evaluated the message, else (#f UID); for request-components, (ANSWER
+;; ASKED) for each component.
+
+(define (evaluated? answer) (car answer))
+(define (evaluation answer) (cdr answer)) ; (UID VALUE)
+(define (component-answer entry) (car entry))
+(define (component-asked entry) (cadr entry))
 
 ;;> Evaluates a publication if it is addressed here.
 (define (receive-publication topic uid proc args)
@@ -321,15 +336,16 @@
 ;;> candidate, its answer to each asking, (#t value) or (#f message).
 (define (receive-components components task-name uid)
   (map (lambda (c)
-         (let ((answer (if (eq? (car c) 'exclusive)
-                           (receive-request-exclusive (cadr c) task-name uid
-                                                      (car (cddr c)) '())
-                           (receive-request (cadr (cadr c)) uid (car (cddr c)) '()))))
-           (list answer (if (car answer) (map ask-here (cadr (cddr c))) '()))))
+         (match c
+           ((type layout proc askings)
+            (let ((answer (if (eq? type 'exclusive)
+                              (receive-request-exclusive layout task-name uid proc '())
+                              (receive-request (cadr layout) uid proc '()))))
+              (list answer (if (evaluated? answer) (map ask-here askings) '()))))))
        components))
 
 ;; An asking is the user's code, so that one raising costs only its own
-;; answer (a guard takes a continuation: one only where user code runs).
+;; answer (a guard only where user code runs: docs/speed.md).
 (define (ask-here proc)
   (guard (e (#t (list #f (error-message e))))
     (list #t (proc))))
@@ -345,16 +361,29 @@
   (deadline reservation-deadline reservation-deadline-set!)
   (state reservation-state reservation-state-set!)) ; reserved running done
 
-(define *reservations* '())             ; those not yet promised away
-(define *lease* 30)
+;; Those not yet promised away.  Global, beside the subscriptions, and
+;; under their lock: a reservation holds subscriptions.
+(define *reservations* '())
 
-;;> Seconds an unapplied promise holds its subjects.
-(define (set-lease! seconds) (set! *lease* seconds))
+;; The leases, made by start-leases!: the lab's lease, read there, and
+;; the thread that frees what outlives it.  Global: one per process, read
+;; by every reservation.
+(define-record-type leases
+  (make-leases seconds keeper)
+  leases?
+  (seconds lease-seconds)
+  (keeper lease-keeper-thread))
 
-;;> Starts freeing the subjects of promises unapplied for \var{seconds}.
-(define (start-leases! seconds)
-  (set-lease! seconds)
-  (thread-start! (make-logged-thread lease-keeper 'lease-keeper)))
+(define *leases* #f)
+
+(define (lease) (lease-seconds *leases*))
+
+;;> Starts freeing the subjects of promises unapplied for \var{lab}'s
+;;> lease.
+(define (start-leases! lab)
+  (set! *leases* (make-leases (lab-setting lab 'lease)
+                              (make-logged-thread lease-keeper 'lease-keeper)))
+  (thread-start! (lease-keeper-thread *leases*)))
 
 ;; A subject is free for task when it is free or already held by task: two
 ;; components of one task may both get a promise from one robot, and
@@ -405,7 +434,7 @@
 
 (define (new-reservation! task exclusive shared)
   (let ((r (make-reservation task exclusive shared
-                             (+ (monotonic-seconds) *lease*) 'reserved)))
+                             (+ (monotonic-seconds) (lease)) 'reserved)))
     (set! *reservations* (cons r *reservations*))
     r))
 
@@ -429,7 +458,8 @@
       (*on-free*)))
 
 ;; What runs when a reservation of exclusive subjects here ends: tasks
-;; that wait for robots hear of it (task.scm).
+;; that wait for robots hear of it (task.scm).  Global: the task layer
+;; sets it as it loads, before the lab is joined.
 (define *on-free* (lambda () #f))
 
 ;;> Sets the thunk that runs, outside any lock, each time exclusive
@@ -438,7 +468,8 @@
 
 ;; While a freed robot is offered to a waiting task's poser, exclusive
 ;; subjects here are reserved for that poser's requests only: (uid
-;; . until), until a monotonic-seconds, or #f.
+;; . until), until a monotonic-seconds, or #f.  Global, beside the
+;; subscriptions and under their lock.
 (define *offered* #f)
 
 ;;> For \var{seconds}, reserves exclusive subjects here only at the
@@ -498,13 +529,13 @@
   (with-subscriptions
     (lambda ()
       (and (eq? (reservation-state r) 'reserved)
-           (begin (reservation-deadline-set! r (+ (monotonic-seconds) *lease*))
+           (begin (reservation-deadline-set! r (+ (monotonic-seconds) (lease)))
                   #t)))))
 
 ;; Frees the reservations whose promise was never applied: the sender
 ;; died, or the network broke.  No subject is held for ever.
 (define (lease-keeper)
-  (thread-sleep! (min 1 (/ *lease* 4)))
+  (thread-sleep! (min 1 (/ (lease) 4)))
   (for-each (lambda (r)
               (log-warn "lease ran out: freeing " (reservation-exclusive r)
                         (reservation-shared r) " held for "

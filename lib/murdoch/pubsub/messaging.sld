@@ -9,9 +9,9 @@
           capability-layout check-subjects
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive receive-components set-lease! start-leases!
+          receive-request-non-exclusive receive-components start-leases!
           on-free! offer-subjects!)
   (import (only (murdoch code) make-logged-thread) (scheme base) (srfi 1) (srfi 18)
-          (murdoch sys) (murdoch lab) (murdoch remote)
+          (chibi match) (murdoch sys) (murdoch lab) (murdoch remote)
           (only (murdoch wire) error-message))
   (include "messaging.scm"))

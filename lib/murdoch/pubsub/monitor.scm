@@ -16,8 +16,9 @@
 ;;> subscribes to idle.
 (define *load-threshold* ".75")
 
-;; Received code reads these and cannot assign them (sandbox.scm): a
-;; setting meant to change changes through its procedure.
+;; The thesis's names (A.5, A.6), global as there.  Received code reads
+;; these and cannot assign them (sandbox.scm): a setting meant to change
+;; changes through its procedure.
 
 ;;> Sets *battery-charging*, the voltage in tenths above which a robot is
 ;;> taken to be on its charging tether.
@@ -30,27 +31,37 @@
 ;;> monitor subscribes to idle.
 (define (set-load-threshold! load) (set! *load-threshold* load))
 
-(define *monitor-period* 60)
-(define *load-source* #f)               ; a thunk answering a number
+;; What the monitors take from the lab, made by initialize-subscriptions!:
+;; its monitor-period, and where the load comes from.  Global: the
+;; monitors are the thesis's procedures of no arguments.
+(define-record-type monitoring
+  (make-monitoring period load-source)
+  monitoring?
+  (period monitoring-period)            ; seconds between looks
+  (load-source monitoring-load-source)) ; a thunk answering a number
+
+(define *monitoring* #f)
 
 ;;> This machine's load as a string, e.g. "0.42": from the lab's (load ...)
 ;;> clause, else the one-minute average of /proc/loadavg.
 (define (get-system-load)
-  (number->string (*load-source*)))
+  (number->string ((monitoring-load-source *monitoring*))))
 
 (define (start-thread! name thunk)
   (thread-start! (make-logged-thread thunk name)))
 
+;; The thesis's names (A.6), global as there: a monitor started again
+;; ends the thread it replaces.
 (define *load-monitor-thread* #f)
 (define *battery-monitor-thread* #f)
 
 ;; A monitor keeps subject in the subscription list while present? holds,
-;; looking every *monitor-period* seconds.
+;; looking every monitor-period seconds.
 (define (watch subject present?)
   (lambda ()
     (let loop ()
       (if (present?) (subscribe subject) (unsubscribe subject))
-      (thread-sleep! *monitor-period*)
+      (thread-sleep! (monitoring-period *monitoring*))
       (loop))))
 
 ;; Starts a monitor thread, terminating the one it replaces, as A.6 does.
@@ -111,13 +122,14 @@
 ;;> capabilities; idle through load-monitor; untethered through
 ;;> battery-monitor on robots.
 (define (initialize-subscriptions! lab entry)
-  (set! *monitor-period* (lab-setting lab 'monitor-period))
-  (set! *load-source* (load-source (and entry (lab-aspace-clause entry 'load))))
+  (set! *monitoring*
+        (make-monitoring (lab-setting lab 'monitor-period)
+                         (load-source (and entry (lab-aspace-clause entry 'load)))))
   (for-each subscribe (list 'all (local-aspace-uid)))
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
                   (else '())))
   (load-monitor)
   (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))
-  (start-leases! (lab-setting lab 'lease))
+  (start-leases! lab)
   #t)

@@ -16,40 +16,60 @@
   (host aspace-host)
   (port aspace-port))
 
-(define *local* #f)                     ; the local aspace, once started
-(define *started-at* #f)                ; (utc-seconds) then
-(define *lab* #f)
-(define *peers* (make-hash-table eq?))  ; uid -> aspace, from lab and hellos
-(define *peers-lock* (make-mutex 'peers))
+;; This process as an address space of its lab: made by join-lab!, once.
+;; Global: a process is one address space, and every layer above asks it.
+(define-record-type membership
+  (make-membership lab started-at environment decode timeout peers unreachable
+                   peers-lock)
+  membership?
+  (lab membership-lab)
+  (started-at membership-started-at)    ; (utc-seconds) at join-lab!
+  (local membership-local membership-local-set!)
+  (environment membership-environment)  ; received code runs in it
+  (decode membership-decode)            ; received code is rebuilt by it
+  (timeout membership-timeout membership-timeout-set!) ; remote-apply's default
+  (peers membership-peers)              ; uid -> aspace, from lab and hellos
+  (unreachable membership-unreachable)  ; uid -> #t: out of the live set
+  (peers-lock membership-peers-lock))   ; over peers and unreachable
+
+(define *membership* #f)
+
+(define (joined)
+  (or *membership* (error "this process has not joined a lab")))
+
+(define (with-peers thunk)
+  (with-lock (membership-peers-lock (joined)) thunk))
 
 ;;> The local address space.
-(define (local-aspace)
-  (or *local* (error "this process has not joined a lab")))
+(define (local-aspace) (membership-local (joined)))
 
 ;;> Makes \var{port} the local address space's: the free one the kernel
 ;;> chose for a guest, which listens on port 0 and says where in its hellos.
 (define (local-aspace-port-set! port)
-  (set! *local* (make-aspace (aspace-uid *local*) (aspace-host *local*) port))
-  (learn-aspace! *local*))
+  (let ((local (local-aspace)))
+    (membership-local-set! (joined)
+                           (make-aspace (aspace-uid local) (aspace-host local) port))
+    (learn-aspace! (local-aspace))))
 
 ;;> The (utc-seconds) at which this address space joined its lab.
-(define (aspace-started-at) *started-at*)
+(define (aspace-started-at) (membership-started-at (joined)))
 
 ;;> The uid of the local address space.
 (define (local-aspace-uid) (aspace-uid (local-aspace)))
 
 ;;> The address space named \var{uid}.
 (define (uid->aspace uid)
-  (or (with-lock *peers-lock* (lambda () (hash-table-ref/default *peers* uid #f)))
+  (or (with-peers
+        (lambda () (hash-table-ref/default (membership-peers (joined)) uid #f)))
       (error "no address space of this uid is known" uid)))
 
 ;;> The uids of every address space known here (the thesis's *uids*).
 (define (known-uids)
-  (with-lock *peers-lock* (lambda () (hash-table-keys *peers*))))
+  (with-peers (lambda () (hash-table-keys (membership-peers (joined))))))
 
 (define (learn-aspace! a)
-  (with-lock *peers-lock*
-    (lambda () (hash-table-set! *peers* (aspace-uid a) a))))
+  (with-peers
+    (lambda () (hash-table-set! (membership-peers (joined)) (aspace-uid a) a))))
 
 ;;; Live membership
 ;;
@@ -59,57 +79,54 @@
 ;; every second and puts it back when it answers.  A newcomer is learned
 ;; from its hello, so it joins by calling anyone.
 
-(define *unreachable* (make-hash-table eq?))   ; uid -> #t
-
 (define (note-unreachable! uid)
-  (if (not (eq? uid (aspace-uid *local*)))
-      (with-lock *peers-lock*
-        (lambda () (hash-table-set! *unreachable* uid #t)))))
+  (if (not (eq? uid (local-aspace-uid)))
+      (with-peers
+        (lambda () (hash-table-set! (membership-unreachable (joined)) uid #t)))))
 
 ;; uid answers again, or a beacon of it came.
 (define (note-reachable! uid)
-  (with-lock *peers-lock* (lambda () (hash-table-delete! *unreachable* uid))))
+  (with-peers
+    (lambda () (hash-table-delete! (membership-unreachable (joined)) uid))))
 
 ;; The uids taken out of the live set, for the prober to try again.
 (define (unreachable-uids)
-  (with-lock *peers-lock* (lambda () (hash-table-keys *unreachable*))))
+  (with-peers (lambda () (hash-table-keys (membership-unreachable (joined))))))
 
 ;;> The uids of the address spaces that answer: the broadcast set.
 (define (live-uids)
-  (with-lock *peers-lock*
-    (lambda ()
-      (remove (lambda (uid) (hash-table-ref/default *unreachable* uid #f))
-              (hash-table-keys *peers*)))))
+  (let ((m (joined)))
+    (with-peers
+      (lambda ()
+        (remove (lambda (uid) (hash-table-ref/default (membership-unreachable m) uid #f))
+                (hash-table-keys (membership-peers m)))))))
 
-;;; Settings
+;;; The timeout
 
-(define *default-timeout* 5)
-
-;;> Seconds remote-apply waits for an answer: the global default.
-(define (set-remote-timeout! seconds) (set! *default-timeout* seconds))
+;;> Seconds remote-apply waits for an answer: the default for this
+;;> address space, the lab's timeout until this is called (a REPL gives
+;;> its repl-timeout).
+(define (set-remote-timeout! seconds) (membership-timeout-set! (joined) seconds))
 
 ;;> A per-call override: (parameterize ((remote-timeout 1)) ...).
 (define remote-timeout (make-parameter #f))
 (sandbox-parameter! remote-timeout)
 
-(define (current-timeout) (or (remote-timeout) *default-timeout*))
+(define (current-timeout) (or (remote-timeout) (membership-timeout (joined))))
 
 ;;; The environment received code runs in
 
-(define *environment* #f)
-(define *decode* #f)
-
 ;;> The environment received code runs in: R7RS base, Murdoch's API and the
 ;;> lab's code files; no file, process, load or eval primitives.
-(define (lab-environment) *environment*)
+(define (lab-environment) (membership-environment (joined)))
 
 ;; The value that received code, an encoded value, stands for here.  The
 ;; code is rebuilt in place (make-decoder): it must be the reader's, fresh
 ;; from a frame, and is not used again.
-(define (decode-value code) (*decode* code))
+(define (decode-value code) ((membership-decode (joined)) code))
 
 (define (describe-procedure proc)
-  (let ((encoded (guard (e (#t #f)) (encode proc *environment* "procedure"))))
+  (let ((encoded (guard (e (#t #f)) (encode proc (lab-environment) "procedure"))))
     (cond ((and (vector? encoded) (eq? (vector-ref encoded 0) 'murdoch:global))
            (vector-ref encoded 1))
           ((and (vector? encoded) (eq? (vector-ref encoded 0) 'murdoch:closure))
@@ -117,21 +134,20 @@
           (else proc))))
 
 ;;> The lab this address space belongs to.
-(define (current-lab) (or *lab* (error "this process has not joined a lab")))
+(define (current-lab) (membership-lab (joined)))
 
 ;;> Makes this process the address space \var{uid} of \var{lab}, listening
 ;;> on \var{port}, receiving code into \var{environment} and decoding what
 ;;> it receives with \var{decode}; answers the local aspace.
 (define (join-lab! lab uid host port environment decode)
-  (set! *lab* lab)
-  (set! *started-at* (utc-seconds))
-  (set! *local* (make-aspace uid host port))
-  (set! *environment* environment)
-  (set! *decode* decode)
-  (set! *default-timeout* (lab-setting lab 'timeout))
+  (set! *membership*
+        (make-membership lab (utc-seconds) environment decode
+                         (lab-setting lab 'timeout) (make-hash-table eq?)
+                         (make-hash-table eq?) (make-mutex 'peers)))
+  (membership-local-set! *membership* (make-aspace uid host port))
   (for-each (lambda (a)
               (learn-aspace! (make-aspace (lab-aspace-uid a) (lab-aspace-host a)
                                           (lab-aspace-port a))))
             (lab-aspaces lab))
-  (learn-aspace! *local*)
-  *local*)
+  (learn-aspace! (local-aspace))
+  (local-aspace))

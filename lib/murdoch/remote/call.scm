@@ -4,29 +4,59 @@
 ;; on the connection to its target (connection.scm) and awaits the answer
 ;; by its deadline: the value, or a remote-error of one of its kinds.
 
-(define (call a kind proc args)
-  (check-not-abandoned (if (eq? kind 'run) "remote-run!" "remote-apply"))
-  (let* ((seconds (current-timeout))
-         (proc-code (encode proc (lab-environment) "the procedure"))
-         (args-code (encode-arguments args))
-         (deadline (+ (monotonic-seconds) seconds)))
-    (let ((g (make-gathering)))
-      (finish-call (start-call a kind proc-code args-code deadline g)
-                   g deadline seconds proc))))
+;; A call as it leaves this address space, to one target or many: what it
+;; applies, encoded once for all of them, and how long it waits.
+(define-record-type call
+  (make-call kind proc args proc-code args-code seconds)
+  call?
+  (kind call-kind)                      ; run or apply
+  (proc call-proc)
+  (args call-args)
+  (proc-code call-proc-code)            ; as encode gives them
+  (args-code call-args-code)
+  (seconds call-seconds))               ; its answers are awaited so long
 
-;; A call sent, its answer to come to gathering g.
-(define (start-call a kind proc-code args-code deadline g)
+;;> The call of \var{kind}, run or apply, of \var{proc} to \var{args},
+;;> encoded, to wait (remote-timeout) seconds.
+(define (new-call kind proc args)
+  (let ((seconds (current-timeout)))
+    (make-call kind proc args (encode proc (lab-environment) "the procedure")
+               (encode-arguments args) seconds)))
+
+;;> The outcome of a call to one of many address spaces: its uid, and the
+;;> value, or why there is none.
+(define-record-type result
+  (make-result uid ok? value)
+  result?
+  (uid result-uid)
+  (ok? result-ok?)                      ; #t when it answered
+  (value result-value))                 ; the value, or what went wrong
+
+(define (result->list r) (list (result-uid r) (result-ok? r) (result-value r)))
+
+(define (caller-name kind) (if (eq? kind 'run) "remote-run!" "remote-apply"))
+
+;; A call of proc to args in address space a: its value, or a remote-error.
+(define (call-to a kind proc args)
+  (check-not-abandoned (caller-name kind))
+  (let ((c (new-call kind proc args)))
+    (let ((deadline (+ (monotonic-seconds) (call-seconds c)))
+          (g (make-gathering)))
+      (finish-call (start-call a c deadline g) g deadline c))))
+
+;; Call c sent to a, its answer to come to gathering g.
+(define (start-call a c deadline g)
   (undo-on-raise
    (lambda () (note-unreachable! (aspace-uid a)))
    (lambda ()
-     (send-call! (connection-to a deadline) kind proc-code args-code g))))
+     (send-call! (connection-to a deadline) (call-kind c) (call-proc-code c)
+                 (call-args-code c) g))))
 
-;; The answer to a pending call, by the deadline (on the monotonic
-;; clock), which is \var{seconds} after the call began: the value, or a
-;; remote-error.
-(define (finish-call p g deadline seconds proc)
+;; The answer to p, pending call c, by the deadline (on the monotonic
+;; clock): the value, or a remote-error.
+(define (finish-call p g deadline c)
   (await-answers g (list p) deadline)
-  (answer-value p seconds proc))
+  (answer-value p c))
 
 ;; Waits until each pending call of ps has its answer, or the deadline
 ;; has passed.  A wait interrupted (Ctrl-C) gives up every call that has
@@ -41,13 +71,14 @@
   (if (and (not (pending-call-answer p)) (pending-call-connection p))
       (give-up-call! (pending-call-connection p) (pending-call-id p))))
 
-;; What the answer of pending call p to a call of proc says: the value, or
-;; a remote-error; none came within seconds, and p is given up.
+;; What the answer of pending call p, of call c, says: the value, or a
+;; remote-error; none came within c's seconds, and p is given up.
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
-(define (answer-value p seconds proc)
-  (let ((uid (pending-call-uid p)))
+(define (answer-value p c)
+  (let ((uid (pending-call-uid p))
+        (proc (call-proc c)))
     (match (pending-call-answer p)
-      (#f (give-up! p) (timed-out uid proc seconds))
+      (#f (give-up! p) (timed-out uid proc (call-seconds c)))
       (('ack . _) #t)
       (('value id value) (decode-value value))
       (('error id message)
@@ -70,68 +101,71 @@
 ;;> and every call is sent before the first answer is awaited, so the time
 ;;> taken is about that of the slowest answer, not their sum.
 (define (remote-apply-all aspaces proc . args)
-  (call-all aspaces 'apply proc args))
+  (map result->list (call-all aspaces 'apply proc args)))
 
 ;;> As remote-apply-all, with remote-run!: the values are #t.
 (define (remote-run-all! aspaces proc . args)
-  (call-all aspaces 'run proc args))
+  (map result->list (call-all aspaces 'run proc args)))
 
+;;> As remote-apply-all and remote-run-all!, for \var{kind} apply or run,
+;;> answering a result for each address space.
 (define (call-all aspaces kind proc args)
   (let ((who (if (eq? kind 'run) "remote-run-all!" "remote-apply-all")))
     (check-not-abandoned who)
     (for-each (lambda (a) (check-aspace who a)) aspaces))
-  (send-all aspaces kind proc args
-            (encode proc (lab-environment) "the procedure")
-            (encode-arguments args)
-            (current-timeout)))
+  (send-all aspaces (new-call kind proc args)))
 
-(define (send-all aspaces kind proc args proc-code args-code seconds)
-  (let* ((deadline (+ (monotonic-seconds) seconds))
+;;> Sends call \var{c} to each of \var{aspaces} in turn, then awaits their
+;;> answers: a result for each.
+(define (send-all aspaces c)
+  (let* ((deadline (+ (monotonic-seconds) (call-seconds c)))
          (g (make-gathering))
          (started
           (capture-each aspace-uid
                         (lambda (a)
-                          (list (aspace-uid a) #t
-                                (if (local? a)
-                                    (local-call kind proc args)
-                                    (start-call a kind proc-code args-code
-                                                deadline g))))
+                          (make-result (aspace-uid a) #t
+                                       (if (local? a)
+                                           (local-call (call-kind c) (call-proc c)
+                                                       (call-args c))
+                                           (start-call a c deadline g))))
                         aspaces)))
     (await-answers g (filter-map started-call started) deadline)
-    (capture-each car
-                  (lambda (s)
-                    (let ((p (started-call s)))
-                      (if p (list (car s) #t (answer-value p seconds proc)) s)))
+    (capture-each result-uid
+                  (lambda (r)
+                    (let ((p (started-call r)))
+                      (if p (make-result (result-uid r) #t (answer-value p c)) r)))
                   started)))
 
-;; The pending call of an entry of send-all's, if it started one.
-(define (started-call s)
-  (and (cadr s) (pending-call? (car (cddr s))) (car (cddr s))))
+;; The pending call of a result of send-all's, if it started one.
+(define (started-call r)
+  (and (result-ok? r) (pending-call? (result-value r)) (result-value r)))
 
 ;; A call to this address space is a remote call too: an abandoned thread
 ;; stops at it (abandon.scm), as a component cut off from its poser whose
 ;; commands go to its own address space must.
 (define (local-call kind proc args)
-  (check-not-abandoned (if (eq? kind 'run) "remote-run!" "remote-apply"))
+  (check-not-abandoned (caller-name kind))
   (if (eq? kind 'run)
       (begin (run-in-worker (lambda () (apply proc args))) #t)
       (apply-here (local-aspace-uid) proc args)))
 
+;;> The result of \scheme{(thunk)} as that of address space \var{uid}, or,
+;;> when it raises, why.
 (define (capture uid thunk)
-  (guard (e (#t (failure-entry uid e)))
-    (list uid #t (thunk))))
+  (guard (e (#t (failure-result uid e)))
+    (make-result uid #t (thunk))))
 
-(define (failure-entry uid e)
-  (list uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
+(define (failure-result uid e)
+  (make-result uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
 
-;; (map entry items), where (entry item) answers (uid #t value); an item
-;; whose entry raised gives (uid #f message), uid being (uid-of item).
-;; The handler is entered once, and again after each failure only: one
-;; per item would cost a continuation each (see undo-on-raise).
+;;> (map entry items), where (entry item) answers a result; an item whose
+;;> entry raised gives the result of its failure, for the uid (uid-of
+;;> item).  The handler is entered once, and again after each failure
+;;> only (docs/speed.md, What Chibi charges).
 (define (capture-each uid-of entry items)
   (let ((done '()) (rest items))
     (let run ()
-      (guard (e (#t (set! done (cons (failure-entry (uid-of (car rest)) e) done))
+      (guard (e (#t (set! done (cons (failure-result (uid-of (car rest)) e) done))
                     (set! rest (cdr rest))
                     (run)))
         (let loop ()
@@ -146,8 +180,7 @@
     (if (null? args)
         (reverse acc)
         (loop (cdr args) (+ i 1)
-              ;; Named only for an error: number->string costs Chibi a
-              ;; string port, 4 KB, and this is every argument of every call.
+              ;; Named only for an error (docs/speed.md, What Chibi charges).
               (cons (encode (car args) (lab-environment)
                             (lambda () (string-append "argument "
                                                       (number->string i))))
@@ -175,7 +208,7 @@
   (check-aspace "remote-run!" a)
   (if (local? a)
       (local-call 'run proc args)
-      (call a 'run proc args)))
+      (call-to a 'run proc args)))
 
 ;;> Applies \var{proc} to \var{args} in address space \var{a} and returns
 ;;> the result.  Raises a remote-error naming \var{a}, the procedure and
@@ -186,7 +219,7 @@
   (check-aspace "remote-apply" a)
   (if (local? a)
       (local-call 'apply proc args)
-      (call a 'apply proc args)))
+      (call-to a 'apply proc args)))
 
 ;;; The answers to datagram calls
 ;;
@@ -194,34 +227,46 @@
 ;; is answered by each address space over its own connection, with an
 ;; answer frame, which that connection's reader hands here.
 
-(define *datagram-calls* (make-hash-table eqv?)) ; id -> (pending-call ...)
-(define *datagram-calls-lock* (make-mutex 'datagram-calls))
-(define *next-datagram-id* 0)
+;; The datagram calls that wait for answers.  Global: any connection's
+;; reader hands in the answers, which come to the caller that sent them.
+(define-record-type datagram-calls
+  (make-datagram-calls waiting lock next-id)
+  datagram-calls?
+  (waiting datagram-calls-waiting)      ; id -> (pending-call ...)
+  (lock datagram-calls-lock)
+  (next-id datagram-calls-next-id datagram-calls-next-id-set!))
+
+(define *datagram-calls* (make-datagram-calls (make-hash-table eqv?)
+                                              (make-mutex 'datagram-calls) 0))
+
+(define (with-datagram-calls thunk)
+  (with-lock (datagram-calls-lock *datagram-calls*) thunk))
 
 ;; A new datagram call's id, whose answers from each of uids will come to
 ;; gathering g; answers it and their pending calls, in the order of uids.
 (define (expect-answers! uids g)
-  (with-lock *datagram-calls-lock*
+  (with-datagram-calls
     (lambda ()
-      (set! *next-datagram-id* (+ *next-datagram-id* 1))
-      (let* ((id *next-datagram-id*)
+      (let* ((id (+ 1 (datagram-calls-next-id *datagram-calls*)))
              (ps (map (lambda (uid) (make-pending-call uid #f id g #f)) uids)))
-        (hash-table-set! *datagram-calls* id ps)
+        (datagram-calls-next-id-set! *datagram-calls* id)
+        (hash-table-set! (datagram-calls-waiting *datagram-calls*) id ps)
         (cons id ps)))))
 
 ;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
-  (with-lock *datagram-calls-lock*
-    (lambda () (hash-table-delete! *datagram-calls* id))))
+  (with-datagram-calls
+    (lambda () (hash-table-delete! (datagram-calls-waiting *datagram-calls*) id))))
 
 ;; Hands an (answer ID KIND VALUE) frame from address space uid to the
 ;; call that waits for it; one for a call no longer waited for is dropped.
 (define (take-datagram-answer! uid message)
   (match message
     (('answer id kind value)
-     (let ((waiting (with-lock *datagram-calls-lock*
+     (let ((waiting (with-datagram-calls
                       (lambda ()
-                        (hash-table-ref/default *datagram-calls* id '())))))
+                        (hash-table-ref/default
+                         (datagram-calls-waiting *datagram-calls*) id '())))))
        (cond ((find (lambda (p) (eq? (pending-call-uid p) uid)) waiting)
               => (lambda (p) (answer-call! p (list kind id value)))))))))
 
@@ -236,7 +281,7 @@
   (for-each (lambda (uid)
               (guard (e (#t #f))       ; still away
                 (parameterize ((remote-timeout probe-seconds))
-                  (call (uid->aspace uid) 'apply local-aspace-uid '()))
+                  (call-to (uid->aspace uid) 'apply local-aspace-uid '()))
                 (note-reachable! uid)))
             (unreachable-uids))
   (prober))

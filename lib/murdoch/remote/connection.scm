@@ -46,7 +46,9 @@
 
 ;; The open connections, and a lock for each uid that one thread holds
 ;; while it connects to that uid: a peer that does not answer holds up the
-;; calls to it for their timeout, and no call to another peer.
+;; calls to it for their timeout, and no call to another peer.  Global:
+;; one connection to each peer for the whole process, made by the first
+;; call to it, from any thread.
 (define *connections* (make-hash-table eq?))  ; uid -> connection
 (define *connecting* (make-hash-table eq?))   ; uid -> mutex
 (define *connections-lock* (make-mutex 'connections))
@@ -121,7 +123,8 @@
 
 ;; The watched connections by descriptor: a vector, which the poller reads
 ;; without a lock (a vector-set! is whole), replaced by a larger one under
-;; *connections-lock* when a descriptor is past its end.
+;; *connections-lock* when a descriptor is past its end.  Global, as the
+;; connections: the process has one poller, started by the first connect.
 (define *watched* (make-vector 64 #f))
 (define *poller-port* #f)               ; on the epoll descriptor
 
@@ -146,8 +149,7 @@
 
 ;; Reads each connection as its bytes come.  A frame that breaks the
 ;; protocol closes its connection; the others carry on.  One handler for
-;; the thread's life, entered again after each fault: one per frame would
-;; cost a continuation each (see undo-on-raise).
+;; the thread's life, entered again after each fault (docs/speed.md).
 (define (poll-connections)
   (let ((current #f))
     (define (take! fd)

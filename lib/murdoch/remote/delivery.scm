@@ -13,7 +13,7 @@
 
 ;;> remote-apply-all to every live address space (here too): by one
 ;;> multicast datagram when the lab's delivery is multicast and the message
-;;> fits, else to each in turn.
+;;> fits, else to each in turn.  Answers a result (call.scm) for each.
 (define (broadcast-apply proc . args) (broadcast 'apply proc args))
 
 ;;> remote-run-all! to every live address space, as broadcast-apply.
@@ -21,18 +21,15 @@
 
 (define (broadcast kind proc args)
   (check-not-abandoned (if (eq? kind 'run) "broadcast-run!" "broadcast-apply"))
-  (let ((seconds (current-timeout))
-        (proc-code (encode proc (lab-environment) "the procedure"))
-        (args-code (encode-arguments args)))
-    (or (multicast-call-all kind proc-code args-code proc args seconds)
-        (send-all (map uid->aspace (live-uids)) kind proc args
-                  proc-code args-code seconds))))
+  (let ((c (new-call kind proc args)))
+    (or (multicast-call-all c)
+        (send-all (map uid->aspace (live-uids)) c))))
 
 ;;; Multicast
 
-;; call-all over multicast, when it is on and the message fits a
-;; datagram: answers call-all's list, or #f to send the broadcast way.
-(define (multicast-call-all kind proc-code args-code proc args seconds)
+;; send-all over multicast, when it is on and call c fits a datagram:
+;; answers send-all's results, or #f to send the broadcast way.
+(define (multicast-call-all c)
   (and (eq? (delivery-mode) 'multicast)
        (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                               (live-uids)))
@@ -41,18 +38,20 @@
               (id (car expected))
               (waiting (cdr expected)))
          (define (forget!) (forget-answers! id))
-         (if (send-datagram! (make-message 'call id kind proc-code args-code))
+         (if (send-datagram! (make-message 'call id (call-kind c) (call-proc-code c)
+                                           (call-args-code c)))
              (let* ((here (capture (local-aspace-uid)
-                                   (lambda () (local-call kind proc args))))
-                    (deadline (+ (monotonic-seconds) seconds)))
+                                   (lambda () (local-call (call-kind c) (call-proc c)
+                                                          (call-args c)))))
+                    (deadline (+ (monotonic-seconds) (call-seconds c))))
                (undo-on-raise forget!
                               (lambda () (await-answers g waiting deadline)))
                (forget!)
                (cons here
                      (capture-each pending-call-uid
                                    (lambda (p)
-                                     (list (pending-call-uid p) #t
-                                           (answer-value p seconds proc)))
+                                     (make-result (pending-call-uid p) #t
+                                                  (answer-value p c)))
                                    waiting)))
              (begin (forget!) #f)))))
 
@@ -73,19 +72,18 @@
 ;; Serves the group's calls while this thread is its listener (see
 ;; read-calls).  A call is answered to its sender over TCP.
 (define (serve-group-calls s receive-call)
-  (define (read-on call)
+  (define (answer c kind value)
+    (send-datagram-answer! (served-call-caller c) (served-call-id c) kind value))
+  (define (read-on r)
     (match (receive-call)
       ((sender id kind proc-code args-code)
-       (let ((to (uid->aspace sender)))
-         (serve-call s call (cons to id) kind proc-code args-code
-                     (lambda (kind value)
-                       (send-datagram-answer! to id kind value)))))
+       (serve-call r (make-served-call (uid->aspace sender) id kind proc-code
+                                       args-code answer)))
       (#f #f))
-    (if (reader? s) (read-on call)))
+    (if (reader? s) (read-on r)))
   (read-calls s read-on
-              (lambda (to+id e)
+              (lambda (c e)
                 (guard (e2 (#t (log-warn "an answer was lost: "
                                          (fault-message e2))))
-                  (send-datagram-answer! (car to+id) (cdr to+id) 'error
-                                          (error-message e))))
+                  (reply! c 'error (error-message e))))
               (lambda (e) (log-warn "datagram dropped: " (fault-message e)))))

@@ -30,16 +30,26 @@
 ;; is handed its handler: serving (delivery.scm) imports the group, and
 ;; the group imports nothing above it.
 
-(define *socket* #f)                    ; the group's, or #f: not joined
-(define *address* #f)                   ; the group's address and port
-(define *buffer* #f)                    ; datagrams are received into it
-(define *sequence* 0)                   ; of the last datagram sent
-(define *sequence-lock* (make-mutex 'sequence))
-(define *started-microseconds* 0)       ; (wall-microseconds) at start-group!
-(define *window* 5)                     ; the lab's frame-timeout, seconds
-(define *last-sequence* (make-hash-table eq?))  ; sender -> sequence
-(define *last-heard* (make-hash-table eq?))     ; uid -> monotonic-seconds
-(define *last-heard-lock* (make-mutex 'last-heard))
+;; The lab's group as this address space joined it, made by start-group!;
+;; #f while the lab's delivery is broadcast.  Global: one per process,
+;; shared by its senders, its listener and its beacons.
+(define-record-type group
+  (make-group socket address buffer window started sequence sequence-lock
+              last-sequence last-heard last-heard-lock)
+  group?
+  (socket group-socket)
+  (address group-address)               ; the group's address and port
+  (buffer group-buffer)                 ; each datagram is received into it
+  (window group-window)                 ; the lab's frame-timeout, seconds
+  (started group-started)               ; (wall-microseconds) at start-group!
+  (sequence group-sequence group-sequence-set!) ; of the last datagram sent
+  (sequence-lock group-sequence-lock)
+  (last-sequence group-last-sequence)   ; sender -> sequence
+  (last-heard group-last-heard)         ; uid -> monotonic-seconds
+  (last-heard-lock group-last-heard-lock))
+
+(define *group* #f)
+
 (define max-datagram 60000)
 (define lab-beacons-per-second 16)
 
@@ -59,30 +69,32 @@
             (port (if (pair? (cddr delivery))
                       (car (cddr delivery))
                       (+ (lab-port-base lab) 149))))
-        (set! *socket*
-              (open-multicast-socket group port (aspace-host (local-aspace))))
-        (set! *address* (get-address-info group port))
-        ;; A new 64 KB bytevector for each datagram, dozens a second,
-        ;; would cost more than serving them.
-        (set! *buffer* (make-bytevector 65536))
-        (set! *window* (lab-setting lab 'frame-timeout))
-        (set! *started-microseconds* (wall-microseconds))
+        (set! *group*
+              (make-group (open-multicast-socket group port
+                                                 (aspace-host (local-aspace)))
+                          (get-address-info group port)
+                          ;; One buffer (docs/speed.md, What Chibi charges).
+                          (make-bytevector 65536)
+                          (lab-setting lab 'frame-timeout) (wall-microseconds)
+                          0 (make-mutex 'sequence) (make-hash-table eq?)
+                          (make-hash-table eq?) (make-mutex 'last-heard)))
         (spawn (lambda () (serve receive-call)) 'multicast)
         (spawn send-beacons 'beacon)))))
 
 ;;> How publish and request reach the lab: \scheme{multicast} or
 ;;> \scheme{broadcast}.
-(define (delivery-mode) (if *socket* 'multicast 'broadcast))
+(define (delivery-mode) (if *group* 'multicast 'broadcast))
 
 ;;; Sending
 
 ;; The sequence of the next datagram: two threads sending at once take
 ;; two, else the receivers would drop the second as a replay.
 (define (next-sequence!)
-  (with-lock *sequence-lock*
+  (with-lock (group-sequence-lock *group*)
     (lambda ()
-      (set! *sequence* (max (+ *sequence* 1) (wall-microseconds)))
-      *sequence*)))
+      (let ((sequence (max (+ (group-sequence *group*) 1) (wall-microseconds))))
+        (group-sequence-set! *group* sequence)
+        sequence))))
 
 ;;> Sends \var{body} to the group; #f when it is too large for a datagram.
 (define (send-datagram! body)
@@ -92,7 +104,7 @@
                    (write-simple (list (local-aspace-uid) sequence body) o))))
          (bytes (datagram-bytes text)))
     (and (<= (bytevector-length bytes) max-datagram)
-         (begin (send *socket* bytes 0 *address*) #t))))
+         (begin (send (group-socket *group*) bytes 0 (group-address *group*)) #t))))
 
 (define (beacon-seconds)
   (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
@@ -106,9 +118,9 @@
   (let ((now (monotonic-seconds))
         (period (beacon-seconds)))
     (for-each (lambda (uid)
-                (if (< (with-lock *last-heard-lock*
+                (if (< (with-lock (group-last-heard-lock *group*)
                          (lambda ()
-                           (hash-table-ref/default *last-heard* uid now)))
+                           (hash-table-ref/default (group-last-heard *group*) uid now)))
                        (- now (* 3 period)))
                     (note-unreachable! uid)))
               (known-uids))
@@ -118,13 +130,15 @@
 ;;; Receiving
 
 (define (receive-call)
-  (let ((n (receive! *socket* *buffer*)))
+  (let* ((buffer (group-buffer *group*))
+         (n (receive! (group-socket *group*) buffer)))
     (and (>= n 0)
-         (match (open-datagram *buffer* n)
+         (match (open-datagram buffer n)
            ((sender sequence body)
-            (with-lock *last-heard-lock*
+            (with-lock (group-last-heard-lock *group*)
               (lambda ()
-                (hash-table-set! *last-heard* sender (monotonic-seconds))))
+                (hash-table-set! (group-last-heard *group*) sender
+                                 (monotonic-seconds))))
             ;; Else our own, looped back.
             (and (not (eq? sender (local-aspace-uid)))
                  (datagram-call sender body)))))))
@@ -136,15 +150,15 @@
     (match d
       ((sender sequence body)
        (check-fresh sender sequence)
-       (hash-table-set! *last-sequence* sender sequence)
+       (hash-table-set! (group-last-sequence *group*) sender sequence)
        d))))
 
 (define (check-fresh sender sequence)
-  (cond ((<= sequence (hash-table-ref/default *last-sequence* sender 0))
+  (cond ((<= sequence (hash-table-ref/default (group-last-sequence *group*) sender 0))
          (frame-fail "replayed or out of order"))
-        ((< sequence *started-microseconds*)
+        ((< sequence (group-started *group*))
          (frame-fail "sent before this address space started"))
-        ((< sequence (- (wall-microseconds) (* 1000000 *window*)))
+        ((< sequence (- (wall-microseconds) (* 1000000 (group-window *group*))))
          (frame-fail "older than frame-timeout"))))
 
 ;; A beacon brings its sender (back) into the live set; a call is the

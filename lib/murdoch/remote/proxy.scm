@@ -3,51 +3,62 @@
 ;; A proxy travels as its maker's uid and an id (sendable.scm); applied
 ;; elsewhere, it is a remote-apply back to its maker.
 
-(define *proxies* (make-hash-table eqv?))        ; id -> procedure
-(define *proxy-stubs* (make-hash-table equal?))  ; (uid . id) -> proxy
-(define *proxies-lock* (make-mutex 'proxies))
-(define *next-proxy-id* 0)
+;; The proxies made here and the stubs of those made elsewhere.  Global:
+;; a proxy made in any thread is applied from any connection.
+(define-record-type proxies
+  (make-proxies made stubs lock next-id)
+  proxies?
+  (made proxies-made)                   ; id -> procedure
+  (stubs proxies-stubs)                 ; (uid . id) -> proxy
+  (lock proxies-lock)
+  (next-id proxies-next-id proxies-next-id-set!))
+
+(define *proxies* (make-proxies (make-hash-table eqv?) (make-hash-table equal?)
+                                (make-mutex 'proxies) 0))
+
+(define (with-proxies thunk) (with-lock (proxies-lock *proxies*) thunk))
 
 ;;> Returns a proxy for \var{proc}: a procedure that, applied in any address
 ;;> space, applies \var{proc} in this one and returns its result.
 (define (encap proc)
-  (with-lock *proxies-lock*
+  (with-proxies
     (lambda ()
-      (set! *next-proxy-id* (+ *next-proxy-id* 1))
-      (hash-table-set! *proxies* *next-proxy-id* proc)
-      (proxy-stub (local-aspace-uid) *next-proxy-id*))))
+      (let ((id (+ 1 (proxies-next-id *proxies*))))
+        (proxies-next-id-set! *proxies* id)
+        (hash-table-set! (proxies-made *proxies*) id proc)
+        (proxy-stub (local-aspace-uid) id)))))
 
 ;;> Forgets \var{proxy} here: where it was made, the procedure behind it,
 ;;> so that applying it afterwards raises an error; elsewhere, only this
 ;;> address space's copy of it, which a later message may bring back.
 (define (release-proxy! proxy)
   (let ((ref (proxy-procedure-ref proxy)))
-    (with-lock *proxies-lock*
+    (with-proxies
       (lambda ()
         (if (eq? (proxy-ref-uid ref) (local-aspace-uid))
-            (hash-table-delete! *proxies* (proxy-ref-id ref)))
-        (hash-table-delete! *proxy-stubs*
+            (hash-table-delete! (proxies-made *proxies*) (proxy-ref-id ref)))
+        (hash-table-delete! (proxies-stubs *proxies*)
                             (cons (proxy-ref-uid ref) (proxy-ref-id ref)))))))
 
 ;; The one proxy procedure this address space has for (uid . id), so that
 ;; a proxy sent back and forth stays the same proxy.  Caller holds the lock.
 (define (proxy-stub uid id)
   (let ((key (cons uid id)))
-    (or (hash-table-ref/default *proxy-stubs* key #f)
+    (or (hash-table-ref/default (proxies-stubs *proxies*) key #f)
         (let ((stub (make-proxy-procedure (make-proxy-ref uid id) apply-proxy)))
-          (hash-table-set! *proxy-stubs* key stub)
+          (hash-table-set! (proxies-stubs *proxies*) key stub)
           stub))))
 
 (define (decode-proxy uid id)
-  (with-lock *proxies-lock* (lambda () (proxy-stub uid id))))
+  (with-proxies (lambda () (proxy-stub uid id))))
 
 (define (apply-proxy ref args)
   (let ((uid (proxy-ref-uid ref)))
     (if (eq? uid (local-aspace-uid))
-        (let ((proc (with-lock *proxies-lock*
+        (let ((proc (with-proxies
                       (lambda ()
-                        (hash-table-ref/default *proxies* (proxy-ref-id ref)
-                                                #f)))))
+                        (hash-table-ref/default (proxies-made *proxies*)
+                                                (proxy-ref-id ref) #f)))))
           (if (not proc)
               (error "this proxy no longer exists" uid (proxy-ref-id ref)))
           (apply proc args))

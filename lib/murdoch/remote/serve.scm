@@ -1,11 +1,10 @@
 ;;;; Serving calls: the callee's side of the wire.
 ;;
 ;; Each connection has one reader thread, and the reader runs an apply
-;; itself: handing it to a worker cost a thread switch, about a seventh of
-;; a receiver's CPU a request.  So that a long apply holds up the calls
-;; behind it on its connection for takeover-seconds at most, the janitor
-;; then gives the connection a new reader; the old one answers its call
-;; and ends.
+;; itself, not a worker (docs/speed.md, What Chibi charges).  So that a
+;; long apply holds up the calls behind it on its connection for
+;; takeover-seconds at most, the janitor then gives the connection a new
+;; reader; the old one answers its call and ends.
 
 ;; A connection being served.  Its deadline is set while a frame is half
 ;; read: a peer that stalls mid-frame would otherwise hold a thread and a
@@ -23,11 +22,26 @@
   (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
   (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
 
-(define *serving* '())
-(define *serving-lock* (make-mutex 'serving))
-(define *frame-timeout* 5)
-(define *max-connections* 256)
-(define *max-connections-per-host* 64)
+;; The server: the connections this address space serves, and the lab's
+;; limits on them, made by start-serving!.  Global: one per process, shared
+;; by its accept loop, its readers and the janitor.
+(define-record-type server
+  (make-server frame-timeout max-connections max-connections-per-host
+               servings lock janitor-mutex janitor-wake janitor-resting?
+               last-refusal)
+  server?
+  (frame-timeout server-frame-timeout)  ; the lab's, read once by start-serving!
+  (max-connections server-max-connections)
+  (max-connections-per-host server-max-connections-per-host)
+  (servings server-servings server-servings-set!)
+  (lock server-lock)                    ; over servings, and each serving
+  (janitor-mutex server-janitor-mutex)  ; see rest-while-idle
+  (janitor-wake server-janitor-wake)
+  (janitor-resting? server-janitor-resting? server-janitor-resting?-set!)
+  (last-refusal server-last-refusal server-last-refusal-set!)) ; monotonic
+
+(define *server* #f)
+
 (define janitor-seconds 0.1)
 (define takeover-seconds 0.1)
 
@@ -37,7 +51,7 @@
     ;; The hello, which proves the key, is due within frame-timeout of the
     ;; connect: anyone can connect, and an idle connection holds a
     ;; descriptor.
-    (serving-deadline-set! s (+ (monotonic-seconds) *frame-timeout*))
+    (serving-deadline-set! s (+ (monotonic-seconds) (server-frame-timeout *server*)))
     (janitor-wanted!)
     (read-as-reader s (lambda ()
                         (let ((hello (read-served-frame s "hello" 0)))
@@ -53,7 +67,8 @@
     (serving-deadline-set! s #f)
     (serving-busy-since-set! s #f)
     (serving-applying-set! s '())
-    (with-lock *serving-lock* (lambda () (set! *serving* (cons s *serving*))))
+    (with-lock (server-lock *server*)
+      (lambda () (server-servings-set! *server* (cons s (server-servings *server*)))))
     s))
 
 ;; Runs a reader's loop; the connection ends with it, unless the janitor
@@ -66,20 +81,23 @@
 (define (reader? s) (eq? (current-thread) (serving-thread s)))
 
 (define (end-serving! s)
-  (with-lock *serving-lock*
-    (lambda () (set! *serving* (remove (lambda (x) (eq? x s)) *serving*))))
+  (with-lock (server-lock *server*)
+    (lambda ()
+      (server-servings-set! *server* (remove (lambda (x) (eq? x s))
+                                             (server-servings *server*)))))
   (guard (e (#t #f)) (close-input-port (serving-in s)))
   (guard (e (#t #f)) (close-output-port (serving-out s))))
 
-;; Waits as long as need be for a frame to begin, then gives it
-;; *frame-timeout* seconds to arrive whole: less when a deadline is
-;; already set (the hello's).
+;; Waits as long as need be for a frame to begin, then gives it the lab's
+;; frame-timeout to arrive whole: less when a deadline is already set (the
+;; hello's).
 (define (read-served-frame s nonce count)
   (if (eof-object? (peek-u8 (serving-in s)))
       (eof-object)
       (begin
         (serving-deadline-set! s (or (serving-deadline s)
-                                     (+ (monotonic-seconds) *frame-timeout*)))
+                                     (+ (monotonic-seconds)
+                                        (server-frame-timeout *server*))))
         (janitor-wanted!)
         (let ((message (read-frame (serving-in s) nonce count)))
           (serving-deadline-set! s #f)
@@ -96,10 +114,10 @@
 
 ;; The connections whose (moment s) is before time.
 (define (serving-where moment time)
-  (with-lock *serving-lock*
+  (with-lock (server-lock *server*)
     (lambda ()
       (filter (lambda (s) (let ((t (moment s))) (and t (< t time))))
-              *serving*))))
+              (server-servings *server*)))))
 
 ;; The janitor rests while no frame is half read and no apply runs in a
 ;; reader: looking ten times a second cost an idle lab of 64 a twelfth of
@@ -108,26 +126,23 @@
 ;; flag to the wait; a reader sets what it begins before it reads the flag.
 ;; So either the look sees what the reader began, or the reader sees the
 ;; flag and its wake-up finds the janitor waiting.
-(define *janitor-resting* #f)
-(define *janitor-mutex* (make-mutex 'janitor))
-(define *janitor-wake* (make-condition-variable 'janitor))
-
 (define (rest-while-idle)
-  (mutex-lock! *janitor-mutex*)
-  (set! *janitor-resting* #t)
-  (cond ((pair? (serving-where (lambda (s) (or (serving-deadline s)
-                                               (serving-busy-since s)))
-                               +inf.0))
-         (set! *janitor-resting* #f)
-         (mutex-unlock! *janitor-mutex*))
-        (else (mutex-unlock! *janitor-mutex* *janitor-wake*))))
+  (let ((m (server-janitor-mutex *server*)))
+    (mutex-lock! m)
+    (server-janitor-resting?-set! *server* #t)
+    (cond ((pair? (serving-where (lambda (s) (or (serving-deadline s)
+                                                 (serving-busy-since s)))
+                                 +inf.0))
+           (server-janitor-resting?-set! *server* #f)
+           (mutex-unlock! m))
+          (else (mutex-unlock! m (server-janitor-wake *server*))))))
 
 (define (janitor-wanted!)
-  (when *janitor-resting*
-    (mutex-lock! *janitor-mutex*)
-    (set! *janitor-resting* #f)
-    (condition-variable-signal! *janitor-wake*)
-    (mutex-unlock! *janitor-mutex*)))
+  (when (server-janitor-resting? *server*)
+    (mutex-lock! (server-janitor-mutex *server*))
+    (server-janitor-resting?-set! *server* #f)
+    (condition-variable-signal! (server-janitor-wake *server*))
+    (mutex-unlock! (server-janitor-mutex *server*))))
 
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
@@ -136,7 +151,7 @@
   (end-serving! s))
 
 (define (take-over! s)
-  (mutex-lock! *serving-lock*)
+  (mutex-lock! (server-lock *server*))
   (when (serving-busy-since s)          ; its apply may just have ended
     (let ((t (make-guarded-thread
               (lambda () (read-as-reader s (serving-read-on s)))
@@ -144,86 +159,108 @@
       (serving-busy-since-set! s #f)
       (serving-thread-set! s t)
       (thread-start! t)))
-  (mutex-unlock! *serving-lock*))
+  (mutex-unlock! (server-lock *server*)))
 
 ;;> Run by an apply served here that runs long, a task's component say:
 ;;> its connection gets a new reader at once, so that the caller's next
 ;;> calls do not wait behind it for the janitor's takeover.
 (define (hand-over-connection!)
-  (mutex-lock! *serving-lock*)
+  (mutex-lock! (server-lock *server*))
   (let ((s (find (lambda (s) (and (eq? (serving-thread s) (current-thread))
                                   (serving-busy-since s)))
-                 *serving*)))
-    (mutex-unlock! *serving-lock*)
+                 (server-servings *server*))))
+    (mutex-unlock! (server-lock *server*))
     (if s (take-over! s))))
 
 ;; Marks the start and the end of the reader's inline apply of call id;
 ;; ending answers whether this thread is still the reader.  Until it ends,
 ;; the thread is found by id when its caller gives up.
 (define (inline-apply-begins! s id)
-  (mutex-lock! *serving-lock*)
+  (mutex-lock! (server-lock *server*))
   (serving-applying-set! s (cons (cons id (current-thread))
                                  (serving-applying s)))
   (serving-busy-since-set! s (monotonic-seconds))
-  (mutex-unlock! *serving-lock*)
+  (mutex-unlock! (server-lock *server*))
   (janitor-wanted!))
 
 (define (inline-apply-ends! s)
-  (mutex-lock! *serving-lock*)
+  (mutex-lock! (server-lock *server*))
   (let ((still (reader? s)))
     (serving-applying-set! s (remove (lambda (a) (eq? (cdr a) (current-thread)))
                                      (serving-applying s)))
     (if still (serving-busy-since-set! s #f))
-    (mutex-unlock! *serving-lock*)
+    (mutex-unlock! (server-lock *server*))
     (if (abandoned?) (forget-abandoned! (current-thread)))
     still))
 
 ;; The caller of apply id gave up on it: its thread is marked, to stop
 ;; where it next calls out (abandon.scm).  An apply already done is let be.
 (define (abandon-call! s id)
-  (let ((a (with-lock *serving-lock* (lambda () (assv id (serving-applying s))))))
+  (let ((a (with-lock (server-lock *server*) (lambda () (assv id (serving-applying s))))))
     (when a
       (log-note "call " id " from " (serving-peer s) " abandoned by its caller;"
                 " it stops at its next remote call or robot command")
       (abandon-thread! (cdr a)))))
 
-;; Runs (read-on call) while this thread is s's reader, under one handler
-;; for the thread's life: a handler per call would cost a continuation
-;; each (see undo-on-raise).  The car of call says which call the thread
-;; is running, if any; an error in it is answered by (answer-error call
-;; e), any other by (other-failure e), which may raise to end the reader.
+;; A call that a reader has read, from a connection or the group: who
+;; sent it, its id, what it applies, and how it is answered, a procedure
+;; of the connection's or the group's (see reply!).
+(define-record-type served-call
+  (make-served-call caller id kind proc-code args-code answer)
+  served-call?
+  (caller served-call-caller)           ; its uid, or for the group its aspace
+  (id served-call-id)
+  (kind served-call-kind)               ; run or apply
+  (proc-code served-call-proc-code)
+  (args-code served-call-args-code)
+  (answer served-call-answer))          ; (answer C KIND VALUE)
+
+;;> Answers served call \var{c}: \var{kind} ack, value or error, and
+;;> \var{value}, the encoded value or the error's message.
+(define (reply! c kind value) ((served-call-answer c) c kind value))
+
+;; A thread reading s's calls: the call it runs, until its answer is made,
+;; for read-calls to answer an error to.
+(define-record-type reading
+  (make-reading serving call)
+  reading?
+  (serving reading-serving)
+  (call reading-call reading-call-set!))
+
+;; Runs (read-on r) while this thread is s's reader, r its reading, under
+;; one handler for the thread's life (docs/speed.md, What Chibi charges).
+;; An error in the call r runs is answered by (answer-error call e), any
+;; other by (other-failure e), which may raise to end the reader.
 (define (read-calls s read-on answer-error other-failure)
-  (let ((call (list #f)))
+  (let ((r (make-reading s #f)))
     (let again ()
-      (guard (e ((car call)
+      (guard (e ((reading-call r)
                  => (lambda (c)
-                      (set-car! call #f)
+                      (reading-call-set! r #f)
                       (let ((still (inline-apply-ends! s)))
                         (answer-error c e)
                         (if still (again)))))
                 (#t (other-failure e)
                     (if (reader? s) (again))))
-        (read-on call)))))
+        (read-on r)))))
 
-;; Runs a call that s's reader has read; (reply KIND VALUE) answers it.
-;; Until the answer is made the car of call is marker, for read-calls to
-;; answer an error with.  A run is acknowledged once its procedure is decoded, so that one
-;; that cannot be is reported to its caller, and runs in a worker; an apply
-;; runs here, until the janitor gives s a new reader, and its value goes
-;; back.
-(define (serve-call s call marker kind proc-code args-code reply)
-  (set-car! call marker)
-  (if (eq? kind 'run)
-      (let ((thunk (decode-call proc-code args-code)))
-        (set-car! call #f)
-        (reply 'ack #t)
+;; Runs call c, which reading r has read.  A run is acknowledged once its
+;; procedure is decoded, so that one that cannot be is reported to its
+;; caller, and runs in a worker; an apply runs here, until the janitor
+;; gives r's connection a new reader, and its value goes back.
+(define (serve-call r c)
+  (reading-call-set! r c)
+  (if (eq? (served-call-kind c) 'run)
+      (let ((thunk (decode-call c)))
+        (reading-call-set! r #f)
+        (reply! c 'ack #t)
         (run-in-worker thunk))
-      (begin
-        (inline-apply-begins! s marker)
-        ;; Answered while the call is marked: a value that cannot go back
+      (let ((s (reading-serving r)))
+        (inline-apply-begins! s (served-call-id c))
+        ;; Answered while the call is r's: a value that cannot go back
         ;; (too large, say) is answered with the error instead.
-        (reply 'value (encoded-result proc-code args-code))
-        (set-car! call #f)
+        (reply! c 'value (encoded-result c))
+        (reading-call-set! r #f)
         (inline-apply-ends! s))))
 
 (define (serve-calls s hello)
@@ -255,20 +292,25 @@
     (define (flush-if-idle!)
       (if (zero? (buffered-byte-count (serving-in s)))
           (with-lock write-lock (lambda () (flush-output-port out)))))
+    (define (answer c kind value)
+      (let ((id (served-call-id c)))
+        (answer! (if (eq? kind 'ack)
+                     (make-message 'ack id)
+                     (make-message kind id value)))))
     ;; Serves frames while this thread is the reader; see read-calls.
-    (define (read-on call)
+    (define (read-on r)
       (let ((message (read-served-frame s nonce (+ count 1))))
         (unless (eof-object? message)
           (set! count (+ count 1))
-          (serve-frame s call uid answer!
+          (serve-frame r uid answer
                        (check-message message '(run apply answer abandon)
                                       "a call"))
           (flush-if-idle!)
-          (if (reader? s) (read-on call)))))
+          (if (reader? s) (read-on r)))))
     (define (serve)
       (read-calls s read-on
-                  (lambda (id e)
-                    (answer! (make-message 'error id (error-message e)))
+                  (lambda (c e)
+                    (reply! c 'error (error-message e))
                     (flush-if-idle!))
                   raise))
     (send-frame! out text caller-nonce 0
@@ -276,30 +318,26 @@
     (serving-read-on-set! s serve)
     (serve)))
 
-;; Serves one frame from the caller uid: a call, whose answer goes back
-;; by answer!; the answer to one of our datagram calls; or an abandon.
-(define (serve-frame s call uid answer! message)
+;; Serves one frame from the caller uid, read by r: a call, which answer
+;; answers; the answer to one of our datagram calls; or an abandon.
+(define (serve-frame r uid answer message)
   (match message
     (('answer . _) (take-datagram-answer! uid message))
-    (('abandon id) (abandon-call! s id))
+    (('abandon id) (abandon-call! (reading-serving r) id))
     ((kind id proc-code args-code)
-     (serve-call s call id kind proc-code args-code
-                 (lambda (kind value)
-                   (answer! (if (eq? kind 'ack)
-                                (make-message 'ack id)
-                                (make-message 'value id value))))))))
+     (serve-call r (make-served-call uid id kind proc-code args-code answer)))))
 
-;; The application a call asks for, as a thunk that runs it in the sandbox.
-(define (decode-call proc-code args-code)
-  (let ((proc (decode-value proc-code))
-        (args (decode-value args-code)))
+;; The application call c asks for, as a thunk that runs it in the sandbox.
+(define (decode-call c)
+  (let ((proc (decode-value (served-call-proc-code c)))
+        (args (decode-value (served-call-args-code c))))
     (if (not (procedure? proc))
         (error "not a procedure" proc))
     (lambda () (call-in-sandbox (lambda () (apply proc args))))))
 
-;; What the application a call asks for answers, encoded to go back.
-(define (encoded-result proc-code args-code)
-  (encode ((decode-call proc-code args-code)) (lab-environment) "the result"))
+;; What the application call c asks for answers, encoded to go back.
+(define (encoded-result c)
+  (encode ((decode-call c)) (lab-environment) "the result"))
 
 (define (peer-name sockaddr)
   (string-append (sockaddr-name sockaddr) ":"
@@ -320,20 +358,19 @@
 ;; from one host: past them, connections that never say hello could take
 ;; every descriptor the process has.
 (define (room-for? host)
-  (with-lock *serving-lock*
+  (with-lock (server-lock *server*)
     (lambda ()
-      (let ((from-host (count (lambda (s) (equal? (serving-host s) host))
-                              *serving*)))
-        (and (< (length *serving*) *max-connections*)
-             (< from-host *max-connections-per-host*))))))
-
-(define *last-refusal* -inf.0)
+      (let* ((servings (server-servings *server*))
+             (from-host (count (lambda (s) (equal? (serving-host s) host))
+                               servings)))
+        (and (< (length servings) (server-max-connections *server*))
+             (< from-host (server-max-connections-per-host *server*)))))))
 
 ;; Closes a connection over the caps; the log tells of one a second.
 (define (refuse-connection! fd peer)
   (close-port (open-input-file-descriptor fd #t))
-  (when (> (monotonic-seconds) (+ *last-refusal* 1))
-    (set! *last-refusal* (monotonic-seconds))
+  (when (> (monotonic-seconds) (+ (server-last-refusal *server*) 1))
+    (server-last-refusal-set! *server* (monotonic-seconds))
     (log-warn "connection from " peer " refused: over max-connections"
               " or max-connections-per-host")))
 
@@ -341,9 +378,11 @@
 ;;> \var{lab}: listens on its port, or on a free one for port 0, and starts
 ;;> the janitor.
 (define (start-serving! lab)
-  (set! *frame-timeout* (lab-setting lab 'frame-timeout))
-  (set! *max-connections* (lab-setting lab 'max-connections))
-  (set! *max-connections-per-host* (lab-setting lab 'max-connections-per-host))
+  (set! *server*
+        (make-server (lab-setting lab 'frame-timeout) (lab-setting lab 'max-connections)
+                     (lab-setting lab 'max-connections-per-host) '()
+                     (make-mutex 'serving) (make-mutex 'janitor)
+                     (make-condition-variable 'janitor) #f -inf.0))
   (let* ((host (aspace-host (local-aspace)))
          (port (aspace-port (local-aspace)))
          (addr (get-address-info host port)))
@@ -356,7 +395,4 @@
       (if (zero? port) (local-aspace-port-set! (socket-port listener)))
       (spawn (lambda () (accept-loop listener addr)) 'accept)
       (spawn janitor 'janitor))))
-
-;; Seconds a frame, once begun, has to arrive whole.
-(define (frame-timeout) *frame-timeout*)
 

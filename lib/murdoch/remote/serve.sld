@@ -3,8 +3,9 @@
 ;;> relieves readers held by a long apply.
 
 (define-library (murdoch remote serve)
-  (export start-serving! frame-timeout hand-over-connection!
+  (export start-serving! hand-over-connection!
           new-serving! read-as-reader reader? read-calls serve-call
+          make-served-call served-call-caller served-call-id reply!
           serving-read-on serving-read-on-set!)
   (import (scheme base) (srfi 1) (srfi 18)
           (only (chibi filesystem) open-input-file-descriptor open-output-file-descriptor)

@@ -11,9 +11,9 @@
 
 ;; A remote-run!'s procedure runs in a thread of its own, since its caller
 ;; does not wait for it (an apply runs in the thread that read it: see
-;; serve.scm).  Making a thread costs Chibi more than the rest of a
-;; call, so a thread that is done waits a while for the next procedure to
-;; run instead of ending.
+;; serve.scm).  A thread that is done waits a while for the next procedure
+;; instead of ending (docs/speed.md, What Chibi charges).
+;; Global: one pool for the process, which every reader hands runs to.
 (define *idle-workers* '())             ; mailboxes of waiting workers
 (define *workers-lock* (make-mutex 'workers))
 (define worker-idle-seconds 10)
@@ -31,8 +31,7 @@
         (spawn (lambda () (work thunk)) 'worker))))
 
 ;; One handler for the worker's whole life, entered again only after a job
-;; raised: a handler per job would cost a continuation each (see
-;; undo-on-raise).
+;; raised (docs/speed.md).
 (define (work job)
   (let serve ((job job))
     (guard (e (#t (log-warn "worker: " (error-message e))

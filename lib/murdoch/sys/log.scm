@@ -1,8 +1,8 @@
 ;;;; One-line log messages on standard error.
 ;;
-;; (chibi log) would do, but loading it costs an address space 0.7 s of
-;; start-up, and labs start many address spaces.
+;; (chibi log) would do, but loads slowly (docs/speed.md).
 
+;; Global: every thread of the process logs under one name, set at start.
 (define *log-name* "murdoch")
 
 ;;> Names this process in log lines, e.g. "murdoch troy".

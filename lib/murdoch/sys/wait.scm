@@ -22,9 +22,7 @@
   (max 0 (- deadline (monotonic-seconds))))
 
 ;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
-;; dynamic-wind, not a guard: a guard takes a continuation, which costs
-;; Chibi a copy of the stack, 25 KB, each time, and these are on the path
-;; of every call.
+;; dynamic-wind, not a guard, on the path of every call (docs/speed.md).
 (define (undo-on-raise undo thunk)
   (let ((done #f))
     (dynamic-wind (lambda () #f)

@@ -96,34 +96,41 @@
 
 ;;; Frames
 
-;; The lab's, set once when the address space starts (configure-wire!).
-(define *key* #f)
-(define *max-frame* 1048576)
-(define *max-depth* 4000)
+;; The wire's state: the key and limits of the lab this process joined,
+;; read once by start-wire!, before the first frame, since every frame
+;; reads them.  Global: every connection and datagram speaks for that lab.
+(define-record-type wire
+  (make-wire key max-frame max-depth)
+  wire?
+  (key wire-key)
+  (max-frame wire-max-frame)
+  (max-depth wire-max-depth))
 
-;;> Sets the lab's key and limits, once, before any frame.
-(define (configure-wire! key max-frame max-depth)
-  (set! *key* key)
-  (set! *max-frame* max-frame)
-  (set! *max-depth* max-depth))
+(define *wire* #f)
+
+;;> Makes the frames and datagrams of this process those of \var{lab}:
+;;> its key, max-frame and max-depth.  Once, before any frame.
+(define (start-wire! lab)
+  (set! *wire* (make-wire (lab-key lab) (lab-setting lab 'max-frame)
+                          (lab-setting lab 'max-depth))))
 
 ;; Each connection writes its frames' text to a string port of its own,
 ;; emptied before each frame, so that a write that failed half-way leaves
-;; nothing behind (its writer holds the connection's lock): a new string
-;; port per frame costs Chibi a 4 KB allocation.
+;; nothing behind (its writer holds the connection's lock).
 (define (frame-text text-port message)
   (reset-output-string! text-port)
   (write-simple message text-port)
   (let ((text (get-output-string text-port)))
     ;; The receiver would refuse it and close the connection, failing the
     ;; calls on it that had nothing to do with this one.
-    (if (> (+ 64 (string-size text)) *max-frame*)
+    (if (> (+ 64 (string-size text)) (wire-max-frame *wire*))
         (error (string-append "the message is larger than the lab's max-frame, "
-                              (number->string *max-frame*) " bytes")))
+                              (number->string (max-frame)) " bytes")))
     text))
 
 (define (write-frame! out text nonce count)
-  (write-netstring (hmac-sha256-sign *key* text (list nonce ":" count ":")) out))
+  (write-netstring (hmac-sha256-sign (wire-key *wire*) text (list nonce ":" count ":"))
+                   out))
 
 (define (send-frame! out text-port nonce count message)
   (write-frame! out (frame-text text-port message) nonce count)
@@ -136,10 +143,9 @@
 
 ;; The next frame's message, or an eof object when the peer closed.  A
 ;; bad frame raises (see fault-message), and the connection's one handler
-;; closes it: a handler of its own for each frame would cost Chibi a
-;; continuation, 25 KB copied, on every message.
+;; closes it (no handler per frame: docs/speed.md, What Chibi charges).
 (define (read-frame in nonce count)
-  (let ((payload (read-netstring in *max-frame*)))
+  (let ((payload (read-netstring in (wire-max-frame *wire*))))
     (if (eof-object? payload)
         payload
         (open-frame payload nonce count))))
@@ -152,32 +158,26 @@
                   (list nonce ":" count ":"))))
 
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
-(define (max-frame) *max-frame*)
+(define (max-frame) (wire-max-frame *wire*))
 
 ;; The text after the MAC in the first end bytes of bytes, once the MAC is
 ;; that of the list parts followed by the text.
 (define (authentic-text bytes end parts)
-  (or (hmac-sha256-open *key* bytes end parts)
+  (or (hmac-sha256-open (wire-key *wire*) bytes end parts)
       (frame-fail "bad MAC")))
 
-;; Chibi's own reader, in C: (scheme read) is SRFI 38's, written in
-;; Scheme and a hundred times slower.  The C reader recurses without
-;; bound and reads datum labels, which make cycles, so the text is first
-;; scanned for both (nests-within?): a message may nest twice max-depth,
-;; room for its envelope and for a value one level too deep, which
-;; decoding then refuses with an error answer; deeper, or with a label,
-;; it is a protocol violation.  Text that is no datum raises a read
-;; error; our writer puts nothing after the datum.
+;; Read by Chibi's own reader (docs/speed.md), which recurses without
+;; bound and makes cycles of datum labels: so a message that nests deeper
+;; than twice max-depth (its envelope, and a value one level too deep for
+;; decoding to refuse), or has a label, is a protocol violation.
 (define (parse-message text)
-  (if (not (nests-within? text (* 2 *max-depth*)))
+  (if (not (nests-within? text (* 2 (wire-max-depth *wire*))))
       (frame-fail "nests deeper than twice max-depth, or has a datum label"))
   (let ((in (open-input-string text)))
     (whole-datum in (read-datum in))))
 
 ;; The message read from in, when it is all there is.  A procedure of its
-;; own, not a let* inside parse-message: Chibi makes a closure for a let
-;; whose body uses a variable of the let around it, and that was a third
-;; of parsing a short answer.
+;; own, not a let* inside parse-message: see docs/speed.md.
 (define (whole-datum in message)
   (cond ((eof-object? message) (frame-fail "empty message"))
         ((not (eof-object? (peek-char in))) (frame-fail "trailing data"))
@@ -201,7 +201,7 @@
 
 ;;> The bytes of a datagram carrying \var{text}, with its MAC.
 (define (datagram-bytes text)
-  (string->utf8 (hmac-sha256-sign *key* text '("mcast:"))))
+  (string->utf8 (hmac-sha256-sign (wire-key *wire*) text '("mcast:"))))
 
 ;;> The message of the authentic datagram in the first n bytes of buffer.
 (define (open-datagram-text buffer n)

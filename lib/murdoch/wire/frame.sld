@@ -4,11 +4,11 @@
 
 (define-library (murdoch wire frame)
   (export message-kinds make-message check-message check-datagram
-          configure-wire! frame-text write-frame! send-frame! read-frame
+          start-wire! frame-text write-frame! send-frame! read-frame
           open-frame max-frame
           frame-fail parse-message protocol-fault? fault-message log-fault
           datagram-bytes open-datagram-text)
   (import (scheme base) (scheme write) (rename (only (chibi) read) (read read-datum))
-          (only (chibi) string-size) (murdoch sys) (murdoch wire remote-error)
-          (murdoch wire netstring) (murdoch wire hmac))
+          (only (chibi) string-size) (murdoch sys) (murdoch lab)
+          (murdoch wire remote-error) (murdoch wire netstring) (murdoch wire hmac))
   (include "frame.scm"))

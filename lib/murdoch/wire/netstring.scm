@@ -77,9 +77,8 @@
         payload)))))
 
 ;;> Writes \var{payload}, a bytevector or a string (its UTF-8 bytes), to
-;;> \var{out} as one netstring.  A string goes out with write-string,
-;;> which Chibi does in C; write-bytevector is a loop in Scheme.  Does not
-;;> flush: the caller knows when a batch of frames is complete.
+;;> \var{out} as one netstring; a string is the faster (docs/speed.md).
+;;> Does not flush: the caller knows when a batch of frames is complete.
 (define (write-netstring payload out)
   (if (string? payload)
       (begin
