@@ -412,7 +412,7 @@
          ((char=? c #\)) (read-char in) (fail line "a ) that closes nothing"))
          (else
           (guard (e (#t (fail line (string-append "cannot read this: "
-                                                  (error-message e)))))
+                                                  (condition-message e)))))
             (read in))))))
     (define (read-list line open)
       (let loop ((items '()))

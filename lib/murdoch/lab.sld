@@ -16,5 +16,6 @@
                 open-output-file-descriptor link-file)
           (only (chibi process) current-process-id)
           (only (chibi ast) port-line)
-          (chibi io) (chibi edit-distance) (only (murdoch wire) error-message))
+          (chibi io) (chibi edit-distance)
+          (only (murdoch sys) condition-message))
   (include "lab.scm" "room.scm"))

@@ -4,6 +4,7 @@
 
 (define-library (murdoch sys)
   (export start-heap-guard! utc-seconds set-log-name! stamp-log-lines! log-note log-warn
+          condition-message
           set-process-name! poll-scheduler-installed? monotonic-seconds
           wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!
           poller-unwatch! poller-ready poller-frames! with-lock with-lock-by

@@ -66,3 +66,21 @@
 
 ;;> Logs a fault that was handled.
 (define (log-warn . parts) (log-line ": warning: " parts))
+
+;;> What \var{e}, any raised object, says, as one line for a log or an
+;;> answer: an error's message and irritants, or what else was raised.
+;;> (murdoch wire)'s error-message says a remote protocol error its own way.
+(define (condition-message e)
+  (cond
+   ((stack-guard-tripped? (current-thread))
+    "recursed too deep: its stack neared Chibi's limit, which ends a process")
+   ((error-object? e)
+    (call-with-output-string
+      (lambda (out)
+        (write-string (error-object-message e) out)
+        (for-each (lambda (x)
+                    (write-char #\space out)
+                    (write (strip-syntactic-closures x) out))
+                  (error-object-irritants e)))))
+   (else (call-with-output-string
+           (lambda (out) (write-string "raised " out) (write e out))))))

@@ -50,19 +50,8 @@
 (define (remote-error-message e) (car (cddr (exception-irritants e))))
 
 ;;> What \var{e}, any raised object, says, as one line for a log or an
-;;> answer.
+;;> answer: a remote protocol error's own message, else condition-message's.
 (define (error-message e)
-  (cond
-   ((stack-guard-tripped? (current-thread))
-    "recursed too deep: its stack neared Chibi's limit, which ends a process")
-   ((remote-protocol-error? e) (remote-error-message e))
-   ((error-object? e)
-    (call-with-output-string
-      (lambda (out)
-        (write-string (error-object-message e) out)
-        (for-each (lambda (x)
-                    (write-char #\space out)
-                    (write (strip-syntactic-closures x) out))
-                  (error-object-irritants e)))))
-   (else (call-with-output-string
-           (lambda (out) (write-string "raised " out) (write e out))))))
+  (if (and (remote-protocol-error? e) (not (stack-guard-tripped? (current-thread))))
+      (remote-error-message e)
+      (condition-message e)))

@@ -9,5 +9,5 @@
   (import (scheme base) (scheme write) (srfi 18)
           (only (chibi) call-with-output-string make-exception exception?
                 exception-kind exception-irritants strip-syntactic-closures)
-          (only (murdoch sys) stack-guard-tripped?))
+          (only (murdoch sys) stack-guard-tripped? condition-message))
   (include "remote-error.scm"))
