@@ -132,11 +132,15 @@
   (with-lock *connections-lock*
     (lambda ()
       (if (not *poller-port*) (start-poller!))
-      (let ((fd (poller-watch! (connection-in c))))
+      (let ((fd (port-fileno (connection-in c))))
         (if (>= fd (vector-length *watched*))
             (set! *watched* (vector-grow *watched* (* 2 (+ fd 1)))))
         (connection-fd-set! c fd)
-        (vector-set! *watched* fd c)))))
+        ;; Known before it is watched: the poller, a thread that may run
+        ;; between any two steps of this one, drops a ready descriptor it
+        ;; does not know, and with it the welcome that came first.
+        (vector-set! *watched* fd c)
+        (poller-watch! (connection-in c))))))
 
 (define (vector-grow v n)
   (let ((grown (make-vector n #f)))
