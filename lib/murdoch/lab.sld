@@ -7,7 +7,9 @@
           lab-aspace-by-uid lab-robots lab-key
           lab-clause lab-robot-radius read-source unread-lab-port-base
           lab-aspace? lab-aspace-uid lab-aspace-index lab-aspace-host
-          lab-aspace-port lab-aspace-clause lab-aspace-clauses random-hex)
+          lab-aspace-port lab-aspace-clause lab-aspace-clauses random-hex
+          lab-walls lab-boxes wall-from wall-to wall-thickness box-centre box-width
+          box-depth box-heading)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
           (scheme process-context)
           (scheme inexact)

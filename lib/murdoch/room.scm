@@ -9,9 +9,8 @@
 (define default-wall-thickness 50)
 
 (define (check-room path clauses)
-  (let* ((world (or (clause 'world clauses) '(world)))
-         (walls (items 'wall 4 (cdr world)))
-         (boxes (items 'box 5 (cdr world)))
+  (let* ((walls (world-items clauses 'wall))
+         (boxes (world-items clauses 'box))
          (radius (robot-radius clauses))
          (robots (filter-map robot-place clauses)))
     (let loop ((robots robots) (before '()))
@@ -60,12 +59,22 @@
                                        thing
                                        (clause-text thing))))))
 
-;; The world's items of kind with at least n numbers.
-(define (items kind n ls)
-  (filter (lambda (i) (and (pair? i) (eq? (car i) kind) (list? i)
-                           (>= (length (cdr i)) n)
-                           (every real? (cdr i))))
-          ls))
+;; The world's walls or boxes (kind) in clauses, each with at least the
+;; numbers its fields below read.
+(define (world-items clauses kind)
+  (let ((world (or (clause 'world clauses) '(world)))
+        (n (if (eq? kind 'wall) 4 5)))
+    (filter (lambda (i) (and (pair? i) (eq? (car i) kind) (list? i)
+                             (>= (length (cdr i)) n)
+                             (every real? (cdr i))))
+            (cdr world))))
+
+;;> The walls and the boxes of \var{lab}'s world, each the clause
+;;> (wall X1 Y1 X2 Y2 [THICK]) or (box X Y W D HEADING [MASS]), read by
+;;> wall-from, wall-to, wall-thickness, box-centre, box-width, box-depth
+;;> and box-heading.
+(define (lab-walls lab) (world-items (lab-clauses lab) 'wall))
+(define (lab-boxes lab) (world-items (lab-clauses lab) 'box))
 
 (define (robot-radius clauses)
   (let ((b14 (clause 'b14 clauses)))
@@ -95,8 +104,7 @@
               (real? (cadr pose)) (real? (car (cddr pose)))
               (make-place c (list (cadr pose) (car (cddr pose))))))))
 
-;; The fields of the world's clauses (wall X1 Y1 X2 Y2 [THICK]) and
-;; (box X Y W D HEADING [MASS]), by name.
+;;> The fields of the world's clauses, by name.
 (define (wall-from w) (list (list-ref w 1) (list-ref w 2)))
 (define (wall-to w) (list (list-ref w 3) (list-ref w 4)))
 (define (wall-thickness w)

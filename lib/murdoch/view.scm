@@ -51,13 +51,6 @@
 
 ;;; The room: the first line of a trace
 
-(define (world-items lab kind n)
-  (filter-map (lambda (item)
-                (and (pair? item) (eq? (car item) kind) (list? item)
-                     (>= (length (cdr item)) n) (every real? (cdr item))
-                     (cdr item)))
-              (cond ((lab-clause lab 'world) => cdr) (else '()))))
-
 ;;> The first line of a trace, as JSON: the lab's name, the robots'
 ;;> radius, its walls as (x1 y1 x2 y2 thickness), its boxes as (x y
 ;;> width depth heading), and its address spaces, robots or not.
@@ -67,13 +60,15 @@
     (radius . ,(num (lab-robot-radius lab)))
     (walls . ,(list->vector
                (map (lambda (w)
-                      (numbers (append (take w 4)
-                                       (if (> (length w) 4)
-                                           (list (list-ref w 4))
-                                           '(50)))))
-                    (world-items lab 'wall 4))))
-    (boxes . ,(list->vector (map (lambda (b) (numbers (take b 5)))
-                                 (world-items lab 'box 5))))
+                      (numbers (append (wall-from w) (wall-to w)
+                                       (list (wall-thickness w)))))
+                    (lab-walls lab))))
+    (boxes . ,(list->vector
+               (map (lambda (b)
+                      (numbers (append (box-centre b)
+                                       (list (box-width b) (box-depth b)
+                                             (box-heading b)))))
+                    (lab-boxes lab))))
     (aspaces . ,(list->vector
                  (map (lambda (a)
                         `((name . ,(symbol->string (lab-aspace-uid a)))
