@@ -120,25 +120,28 @@
 (define (send-all aspaces c)
   (let* ((deadline (+ (monotonic-seconds) (call-seconds c)))
          (g (make-gathering))
+         ;; A pending call for each call sent; a result for the local call
+         ;; and for each that could not be sent.
          (started
           (capture-each aspace-uid
                         (lambda (a)
-                          (make-result (aspace-uid a) #t
-                                       (if (local? a)
+                          (if (local? a)
+                              (make-result (aspace-uid a) #t
                                            (local-call (call-kind c) (call-proc c)
-                                                       (call-args c))
-                                           (start-call a c deadline g))))
+                                                       (call-args c)))
+                              (start-call a c deadline g)))
                         aspaces)))
-    (await-answers g (filter-map started-call started) deadline)
-    (capture-each result-uid
-                  (lambda (r)
-                    (let ((p (started-call r)))
-                      (if p (make-result (result-uid r) #t (answer-value p c)) r)))
+    (await-answers g (filter pending-call? started) deadline)
+    (capture-each started-uid
+                  (lambda (x)
+                    (if (pending-call? x)
+                        (make-result (pending-call-uid x) #t (answer-value x c))
+                        x))
                   started)))
 
-;; The pending call of a result of send-all's, if it started one.
-(define (started-call r)
-  (and (result-ok? r) (pending-call? (result-value r)) (result-value r)))
+;; The uid of what send-all started: a pending call or a result.
+(define (started-uid x)
+  (if (pending-call? x) (pending-call-uid x) (result-uid x)))
 
 ;; A call to this address space is a remote call too: an abandoned thread
 ;; stops at it (abandon.scm), as a component cut off from its poser whose
@@ -158,9 +161,8 @@
 (define (failure-result uid e)
   (make-result uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
 
-;;> (map entry items), where (entry item) answers a result; an item whose
-;;> entry raised gives the result of its failure, for the uid (uid-of
-;;> item).  The handler is entered once, and again after each failure
+;;> (map entry items); an item whose entry raised gives the result of
+;;> its failure, for the uid (uid-of item).  The handler is entered once, and again after each failure
 ;;> only (docs/speed.md, What Chibi charges).
 (define (capture-each uid-of entry items)
   (let ((done '()) (rest items))
