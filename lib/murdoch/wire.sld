@@ -4,11 +4,13 @@
 
 (define-library (murdoch wire)
   (export open-connection socket-port message-kinds make-message check-message
-          check-datagram start-wire! frame-text write-frame! send-frame! read-frame
+          check-datagram start-wire! frame-text message-without-id spliced-text
+          write-frame! send-frame! read-frame
           open-frame max-frame frame-fail parse-message protocol-fault? fault-message
           log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign
           hmac-sha256-open open-multicast-socket read-netstring write-netstring
-          buffered-byte-count reset-output-string! nests-within? netstring-error?
+          buffered-byte-count reset-output-string! nests-within? fixnum->decimal
+          netstring-error?
           netstring-error-message remote-error protocol-fail error-message remote-error?
           remote-error-uid remote-error-message remote-timeout-error?
           remote-unreachable-error? remote-raised-error? remote-protocol-error?)

@@ -42,15 +42,19 @@
   (let ((c (new-call kind proc args)))
     (let ((deadline (+ (monotonic-seconds) (call-seconds c)))
           (g (make-gathering)))
-      (finish-call (start-call a c deadline g) g deadline c))))
+      (finish-call (start-call a c (call-tail c) deadline g) g deadline c))))
 
-;; Call c sent to a, its answer to come to gathering g.
-(define (start-call a c deadline g)
+;; The text of call c's frames but their ids (message-without-id).
+(define (call-tail c)
+  (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
+
+;; Call c sent to a, its frame's text but the id tail, its answer to come
+;; to gathering g.
+(define (start-call a c tail deadline g)
   (undo-on-raise
    (lambda () (note-unreachable! (aspace-uid a)))
    (lambda ()
-     (send-call! (connection-to a deadline) (call-kind c) (call-proc-code c)
-                 (call-args-code c) g))))
+     (send-call! (connection-to a deadline) tail g))))
 
 ;; The answer to p, pending call c, by the deadline (on the monotonic
 ;; clock): the value, or a remote-error.
@@ -120,6 +124,7 @@
 (define (send-all aspaces c)
   (let* ((deadline (+ (monotonic-seconds) (call-seconds c)))
          (g (make-gathering))
+         (tail (call-tail c))
          ;; A pending call for each call sent; a result for the local call
          ;; and for each that could not be sent.
          (started
@@ -129,7 +134,7 @@
                               (make-result (aspace-uid a) #t
                                            (local-call (call-kind c) (call-proc c)
                                                        (call-args c)))
-                              (start-call a c deadline g)))
+                              (start-call a c tail deadline g)))
                         aspaces)))
     (await-answers g (filter pending-call? started) deadline)
     (capture-each started-uid

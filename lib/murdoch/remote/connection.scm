@@ -69,11 +69,13 @@
                     (lambda () (hash-table-set! *connections* uid c)))
                   c)))))))
 
+;; The lock without a dynamic-wind: nothing under it raises, and this is
+;; on the way of every call.
 (define (live-connection-to uid)
-  (with-lock *connections-lock*
-    (lambda ()
-      (let ((c (hash-table-ref/default *connections* uid #f)))
-        (and c (connection-open? c) c)))))
+  (mutex-lock! *connections-lock*)
+  (let ((c (hash-table-ref/default *connections* uid #f)))
+    (mutex-unlock! *connections-lock*)
+    (and c (connection-open? c) c)))
 
 (define (connecting-lock uid)
   (with-lock *connections-lock*
@@ -249,51 +251,66 @@
       (guard (e (#t #f)) (close-output-port (connection-out c))))
     (for-each (lambda (p) (answer-call! p '(lost))) waiting)))
 
-;;> Sends one call, whose answer its gathering g will be handed; answers
-;;> the pending call.
-(define (send-call! c kind proc-code args-code g)
-  (with-lock (connection-write-lock c)
-    (lambda ()
-      (let* ((id (+ 1 (connection-next-id c)))
-             (p (make-pending-call (connection-uid c) c id g #f)))
-        (connection-next-id-set! c id)
-        (hash-table-set! (connection-pending c) id p)
-        (send-counted! c (make-message kind id proc-code args-code)
-                       (lambda () (hash-table-delete! (connection-pending c) id)))
-        p))))
+;;> Sends one call, its text but the id \var{tail} (message-without-id),
+;;> whose answer its gathering g will be handed; answers the pending call.
+;;> Its id is drawn first, so that its text is made outside the lock.
+(define (send-call! c tail g)
+  (let* ((id (next-call-id! c))
+         (p (make-pending-call (connection-uid c) c id g #f)))
+    (send-counted! c (spliced-text tail id) p)
+    p))
 
-;; Sends message as the connection's next frame; the caller holds its
-;; write lock.  A frame that fails to go out leaves the connection closed
-;; to calls, and (forget) is called.
-(define (send-counted! c message forget)
-  (if (not (connection-open? c))
-      (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
-  (let ((text (frame-text (connection-text c) message))
-        (count (+ 1 (connection-sent c))))
-    (connection-sent-set! c count)
-    (undo-on-raise
-     (lambda () (connection-open?-set! c #f) (forget))
+;; An id no other call on c has; the lock without a dynamic-wind, since
+;; nothing under it raises.
+(define (next-call-id! c)
+  (let ((lock (connection-write-lock c)))
+    (mutex-lock! lock)
+    (let ((id (+ 1 (connection-next-id c))))
+      (connection-next-id-set! c id)
+      (mutex-unlock! lock)
+      id)))
+
+;; Sends message, or its text, as c's next frame, under c's write lock,
+;; with pending call p (or #f) in c's table.  A frame that fails to go
+;; out leaves the connection closed to calls; a message that cannot be
+;; sent (too large, say) leaves it as it was.  Either way p is taken out.
+;; One dynamic-wind for the lock and the undo: a dynamic-wind and the
+;; closures around it cost a call 2.5 to 3 us each (docs/speed.md).
+(define (send-counted! c message p)
+  (let ((lock (connection-write-lock c))
+        (state 'before))
+    (dynamic-wind
+     (lambda () (mutex-lock! lock))
      (lambda ()
-       (write-frame! (connection-out c) text (connection-nonce c) count)
-       (flush-output-port (connection-out c))))))
-
-(define (nothing) #f)
+       (if (not (connection-open? c))
+           (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
+       (let ((text (if (string? message)
+                       message
+                       (frame-text (connection-text c) message)))
+             (count (+ 1 (connection-sent c))))
+         (if p (hash-table-set! (connection-pending c) (pending-call-id p) p))
+         (connection-sent-set! c count)
+         (set! state 'writing)
+         (write-frame! (connection-out c) text (connection-nonce c) count)
+         (flush-output-port (connection-out c))
+         (set! state 'sent)))
+     (lambda ()
+       (unless (eq? state 'sent)
+         (if (eq? state 'writing) (connection-open?-set! c #f))
+         (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
+       (mutex-unlock! lock)))))
 
 ;;> Sends the answer to call id of a multicast datagram that a, its sender,
 ;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
 ;; -- no acknowledgement, no worker -- since a waits for it anyway.
 (define (send-datagram-answer! a id kind value)
-  (let ((c (connection-to a (+ (monotonic-seconds) (current-timeout)))))
-    (with-lock (connection-write-lock c)
-      (lambda ()
-        (send-counted! c (make-message 'answer id kind value) nothing)))))
+  (send-counted! (connection-to a (+ (monotonic-seconds) (current-timeout)))
+                 (make-message 'answer id kind value) #f))
 
 ;; Forgets call id, and tells the callee, if the connection still stands,
 ;; that nobody waits for it (see abandon.scm).
 (define (give-up-call! c id)
+  (with-lock (connection-write-lock c)
+    (lambda () (hash-table-delete! (connection-pending c) id)))
   (guard (e (#t #f))                    ; the connection broke: no matter
-    (with-lock (connection-write-lock c)
-      (lambda ()
-        (hash-table-delete! (connection-pending c) id)
-        (when (connection-open? c)
-          (send-counted! c (make-message 'abandon id) nothing))))))
+    (send-counted! c (make-message 'abandon id) #f)))

@@ -120,13 +120,32 @@
 (define (frame-text text-port message)
   (reset-output-string! text-port)
   (write-simple message text-port)
-  (let ((text (get-output-string text-port)))
-    ;; The receiver would refuse it and close the connection, failing the
-    ;; calls on it that had nothing to do with this one.
-    (if (> (+ 64 (string-size text)) (wire-max-frame *wire*))
-        (error (string-append "the message is larger than the lab's max-frame, "
-                              (number->string (max-frame)) " bytes")))
-    text))
+  (within-max-frame (get-output-string text-port)))
+
+;; The receiver would refuse a frame past max-frame and close the
+;; connection, failing the calls on it that had nothing to do with this one.
+(define (within-max-frame text)
+  (if (> (+ 64 (string-size text)) (wire-max-frame *wire*))
+      (error (string-append "the message is larger than the lab's max-frame, "
+                            (number->string (max-frame)) " bytes")))
+  text)
+
+;;> The text of the message (\var{kind} ID FIELD ...) for \var{fields}
+;;> but its id, for \scheme{spliced-text}: a call to many peers differs only
+;;> by its id, so its text is written once, not once a peer.
+(define (message-without-id kind fields)
+  (let ((out (open-output-string)))
+    (for-each (lambda (field) (write-char #\space out) (write-simple field out))
+              fields)
+    (write-char #\) out)
+    (cons (string-append "(" (symbol->string kind) " ") (get-output-string out))))
+
+;;> The text of the message that \var{parts}, from message-without-id,
+;;> and \var{id} make: the text frame-text would give.  The id's digits by
+;;> fixnum->decimal: Chibi's number->string and symbol->string take a
+;;> microsecond each, as long as writing the whole message.
+(define (spliced-text parts id)
+  (within-max-frame (string-append (car parts) (fixnum->decimal id) (cdr parts))))
 
 (define (write-frame! out text nonce count)
   (write-netstring (hmac-sha256-sign (wire-key *wire*) text (list nonce ":" count ":"))

@@ -4,7 +4,8 @@
 
 (define-library (murdoch wire frame)
   (export message-kinds make-message check-message check-datagram
-          start-wire! frame-text write-frame! send-frame! read-frame
+          start-wire! frame-text message-without-id spliced-text write-frame!
+          send-frame! read-frame
           open-frame max-frame
           frame-fail parse-message protocol-fault? fault-message log-fault
           datagram-bytes open-datagram-text)

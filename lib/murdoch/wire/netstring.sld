@@ -3,7 +3,7 @@
 
 (define-library (murdoch wire netstring)
   (export read-netstring write-netstring buffered-byte-count
-          reset-output-string! nests-within?
+          reset-output-string! nests-within? fixnum->decimal
           netstring-error? netstring-error-message)
   (import (scheme base) (only (chibi) string-size)
           (murdoch wire remote-error))
