@@ -49,12 +49,10 @@
   (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
 
 ;; Call c sent to a, its frame's text but the id tail, its answer to come
-;; to gathering g.
+;; to gathering g.  A peer that cannot be connected to or sent to is
+;; noted unreachable (connection.scm).
 (define (start-call a c tail deadline g)
-  (undo-on-raise
-   (lambda () (note-unreachable! (aspace-uid a)))
-   (lambda ()
-     (send-call! (connection-to a deadline) tail g))))
+  (send-call! (connection-to a deadline) tail g))
 
 ;; The answer to p, pending call c, by the deadline (on the monotonic
 ;; clock): the value, or a remote-error.

@@ -54,20 +54,24 @@
 (define *connections-lock* (make-mutex 'connections))
 
 ;; The open connection to uid, made (and greeted) if there is none, by
-;; the deadline (on the monotonic clock).
+;; the deadline (on the monotonic clock).  A peer that cannot be
+;; connected to is noted unreachable (aspace.scm).
 (define (connection-to a deadline)
   (let ((uid (aspace-uid a)))
     (or (live-connection-to uid)
-        (with-lock-by (connecting-lock uid) deadline
-          (lambda ()
-            (remote-error 'timed-out uid 'connect
-                          "another call's connect did not end in time"))
-          (lambda ()
-            (or (live-connection-to uid)
-                (let ((c (connect! a deadline)))
-                  (with-lock *connections-lock*
-                    (lambda () (hash-table-set! *connections* uid c)))
-                  c)))))))
+        (undo-on-raise
+         (lambda () (note-unreachable! uid))
+         (lambda ()
+           (with-lock-by (connecting-lock uid) deadline
+             (lambda ()
+               (remote-error 'timed-out uid 'connect
+                             "another call's connect did not end in time"))
+             (lambda ()
+               (or (live-connection-to uid)
+                   (let ((c (connect! a deadline)))
+                     (with-lock *connections-lock*
+                       (lambda () (hash-table-set! *connections* uid c)))
+                     c)))))))))
 
 ;; The lock without a dynamic-wind: nothing under it raises, and this is
 ;; on the way of every call.
@@ -273,9 +277,10 @@
 ;; Sends message, or its text, as c's next frame, under c's write lock,
 ;; with pending call p (or #f) in c's table.  A frame that fails to go
 ;; out leaves the connection closed to calls; a message that cannot be
-;; sent (too large, say) leaves it as it was.  Either way p is taken out.
-;; One dynamic-wind for the lock and the undo: a dynamic-wind and the
-;; closures around it cost a call 2.5 to 3 us each (docs/speed.md).
+;; sent (too large, say) leaves it as it was.  Either way p is taken out,
+;; and its peer is noted unreachable.  One dynamic-wind for the lock and
+;; the undo: a dynamic-wind and the closures around it cost a call 2.5 to
+;; 3 us each (docs/speed.md).
 (define (send-counted! c message p)
   (let ((lock (connection-write-lock c))
         (state 'before))
@@ -298,7 +303,8 @@
        (unless (eq? state 'sent)
          (if (eq? state 'writing) (connection-open?-set! c #f))
          (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
-       (mutex-unlock! lock)))))
+       (mutex-unlock! lock)
+       (if (and p (not (eq? state 'sent))) (note-unreachable! (connection-uid c)))))))
 
 ;;> Sends the answer to call id of a multicast datagram that a, its sender,
 ;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
