@@ -258,6 +258,16 @@
         (hash-table-set! (datagram-calls-waiting *datagram-calls*) id ps)
         (cons id ps)))))
 
+;; The pending calls of datagram call id, or none.  The lock without a
+;; dynamic-wind: nothing under it raises, and every answer comes here.
+(define (datagram-calls-waiting-for id)
+  (let ((lock (datagram-calls-lock *datagram-calls*)))
+    (mutex-lock! lock)
+    (let ((waiting (hash-table-ref/default (datagram-calls-waiting *datagram-calls*)
+                                           id '())))
+      (mutex-unlock! lock)
+      waiting)))
+
 ;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
   (with-datagram-calls
@@ -268,10 +278,7 @@
 (define (take-datagram-answer! uid message)
   (match message
     (('answer id kind value)
-     (let ((waiting (with-datagram-calls
-                      (lambda ()
-                        (hash-table-ref/default
-                         (datagram-calls-waiting *datagram-calls*) id '())))))
+     (let ((waiting (datagram-calls-waiting-for id)))
        (cond ((find (lambda (p) (eq? (pending-call-uid p) uid)) waiting)
               => (lambda (p) (answer-call! p (list kind id value)))))))))
 

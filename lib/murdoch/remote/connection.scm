@@ -39,10 +39,8 @@
 
 ;;> Gives pending call p its answer, unless it has one.
 (define (answer-call! p answer)
-  (gathering-put! (pending-call-gathering p)
-                  (lambda ()
-                    (and (not (pending-call-answer p))
-                         (begin (pending-call-answer-set! p answer) #t)))))
+  (gathering-put! (pending-call-gathering p) p answer
+                  pending-call-answer pending-call-answer-set!))
 
 ;; The open connections, and a lock for each uid that one thread holds
 ;; while it connects to that uid: a peer that does not answer holds up the

@@ -277,6 +277,7 @@
         (text (open-output-string))
         (write-lock (make-mutex))
         (sent 0)
+        (flushed 0)                     ; sent when last flushed
         (count 0))
     ;; The reader's own answers wait in the port's buffer until it has
     ;; read every call that has arrived: a burst of calls is answered in
@@ -288,10 +289,19 @@
             (set! sent (+ sent 1))
             ;; A caller that left makes this raise, and the connection end.
             (write-frame! out frame caller-nonce sent))
-          (if (not (reader? s)) (flush-output-port out)))))
+          (if (not (reader? s)) (flush!)))))
+    ;; The caller holds the write lock.
+    (define (flush!)
+      (flush-output-port out)
+      (set! flushed sent))
+    ;; Nothing to flush after a frame that had no answer (the answers to
+    ;; our own datagram calls, which a requester gets from every peer): no
+    ;; lock taken for it.  Sent and flushed change under the write lock,
+    ;; and a writer flushes or comes here after its write.
     (define (flush-if-idle!)
-      (if (zero? (buffered-byte-count (serving-in s)))
-          (with-lock write-lock (lambda () (flush-output-port out)))))
+      (if (and (not (= flushed sent))
+               (zero? (buffered-byte-count (serving-in s))))
+          (with-lock write-lock flush!)))
     (define (answer c kind value)
       (let ((id (served-call-id c)))
         (answer! (if (eq? kind 'ack)

@@ -101,13 +101,15 @@
 (define (make-gathering)
   (%make-gathering (make-mutex) (make-condition-variable) 0 #f))
 
-;;> Calls \scheme{(put!)} under the gathering's lock, which records an
-;;> answer and answers whether it is a new one; counts it if so.  No
-;;> dynamic-wind: put! only sets a field.
-(define (gathering-put! g put!)
+;;> Gives \var{item} the answer \var{value}, by \scheme{(put item value)},
+;;> under the gathering's lock, and counts it, unless \scheme{(get item)}
+;;> shows it has one.  No dynamic-wind, since put only sets a field, and
+;;> no closure made: both would cost every answer (docs/speed.md).
+(define (gathering-put! g item value get put)
   (let ((m (gathering-mutex g)))
     (mutex-lock! m)
-    (when (put!)
+    (when (not (get item))
+      (put item value)
       (let ((got (+ 1 (gathering-got g))))
         (gathering-got-set! g got)
         (if (and (gathering-wanted g) (>= got (gathering-wanted g)))
