@@ -165,8 +165,8 @@
   (make-result uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
 
 ;;> (map entry items); an item whose entry raised gives the result of
-;;> its failure, for the uid (uid-of item).  The handler is entered once, and again after each failure
-;;> only (docs/speed.md, What Chibi charges).
+;;> its failure, for the uid (uid-of item).  The handler is entered once,
+;;> and again after each failure only (docs/speed.md, What Chibi charges).
 (define (capture-each uid-of entry items)
   (let ((done '()) (rest items))
     (let run ()
