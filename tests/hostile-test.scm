@@ -140,6 +140,39 @@
     (test "a stalled frame is still cut off" #t (raw-closed? conn)))
   (still-fine "after the ports"))
 
+(test-group "a connection moves from the poller to a reader of its own"
+  ;; The poller reads a connection until its first call; a frame cut in
+  ;; two across that move, or across the poller's reads, is still read
+  ;; whole, and frames in one write with it are not lost.
+  (let* ((welcomed (welcomed-raw-connect key (aspace-port (troy)) "m1"))
+         (conn (car welcomed)))
+    (define (frame count datum) (counted key (cdr welcomed) count datum))
+    (define (cut bytes) (bytevector-copy bytes 0 12))
+    (define (rest bytes) (bytevector-copy bytes 12))
+    (define call-2 (frame 2 '(apply 2 #(murdoch:global list) (2))))
+    (define call-4 (frame 4 '(apply 4 #(murdoch:global list) (4))))
+    ;; An abandon the poller serves, with half of the first call.
+    (raw-send! conn (bytevector-append (frame 1 '(abandon 99)) (cut call-2)))
+    (thread-sleep! 0.2)
+    ;; The rest of it, a whole call, and half of the next: the poller
+    ;; hands the connection over at the first call, with what follows.
+    (raw-send! conn (bytevector-append (rest call-2)
+                                       (frame 3 '(apply 3 #(murdoch:global list) (3)))
+                                       (cut call-4)))
+    (thread-sleep! 0.2)
+    (raw-send! conn (rest call-4))
+    (test "each call is answered, in order" '((value 2 (2)) (value 3 (3)) (value 4 (4)))
+      (let* ((a (raw-answer conn)) (b (raw-answer conn)) (c (raw-answer conn)))
+        (list a b c)))
+    (raw-close! conn))
+  (let* ((welcomed (welcomed-raw-connect key (aspace-port (troy)) "m2"))
+         (conn (car welcomed)))
+    (raw-send! conn (bytevector-append (counted key (cdr welcomed) 1 '(abandon 99))
+                                       (string->utf8 "5:ab")))
+    (test "half a frame after the poller's last frame is still cut off" #t
+      (raw-closed? conn)))
+  (still-fine "after the move"))
+
 (test-group "deep, wide, circular and huge data"
   ;; Written out by hand: Chibi's writer stops at depth 10,000.
   (define (deep-call id depth)

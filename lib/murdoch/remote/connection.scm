@@ -146,6 +146,38 @@
         (vector-set! *watched* fd c)
         (poller-watch! (connection-in c))))))
 
+;;> Watches the connection served on input port \var{in}, \var{s} to the
+;;> serving side: the poller hands \scheme{(take s items)} what
+;;> poller-frames! reads, and \scheme{(fault s e)} what it raises.
+;;> Answers the descriptor.
+(define (watch-served! in s take fault)
+  (with-lock *connections-lock*
+    (lambda ()
+      (if (not *poller-port*) (start-poller!))
+      (let ((fd (port-fileno in)))
+        (if (>= fd (vector-length *watched*))
+            (set! *watched* (vector-grow *watched* (* 2 (+ fd 1)))))
+        (vector-set! *watched* fd (make-watcher s take fault))  ; before: see watch!
+        (poller-watch! in)
+        fd))))
+
+;;> The poller stops reading served descriptor \var{fd}: for good
+;;> (poller-unwatch!), or, with \var{keep?}, leaving its buffer to a
+;;> thread of its own (poller-release!).
+(define (unwatch-served! fd keep?)
+  (with-lock *connections-lock*
+    (lambda ()
+      (vector-set! *watched* fd #f)
+      (if keep? (poller-release! fd) (poller-unwatch! fd)))))
+
+;; A served connection as the poller knows it.
+(define-record-type watcher
+  (make-watcher serving take fault)
+  watcher?
+  (serving watcher-serving)
+  (take watcher-take)
+  (fault watcher-fault))
+
 (define (vector-grow v n)
   (let ((grown (make-vector n #f)))
     (vector-copy! grown 0 v)
@@ -163,11 +195,12 @@
     (define (take! fd)
       (let ((c (and (< fd (vector-length *watched*)) (vector-ref *watched* fd))))
         (set! current c)
-        (if c
-            (take-frames! c (poller-frames! fd (max-frame)))
-            (poller-unwatch! fd))))
+        (cond ((connection? c) (take-frames! c (poller-frames! fd (max-frame))))
+              (c ((watcher-take c) (watcher-serving c) (poller-frames! fd (max-frame))))
+              (else (poller-unwatch! fd)))))
     (let again ()
-      (guard (e (#t (if current (connection-fault! current e))
+      (guard (e (#t (cond ((connection? current) (connection-fault! current e))
+                          (current ((watcher-fault current) (watcher-serving current) e)))
                     (again)))
         (let loop ()
           (let ((fds (poller-ready)))

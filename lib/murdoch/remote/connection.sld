@@ -6,7 +6,7 @@
   (export connection-to send-call! give-up-call! send-datagram-answer!
           make-pending-call pending-call? pending-call-uid
           pending-call-connection pending-call-id pending-call-answer
-          answer-call!)
+          answer-call! watch-served! unwatch-served!)
   (import (only (murdoch code) make-logged-thread)
           (scheme base) (srfi 18) (srfi 69) (only (chibi string) string-prefix?)
           (only (chibi) port-fileno)

@@ -1,10 +1,14 @@
 ;;;; Serving calls: the callee's side of the wire.
 ;;
-;; Each connection has one reader thread, and the reader runs an apply
-;; itself, not a worker (docs/speed.md, What Chibi charges).  So that a
-;; long apply holds up the calls behind it on its connection for
-;; takeover-seconds at most, the janitor then gives the connection a new
-;; reader; the old one answers its call and ends.
+;; The poller (connection.scm) reads each connection from its hello until
+;; its first call: the hello, the answers to our datagram calls and the
+;; abandons need no thread, and a requester gets an answer to each of its
+;; multicast requests on every peer's connection.  At its first call the
+;; connection gets a reader thread of its own, which reads on from the
+;; poller's buffer and runs an apply itself, not in a worker (docs/speed.md,
+;; What Chibi charges).  So that a long apply holds up the calls behind it
+;; on its connection for takeover-seconds at most, the janitor then gives
+;; the connection a new reader; the old one answers its call and ends.
 
 ;; A connection being served.  Its deadline is set while a frame is half
 ;; read: a peer that stalls mid-frame would otherwise hold a thread and a
@@ -14,9 +18,12 @@
   serving?
   (peer serving-peer)
   (host serving-host)
-  (thread serving-thread serving-thread-set!)  ; the reader
+  (thread serving-thread serving-thread-set!)  ; the reader; #f: the poller
   (in serving-in)
   (out serving-out)
+  (fd serving-fd serving-fd-set!)       ; #f for the group
+  (frames serving-frames serving-frames-set!) ; read, not yet served
+  (greeting serving-greeting serving-greeting-set!) ; after the hello
   (deadline serving-deadline serving-deadline-set!)
   (busy-since serving-busy-since serving-busy-since-set!) ; of an inline apply
   (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
@@ -48,17 +55,14 @@
 (define (serve-connection fd peer host)
   (let ((s (new-serving! peer host (open-input-file-descriptor fd #t)
                          (open-output-file-descriptor fd #t))))
+    (serving-thread-set! s #f)
+    (serving-fd-set! s (port-fileno (serving-in s)))
     ;; The hello, which proves the key, is due within frame-timeout of the
     ;; connect: anyone can connect, and an idle connection holds a
     ;; descriptor.
     (serving-deadline-set! s (+ (monotonic-seconds) (server-frame-timeout *server*)))
     (janitor-wanted!)
-    (read-as-reader s (lambda ()
-                        (let ((hello (read-served-frame s "hello" 0)))
-                          ;; A peer that connects and leaves at once is
-                          ;; probing the port.
-                          (if (not (eof-object? hello))
-                              (serve-calls s hello)))))))
+    (watch-served! (serving-in s) s take-polled! polled-fault!)))
 
 ;; A connection (or the multicast group: no ports, no host) that this
 ;; thread reads, among those the janitor watches.
@@ -67,6 +71,9 @@
     (serving-deadline-set! s #f)
     (serving-busy-since-set! s #f)
     (serving-applying-set! s '())
+    (serving-fd-set! s #f)
+    (serving-frames-set! s '())
+    (serving-greeting-set! s #f)
     (with-lock (server-lock *server*)
       (lambda () (server-servings-set! *server* (cons s (server-servings *server*)))))
     s))
@@ -80,28 +87,96 @@
 
 (define (reader? s) (eq? (current-thread) (serving-thread s)))
 
+;; Once: the janitor and the connection's reader may both end it.  The
+;; poller lets go of the descriptor before it closes: a closed number may
+;; be another connection's next.
 (define (end-serving! s)
-  (with-lock (server-lock *server*)
-    (lambda ()
-      (server-servings-set! *server* (remove (lambda (x) (eq? x s))
-                                             (server-servings *server*)))))
-  (guard (e (#t #f)) (close-input-port (serving-in s)))
-  (guard (e (#t #f)) (close-output-port (serving-out s))))
+  (when (with-lock (server-lock *server*)
+          (lambda ()
+            (and (memq s (server-servings *server*))
+                 (begin (server-servings-set!
+                         *server* (remove (lambda (x) (eq? x s))
+                                          (server-servings *server*)))
+                        #t))))
+    (if (serving-fd s) (unwatch-served! (serving-fd s) #f))
+    (guard (e (#t #f)) (close-input-port (serving-in s)))
+    (guard (e (#t #f)) (close-output-port (serving-out s)))))
 
-;; Waits as long as need be for a frame to begin, then gives it the lab's
-;; frame-timeout to arrive whole: less when a deadline is already set (the
-;; hello's).
-(define (read-served-frame s nonce count)
-  (if (eof-object? (peek-u8 (serving-in s)))
-      (eof-object)
-      (begin
-        (serving-deadline-set! s (or (serving-deadline s)
-                                     (+ (monotonic-seconds)
-                                        (server-frame-timeout *server*))))
-        (janitor-wanted!)
-        (let ((message (read-frame (serving-in s) nonce count)))
-          (serving-deadline-set! s #f)
-          message))))
+;;; Frames as the poller reads them
+
+;; The frames, eof or fault that poller-frames! read from s, whose
+;; reader is the poller: the hello; then the answers to our datagram calls
+;; and abandons, served here; at the first call, s and what is left of
+;; items go to a reader thread.  A frame begun and not whole has
+;; frame-timeout to come whole (the janitor ends s if not); the hello
+;; keeps the deadline of the connect.
+(define (take-polled! s items)
+  (cond ((null? items) (await-whole! s))
+        ((bytevector? (car items))
+         (if (serving-greeting s)
+             (let ((message (check-message (open-served s (car items))
+                                           '(run apply answer abandon) "a call")))
+               (if (memq (car message) '(run apply))
+                   (hand-to-reader! s (cons message (cdr items)))
+                   (begin (serve-notice s (greeting-uid (serving-greeting s)) message)
+                          (take-polled! s (cdr items)))))
+             (begin (greet! s (open-frame (car items) "hello" 0))
+                    (take-polled! s (cdr items)))))
+        ;; A peer that connects and leaves at once is probing the port.
+        ((eof-object? (car items)) (end-serving! s))
+        (else (protocol-fail "netstring" (car items)))))
+
+(define (await-whole! s)
+  (cond ((positive? (poller-buffered (serving-fd s)))
+         (unless (serving-deadline s)
+           (serving-deadline-set! s (+ (monotonic-seconds)
+                                       (server-frame-timeout *server*)))
+           (janitor-wanted!)))
+        ((serving-greeting s) (serving-deadline-set! s #f))))
+
+;; A frame that breaks the protocol, or a hello that is wrong, ends its
+;; connection, and the log says why.
+(define (polled-fault! s e)
+  (log-fault (serving-peer s) e)
+  (end-serving! s))
+
+;; s gets a reader thread, which serves frames first.
+(define (hand-to-reader! s frames)
+  (unwatch-served! (serving-fd s) #t)
+  (serving-frames-set! s frames)
+  (serving-deadline-set! s #f)
+  (let ((t (make-guarded-thread (lambda () (read-as-reader s (serving-read-on s)))
+                                'connection)))
+    (with-lock (server-lock *server*) (lambda () (serving-thread-set! s t)))
+    (thread-start! t)))
+
+;; The next message of s for its reader thread, or an eof object; waits
+;; as long as need be for a frame to begin, then gives it the lab's
+;; frame-timeout to come whole.
+(define (read-served s)
+  (let ((x (next-served-frame s)))
+    (cond ((pair? x) x)                 ; opened by the poller
+          ((bytevector? x) (open-served s x))
+          ((eof-object? x) x)
+          (else (protocol-fail "netstring" x)))))
+
+(define (next-served-frame s)
+  (let ((frames (serving-frames s)))
+    (if (pair? frames)
+        (begin (serving-frames-set! s (cdr frames))
+               (car frames))
+        (begin
+          (await-whole! s)
+          (port-wait! (serving-in s) 3600)
+          (serving-frames-set! s (poller-frames! (serving-fd s) (max-frame)))
+          (next-served-frame s)))))
+
+;; The message of the frame whose payload is bytes, s's next.
+(define (open-served s bytes)
+  (let* ((g (serving-greeting s))
+         (count (+ 1 (greeting-count g))))
+    (greeting-count-set! g count)
+    (open-frame bytes (greeting-nonce g) count)))
 
 (define (janitor)
   (thread-sleep! janitor-seconds)
@@ -147,7 +222,7 @@
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
             " closed: no whole frame within frame-timeout")
-  (thread-terminate! (serving-thread s))
+  (if (serving-thread s) (thread-terminate! (serving-thread s)))
   (end-serving! s))
 
 (define (take-over! s)
@@ -263,79 +338,108 @@
         (reading-call-set! r #f)
         (inline-apply-ends! s))))
 
-(define (serve-calls s hello)
+;; What a connection knows once its caller has said hello: who called,
+;; the nonces each side MACs with, and the count of frames each way.
+(define-record-type greeting
+  (make-greeting uid caller-nonce nonce text write-lock)
+  greeting?
+  (uid greeting-uid)
+  (caller-nonce greeting-caller-nonce)  ; our answers are MACed with it
+  (nonce greeting-nonce)                ; the caller's frames are
+  (text greeting-text)                  ; see frame-text
+  (write-lock greeting-write-lock)
+  (answer greeting-answer greeting-answer-set!) ; a served call's (reply!)
+  (count greeting-count greeting-count-set!)    ; frames read
+  (sent greeting-sent greeting-sent-set!)       ; frames written
+  (flushed greeting-flushed greeting-flushed-set!)) ; sent when last flushed
+
+;; Welcomes the caller of hello, which the poller read on s.
+(define (greet! s hello)
   (match (check-message hello '(hello) "a hello")
     (('hello uid host port caller-nonce)
      ;; Where the caller listens, learned from its hello.
      (learn-aspace! (make-aspace uid host port))
-     (serve-greeted s uid caller-nonce))))
+     (let ((g (make-greeting uid caller-nonce (random-hex 16) (open-output-string)
+                             (make-mutex))))
+       (greeting-answer-set! g (lambda (c kind value) (answer-call s c kind value)))
+       (greeting-count-set! g 0)
+       (greeting-sent-set! g 0)
+       (greeting-flushed-set! g 0)
+       (serving-greeting-set! s g)
+       (serving-deadline-set! s #f)
+       (serving-read-on-set! s (lambda () (serve-greeted s)))
+       (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
+                    (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))))
 
-;; Welcomes the caller uid, then serves its frames.
-(define (serve-greeted s uid caller-nonce)
-  (let ((nonce (random-hex 16))
-        (out (serving-out s))
-        (text (open-output-string))
-        (write-lock (make-mutex))
-        (sent 0)
-        (flushed 0)                     ; sent when last flushed
-        (count 0))
-    ;; The reader's own answers wait in the port's buffer until it has
-    ;; read every call that has arrived: a burst of calls is answered in
-    ;; one write.  Answers from former readers go at once.
-    (define (answer! message)
-      (with-lock write-lock
-        (lambda ()
-          (let ((frame (frame-text text message)))
-            (set! sent (+ sent 1))
-            ;; A caller that left makes this raise, and the connection end.
-            (write-frame! out frame caller-nonce sent))
-          (if (not (reader? s)) (flush!)))))
-    ;; The caller holds the write lock.
-    (define (flush!)
-      (flush-output-port out)
-      (set! flushed sent))
-    ;; Nothing to flush after a frame that had no answer (the answers to
-    ;; our own datagram calls, which a requester gets from every peer): no
-    ;; lock taken for it.  Sent and flushed change under the write lock,
-    ;; and a writer flushes or comes here after its write.
-    (define (flush-if-idle!)
-      (if (and (not (= flushed sent))
-               (zero? (buffered-byte-count (serving-in s))))
-          (with-lock write-lock flush!)))
-    (define (answer c kind value)
-      (let ((id (served-call-id c)))
-        (answer! (if (eq? kind 'ack)
-                     (make-message 'ack id)
-                     (make-message kind id value)))))
-    ;; Serves frames while this thread is the reader; see read-calls.
-    (define (read-on r)
-      (let ((message (read-served-frame s nonce (+ count 1))))
-        (unless (eof-object? message)
-          (set! count (+ count 1))
-          (serve-frame r uid answer
-                       (check-message message '(run apply answer abandon)
-                                      "a call"))
-          (flush-if-idle!)
-          (if (reader? s) (read-on r)))))
-    (define (serve)
-      (read-calls s read-on
-                  (lambda (c e)
-                    (reply! c 'error (error-message e))
-                    (flush-if-idle!))
-                  raise))
-    (send-frame! out text caller-nonce 0
-                 (make-message 'welcome (local-aspace-uid) nonce))
-    (serving-read-on-set! s serve)
-    (serve)))
+;; Serves s's frames while this thread is its reader; see read-calls.
+(define (serve-greeted s)
+  (read-calls s (lambda (r) (read-on s r))
+              (lambda (c e)
+                (reply! c 'error (error-message e))
+                (flush-if-idle! s))
+              raise))
+
+(define (read-on s r)
+  (let ((message (read-served s)))
+    (unless (eof-object? message)
+      (let ((g (serving-greeting s)))
+        (serve-frame r (greeting-uid g) (greeting-answer g)
+                     (check-message message '(run apply answer abandon) "a call")))
+      (flush-if-idle! s)
+      (if (reader? s) (read-on s r)))))
+
+;; Answers served call c on s.
+(define (answer-call s c kind value)
+  (let ((id (served-call-id c)))
+    (answer! s (if (eq? kind 'ack)
+                   (make-message 'ack id)
+                   (make-message kind id value)))))
+
+;; The reader's own answers wait in the port's buffer until it has read
+;; every call that has arrived: a burst of calls is answered in one write.
+;; Answers from former readers go at once.
+(define (answer! s message)
+  (let ((g (serving-greeting s)))
+    (with-lock (greeting-write-lock g)
+      (lambda ()
+        (let ((frame (frame-text (greeting-text g) message))
+              (sent (+ 1 (greeting-sent g))))
+          (greeting-sent-set! g sent)
+          ;; A caller that left makes this raise, and the connection end.
+          (write-frame! (serving-out s) frame (greeting-caller-nonce g) sent))
+        (if (not (reader? s)) (flush! s))))))
+
+;; The caller holds the write lock.
+(define (flush! s)
+  (let ((g (serving-greeting s)))
+    (flush-output-port (serving-out s))
+    (greeting-flushed-set! g (greeting-sent g))))
+
+;; Nothing to flush after a frame that had no answer (the answers to our
+;; own datagram calls, which a requester gets from every peer): no lock
+;; taken for it.  Sent and flushed change under the write lock, and a
+;; writer flushes or comes here after its write.
+(define (flush-if-idle! s)
+  (let ((g (serving-greeting s)))
+    (if (and (not (= (greeting-flushed g) (greeting-sent g)))
+             (null? (serving-frames s)))
+        (with-lock (greeting-write-lock g) (lambda () (flush! s))))))
 
 ;; Serves one frame from the caller uid, read by r: a call, which answer
-;; answers; the answer to one of our datagram calls; or an abandon.
+;; answers, or one that needs no answer (serve-notice).
 (define (serve-frame r uid answer message)
+  (if (memq (car message) '(run apply))
+      (match message
+        ((kind id proc-code args-code)
+         (serve-call r (make-served-call uid id kind proc-code args-code answer))))
+      (serve-notice (reading-serving r) uid message)))
+
+;; Serves a frame of s from uid that needs no answer: the answer to one
+;; of our datagram calls, or an abandon.
+(define (serve-notice s uid message)
   (match message
     (('answer . _) (take-datagram-answer! uid message))
-    (('abandon id) (abandon-call! (reading-serving r) id))
-    ((kind id proc-code args-code)
-     (serve-call r (make-served-call uid id kind proc-code args-code answer)))))
+    (('abandon id) (abandon-call! s id))))
 
 ;; The application call c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
@@ -360,7 +464,7 @@
         (let ((peer (peer-name (address-info-address addr)))
               (host (sockaddr-name (address-info-address addr))))
           (if (room-for? host)
-              (spawn (lambda () (serve-connection fd peer host)) 'connection)
+              (serve-connection fd peer host)
               (refuse-connection! fd peer))))
     (accept-loop listener addr)))
 

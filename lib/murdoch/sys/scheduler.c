@@ -712,6 +712,27 @@ static sexp poller_unwatch (sexp ctx, sexp self, sexp_sint_t n, sexp fd) {
   return SEXP_VOID;
 }
 
+/* (poller-release! fd): stops watching fd but keeps its buffer, for a
+ * thread of its own to read on with poller-frames!. */
+static sexp poller_release (sexp ctx, sexp self, sexp_sint_t n, sexp fd) {
+  if (!sexp_fixnump(fd))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, fd);
+  if (poller_fd >= 0)
+    epoll_ctl(poller_fd, EPOLL_CTL_DEL, sexp_unbox_fixnum(fd), NULL);
+  return SEXP_VOID;
+}
+
+/* (poller-buffered fd): the bytes of a frame not yet whole in fd's
+ * buffer. */
+static sexp poller_buffered (sexp ctx, sexp self, sexp_sint_t n, sexp fd) {
+  long i;
+  if (!sexp_fixnump(fd))
+    return sexp_type_exception(ctx, self, SEXP_FIXNUM, fd);
+  i = sexp_unbox_fixnum(fd);
+  return sexp_make_fixnum(i >= 0 && (size_t)i < inbox_count
+                          ? (long)inboxes[i].length : 0);
+}
+
 /* (poller-ready): the descriptors with something to read, or that ended;
  * never waits. */
 static sexp poller_ready (sexp ctx, sexp self, sexp_sint_t n) {
@@ -858,6 +879,8 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "poller-port", 0, poller_port);
   sexp_define_foreign(ctx, env, "poller-watch!", 1, poller_watch);
   sexp_define_foreign(ctx, env, "poller-unwatch!", 1, poller_unwatch);
+  sexp_define_foreign(ctx, env, "poller-release!", 1, poller_release);
+  sexp_define_foreign(ctx, env, "poller-buffered", 1, poller_buffered);
   sexp_define_foreign(ctx, env, "poller-ready", 0, poller_ready);
   sexp_define_foreign(ctx, env, "poller-frames!", 2, poller_frames);
   return install(ctx);

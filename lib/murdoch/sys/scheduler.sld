@@ -45,6 +45,13 @@
 ;;> Stops watching \var{fd} and drops its buffer; call it before the
 ;;> descriptor is closed.
 ;;>
+;;> \procedure{(poller-release! fd)}
+;;> Stops watching \var{fd} but keeps its buffer, for a thread of its own
+;;> to read on with poller-frames!; poller-unwatch! drops it at the end.
+;;>
+;;> \procedure{(poller-buffered fd)}
+;;> How many bytes of a frame not yet whole \var{fd}'s buffer holds.
+;;>
 ;;> \procedure{(poller-ready)}
 ;;> The watched descriptors with bytes to read or an end, without waiting.
 ;;>
@@ -59,8 +66,8 @@
   (export poll-scheduler-installed? monotonic-seconds wall-microseconds
           stack-guard-tripped?
           port-wait!
-          poller-port poller-watch! poller-unwatch! poller-ready
-          poller-frames!)
+          poller-port poller-watch! poller-unwatch! poller-release!
+          poller-buffered poller-ready poller-frames!)
   ;; (srfi 18) installs Chibi's scheduler, which the wrapper goes in front of.
   (import (scheme base) (srfi 18))
   (include-shared "scheduler")
