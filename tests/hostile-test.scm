@@ -171,6 +171,24 @@
                                        (string->utf8 "5:ab")))
     (test "half a frame after the poller's last frame is still cut off" #t
       (raw-closed? conn)))
+  ;; Each frame has frame-timeout from when it begins, not from when the
+  ;; first of them did.
+  (let* ((welcomed (welcomed-raw-connect key (aspace-port (troy)) "m3"))
+         (conn (car welcomed)))
+    (define (frame count datum) (counted key (cdr welcomed) count datum))
+    (define (cut bytes) (bytevector-copy bytes 0 12))
+    (define (rest bytes) (bytevector-copy bytes 12))
+    (define abandon-2 (frame 2 '(abandon 98)))
+    (define abandon-3 (frame 3 '(abandon 97)))
+    (raw-send! conn (bytevector-append (frame 1 '(abandon 99)) (cut abandon-2)))
+    (thread-sleep! 0.6)
+    (raw-send! conn (bytevector-append (rest abandon-2) (cut abandon-3)))
+    (thread-sleep! 0.6)
+    (raw-send! conn (bytevector-append (rest abandon-3)
+                                       (frame 4 '(apply 4 #(murdoch:global list) (4)))))
+    (test "frames that come whole a part at a time are not cut off" '(value 4 (4))
+      (raw-answer conn))
+    (raw-close! conn))
   (still-fine "after the move"))
 
 (test-group "deep, wide, circular and huge data"

@@ -171,11 +171,14 @@
           (serving-frames-set! s (poller-frames! (serving-fd s) (max-frame)))
           (next-served-frame s)))))
 
-;; The message of the frame whose payload is bytes, s's next.
+;; The message of the frame whose payload is bytes, s's next.  It came
+;; whole: a deadline set for it is met (await-whole! sets one for the
+;; next when part of it waits).
 (define (open-served s bytes)
   (let* ((g (serving-greeting s))
          (count (+ 1 (greeting-count g))))
     (greeting-count-set! g count)
+    (serving-deadline-set! s #f)
     (open-frame bytes (greeting-nonce g) count)))
 
 (define (janitor)
