@@ -18,7 +18,7 @@
           receive-rival pose-negotiations reservation-aspace-uid resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t sort-list
           make-maxrandom progress explain-no-takers explain-components with-coordinator
-          team-barrier team-send! team-receive step-team make-coordinator error-why
+          team-barrier team-send! team-receive step-team make-coordinator
           negotiated-winners negotiated-types negotiated-name winner-uid winner-promise)
   (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
           (murdoch task metric) (murdoch task pose-task) (murdoch task progress)

@@ -156,7 +156,7 @@
     (make-result uid #t (thunk))))
 
 (define (failure-result uid e)
-  (make-result uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
+  (make-result uid #f (error-message e)))
 
 ;;> (map entry items), where (entry item) answers a result; an item whose
 ;;> entry raised gives the result of its failure, for the uid (uid-of

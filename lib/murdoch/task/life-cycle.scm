@@ -299,8 +299,8 @@
       (if (and (pair? what) (eq? (car what) 'robot-failure))
           (list 'lost (cadr what))
           (list 'done what)))
-     ((remote-unreachable-error? what) (list 'lost (remote-error-message what)))
-     (else (list 'failed (error-why what))))))
+     ((remote-unreachable-error? what) (list 'lost (error-message what)))
+     (else (list 'failed (error-message what))))))
 
 ;; A component's result, as pose-task gives it: its value, or (error UID
 ;; WHY) with the last robot it had.

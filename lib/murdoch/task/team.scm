@@ -129,15 +129,9 @@
 ;; The default on-error: tell, and let (error UID WHY) stand for the
 ;; result, so the other components' results still come back.
 (define (team-error uid e)
-  (let ((why (error-why e)))
+  (let ((why (error-message e)))
     (log-warn "component on " uid " failed: " why)
     (list 'error uid why)))
-
-;;> The WHY of a component's (error UID WHY): what \var{e}, the condition
-;;> it raised, says, as one line; a remote error's own message, since the
-;;> uid is said beside it.
-(define (error-why e)
-  (if (remote-error? e) (remote-error-message e) (error-message e)))
 
 ;;; Synchronization inside a team, MOVER's way
 ;;
