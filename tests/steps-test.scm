@@ -118,8 +118,8 @@
                 (text-contains? (car (cddr (car (car r)))) "far")))
     (test "the task stops after the failed step" 1 (length r))
     (test "and says so" '(posed failed)
-      (let ((e (find (lambda (e) (eq? (cadr e) (task-id t))) (tasks))))
-        (list (car e) (car (cddr e)))))
+      (let ((e (find (lambda (e) (eq? (listed-id e) (task-id t))) (tasks))))
+        (list (car e) (listed-state e))))
     (test "every subject is free" #t (wait-until 5 all-free?))))
 
 ;; far does component 2 at once, then takes component 1 when near is lost;
@@ -143,7 +143,7 @@
          (runs-1 (lambda ()
                    (let ((steps (task-status t)))
                      (and (pair? steps) (pair? (car (cddr (car steps))))
-                          (let ((state (cadr (car (car (cddr (car steps)))))))
+                          (let ((state (status-state (car (car (cddr (car steps)))))))
                             (and (eq? 'running (car state)) (cadr state)))))))
          (freeze-until-moved!
           (lambda (uid)

@@ -97,8 +97,8 @@
   (thread-sleep! 0.5)
   (counts-at uid))
 (define near-first (location-metric-maker '(0 0 0 0)))
-(define (state-of task k) (cadr (list-ref (task-status task) (- k 1))))
-(define (attempts-of task k) (car (cddr (list-ref (task-status task) (- k 1)))))
+(define (state-of task k) (status-state (list-ref (task-status task) (- k 1))))
+(define (attempts-of task k) (status-attempts (list-ref (task-status task) (- k 1))))
 ;; Waits until component k of task runs on uid and has called out there.
 (define (running-on? task k uid)
   (let ((before (spins-at uid)))

@@ -6,8 +6,12 @@
   (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
           dominant-cost run-component run-posed-component
           component-heartbeat! stop-component! components-running components-ended
+          ended-id ended-index ended-started ended-ended ended-end
           lost-periods
-          start-task task? task-id task-name task-status task-wait cancel-task tasks
+          start-task task? task-id task-name task-status task-wait cancel-task
+          status-index status-state status-attempts
+          tasks listed-posed? listed-id listed-state listed-place listed-why
+          listed-index listed-poser
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer
           receive-give-way note-waiters! location-metric-maker load-metric-maker
           load-metric reverse-metric metric-by metric-by-asking metric-within

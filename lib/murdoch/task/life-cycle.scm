@@ -312,7 +312,8 @@
                        (and (pair? attempts) (car (last attempts))))
               (cadr state)))))
 
-;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS):
+;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS),
+;;> read by status-index, status-state and status-attempts:
 ;;> STATE is (negotiating), (running UID SINCE), (done VALUE), (failed
 ;;> WHY) or (reassigned FROM TO), SINCE a (utc-seconds); ATTEMPTS has
 ;;> (UID . OUTCOME) for each robot that had the component and is done
@@ -327,6 +328,17 @@
              (list (component-index c) (component-state c)
                    (component-attempts c)))
            (task-components task))))
+
+;;> The component's number in \var{s}, an entry of task-status.
+(define (status-index s) (car s))
+
+;;> The component's state in \var{s}, an entry of task-status:
+;;> (negotiating), (running UID SINCE), (done VALUE) ...
+(define (status-state s) (cadr s))
+
+;;> The (UID . OUTCOME) of each robot done with the component in \var{s},
+;;> an entry of task-status.
+(define (status-attempts s) (car (cddr s)))
 
 ;;> Waits for \var{task} to end, at most \var{seconds} (default: for
 ;;> ever), and answers what pose-task would have: each component's result,
@@ -372,7 +384,9 @@
       (error (string-append who ": not a task; start-task answers one") x)))
 
 ;;> The tasks of this address space: (posed ID STATE) for each it started,
-;;> newest first, and (running ID INDEX POSER) for each component it runs.
+;;> newest first, (posed ID waiting PLACE WHY) for one waiting its turn,
+;;> and (running ID INDEX POSER) for each component it runs.  listed-id
+;;> and the other listed- procedures read them.
 (define (tasks)
   (append (map (lambda (t)
                  (let ((w (task-waiter t)))
@@ -382,6 +396,30 @@
                        (list 'posed (task-id t) (task-state t)))))
                (with-lock *tasks-lock* (lambda () *posed*)))
           (map (lambda (r) (cons 'running r)) (components-running))))
+
+;;> Whether \var{e}, an entry of (tasks), is a task started here.
+(define (listed-posed? e) (eq? (car e) 'posed))
+
+;;> The task id of \var{e}, an entry of (tasks).
+(define (listed-id e) (cadr e))
+
+;;> The state of \var{e}, a posed entry of (tasks): waiting, running,
+;;> done ...
+(define (listed-state e) (car (cddr e)))
+
+;;> The place in line of \var{e}, a posed entry of (tasks), when it
+;;> waits, else #f.
+(define (listed-place e) (and (= (length e) 5) (list-ref e 3)))
+
+;;> Why \var{e}, a posed entry of (tasks) that waits, waits: a string for
+;;> each task ahead of it.
+(define (listed-why e) (list-ref e 4))
+
+;;> The component's number in \var{e}, a running entry of (tasks).
+(define (listed-index e) (car (cddr e)))
+
+;;> The poser of the component in \var{e}, a running entry of (tasks).
+(define (listed-poser e) (cadr (cddr e)))
 
 ;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
 ;;; synchronization)

@@ -5,7 +5,9 @@
 
 (define-library (murdoch task life-cycle)
   (export start-task task? task-id task-name task-status task-wait cancel-task
-          tasks task-step start-steps pose-steps
+          status-index status-state status-attempts
+          tasks listed-posed? listed-id listed-state listed-place listed-why
+          listed-index listed-poser task-step start-steps pose-steps
           waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
   (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
           (srfi 132) (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)

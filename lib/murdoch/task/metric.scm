@@ -206,8 +206,8 @@
 ;; its answer does not score) measures +inf.0, and so comes last.
 (define (measure-all measure uids)
   (if (asking? measure)
-      (map (lambda (answer)
-             (score measure (cadr answer) (and (cadr answer) (car (cddr answer)))))
+      (map (lambda (o)
+             (score measure (outcome-ok? o) (and (outcome-ok? o) (outcome-value o))))
            (remote-apply-all (map uid->aspace uids) (asking-proc measure)))
       (map thread-join!
            (map (lambda (uid)
