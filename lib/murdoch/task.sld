@@ -21,7 +21,8 @@
           pose-task-priority pose-task-retries pose-task-backoff pose-task-excluded
           receive-rival pose-negotiations reservation-aspace-uid resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t sort-list
-          make-maxrandom progress explain-no-takers explain-components with-coordinator
+          make-maxrandom progress explain-no-takers explain-components explanation?
+          explanation-line explanation-free explanation-capable with-coordinator
           team-barrier team-send! team-receive step-team make-coordinator
           negotiated-winners negotiated-types negotiated-name winner-uid winner-promise)
   (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)

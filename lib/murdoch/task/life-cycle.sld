@@ -15,5 +15,6 @@
           (murdoch task team) (murdoch task pose-task) (murdoch task running)
           (only (murdoch pubsub) subscribe unsubscribe publish request
                 capability-layout subscription-statuses on-free! offer-subjects!)
-          (only (murdoch task takers) explain-components))
+          (only (murdoch task takers) explain-components explanation-line
+                explanation-free explanation-capable))
   (include "life-cycle.scm"))
