@@ -37,6 +37,7 @@
           ;; the task life cycle (lib/murdoch/task/life-cycle.scm)
           start-task task? task-id task-name task-status task-wait cancel-task
           status-index status-state status-attempts
+          step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
           listed-index listed-poser run-component run-posed-component components-ended
           ended-id ended-index ended-started ended-ended ended-end

@@ -319,7 +319,8 @@
                         (let ((steps (task-status stepped)))
                           (if (null? steps)
                               '(not-started)
-                              (status-state (car (car (cddr (car steps))))))))))
+                              (status-state
+                               (car (step-status-entries (car steps)))))))))
     (test "its first step waits" 'waiting
       (begin (wait-until 10 (lambda () (eq? (car (first-state)) 'waiting)))
              (car (first-state))))

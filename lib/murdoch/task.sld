@@ -10,6 +10,7 @@
           lost-periods
           start-task task? task-id task-name task-status task-wait cancel-task
           status-index status-state status-attempts
+          step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
           listed-index listed-poser
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer

@@ -18,5 +18,5 @@
           (murdoch cli command) (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment)
           (only (murdoch status) write-lab-status)
-          (only (murdoch task) status-state))
+          (only (murdoch task) status-state step-status? step-status-entries))
   (include "launch.scm"))

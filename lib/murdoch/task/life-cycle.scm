@@ -340,6 +340,17 @@
 ;;> an entry of task-status.
 (define (status-attempts s) (car (cddr s)))
 
+;;> Whether \var{s}, an entry of task-status, is a step's (step I
+;;> STATUS), as a task of steps gives.
+(define (step-status? s) (eq? (car s) 'step))
+
+;;> The number I of the step in \var{s}, a step's entry of task-status.
+(define (step-status-index s) (cadr s))
+
+;;> The STATUS in \var{s}, a step's entry of task-status: the step's own
+;;> task-status, an entry for each of its components.
+(define (step-status-entries s) (car (cddr s)))
+
 ;;> Waits for \var{task} to end, at most \var{seconds} (default: for
 ;;> ever), and answers what pose-task would have: each component's result,
 ;;> (error UID WHY) for a failed one, or not-enough-takers.  Raises an
@@ -454,9 +465,10 @@
 
 ;;> Starts a task of \var{steps} (made by task-step) and answers its task
 ;;> record at once; start-task's keywords may follow the steps, and each
-;;> step is started with them.  task-status gives (step I STATUS) for each step
-;;> started, task-wait the list of each step's results, and cancel-task
-;;> stops the step running and those after it.
+;;> step is started with them.  task-status gives (step I STATUS) for each
+;;> step started (read by step-status? and the other step-status-
+;;> procedures), task-wait the list of each step's results, and
+;;> cancel-task stops the step running and those after it.
 (define (start-steps task-name . steps+options)
   (let ((steps (take-while step? steps+options))
         (options (drop-while step? steps+options)))

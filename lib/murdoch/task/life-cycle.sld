@@ -6,6 +6,7 @@
 (define-library (murdoch task life-cycle)
   (export start-task task? task-id task-name task-status task-wait cancel-task
           status-index status-state status-attempts
+          step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
           listed-index listed-poser task-step start-steps pose-steps
           waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
