@@ -50,8 +50,9 @@
 (define (remote-error-message e) (car (cddr (exception-irritants e))))
 
 ;;> What \var{e}, any raised object, says, as one line for a log or an
-;;> answer: a remote protocol error's own message, else condition-message's.
+;;> answer: a remote error's own message (its uid and procedure are its
+;;> irritants, for whoever names them), else condition-message's.
 (define (error-message e)
-  (if (and (remote-protocol-error? e) (not (stack-guard-tripped? (current-thread))))
+  (if (and (remote-error? e) (not (stack-guard-tripped? (current-thread))))
       (remote-error-message e)
       (condition-message e)))
