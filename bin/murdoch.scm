@@ -8,7 +8,7 @@
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
         (only (chibi ast) setenv unsetenv)
-        (only (murdoch wire) error-message) (murdoch lab) (murdoch cli command)
+        (only (murdoch wire) error-message error-message-naming) (murdoch lab) (murdoch cli command)
         (murdoch cli launch))
 
 (define version "0.3")
@@ -307,7 +307,7 @@
   (let ((started? #f))
     (guard (e ((and (error-object? e) started?)
                (write-string (string-append "murdoch " (symbol->string (car c))
-                                            ": ERROR: " (error-message e) "\n")
+                                            ": ERROR: " (error-message-naming e) "\n")
                              (current-error-port))
                (exit 2))
               ((error-object? e) (mistake c (error-message e))))

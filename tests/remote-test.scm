@@ -95,6 +95,13 @@
          (list (lambda () (remote-apply (troy) (lambda () (car '()))))
                (lambda () (parameterize ((remote-timeout 1/2))
                             (remote-apply (troy) slow 3))))))
+  (test "an error from a third address space names it, the caller's answer"
+      "praline: car: not a pair ()"
+    (error-text (lambda ()
+                  (remote-apply (troy)
+                                (lambda ()
+                                  (remote-apply (uid->aspace 'praline)
+                                                (lambda () (car '()))))))))
   (test "and so does remote-apply-all's outcome of each that failed"
       '((troy #f "car: not a pair ()") (praline #t 2))
     (remote-apply-all (list (troy) (uid->aspace 'praline))

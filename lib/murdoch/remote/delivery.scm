@@ -86,5 +86,5 @@
               (lambda (c e)
                 (guard (e2 (#t (log-warn "an answer was lost: "
                                          (fault-message e2))))
-                  (reply! c 'error (error-message e))))
+                  (reply! c 'error (error-message-naming e))))
               (lambda (e) (log-warn "datagram dropped: " (fault-message e)))))

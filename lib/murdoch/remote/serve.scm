@@ -310,7 +310,7 @@
     (define (serve)
       (read-calls s read-on
                   (lambda (c e)
-                    (reply! c 'error (error-message e))
+                    (reply! c 'error (error-message-naming e))
                     (flush-if-idle!))
                   raise))
     (send-frame! out text caller-nonce 0

@@ -56,3 +56,13 @@
   (if (and (remote-error? e) (not (stack-guard-tripped? (current-thread))))
       (remote-error-message e)
       (condition-message e)))
+
+;;> As error-message, but a remote error's message follows the uid of the
+;;> address space it concerns, as \scheme{"praline: car: not a pair ()"}:
+;;> for an error that leaves the place that knows the uid, an answer to
+;;> another caller or the command line's ERROR line.
+(define (error-message-naming e)
+  (let ((uid (and (remote-error? e) (remote-error-uid e))))
+    (if uid
+        (string-append (symbol->string uid) ": " (error-message e))
+        (error-message e))))
