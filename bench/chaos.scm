@@ -115,7 +115,7 @@
                        (list (lab-proc 'chaos-component)) '(1) '(#t)))
         (began (monotonic-seconds)))
     (let watch ((uid #f) (since began))
-      (let ((state (cadr (car (task-status t)))))
+      (let ((state (status-state (car (task-status t)))))
         (cond
          ((memq (car state) '(done failed))
           (note! (outcome-of state)))

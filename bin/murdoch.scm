@@ -8,7 +8,7 @@
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
         (only (chibi ast) setenv unsetenv)
-        (only (murdoch wire) error-message) (murdoch lab) (murdoch cli command)
+        (only (murdoch wire) error-message error-message-naming) (murdoch lab) (murdoch cli command)
         (murdoch cli launch))
 
 (define version "0.3")
@@ -103,6 +103,11 @@
 (define (command-options c) (cadr (cddr c)))
 (define (command-proc c) (car (cddr (cddr c))))
 
+;; An option of a command, (NAME TYPE DOC), by name.
+(define (option-key o) (car o))
+(define (option-type o) (cadr o))
+(define (option-doc o) (car (cddr o)))
+
 (define (optional? arg) (pair? arg))
 (define (arg-name arg) (symbol->string (if (pair? arg) (car arg) arg)))
 
@@ -131,9 +136,9 @@
 (define (show-command-usage c out)
   (write-string (string-append "Usage: " (usage-line c) "\n  " (command-doc c) "\n") out)
   (for-each (lambda (o)
-              (write-string (string-append "  --" (symbol->string (car o)) " "
-                                           (string-upcase-name (cadr o))
-                                           "\n      " (car (cddr o)) "\n")
+              (write-string (string-append "  --" (symbol->string (option-key o)) " "
+                                           (string-upcase-name (option-type o))
+                                           "\n      " (option-doc o) "\n")
                             out))
             (command-options c)))
 
@@ -212,13 +217,13 @@
                                 (and (pair? (cdr rest)) (cadr rest))))
                      (next (if (inline-value arg) (cdr rest) (cddr* rest))))
                  (cond
-                  ((and (eq? (car o) 'view) (not (inline-value arg))
+                  ((and (eq? (option-key o) 'view) (not (inline-value arg))
                         (not (and value (string->number value))))
                    (if (and value (not (option-word? value))
                             (> (length (positional args)) (length (command-args c))))
                        (mistake c (value-mistake o value)))
                    (loop (cdr rest)))
-                  ((not (and value (value-fits? (cadr o) value)))
+                  ((not (and value (value-fits? (option-type o) value)))
                    (mistake c (value-mistake o value)))
                   (else (loop next))))))
          (else
@@ -234,17 +239,17 @@
       (else (not (option-word? text))))))
 
 (define (value-mistake o value)
-  (string-append "--" (symbol->string (car o)) " takes "
-                 (case (cadr o)
+  (string-append "--" (symbol->string (option-key o)) " takes "
+                 (case (option-type o)
                    ((real) "a positive number")
-                   ((integer) (if (eq? (car o) 'view) "a port number, or nothing"
+                   ((integer) (if (eq? (option-key o) 'view) "a port number, or nothing"
                                   "a port number"))
                    ((string) "a name")
                    (else "names, as a,b,..."))
                  (if value (string-append ", not " value) "")))
 
 (define (nearest-option c arg)
-  (let* ((names (map (lambda (o) (string-append "--" (symbol->string (car o))))
+  (let* ((names (map (lambda (o) (string-append "--" (symbol->string (option-key o))))
                      (command-options c)))
          (near (find-nearest-edits arg names)))
     ;; Two edits from a name of another first letter is another word.
@@ -302,7 +307,7 @@
   (let ((started? #f))
     (guard (e ((and (error-object? e) started?)
                (write-string (string-append "murdoch " (symbol->string (car c))
-                                            ": ERROR: " (error-message e) "\n")
+                                            ": ERROR: " (error-message-naming e) "\n")
                              (current-error-port))
                (exit 2))
               ((error-object? e) (mistake c (error-message e))))

@@ -47,10 +47,10 @@
   (let ((seen (fiducials)))
     (and (pair? seen)
          (let* ((f (car seen)) (me (reckon))
-                (a (* degrees (+ (list-ref me 2) (list-ref f 2)))))
-           (list (+ (car me) (* (list-ref f 1) (cos a)))
-                 (+ (cadr me) (* (list-ref f 1) (sin a)))
-                 (+ (list-ref me 2) (list-ref f 3)))))))
+                (a (* degrees (+ (list-ref me 2) (fiducial-bearing f)))))
+           (list (+ (car me) (* (fiducial-range f) (cos a)))
+                 (+ (cadr me) (* (fiducial-range f) (sin a)))
+                 (+ (list-ref me 2) (fiducial-orientation f)))))))
 
 ;; The distance from point p to the leg from a to b.
 (define (leg-distance p a b)

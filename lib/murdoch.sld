@@ -11,7 +11,8 @@
           remote-error? remote-error-uid remote-error-message
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
           remote-protocol-error?
-          remote-apply-all remote-run-all! live-uids delivery-mode
+          remote-apply-all remote-run-all! outcome-uid outcome-ok? outcome-value
+          live-uids delivery-mode
           encap var-ref var-set! display-remote
           ;; publish/subscribe (lib/murdoch/pubsub/messaging.scm)
           subscribe unsubscribe subscriptions topic-status set-topic-status!
@@ -35,7 +36,11 @@
           sort-list make-maxrandom
           ;; the task life cycle (lib/murdoch/task/life-cycle.scm)
           start-task task? task-id task-name task-status task-wait cancel-task
-          tasks run-component run-posed-component components-ended
+          status-index status-state status-attempts
+          step-status? step-status-index step-status-entries
+          tasks listed-posed? listed-id listed-state listed-place listed-why
+          listed-index listed-poser run-component run-posed-component components-ended
+          ended-id ended-index ended-started ended-ended ended-end
           component-heartbeat! stop-component!
           waiting-ranks waiting-for receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
@@ -47,6 +52,7 @@
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether! fiducials
+          fiducial-id fiducial-range fiducial-bearing fiducial-orientation
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch code) (murdoch remote) (murdoch pubsub) (murdoch task)
           (murdoch robot)

@@ -289,7 +289,7 @@
                        (list (eval 'steady (lab-environment))))))
     (test "another task's component runs on troy" 'troy
       (wait-until 10 (lambda ()
-                       (let ((state (cadr (car (task-status t)))))
+                       (let ((state (status-state (car (task-status t)))))
                          (and (eq? (car state) 'running) (cadr state))))))
     (for-each
      (lambda (attack)

@@ -82,13 +82,16 @@
            (cons (cadr form) (filter ours? (imports form)))))
        library-files))
 
-;; The libraries on a path of imports from name back to name, or #f.
+;; The libraries on a path of imports from name back to name, or #f.  A
+;; library already walked from leads back to name no more the second time.
 (define (cycle-from name)
-  (let walk ((here name) (path '()))
-    (cond ((and (pair? path) (equal? here name)) (reverse (cons here path)))
-          ((member here path) #f)
-          (else (any (lambda (next) (walk next (cons here path)))
-                     (cond ((assoc here graph) => cdr) (else '())))))))
+  (let ((seen '()))
+    (let walk ((here name) (path '()))
+      (cond ((and (pair? path) (equal? here name)) (reverse (cons here path)))
+            ((member here seen) #f)
+            (else (set! seen (cons here seen))
+                  (any (lambda (next) (walk next (cons here path)))
+                       (cond ((assoc here graph) => cdr) (else '()))))))))
 
 ;; How README's shape table names a library: its path under lib/murdoch/,
 ;; `wire/frame`, or `(murdoch)`.

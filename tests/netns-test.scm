@@ -121,7 +121,7 @@
   (remote-apply (uid->aspace uid) (eval '(lambda () spins) (lab-environment))))
 (define (stopped-at? uid)
   (remote-apply (uid->aspace uid) (eval '(lambda () stopped) (lab-environment))))
-(define (state-of t) (cadr (car (task-status t))))
+(define (state-of t) (status-state (car (task-status t))))
 ;; The (current-second) at which thunk first answers true, looked at every
 ;; 10 ms, or #f after seconds.
 (define (second-when seconds thunk)
@@ -258,7 +258,7 @@
        (test "its component moves to a robot on the other side" #t
          (and (wait-until 15 (lambda () (memq (running-on t) '(far spare)))) #t))
        (test "the status says near was lost" 'lost
-         (cadr (car (car (cddr (car (task-status t)))))))
+         (cadr (car (status-attempts (car (task-status t))))))
        (ip "link" "set" (veth 'near) "up")
        (test "when the link returns, near's stale component has stopped" #t
          (wait-until 20 (lambda () (guard (e (#t #f)) (stopped-at? 'near)))))
@@ -291,7 +291,8 @@
        (let* ((fed! (starve! 'near 0.12))
               (cut (begin (ip "link" "set" (veth 'near) "down") #t))
               (lost-at (second-when 15 (lambda ()
-                                         (pair? (car (cddr (car (task-status t)))))))))
+                                         (pair? (status-attempts
+                                                 (car (task-status t))))))))
          (test "it moves to a robot on the other side" #t
            (and (wait-until 15 (lambda () (let ((uid (running-on t)))
                                             (and uid (positive? (commands uid))))))

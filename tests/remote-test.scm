@@ -6,6 +6,7 @@
               open-output-file-descriptor)
         (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
         (murdoch wire netstring) (murdoch wire hmac) (murdoch wire connect)
+        (only (murdoch wire) error-message)
         (murdoch testing harness)
         (murdoch testing raw)
         (only (murdoch sys wait) make-mailbox mailbox-put! mailbox-take)
@@ -87,7 +88,24 @@
     (parameterize ((remote-timeout 1/2))
       (error-text (lambda () (remote-apply (troy) slow 3)))))
   (test "the connection still works after a timeout" 3
-    (remote-apply (troy) (lambda () 3))))
+    (remote-apply (troy) (lambda () 3)))
+  (test "as one line, a remote error says its own message: the uid is beside it"
+      '("car: not a pair ()" "no answer within 1/2 s")
+    (map (lambda (thunk) (guard (e (#t (error-message e))) (thunk)))
+         (list (lambda () (remote-apply (troy) (lambda () (car '()))))
+               (lambda () (parameterize ((remote-timeout 1/2))
+                            (remote-apply (troy) slow 3))))))
+  (test "an error from a third address space names it, the caller's answer"
+      "praline: car: not a pair ()"
+    (error-text (lambda ()
+                  (remote-apply (troy)
+                                (lambda ()
+                                  (remote-apply (uid->aspace 'praline)
+                                                (lambda () (car '()))))))))
+  (test "and so does remote-apply-all's outcome of each that failed"
+      '((troy #f "car: not a pair ()") (praline #t 2))
+    (remote-apply-all (list (troy) (uid->aspace 'praline))
+                      (lambda () (if (eq? (local-aspace-uid) 'troy) (car '()) 2)))))
 
 (test-group "each way a call fails has a predicate of its own"
   (define (failure thunk) (guard (e (#t e)) (thunk)))

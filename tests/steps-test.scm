@@ -117,9 +117,11 @@
                 (text-contains? (car (cddr (car (car r)))) "timed out waiting for")
                 (text-contains? (car (cddr (car (car r)))) "far")))
     (test "the task stops after the failed step" 1 (length r))
-    (test "and says so" '(posed failed)
-      (let ((e (find (lambda (e) (eq? (cadr e) (task-id t))) (tasks))))
-        (list (car e) (car (cddr e)))))
+    (test "and says so" '(#t failed)
+      (let ((e (find (lambda (e) (eq? (listed-id e) (task-id t))) (tasks))))
+        (list (listed-posed? e) (listed-state e))))
+    (test "task-status tells the step it started, by its number" '(1)
+      (map step-status-index (task-status t)))
     (test "every subject is free" #t (wait-until 5 all-free?))))
 
 ;; far does component 2 at once, then takes component 1 when near is lost;
@@ -142,8 +144,9 @@
          ;; The robot component 1 of step 1 runs on, or #f.
          (runs-1 (lambda ()
                    (let ((steps (task-status t)))
-                     (and (pair? steps) (pair? (car (cddr (car steps))))
-                          (let ((state (cadr (car (car (cddr (car steps)))))))
+                     (and (pair? steps) (pair? (step-status-entries (car steps)))
+                          (let ((state (status-state
+                                        (car (step-status-entries (car steps))))))
                             (and (eq? 'running (car state)) (cadr state)))))))
          (freeze-until-moved!
           (lambda (uid)

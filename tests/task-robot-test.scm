@@ -47,7 +47,7 @@
 (define (lab-proc name) (eval name (lab-environment)))
 ;; moseley first, by name.
 (define moseley-first (metric-by (lambda (uid) (if (eq? uid 'moseley) 0 1))))
-(define (attempts-of t) (car (cddr (car (task-status t)))))
+(define (attempts-of t) (status-attempts (car (task-status t))))
 
 (test-begin "robot failures")
 
@@ -67,7 +67,7 @@
 (test-group "a trip server that dies is a robot failure"
   (let ((t (start-task 'watch 1 (list '((mobile) ())) (list moseley-first)
                        (list (lab-proc 'watch)))))
-    (wait-until 20 (lambda () (eq? (car (cadr (car (task-status t)))) 'running)))
+    (wait-until 20 (lambda () (eq? (car (status-state (car (task-status t)))) 'running)))
     (thread-sleep! 0.5)
     ;; Every robot's trip connection closes; their address spaces live on.
     (kill-process! sim-pid)

@@ -97,8 +97,8 @@
   (thread-sleep! 0.5)
   (counts-at uid))
 (define near-first (location-metric-maker '(0 0 0 0)))
-(define (state-of task k) (cadr (list-ref (task-status task) (- k 1))))
-(define (attempts-of task k) (car (cddr (list-ref (task-status task) (- k 1)))))
+(define (state-of task k) (status-state (list-ref (task-status task) (- k 1))))
+(define (attempts-of task k) (status-attempts (list-ref (task-status task) (- k 1))))
 ;; Waits until component k of task runs on uid and has called out there.
 (define (running-on? task k uid)
   (let ((before (spins-at uid)))
@@ -116,9 +116,11 @@
                        (list (lab-proc 'who-am-i) (lab-proc 'who-am-i)))))
     (test-assert "a task record" (task? t))
     (test "its components negotiate or run meanwhile" #t
-      (every (lambda (s) (and (memq (car (cadr s)) '(negotiating running)) #t))
+      (every (lambda (s) (and (memq (car (status-state s)) '(negotiating running)) #t))
              (task-status t)))
     (test "task-wait gives the results" '(near far) (task-wait t 10))
+    (test "task-status tells each component by its number" '(1 2)
+      (map status-index (task-status t)))
     (test "each one's setup and cleanup ran once" '((1 1) (1 1))
       (list (counts-at 'near) (counts-at 'far)))
     (test "each is done, with its value" '((done near) (done far))

@@ -123,15 +123,16 @@ LAB
   (rotate 'by 90)
   (let ((seen (fiducials)))
     (test "facing them, one box seen, the lab's first: the other is behind a wall"
-          '(0) (map car seen))
+          '(0) (map fiducial-id seen))
     (test-assert "each as (ID RANGE BEARING ORIENTATION), id and range integers"
-      (and (= 4 (length (car seen))) (exact-integer? (car (car seen)))
-           (exact-integer? (cadr (car seen)))))
-    (test-assert "its range, from here, in mm" (near? (cadr (car seen)) 2199 60))
+      (and (= 4 (length (car seen))) (exact-integer? (fiducial-id (car seen)))
+           (exact-integer? (fiducial-range (car seen)))))
+    (test-assert "its range, from here, in mm"
+      (near? (fiducial-range (car seen)) 2199 60))
     (test-assert "its bearing, from the heading, in degrees"
-      (near? (car (cddr (car seen))) 4.5 5))
+      (near? (fiducial-bearing (car seen)) 4.5 5))
     (test-assert "its orientation relative to the robot's"
-      (near? (cadr (cddr (car seen))) -45 3)))
+      (near? (fiducial-orientation (car seen)) -45 3)))
   (rotate 'by 180)
   (test "facing away, none" '() (fiducials)))
 

@@ -8,7 +8,8 @@
           local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
           learn-aspace! live-uids current-lab lab-environment
           remote-run! remote-apply remote-timeout set-remote-timeout!
-          remote-apply-all remote-run-all! call-all broadcast-apply broadcast-run!
+          remote-apply-all remote-run-all! outcome-uid outcome-ok? outcome-value
+          call-all broadcast-apply broadcast-run!
           make-result result? result-uid result-ok? result-value
           delivery-mode
           remote-error? remote-error-uid remote-error-message

@@ -8,6 +8,7 @@
           translate angle-to-heading set-velocity stop-base reckon set-reckon-position!
           set-reckon-heading! sonar-start sonar-stop sonar-read ir-read bumpers-read
           skirt-read buttons-read lights say battery-voltage tethered? set-tether!
-          fiducials safe-im safe-battery-voltage safe-reckon workstation-position
+          fiducials fiducial-id fiducial-range fiducial-bearing fiducial-orientation
+          safe-im safe-battery-voltage safe-reckon workstation-position
           split-words)
   (import (murdoch robot trip)))

@@ -13,13 +13,13 @@
   ;; The components running are read before those ended: one that ends
   ;; in between is then in both lists, never in neither.
   (let* ((not-over (remove (lambda (t)
-                             (and (eq? (car t) 'posed)
-                                  (memq (car (cddr t)) '(done failed cancelled))))
+                             (and (listed-posed? t)
+                                  (memq (listed-state t) '(done failed cancelled))))
                            (tasks)))
          (ended (components-ended)))
     (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
           (safe-battery-voltage)
-          (filter (lambda (s) (not (null? (cadr s))))
+          (filter (lambda (h) (not (null? (held-holder h))))
                   (subscription-statuses '>))
           not-over (goto-goal) ended)))
 
@@ -34,6 +34,10 @@
 (define (report-goal r) (and (> (length r) 6) (list-ref r 6)))
 (define (report-ended r) (if (> (length r) 7) (list-ref r 7) '()))
 
+;;> The subject and its holder in \var{h}, one of a report's HELD.
+(define (held-subject h) (car h))
+(define (held-holder h) (cadr h))
+
 ;; lab-status's entry for an address space that did not answer.
 (define (make-away uid why) (list uid 'away why))
 (define (away? r) (eq? (cadr r) 'away))
@@ -43,8 +47,10 @@
 ;;> its report (see aspace-report) when it answered within
 ;;> (remote-timeout) seconds, else (UID away WHY).
 (define (lab-status lab)
-  (map (lambda (r)
-         (if (cadr r) (car (cddr r)) (make-away (car r) (car (cddr r)))))
+  (map (lambda (o)
+         (if (outcome-ok? o)
+             (outcome-value o)
+             (make-away (outcome-uid o) (outcome-value o))))
        (remote-apply-all (map (lambda (a) (uid->aspace (lab-aspace-uid a)))
                               (lab-aspaces lab))
                          aspace-report)))
@@ -77,23 +83,22 @@
                   (pose-text (report-pose r))
                   "  battery " (tenths-text (report-battery r)))
       (for-each (lambda (held)
-                  (write-line out "    " (symbol->string (car held))
-                              " held by " (held-text (cadr held))))
+                  (write-line out "    " (symbol->string (held-subject held))
+                              " held by " (held-text (held-holder held))))
                 (report-held r))
       (for-each (lambda (t) (write-line out "    " (task-text t)))
                 (report-tasks r))))))
 
-;; (posed ID STATE), (posed ID waiting POSITION WHY) or (running ID INDEX
-;; POSER), as a line.
+;; An entry of (tasks), as a line.
 (define (task-text t)
-  (if (eq? (car t) 'posed)
-      (string-append "task " (held-text (cadr t)) " " (held-text (car (cddr t)))
-                     (if (= (length t) 5)
-                         (string-append ", " (held-text (list-ref t 3)) " in line: "
-                                        (join-text (list-ref t 4)))
+  (if (listed-posed? t)
+      (string-append "task " (held-text (listed-id t)) " " (held-text (listed-state t))
+                     (if (listed-place t)
+                         (string-append ", " (held-text (listed-place t)) " in line: "
+                                        (join-text (listed-why t)))
                          ""))
-      (string-append "runs component " (held-text (car (cddr t))) " of "
-                     (held-text (cadr t)) " for " (held-text (cadr (cddr t))))))
+      (string-append "runs component " (held-text (listed-index t)) " of "
+                     (held-text (listed-id t)) " for " (held-text (listed-poser t)))))
 
 ;; Strings, joined by "; ".
 (define (join-text strings)

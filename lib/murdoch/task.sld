@@ -6,8 +6,13 @@
   (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
           dominant-cost run-component run-posed-component
           component-heartbeat! stop-component! components-running components-ended
+          ended-id ended-index ended-started ended-ended ended-end
           lost-periods
-          start-task task? task-id task-name task-status task-wait cancel-task tasks
+          start-task task? task-id task-name task-status task-wait cancel-task
+          status-index status-state status-attempts
+          step-status? step-status-index step-status-entries
+          tasks listed-posed? listed-id listed-state listed-place listed-why
+          listed-index listed-poser
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer
           receive-give-way note-waiters! location-metric-maker load-metric-maker
           load-metric reverse-metric metric-by metric-by-asking metric-within
@@ -17,8 +22,9 @@
           pose-task-priority pose-task-retries pose-task-backoff pose-task-excluded
           receive-rival pose-negotiations reservation-aspace-uid resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t sort-list
-          make-maxrandom progress explain-no-takers explain-components with-coordinator
-          team-barrier team-send! team-receive step-team make-coordinator error-why
+          make-maxrandom progress explain-no-takers explain-components explanation?
+          explanation-line explanation-free explanation-capable with-coordinator
+          team-barrier team-send! team-receive step-team make-coordinator
           negotiated-winners negotiated-types negotiated-name winner-uid winner-promise)
   (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
           (murdoch task metric) (murdoch task pose-task) (murdoch task progress)

@@ -43,14 +43,23 @@
   (end component-entry-end component-entry-end-set!)
   (from component-entry-from))
 
-;;> A table of the tasks seen so far, empty.
-(define (make-task-table) (list (list 'robots)))
+(define-record-type task-table
+  (%make-task-table robots tasks)
+  task-table?
+  (robots table-robots table-robots-set!)       ; seen-robots
+  (tasks table-tasks table-tasks-set!))         ; task-entries, oldest first
 
-;; The car of a table holds, after 'robots, (ROBOT UP-SINCE AWAY) for each
-;; robot seen: when it last started, and how many looks in a row it has
-;; not answered.
-(define (table-tasks table) (cdr table))
-(define (table-robots table) (car table))
+;; A robot the table has seen: when it last started, and how many looks
+;; in a row it has not answered.
+(define-record-type seen-robot
+  (make-seen-robot name since silent)
+  seen-robot?
+  (name seen-robot-name)
+  (since seen-robot-since seen-robot-since-set!)
+  (silent seen-robot-silent seen-robot-silent-set!))
+
+;;> A table of the tasks seen so far, empty.
+(define (make-task-table) (%make-task-table '() '()))
 
 (define away-polls 3)
 
@@ -65,60 +74,71 @@
   (let ((nt (reservation-task key)))
     (if (cadr nt) (string-append (car nt) "@" (cadr nt)) key)))
 
-;; What one address space's report shows running there: (KEY INDEX
-;; SUBJECTS) for each component, INDEX #f when only held subjects show it.
+;; A component one address space's report shows there: KEY its task's,
+;; INDEX #f when only held subjects show it.
+(define-record-type shown
+  (make-shown key index subjects)
+  shown?
+  (key shown-key)
+  (index shown-index)
+  (subjects shown-subjects))
+
+;; The (subject . holder) of each subject a report says is held, as text.
+(define (held-texts report)
+  (map (lambda (h) (cons (text (held-subject h)) (text (held-holder h))))
+       (report-held report)))
+
+;; What one address space's report shows running there: a shown for
+;; each component.
 (define (report-components report)
-  (let* ((held (map (lambda (h) (cons (text (car h)) (text (cadr h))))
-                    (report-held report)))
+  (let* ((held (held-texts report))
          (running (filter-map (lambda (t)
-                                (and (pair? t) (eq? (car t) 'running)
+                                (and (pair? t) (not (listed-posed? t))
                                      (>= (length t) 3)
-                                     (list (text (cadr t)) (list-ref t 2))))
+                                     (make-shown (text (listed-id t)) (listed-index t)
+                                                 '())))
                               (report-tasks report)))
          (subjects-of (lambda (pred)
                         (map car (filter (lambda (h) (pred (cdr h))) held))))
          (covered? (lambda (holder)
-                     (any (lambda (r) (equal? (key-base (car r)) (key-base holder)))
+                     (any (lambda (r) (equal? (key-base (shown-key r)) (key-base holder)))
                           running))))
     (append
      (map (lambda (r)
-            (list (car r) (cadr r)
-                  (subjects-of (lambda (holder)
-                                 (equal? (key-base holder) (key-base (car r)))))))
+            (make-shown (shown-key r) (shown-index r)
+                        (subjects-of (lambda (holder)
+                                       (equal? (key-base holder)
+                                               (key-base (shown-key r)))))))
           running)
      (map (lambda (holder)
-            (list holder #f (subjects-of (lambda (h) (equal? h holder)))))
+            (make-shown holder #f (subjects-of (lambda (h) (equal? h holder)))))
           (delete-duplicates (remove covered? (map cdr held)))))))
 
-;; (KEY STATE) for each task of tasks, entries as (tasks) answers, posed
+;; (KEY . STATE) for each task of tasks, entries as (tasks) answers, posed
 ;; by the address space that answered them.
 (define (posed-states tasks)
   (filter-map (lambda (t)
-                (and (pair? t) (eq? (car t) 'posed) (memv (length t) '(3 5))
-                     (list (text (cadr t))
-                           (if (= (length t) 5)
-                               (string-append "waiting, " (text (list-ref t 3))
+                (and (pair? t) (listed-posed? t) (memv (length t) '(3 5))
+                     (cons (text (listed-id t))
+                           (if (listed-place t)
+                               (string-append "waiting, " (text (listed-place t))
                                               " in line")
-                               (text (car (cddr t)))))))
+                               (text (listed-state t))))))
               tasks))
 
-;; Whether the table takes a posed task's state: it goes on, or it is
-;; one the table has; a task over before the view saw it is left out.
+;; Whether the table takes a posed task's (KEY . STATE): it goes on, or
+;; it is one the table has; a task over before the view saw it is left out.
 (define (posed-news? table posed)
   (or (task-known table (car posed))
-      (not (member (cadr posed) '("done" "failed" "cancelled")))))
+      (not (member (cdr posed) '("done" "failed" "cancelled")))))
 
-;; (KEY INDEX SINCE UNTIL END) for each component the report says ended
-;; there (components-ended): SINCE and UNTIL in seconds before the
-;; report, END as the table shows it.
+;; The entries of components-ended that a report gives, those well made.
 (define (ended-entries report)
-  (filter-map (lambda (e)
-                (and (list? e) (= (length e) 6) (exact-integer? (cadr e))
-                     (real? (list-ref e 3)) (real? (list-ref e 4))
-                     (pair? (list-ref e 5))
-                     (list (text (car e)) (cadr e) (list-ref e 3) (list-ref e 4)
-                           (end-text (list-ref e 5)))))
-              (report-ended report)))
+  (filter (lambda (e)
+            (and (list? e) (= (length e) 6) (exact-integer? (ended-index e))
+                 (real? (ended-started e)) (real? (ended-ended e))
+                 (pair? (ended-end e))))
+          (report-ended report)))
 
 ;; (done), (failed WHY) or (lost WHY), as "done", "failed: WHY" ...; a
 ;; long WHY cut short.
@@ -138,7 +158,7 @@
   (or (task-known table key)
       (let* ((nt (reservation-task key))
              (t (make-task-entry key (car nt) (cadr nt) #f '())))
-        (set-cdr! table (append (table-tasks table) (list t)))
+        (table-tasks-set! table (append (table-tasks table) (list t)))
         t)))
 
 (define (open? c) (not (component-entry-until c)))
@@ -179,26 +199,24 @@
 (define (task-table-update! table t reports)
   (let ((seen '()))                     ; the component entries seen now
     (for-each
-     (lambda (uid+report)
-       (let ((robot (text (car uid+report)))
-             (report (cadr uid+report)))
+     (lambda (r)
+       (let ((robot (text (sighting-uid r)))
+             (report (sighting-report r)))
          (for-each (lambda (posed)
                      (if (posed-news? table posed)
                          (task-entry-state-set! (task-named table (car posed))
-                                                (cadr posed))))
-                   (posed-states (if (pair? (cddr uid+report))
-                                     (car (cddr uid+report))
-                                     (report-tasks report))))
+                                                (cdr posed))))
+                   (posed-states (or (sighting-posed r) (report-tasks report))))
          (for-each
-          (lambda (obs)
-            (set! seen (cons (observe! table (task-named table (car obs)) t robot
-                                       (cadr obs) (car (cddr obs)))
+          (lambda (shown)
+            (set! seen (cons (observe! table (task-named table (shown-key shown)) t
+                                       robot (shown-index shown) (shown-subjects shown))
                              seen)))
           (report-components report))
          (for-each (lambda (e) (note-ended! table t robot e))
                    (ended-entries report))))
      reports)
-    (let* ((answered (map (lambda (r) (text (car r))) reports))
+    (let* ((answered (map (lambda (r) (text (sighting-uid r))) reports))
            (gone (note-robots! table t reports)))
       (for-each
        (lambda (task)
@@ -216,35 +234,44 @@
                    (task-entry-components task)))
        (table-tasks table)))))
 
+;; The parts of one of task-table-update!'s reports, a sighting: the
+;; (UID REPORT [POSED]) that the view makes of an outcome, and tests write.
+(define (sighting-uid r) (car r))
+(define (sighting-report r) (cadr r))
+(define (sighting-posed r) (and (pair? (cddr r)) (car (cddr r))))
+
 ;; Brings the table's robots up to date with reports, and answers
 ;; ((ROBOT . WHY) ...) for those whose components seen before were lost:
 ;; started again, or silent for away-polls looks.
 (define (note-robots! table t reports)
-  (let ((robots (table-robots table))
-        (gone '()))
+  (let ((gone '()))
     (for-each
-     (lambda (uid+report)
-       (let* ((robot (text (car uid+report)))
-              (since (cadr (cadr uid+report)))
-              (entry (assoc robot (cdr robots))))
-         (cond ((not entry) (set-cdr! robots (cons (list robot since 0) (cdr robots))))
+     (lambda (r)
+       (let* ((robot (text (sighting-uid r)))
+              (since (report-since (sighting-report r)))
+              (entry (find (lambda (s) (equal? (seen-robot-name s) robot))
+                           (table-robots table))))
+         (cond ((not entry)
+                (table-robots-set! table (cons (make-seen-robot robot since 0)
+                                               (table-robots table))))
                (else
-                (if (not (equal? (cadr entry) since))
+                (if (not (equal? (seen-robot-since entry) since))
                     (set! gone (cons (cons robot (string-append "lost: " robot
                                                                 " started again"))
                                      gone)))
-                (set-car! (cdr entry) since)
-                (set-car! (cddr entry) 0)))))
+                (seen-robot-since-set! entry since)
+                (seen-robot-silent-set! entry 0)))))
      reports)
     (for-each (lambda (entry)
-                (when (not (any (lambda (r) (equal? (text (car r)) (car entry))) reports))
-                  (set-car! (cddr entry) (+ 1 (car (cddr entry))))
-                  (if (= (car (cddr entry)) away-polls)
-                      (set! gone (cons (cons (car entry)
-                                             (string-append "lost: " (car entry)
-                                                            " does not answer"))
-                                       gone)))))
-              (cdr robots))
+                (let ((robot (seen-robot-name entry)))
+                  (when (not (any (lambda (r) (equal? (text (sighting-uid r)) robot))
+                                  reports))
+                    (seen-robot-silent-set! entry (+ 1 (seen-robot-silent entry)))
+                    (if (= (seen-robot-silent entry) away-polls)
+                        (set! gone (cons (cons robot (string-append "lost: " robot
+                                                                    " does not answer"))
+                                         gone))))))
+              (table-robots table))
     gone))
 
 ;; The component entry of task that robot shows at t, made if new.
@@ -298,26 +325,30 @@
            (task-entry-components-set!
             other (remove (lambda (c) (memq c held)) (task-entry-components other))))))
      (table-tasks table))
-    (set-cdr! table (remove (lambda (other) (and (null? (task-entry-components other))
-                                                 (not (task-entry-state other))
-                                                 (not (eq? other task))))
-                            (table-tasks table)))
+    (table-tasks-set! table
+                      (remove (lambda (other) (and (null? (task-entry-components other))
+                                                   (not (task-entry-state other))
+                                                   (not (eq? other task))))
+                              (table-tasks table)))
     since))
 
 ;; Brings robot's component that e, an entry of ended-entries, tells of to
 ;; its end: the open entry seen before, or a new one when it ended since
 ;; the view started and the table has none.
 (define (note-ended! table t robot e)
-  (let* ((ended-at (- t (list-ref e 3)))
-         (task (if (>= ended-at 0) (task-named table (car e)) (task-known table (car e))))
+  (let* ((key (text (ended-id e)))
+         (k (ended-index e))
+         (ended-at (- t (ended-ended e)))
+         (end (end-text (ended-end e)))
+         (task (if (>= ended-at 0) (task-named table key) (task-known table key)))
          (c (and task
-                 (find (lambda (c) (and (eqv? (component-entry-index c) (cadr e))
+                 (find (lambda (c) (and (eqv? (component-entry-index c) k)
                                         (equal? (component-entry-robot c) robot)))
                        (task-entry-components task)))))
-    (cond ((and c (open? c)) (end-component! c ended-at (list-ref e 4)))
+    (cond ((and c (open? c)) (end-component! c ended-at end))
           ((and task (not c))
-           (end-component! (observe! table task (- t (list-ref e 2)) robot (cadr e) '())
-                           ended-at (list-ref e 4))))))
+           (end-component! (observe! table task (- t (ended-started e)) robot k '())
+                           ended-at end)))))
 
 (define (end-component! c until end)
   (component-entry-until-set! c until)

@@ -99,8 +99,23 @@
      (list (aspace-report)
            (guard (e (#t #f)) (sonar-read))
            (guard (e (#t #f)) (fiducials))
-           (let ((posed (filter (lambda (t) (eq? (car t) 'posed)) (tasks))))
+           (let ((posed (filter listed-posed? (tasks))))
              (if (> (length posed) 12) (take posed 12) posed)))))
+
+;; The parts of what report-source answers, a look at one address space.
+(define (look-report look) (car look))
+(define (look-sonar look) (cadr look))
+(define (look-seen look) (car (cddr look)))
+;; A peer older than POSED answers none.
+(define (look-posed look) (and (> (length look) 3) (list-ref look 3)))
+
+;; A robot's last sonar ring, and the pose it was first read at.
+(define-record-type ring
+  (make-ring uid ranges pose)
+  ring?
+  (uid ring-uid)
+  (ranges ring-ranges)
+  (pose ring-pose))
 
 ;; What the view remembers from one poll to the next: where the boxes
 ;; are, the task table, and for each robot its last sonar ring with the
@@ -112,7 +127,7 @@
   view-state?
   (boxes view-state-boxes)
   (table view-state-table)
-  (sonars view-state-sonars view-state-sonars-set!))  ; ((UID RANGES POSE) ...)
+  (sonars view-state-sonars view-state-sonars-set!))  ; rings
 
 ;;> The view's memory, at the start, for the room \var{header} (see
 ;;> lab-header).
@@ -125,20 +140,19 @@
 ;;> \var{state} what the view remembers (new-view-state), brought up to
 ;;> date.
 (define (view-snapshot lab t answers state)
-  (let ((reports (filter-map (lambda (a)
-                                (and (cadr a)
-                                     (let ((value (car (cddr a))))
-                                       (cons (car a)
-                                             (cons (car value)
-                                                   (if (> (length value) 3)
-                                                       (list (list-ref value 3))
-                                                       '()))))))
-                             answers))
-        (boxes (view-state-boxes state)))
-    (task-table-update! (view-state-table state) t reports)
-    (for-each (lambda (a) (if (cadr a) (move-boxes! boxes (car (cddr a))))) answers)
-    (for-each (lambda (a) (if (cadr a) (note-sonar! state (car a) (car (cddr a)))))
-              answers)
+  (let* ((answered (filter outcome-ok? answers))
+         (boxes (view-state-boxes state)))
+    (task-table-update! (view-state-table state) t
+                        (map (lambda (o)
+                               (let ((look (outcome-value o)))
+                                 (cons* (outcome-uid o) (look-report look)
+                                        (if (look-posed look)
+                                            (list (look-posed look))
+                                            '()))))
+                             answered))
+    (for-each (lambda (o) (move-boxes! boxes (outcome-value o))) answered)
+    (for-each (lambda (o) (note-sonar! state (outcome-uid o) (outcome-value o)))
+              answered)
     `((kind . "state")
       (t . ,(num t))
       (clock . ,(num (utc-seconds)))
@@ -146,41 +160,46 @@
       (boxes . ,(vector-map (lambda (b) b) boxes))
       (tasks . ,(task-table->json (view-state-table state) 12)))))
 
+;; The ring the view remembers of uid, or #f.
+(define (ring-of state uid)
+  (find (lambda (r) (eq? (ring-uid r) uid)) (view-state-sonars state)))
+
 ;; Remembers uid's sonar ring, with its pose now when the ring is new.
-(define (note-sonar! state uid answer)
-  (let ((ranges (cadr answer))
-        (pose (report-pose (car answer)))
-        (old (assq uid (view-state-sonars state))))
+(define (note-sonar! state uid look)
+  (let ((ranges (look-sonar look))
+        (pose (report-pose (look-report look)))
+        (old (ring-of state uid)))
     (if (and (list? ranges) (pair? ranges) (every real? ranges) (list? pose)
              (>= (length pose) 3)
-             (not (and old (equal? (cadr old) ranges))))
+             (not (and old (equal? (ring-ranges old) ranges))))
         (view-state-sonars-set!
-         state (cons (list uid ranges (take pose 3))
-                     (remove (lambda (s) (eq? (car s) uid))
+         state (cons (make-ring uid ranges (take pose 3))
+                     (remove (lambda (r) (eq? (ring-uid r) uid))
                              (view-state-sonars state)))))))
 
-(define (move-boxes! boxes answer)
-  (let ((pose (report-pose (car answer)))
-        (seen (car (cddr answer))))
+(define (move-boxes! boxes look)
+  (let ((pose (report-pose (look-report look)))
+        (seen (look-seen look)))
     (if (and pose (list? seen))
         (for-each
          (lambda (f)
-           (let ((id (car f)))
+           (let ((id (fiducial-id f)))
              (if (and (exact-integer? id) (< -1 id (vector-length boxes)))
                  (let ((b (vector-ref boxes id))
-                       (at (box-seen pose (cadr f) (list-ref f 2) (list-ref f 3))))
+                       (at (box-seen pose (fiducial-range f) (fiducial-bearing f)
+                                     (fiducial-orientation f))))
                    (vector-set! boxes id
                                 (vector (num (car at)) (num (cadr at))
                                         (vector-ref b 2) (vector-ref b 3)
                                         (num (car (cddr at)))))))))
          seen))))
 
-(define (aspace-json answer state)
-  (let ((name (text (car answer))))
-    (if (not (cadr answer))
-        `((name . ,name) (away . #t) (why . ,(text (car (cddr answer)))))
-        (let* ((value (car (cddr answer)))
-               (report (car value))
+(define (aspace-json o state)
+  (let ((name (text (outcome-uid o))))
+    (if (not (outcome-ok? o))
+        `((name . ,name) (away . #t) (why . ,(text (outcome-value o))))
+        (let* ((report (look-report (outcome-value o)))
+               (ring (ring-of state (outcome-uid o)))
                (pose (report-pose report))
                (battery (report-battery report)))
           `((name . ,name)
@@ -190,16 +209,11 @@
                          (numbers (take pose 3))
                          'null))
             (battery . ,(if (real? battery) (num (/ battery 10)) 'null))
-            (held . ,(list->vector (map (lambda (h)
-                                          (vector (text (car h)) (text (cadr h))))
-                                        (report-held report))))
+            (held . ,(list->vector (map (lambda (h) (vector (car h) (cdr h)))
+                                        (held-texts report))))
             ;; The last sonar ring, and the pose it was read at.
-            (sonar . ,(cond ((assq (car answer) (view-state-sonars state))
-                             => (lambda (s) (numbers (cadr s))))
-                            (else 'null)))
-            (sonar-at . ,(cond ((assq (car answer) (view-state-sonars state))
-                                => (lambda (s) (numbers (car (cddr s)))))
-                               (else 'null)))
+            (sonar . ,(if ring (numbers (ring-ranges ring)) 'null))
+            (sonar-at . ,(if ring (numbers (ring-pose ring)) 'null))
             ;; Where the robot's goto-xy is going (aspace-report's GOAL).
             (goal . ,(let ((goal (report-goal report)))
                        (if (and (list? goal) (>= (length goal) 2)

@@ -10,8 +10,8 @@
           log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign
           hmac-sha256-open open-multicast-socket read-netstring write-netstring
           buffered-byte-count reset-output-string! nests-within? fixnum->decimal
-          netstring-error?
-          netstring-error-message remote-error protocol-fail error-message remote-error?
+          netstring-error? netstring-error-message remote-error protocol-fail
+          error-message error-message-naming remote-error?
           remote-error-uid remote-error-message remote-timeout-error?
           remote-unreachable-error? remote-raised-error? remote-protocol-error?)
   (import (murdoch wire connect) (murdoch wire frame) (murdoch wire hmac)

@@ -60,7 +60,7 @@
 (define (tell-who-is-away lab)
   (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                          (map lab-aspace-uid (lab-aspaces lab))))
-         (away (filter-map (lambda (r) (and (not (cadr r)) (car r)))
+         (away (filter-map (lambda (o) (and (not (outcome-ok? o)) (outcome-uid o)))
                            (parameterize ((remote-timeout 2))
                              (remote-apply-all (map uid->aspace others)
                                                local-aspace-uid)))))

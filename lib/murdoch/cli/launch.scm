@@ -213,10 +213,11 @@
                                 (symbol? (cadr r))))
                result))))
 
+;; s an entry of task-status: a component's, or a step's.
 (define (failed-status? s)
-  (if (eq? (car s) 'step)
-      (any failed-status? (car (cddr s)))
-      (eq? (car (cadr s)) 'failed)))
+  (if (step-status? s)
+      (any failed-status? (step-status-entries s))
+      (eq? (car (status-state s)) 'failed)))
 
 ;;> `murdoch status LAB`: joins the lab as a guest and shows what each of
 ;;> its address spaces says of itself (see show-status); one that does not

@@ -17,5 +17,6 @@
           (only (murdoch sys) set-process-name!) (murdoch lab)
           (murdoch cli command) (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment)
-          (only (murdoch status) write-lab-status))
+          (only (murdoch status) write-lab-status)
+          (only (murdoch task) status-state step-status? step-status-entries))
   (include "launch.scm"))

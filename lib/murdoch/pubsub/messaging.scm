@@ -350,6 +350,13 @@
   (guard (e (#t (list #f (error-message e))))
     (list #t (proc))))
 
+;;> Whether \var{a}, a candidate's answer to an asking of
+;;> request-components, (#t value) or (#f message), was a value.
+(define (asked-ok? a) (car a))
+
+;;> The value of \var{a}, a candidate's answer to an asking, or why none.
+(define (asked-value a) (cadr a))
+
 ;;; Reservations
 
 (define-record-type reservation

@@ -99,7 +99,8 @@
 ;;> Applies \var{proc} to \var{args} in each address space of
 ;;> \var{aspaces} at once, and answers, in their order, (uid #t value) for
 ;;> each that answered and (uid #f message) for each that failed or did not
-;;> answer within (remote-timeout) seconds.  The procedure is encoded once,
+;;> answer within (remote-timeout) seconds: outcomes, read by outcome-uid,
+;;> outcome-ok? and outcome-value.  The procedure is encoded once,
 ;;> and every call is sent before the first answer is awaited, so the time
 ;;> taken is about that of the slowest answer, not their sum.
 (define (remote-apply-all aspaces proc . args)
@@ -108,6 +109,18 @@
 ;;> As remote-apply-all, with remote-run!: the values are #t.
 (define (remote-run-all! aspaces proc . args)
   (map result->list (call-all aspaces 'run proc args)))
+
+;; An outcome, one of remote-apply-all's answers, stays a list: the REPL
+;; shows it as it reads, and its readers below are its users' names.
+
+;;> The uid of outcome \var{o}, one of remote-apply-all's answers.
+(define (outcome-uid o) (car o))
+
+;;> Whether the address space of outcome \var{o} answered.
+(define (outcome-ok? o) (cadr o))
+
+;;> The value of outcome \var{o} when it answered, else why not.
+(define (outcome-value o) (car (cddr o)))
 
 ;;> As remote-apply-all and remote-run-all!, for \var{kind} apply or run,
 ;;> answering a result for each address space.
@@ -162,7 +175,7 @@
     (make-result uid #t (thunk))))
 
 (define (failure-result uid e)
-  (make-result uid #f (if (remote-error? e) (remote-error-message e) (error-message e))))
+  (make-result uid #f (error-message e)))
 
 ;;> (map entry items); an item whose entry raised gives the result of
 ;;> its failure, for the uid (uid-of item).  The handler is entered once,

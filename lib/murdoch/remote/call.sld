@@ -3,6 +3,7 @@
 
 (define-library (murdoch remote call)
   (export remote-run! remote-apply remote-apply-all remote-run-all!
+          outcome-uid outcome-ok? outcome-value
           new-call call? call-kind call-proc call-args call-proc-code call-args-code
           call-seconds call-all make-result result? result-uid result-ok? result-value
           encode-arguments send-all local-call capture

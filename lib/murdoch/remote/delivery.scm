@@ -75,15 +75,16 @@
   (define (answer c kind value)
     (send-datagram-answer! (served-call-caller c) (served-call-id c) kind value))
   (define (read-on r)
-    (match (receive-call)
-      ((sender id kind proc-code args-code)
-       (serve-call r (make-served-call (uid->aspace sender) id kind proc-code
-                                       args-code answer)))
-      (#f #f))
+    (let ((call (receive-call)))
+      (if call
+          (serve-call r (make-served-call (uid->aspace (group-call-sender call))
+                                          (group-call-id call) (group-call-kind call)
+                                          (group-call-proc-code call)
+                                          (group-call-args-code call) answer))))
     (if (reader? s) (read-on r)))
   (read-calls s read-on
               (lambda (c e)
                 (guard (e2 (#t (log-warn "an answer was lost: "
                                          (fault-message e2))))
-                  (reply! c 'error (error-message e))))
+                  (reply! c 'error (error-message-naming e))))
               (lambda (e) (log-warn "datagram dropped: " (fault-message e)))))

@@ -4,7 +4,7 @@
 
 (define-library (murdoch remote delivery)
   (export broadcast-apply broadcast-run! serve-group)
-  (import (scheme base) (srfi 1) (srfi 18) (chibi match) (murdoch sys) (murdoch code)
+  (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code)
           (murdoch wire) (murdoch lab) (murdoch remote aspace)
           (murdoch remote connection) (murdoch remote call) (murdoch remote serve)
           (murdoch remote group))

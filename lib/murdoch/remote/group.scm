@@ -56,9 +56,9 @@
 ;;> Joins \var{lab}'s multicast group when the lab's delivery is
 ;;> multicast, and starts its beacons and a thread that applies
 ;;> \var{serve} to \scheme{receive-call}: a procedure of no arguments that
-;;> waits for the group's next datagram and returns the call it carries,
-;;> \scheme{(SENDER ID KIND PROC ARGS)}, or #f when it carried none (a
-;;> beacon, or our own datagram looped back).  It raises for a datagram
+;;> waits for the group's next datagram and returns the group-call it
+;;> carries, or #f when it carried none (a beacon, or our own datagram
+;;> looped back).  It raises for a datagram
 ;;> that is not authentic or not fresh.  Only one thread at a time may
 ;;> call it: the datagram is read into one buffer.
 (define (start-group! lab serve)
@@ -161,6 +161,18 @@
         ((< sequence (- (wall-microseconds) (* 1000000 (group-window *group*))))
          (frame-fail "older than frame-timeout"))))
 
+;;> A call that came by the group: from address space \var{sender}, its
+;;> \var{id} there, \var{kind} run or apply, and its procedure and
+;;> arguments encoded.
+(define-record-type group-call
+  (make-group-call sender id kind proc-code args-code)
+  group-call?
+  (sender group-call-sender)
+  (id group-call-id)
+  (kind group-call-kind)
+  (proc-code group-call-proc-code)
+  (args-code group-call-args-code))
+
 ;; A beacon brings its sender (back) into the live set; a call is the
 ;; caller's to serve.
 (define (datagram-call sender body)
@@ -170,4 +182,4 @@
      (note-reachable! sender)
      #f)
     (('call id kind proc-code args-code)
-     (list sender id kind proc-code args-code))))
+     (make-group-call sender id kind proc-code args-code))))

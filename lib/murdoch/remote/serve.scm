@@ -378,7 +378,7 @@
 (define (serve-greeted s)
   (read-calls s (lambda (r) (read-on s r))
               (lambda (c e)
-                (reply! c 'error (error-message e))
+                (reply! c 'error (error-message-naming e))
                 (flush-if-idle! s))
               raise))
 

@@ -419,6 +419,7 @@
 ;;> centre, BEARING in degrees from the heading (counter-clockwise), and
 ;;> ORIENTATION the box's heading less the robot's, in degrees.  Only boxes
 ;;> within range and the field of view, and in sight; () when none.
+;;> fiducial-id and the other fiducial- procedures read each.
 (define (fiducials)
   (let loop ((words (cdr (device 'fiducial "read"))) (seen '()))
     (if (null? words)
@@ -427,6 +428,19 @@
               (cons (list (exact (car words)) (exact (cadr words)) (car (cddr words))
                           (cadr (cddr words)))
                     seen)))))
+
+;;> The ID, the box's index among the lab's boxes, of \var{f}, one box
+;;> that fiducials answers.
+(define (fiducial-id f) (car f))
+
+;;> The RANGE in mm of \var{f}, one box that fiducials answers.
+(define (fiducial-range f) (cadr f))
+
+;;> The BEARING in degrees of \var{f}, one box that fiducials answers.
+(define (fiducial-bearing f) (car (cddr f)))
+
+;;> The ORIENTATION in degrees of \var{f}, one box that fiducials answers.
+(define (fiducial-orientation f) (cadr (cddr f)))
 
 ;;> The battery in tenths of a volt, an integer (136 for 13.6 V): the unit
 ;;> of the thesis's thresholds (130 charging, 100 low, 140 a workstation).

@@ -10,6 +10,7 @@
           reckon set-reckon-position! set-reckon-heading!
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether! fiducials
+          fiducial-id fiducial-range fiducial-bearing fiducial-orientation
           safe-im safe-battery-voltage safe-reckon workstation-position
           split-words)
   (import (scheme base) (scheme write) (srfi 18) (srfi 69) (srfi 151)

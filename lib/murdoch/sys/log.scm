@@ -69,7 +69,7 @@
 
 ;;> What \var{e}, any raised object, says, as one line for a log or an
 ;;> answer: an error's message and irritants, or what else was raised.
-;;> (murdoch wire)'s error-message says a remote protocol error its own way.
+;;> (murdoch wire)'s error-message says a remote error its own way.
 (define (condition-message e)
   (cond
    ((stack-guard-tripped? (current-thread))

@@ -299,8 +299,8 @@
       (if (and (pair? what) (eq? (car what) 'robot-failure))
           (list 'lost (cadr what))
           (list 'done what)))
-     ((remote-unreachable-error? what) (list 'lost (remote-error-message what)))
-     (else (list 'failed (error-why what))))))
+     ((remote-unreachable-error? what) (list 'lost (error-message what)))
+     (else (list 'failed (error-message what))))))
 
 ;; A component's result, as pose-task gives it: its value, or (error UID
 ;; WHY) with the last robot it had.
@@ -312,7 +312,8 @@
                        (and (pair? attempts) (car (last attempts))))
               (cadr state)))))
 
-;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS):
+;;> For each component of \var{task}, in order, (INDEX STATE ATTEMPTS),
+;;> read by status-index, status-state and status-attempts:
 ;;> STATE is (negotiating), (running UID SINCE), (done VALUE), (failed
 ;;> WHY) or (reassigned FROM TO), SINCE a (utc-seconds); ATTEMPTS has
 ;;> (UID . OUTCOME) for each robot that had the component and is done
@@ -327,6 +328,28 @@
              (list (component-index c) (component-state c)
                    (component-attempts c)))
            (task-components task))))
+
+;;> The component's number in \var{s}, an entry of task-status.
+(define (status-index s) (car s))
+
+;;> The component's state in \var{s}, an entry of task-status:
+;;> (negotiating), (running UID SINCE), (done VALUE) ...
+(define (status-state s) (cadr s))
+
+;;> The (UID . OUTCOME) of each robot done with the component in \var{s},
+;;> an entry of task-status.
+(define (status-attempts s) (car (cddr s)))
+
+;;> Whether \var{s}, an entry of task-status, is a step's (step I
+;;> STATUS), as a task of steps gives.
+(define (step-status? s) (eq? (car s) 'step))
+
+;;> The number I of the step in \var{s}, a step's entry of task-status.
+(define (step-status-index s) (cadr s))
+
+;;> The STATUS in \var{s}, a step's entry of task-status: the step's own
+;;> task-status, an entry for each of its components.
+(define (step-status-entries s) (car (cddr s)))
 
 ;;> Waits for \var{task} to end, at most \var{seconds} (default: for
 ;;> ever), and answers what pose-task would have: each component's result,
@@ -372,7 +395,9 @@
       (error (string-append who ": not a task; start-task answers one") x)))
 
 ;;> The tasks of this address space: (posed ID STATE) for each it started,
-;;> newest first, and (running ID INDEX POSER) for each component it runs.
+;;> newest first, (posed ID waiting PLACE WHY) for one waiting its turn,
+;;> and (running ID INDEX POSER) for each component it runs.  listed-id
+;;> and the other listed- procedures read them.
 (define (tasks)
   (append (map (lambda (t)
                  (let ((w (task-waiter t)))
@@ -382,6 +407,30 @@
                        (list 'posed (task-id t) (task-state t)))))
                (with-lock *tasks-lock* (lambda () *posed*)))
           (map (lambda (r) (cons 'running r)) (components-running))))
+
+;;> Whether \var{e}, an entry of (tasks), is a task started here.
+(define (listed-posed? e) (eq? (car e) 'posed))
+
+;;> The task id of \var{e}, an entry of (tasks).
+(define (listed-id e) (cadr e))
+
+;;> The state of \var{e}, a posed entry of (tasks): waiting, running,
+;;> done ...
+(define (listed-state e) (car (cddr e)))
+
+;;> The place in line of \var{e}, a posed entry of (tasks), when it
+;;> waits, else #f.
+(define (listed-place e) (and (= (length e) 5) (list-ref e 3)))
+
+;;> Why \var{e}, a posed entry of (tasks) that waits, waits: a string for
+;;> each task ahead of it.
+(define (listed-why e) (list-ref e 4))
+
+;;> The component's number in \var{e}, a running entry of (tasks).
+(define (listed-index e) (car (cddr e)))
+
+;;> The poser of the component in \var{e}, a running entry of (tasks).
+(define (listed-poser e) (cadr (cddr e)))
 
 ;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
 ;;; synchronization)
@@ -416,9 +465,10 @@
 
 ;;> Starts a task of \var{steps} (made by task-step) and answers its task
 ;;> record at once; start-task's keywords may follow the steps, and each
-;;> step is started with them.  task-status gives (step I STATUS) for each step
-;;> started, task-wait the list of each step's results, and cancel-task
-;;> stops the step running and those after it.
+;;> step is started with them.  task-status gives (step I STATUS) for each
+;;> step started (read by step-status? and the other step-status-
+;;> procedures), task-wait the list of each step's results, and
+;;> cancel-task stops the step running and those after it.
 (define (start-steps task-name . steps+options)
   (let ((steps (take-while step? steps+options))
         (options (drop-while step? steps+options)))
@@ -570,12 +620,19 @@
   (list (- (turn-priority turn) (* (lab-setting (current-lab) 'aging) (turn-posed turn)))
         (turn-posed turn) (symbol->string id)))
 
+;; The parts of a rank, (SCORE POSED ID) as turn-rank makes it: it travels
+;; to the other posers.
+(define (rank-score r) (car r))
+(define (rank-posed r) (cadr r))
+(define (rank-id r) (car (cddr r)))
+
 ;; Whether rank a goes before rank b.
 (define (rank<? a b)
-  (or (> (car a) (car b))
-      (and (= (car a) (car b))
-           (or (< (cadr a) (cadr b))
-               (and (= (cadr a) (cadr b)) (string<? (car (cddr a)) (car (cddr b))))))))
+  (or (> (rank-score a) (rank-score b))
+      (and (= (rank-score a) (rank-score b))
+           (or (< (rank-posed a) (rank-posed b))
+               (and (= (rank-posed a) (rank-posed b))
+                    (string<? (rank-id a) (rank-id b)))))))
 
 ;; A task waiting here: news is what came for it, offers and cancels, and
 ;; bell rings when news comes.
@@ -622,9 +679,17 @@
     (lambda ()
       (task-waiter-set! (waiter-task w) #f)
       (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*))
-      (answer-offers! (filter (lambda (n) (eq? (car n) 'offer)) (waiter-news w)) #f)
+      (answer-offers! (filter offer? (waiter-news w)) #f)
       (waiter-news-set! w '())
       (if (null? *waiters*) (unsubscribe 'waiting-tasks)))))
+
+;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
+;; UID): its kind, then what it says, read by name.
+(define (news-kind n) (car n))
+(define (offer? n) (eq? (news-kind n) 'offer))
+(define (offer-reply n) (cadr n))
+(define (offer-uid n) (car (cddr n)))
+(define (give-way-uid n) (cadr n))
 
 (define (tell-waiter! w news)
   (with-lock *tasks-lock*
@@ -632,7 +697,7 @@
       (cond ((memq w *waiters*)
              (waiter-news-set! w (cons news (waiter-news w)))
              (mailbox-put! (waiter-bell w) #t))
-            ((eq? (car news) 'offer) (answer-offers! (list news) #f))))))
+            ((offer? news) (answer-offers! (list news) #f))))))
 
 ;; The news that came for w, oldest first, once some has come or the
 ;; monotonic second until has passed.
@@ -667,7 +732,7 @@
 ;; try.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
-        (offers (filter (lambda (n) (eq? (car n) 'offer)) news))
+        (offers (filter offer? news))
         (held (held-uids w)))
     (give-way! w news)
     (cond
@@ -676,7 +741,7 @@
      (else
       (let ((team (if (or (pair? offers)
                           (and (equal? news '((posed))) (not (behind-others? w))))
-                      (try-in-turn w try (map (lambda (o) (car (cddr o))) offers))
+                      (try-in-turn w try (map offer-uid offers))
                       'not-enough-takers)))
         (answer-offers! offers (pair? team))
         (cond
@@ -756,6 +821,7 @@
             (else 'not-enough-takers)))))
 
 ;; What w holds of a component, (INDEX WINNER TYPE), read by name.
+(define (held-index h) (car h))
 (define (held-winner h) (cadr h))
 (define (held-type h) (car (cddr h)))
 (define (held-uid h) (winner-uid (held-winner h)))
@@ -783,14 +849,15 @@
 (define (give-way! w news)
   (for-each
    (lambda (n)
-     (case (car n)
+     (case (news-kind n)
        ((give-way)
-        (when (memq (cadr n) (held-uids w))
-          (progress (task-id (waiter-task w)) ": gives way on " (cadr n))
-          (let-go-held! w (cadr n))
-          (waiter-yielded-set! w (cons (cadr n) (waiter-yielded w)))))
+        (let ((uid (give-way-uid n)))
+          (when (memq uid (held-uids w))
+            (progress (task-id (waiter-task w)) ": gives way on " uid)
+            (let-go-held! w uid)
+            (waiter-yielded-set! w (cons uid (waiter-yielded w))))))
        ((offer)
-        (waiter-yielded-set! w (remove (lambda (u) (eq? u (car (cddr n))))
+        (waiter-yielded-set! w (remove (lambda (u) (eq? u (offer-uid n)))
                                        (waiter-yielded w))))))
    news))
 
@@ -808,15 +875,17 @@
 ;; start with, to give way, when with those robots and the free ones each
 ;; of w's components not held would have one.
 (define (ask-way! w lines others)
-  (let* ((worse (filter (lambda (o) (rank<? (waiter-rank w) (car (cadr o)))) others))
-         (yieldable (append-map (lambda (o) (car (cddr (cadr o)))) worse))
-         (held (map car (waiter-held w)))
+  (let* ((worse (filter (lambda (o) (rank<? (waiter-rank w) (waiting-there-rank o)))
+                        others))
+         (yieldable (append-map waiting-there-held worse))
+         (held (map held-index (waiter-held w)))
          (open (filter-map (lambda (c line)
                              (and (not (memv (component-index c) held))
-                                  (filter (lambda (uid) (or (memq uid (cadr line))
-                                                            (memq uid yieldable)))
+                                  (filter (lambda (uid)
+                                            (or (memq uid (explanation-free line))
+                                                (memq uid yieldable)))
                                           (remove (lambda (u) (memq u (held-uids w)))
-                                                  (car (cddr line))))))
+                                                  (explanation-capable line)))))
                            (waiter-components w) lines))
          (wanted (filter (lambda (uid) (memq uid yieldable)) (apply append open))))
     (when (and (pair? wanted) (every pair? open)
@@ -825,9 +894,9 @@
                   (for-each (lambda (uid)
                               (if (memq uid wanted)
                                   (guard (e (#t #f))
-                                    (remote-apply (uid->aspace (car o)) receive-give-way
-                                                  uid (waiter-rank w)))))
-                            (car (cddr (cadr o)))))
+                                    (remote-apply (uid->aspace (waiting-there-poser o))
+                                                  receive-give-way uid (waiter-rank w)))))
+                            (waiting-there-held o)))
                 worse))))
 
 (define (look-due? w)
@@ -848,7 +917,7 @@
     (try)))
 
 (define (answer-offers! offers took?)
-  (for-each (lambda (offer) (mailbox-put! (cadr offer) took?)) offers))
+  (for-each (lambda (offer) (mailbox-put! (offer-reply offer) took?)) offers))
 
 ;; Looks at the lab for w after a try that failed: why it waits, and its
 ;; place in line, in its components' states; answers why it never can be
@@ -860,12 +929,9 @@
                  (map (lambda (c) (capability-layout (component-capabilities c))) cs)))
          (capable (map (lambda (line)
                          (remove (lambda (uid) (memq uid (pose-task-excluded)))
-                                 (car (cddr line))))
+                                 (explanation-capable line)))
                        lines))
-         (others (guard (e (#t '()))
-                   (append-map (lambda (poser)
-                                 (map (lambda (o) (list (car poser) o)) (cadr poser)))
-                               (request 'waiting-tasks waiting-ranks))))
+         (others (guard (e (#t '())) (waiting-elsewhere)))
          (exclusive (filter-map (lambda (c caps)
                                   (and (pair? (car (capability-layout
                                                     (component-capabilities c))))
@@ -874,14 +940,14 @@
     (cond
      ((any null? capable)
       (string-append "no live robot of the lab is capable of it:"
-                     (apply string-append (map car lines))))
+                     (apply string-append (map explanation-line lines))))
      ((< (length (delete-duplicates (apply append exclusive))) (length exclusive))
       "fewer live robots of the lab are capable of it than it has components")
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
-      (remind-free! (delete-duplicates (append-map cadr lines)))
-      (waiter-why-set! w (map (lambda (line) (trimmed (car line))) lines))
-      (waiter-position-set! w (place-in-line w (map cadr others)))
+      (remind-free! (delete-duplicates (append-map explanation-free lines)))
+      (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
+      (waiter-position-set! w (place-in-line w others))
       (ask-way! w lines others)
       (with-lock *tasks-lock*
         (lambda ()
@@ -916,8 +982,7 @@
 ;; Brings w's place in line, in its components' states, up to date.
 (define (move-up! w)
   (let ((place (guard (e (#t (waiter-position w)))
-                 (place-in-line w (append-map cadr (request 'waiting-tasks
-                                                            waiting-ranks))))))
+                 (place-in-line w (waiting-elsewhere)))))
     (waiter-position-set! w place)
     (for-each (lambda (c)
                 (let ((state (component-state c)))
@@ -927,22 +992,20 @@
 
 ;; Whether a better-ranked task of the lab waits for a robot w may use.
 (define (behind-others? w)
-  (> (place-in-line w (guard (e (#t '()))
-                        (append-map cadr (request 'waiting-tasks waiting-ranks))))
-     1))
+  (> (place-in-line w (guard (e (#t '())) (waiting-elsewhere))) 1))
 
 ;; w's place among the tasks of the lab that wait for a robot it may use:
 ;; 1 + how many of them rank before it.
 (define (place-in-line w others)
   (+ 1 (count (lambda (other)
-                (and (rank<? (car other) (waiter-rank w))
+                (and (rank<? (waiting-there-rank other) (waiter-rank w))
                      (may-use? other (waiter-capable w))))
               others)))
 
-;; Whether the waiting task (RANK CAPABLE HELD) may use one of uids.
+;; Whether other, a waiting-there, may use one of uids.
 (define (may-use? other uids)
-  (or (eq? (cadr other) #t) (eq? uids #t)
-      (any (lambda (uid) (memq uid (cadr other))) uids)))
+  (or (eq? (waiting-there-capable other) #t) (eq? uids #t)
+      (any (lambda (uid) (memq uid (waiting-there-capable other))) uids)))
 
 ;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
 ;;> of the robots it may use (#t before it has looked), and of those it
@@ -951,6 +1014,23 @@
   (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
        (with-lock *tasks-lock* (lambda () *waiters*))))
 
+;; A task that waits at poser, as its entry of waiting-ranks says.
+(define-record-type waiting-there
+  (make-waiting-there poser rank capable held)
+  waiting-there?
+  (poser waiting-there-poser)
+  (rank waiting-there-rank)
+  (capable waiting-there-capable)
+  (held waiting-there-held))
+
+;; Every task of the lab that waits, each a waiting-there; request
+;; answers (POSER ENTRIES) for each poser.
+(define (waiting-elsewhere)
+  (append-map (lambda (answer)
+                (map (lambda (e) (apply make-waiting-there (car answer) e))
+                     (cadr answer)))
+              (request 'waiting-tasks waiting-ranks)))
+
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}.
 (define (waiting-for uid)
@@ -958,6 +1038,11 @@
                 (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w)))
                      (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
               (with-lock *tasks-lock* (lambda () *waiters*))))
+
+;; The parts of an entry of waiting-for, from any poser of the lab.
+(define (wanting-rank e) (car e))
+(define (wanting-poser e) (cadr e))
+(define (wanting-id e) (car (cddr e)))
 
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
 ;;> task tries again at once; answers whether it started, #f when it is
@@ -1077,7 +1162,7 @@
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
     (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
-    (let ((waiting (list-sort (lambda (a b) (rank<? (car a) (car b)))
+    (let ((waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                               (guard (e (#t '()))
                                 (append-map cadr (request 'waiting-tasks
                                                           waiting-for me))))))
@@ -1087,12 +1172,12 @@
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
-    (let ((poser (cadr (car waiting))))
+    (let ((poser (wanting-poser (car waiting))))
       (offer-subjects! poser 3)
       (guard (e (#t #f))
         (parameterize ((remote-timeout 3))
           (remote-apply (uid->aspace poser) receive-offer
-                        (car (cddr (car waiting))) me)))
+                        (wanting-id (car waiting)) me)))
       (if (and *new-waiters* (free-here?))
           (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
           (offer-to me (cdr waiting))))))

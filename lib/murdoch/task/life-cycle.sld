@@ -5,7 +5,10 @@
 
 (define-library (murdoch task life-cycle)
   (export start-task task? task-id task-name task-status task-wait cancel-task
-          tasks task-step start-steps pose-steps
+          status-index status-state status-attempts
+          step-status? step-status-index step-status-entries
+          tasks listed-posed? listed-id listed-state listed-place listed-why
+          listed-index listed-poser task-step start-steps pose-steps
           waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
   (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
           (srfi 132) (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
@@ -13,5 +16,6 @@
           (murdoch task team) (murdoch task pose-task) (murdoch task running)
           (only (murdoch pubsub) subscribe unsubscribe publish request
                 capability-layout subscription-statuses on-free! offer-subjects!)
-          (only (murdoch task takers) explain-components))
+          (only (murdoch task takers) explain-components explanation-line
+                explanation-free explanation-capable))
   (include "life-cycle.scm"))

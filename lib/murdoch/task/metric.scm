@@ -175,12 +175,14 @@
                                       (measure-all measure (map car response)))
                        (loop (cdr keys) k))))))))
 
-;; Candidate entry's score by an asking measure from its k-th answer.
+;; Candidate entry's score by an asking measure from its k-th answer;
+;; asked is request-components's ((uid answer ...) ...).
 (define (asked-score measure asked entry k)
   (let ((answers (assq (car entry) asked)))
     (if (and answers (> (length answers) (+ k 1)) (list? (list-ref answers (+ k 1))))
         (let ((answer (list-ref answers (+ k 1))))
-          (score measure (car answer) (and (pair? (cdr answer)) (cadr answer))))
+          (score measure (asked-ok? answer)
+                 (and (pair? (cdr answer)) (asked-value answer))))
         +inf.0)))
 
 (define (measured-told uids measures)
@@ -206,8 +208,8 @@
 ;; its answer does not score) measures +inf.0, and so comes last.
 (define (measure-all measure uids)
   (if (asking? measure)
-      (map (lambda (answer)
-             (score measure (cadr answer) (and (cadr answer) (car (cddr answer)))))
+      (map (lambda (o)
+             (score measure (outcome-ok? o) (and (outcome-ok? o) (outcome-value o))))
            (remote-apply-all (map uid->aspace uids) (asking-proc measure)))
       (map thread-join!
            (map (lambda (uid)

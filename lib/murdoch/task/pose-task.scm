@@ -47,12 +47,20 @@
 (define (component-type layout)
   (if (null? (car layout)) 'non-exclusive 'exclusive))
 
-;; The poses made here, counted, and those negotiating, each as
-;; (name rank rival-rank ...): the ranks of the other tasks that said
-;; they want robots it holds.  Threads and received calls pose at once.
-;; Global: a rival's call (receive-rival) finds them by name.
+;; The poses made here, counted, and those negotiating, each a
+;; negotiation.  Threads and received calls pose at once.  Global: a
+;; rival's call (receive-rival) finds them by name.
 (define *poses* 0)
 (define *negotiating* '())
+
+;; A pose negotiating here: its name, its rank, and the ranks of the other
+;; tasks that said they want robots it holds.
+(define-record-type negotiation
+  (make-negotiation name rank rivals)
+  negotiation?
+  (name negotiation-name)
+  (rank negotiation-rank)
+  (rivals negotiation-rivals negotiation-rivals-set!))
 (define *poses-lock* (make-mutex 'poses))
 
 (define (with-poses thunk) (with-lock *poses-lock* thunk))
@@ -279,10 +287,10 @@
               (if (eq? type 'exclusive)
                   (for-each (lambda (entry)
                               (if (not (memq entry winners))
-                                  (guard (e (#t (log-warn "releasing " (car entry)
+                                  (guard (e (#t (log-warn "releasing " (winner-uid entry)
                                                           ": " (error-message e))))
-                                    ((cadr entry) #f)
-                                    (release-proxy! (cadr entry)))))
+                                    ((winner-promise entry) #f)
+                                    (release-proxy! (winner-promise entry)))))
                             response)))
             responses type-list))
 
@@ -394,12 +402,16 @@
 
 ;;; Tasks posed at once
 
-;; A rank is (priority name); the higher priority outranks, then the
-;; smaller name, so that no two ranks tie.
+;; A rank is (priority name), as it travels to rival posers; the higher
+;; priority outranks, then the smaller name, so that no two ranks tie.
+(define (rank-priority rank) (car rank))
+(define (rank-name rank) (cadr rank))
+
 (define (outranks? rank1 rank2)
-  (or (> (car rank1) (car rank2))
-      (and (= (car rank1) (car rank2))
-           (string<? (symbol->string (cadr rank1)) (symbol->string (cadr rank2))))))
+  (or (> (rank-priority rank1) (rank-priority rank2))
+      (and (= (rank-priority rank1) (rank-priority rank2))
+           (string<? (symbol->string (rank-name rank1))
+                     (symbol->string (rank-name rank2))))))
 
 (define (own-rank name) (list (pose-task-priority) name))
 
@@ -408,45 +420,60 @@
   (dynamic-wind
    (lambda ()
      (with-poses
-      (lambda () (set! *negotiating* (cons (list name (own-rank name)) *negotiating*)))))
+      (lambda ()
+        (set! *negotiating* (cons (make-negotiation name (own-rank name) '())
+                                  *negotiating*)))))
    thunk
    (lambda ()
-     (with-poses (lambda () (set! *negotiating* (without-key name *negotiating*)))))))
+     (with-poses (lambda () (set! *negotiating* (without-name name)))))))
 
-(define (without-key key alist) (remove (lambda (entry) (eq? (car entry) key)) alist))
+;; The negotiations here, but name's; and name's.  Under the poses' lock.
+(define (without-name name)
+  (remove (lambda (n) (eq? (negotiation-name n) name)) *negotiating*))
+(define (negotiation-named name)
+  (find (lambda (n) (eq? (negotiation-name n) name)) *negotiating*))
 
 ;;> What a pose that wants robots held by pose \var{name} calls where
 ;;> \var{name} was posed, with its \var{rank} (priority name): answers #t
 ;;> when \var{name} is still negotiating here, and will hear of it.
 (define (receive-rival name rank)
   ;; A rank comes from another peer, and is compared under the lock.
-  (if (not (and (list? rank) (= (length rank) 2) (real? (car rank))
-                (symbol? (cadr rank))))
+  (if (not (and (list? rank) (= (length rank) 2) (real? (rank-priority rank))
+                (symbol? (rank-name rank))))
       (error "receive-rival: a rank is (priority name)" rank))
   (with-poses
    (lambda ()
-     (let ((entry (assq name *negotiating*)))
-       (and entry
-            (begin (set-cdr! (cdr entry) (cons rank (cddr entry))) #t))))))
+     (let ((n (negotiation-named name)))
+       (and n
+            (begin (negotiation-rivals-set! n (cons rank (negotiation-rivals n)))
+                   #t))))))
 
 ;;> The poses negotiating here, each as (name rank rival-rank ...): its
 ;;> (priority name) and those of the poses that want robots it holds.
 (define (pose-negotiations)
-  (with-poses (lambda () (map list-copy *negotiating*))))
+  (with-poses
+   (lambda ()
+     (map (lambda (n)
+            (cons* (negotiation-name n) (negotiation-rank n) (negotiation-rivals n)))
+          *negotiating*))))
 
 ;; The ranks of the rivals that outrank pose name.
 (define (outranking-rivals name)
-  (let ((entry (assq name (pose-negotiations))))
-    (filter (lambda (rank) (outranks? rank (cadr entry))) (cddr entry))))
+  (with-poses
+   (lambda ()
+     (let ((n (negotiation-named name)))
+       (filter (lambda (rank) (outranks? rank (negotiation-rank n)))
+               (negotiation-rivals n))))))
 
 ;; Commits pose name to the winners it has: #f if a rival outranks it.
 ;; Rivals heard of later find it no longer negotiating.
 (define (commit! name)
   (with-poses
    (lambda ()
-     (let ((entry (assq name *negotiating*)))
-       (and (not (any (lambda (rank) (outranks? rank (cadr entry))) (cddr entry)))
-            (begin (set! *negotiating* (without-key name *negotiating*)) #t))))))
+     (let ((n (negotiation-named name)))
+       (and (not (any (lambda (rank) (outranks? rank (negotiation-rank n)))
+                      (negotiation-rivals n)))
+            (begin (set! *negotiating* (without-name name)) #t))))))
 
 ;; Whether a rival that outranks pose name is still negotiating where it
 ;; was posed.  Rivals that are done are forgotten, so that they no longer
@@ -455,15 +482,15 @@
   (let ((done (remove rival-negotiating? (outranking-rivals name))))
     (with-poses
      (lambda ()
-       (let ((entry (assq name *negotiating*)))
-         (set-cdr! (cdr entry)
-                   (remove (lambda (rank) (member rank done)) (cddr entry))))))
+       (let ((n (negotiation-named name)))
+         (negotiation-rivals-set!
+          n (remove (lambda (rank) (member rank done)) (negotiation-rivals n))))))
     (pair? (outranking-rivals name))))
 
 (define (rival-negotiating? rank)
   (guard (e (#t #f))
-    (and (assq (cadr rank)
-               (remote-apply (uid->aspace (reservation-aspace-uid (cadr rank)))
+    (and (assq (rank-name rank)
+               (remote-apply (uid->aspace (reservation-aspace-uid (rank-name rank)))
                              pose-negotiations))
          #t)))
 

@@ -131,8 +131,7 @@
 
 ;;; The components ended here
 ;;
-;; The last kept-ended of them, newest first, each as (ID INDEX POSER
-;; STARTED ENDED END), the times by the monotonic clock.  A component
+;; The last kept-ended of them, newest first, each an ending.  A component
 ;; leaves the running list and joins this one at once, under the lock: a
 ;; report that reads the running list first, then this one, finds every
 ;; component in one or the other.
@@ -140,10 +139,17 @@
 (define kept-ended 16)
 (define *ended* '())
 
+;; Running r over, at a time on the monotonic clock, as end-of says.
+(define-record-type ending
+  (make-ending running at end)
+  ending?
+  (running ending-running)
+  (at ending-at)
+  (end ending-end))
+
 ;; r is over, with outcome, as run-listed catches it.
 (define (note-ended! r outcome)
-  (let ((entry (list (running-id r) (running-index r) (running-poser r)
-                     (running-started r) (monotonic-seconds) (end-of outcome))))
+  (let ((entry (make-ending r (monotonic-seconds) (end-of outcome))))
     (with-lock *running-lock*
       (lambda ()
         (set! *running* (remove (lambda (x) (eq? x r)) *running*))
@@ -162,10 +168,31 @@
 
 ;;> The components that ended here, the last sixteen, newest first, each
 ;;> as (ID INDEX POSER STARTED ENDED END): STARTED and ENDED are seconds
-;;> before now, END is (done), (failed WHY) or (lost WHY).
+;;> before now, END is (done), (failed WHY) or (lost WHY).  They travel
+;;> as lists, to the status and the view; ended-id and the other ended-
+;;> procedures read them.
 (define (components-ended)
   (let ((now (monotonic-seconds)))
     (map (lambda (e)
-           (append (take e 3)
-                   (list (- now (list-ref e 3)) (- now (list-ref e 4)) (list-ref e 5))))
+           (let ((r (ending-running e)))
+             (list (running-id r) (running-index r) (running-poser r)
+                   (- now (running-started r)) (- now (ending-at e)) (ending-end e))))
          (with-lock *running-lock* (lambda () *ended*)))))
+
+;;> The task id of \var{e}, an entry of components-ended.
+(define (ended-id e) (car e))
+
+;;> The component's number in \var{e}, an entry of components-ended.
+(define (ended-index e) (cadr e))
+
+;;> The seconds since the component of \var{e}, an entry of
+;;> components-ended, started.
+(define (ended-started e) (list-ref e 3))
+
+;;> The seconds since the component of \var{e}, an entry of
+;;> components-ended, ended.
+(define (ended-ended e) (list-ref e 4))
+
+;;> How the component of \var{e}, an entry of components-ended, ended:
+;;> (done), (failed WHY) or (lost WHY).
+(define (ended-end e) (list-ref e 5))

@@ -8,7 +8,8 @@
 
 (define-library (murdoch task running)
   (export run-component run-posed-component component-heartbeat! stop-component!
-          components-running components-ended lost-periods)
+          components-running components-ended ended-id ended-index ended-started
+          ended-ended ended-end lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
           (murdoch robot) (only (murdoch remote) hand-over-connection!))
   (include "running.scm"))

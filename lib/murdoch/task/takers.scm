@@ -15,15 +15,23 @@
   (let ((lines (explain-components layouts)))
     (write-string (string-append "pose-task: not enough takers for "
                                  (name task-name) ":\n"
-                                 (apply string-append (map car lines))
-                                 (too-few-line layouts (map cadr lines)))
+                                 (apply string-append (map explanation-line lines))
+                                 (too-few-line layouts (map explanation-free lines)))
                   port)
     (flush-output-port port)))
 
-;;> For each of \var{layouts}, in order, (LINE FREE CAPABLE): LINE says
-;;> who could take the component and why none did, as explain-no-takers
-;;> writes it; FREE and CAPABLE are the uids of the live address spaces
-;;> capable of it that are free, and all of them.
+;;> What is known of one component's takers: its line says who could take
+;;> it and why none did, as explain-no-takers writes it; free and capable
+;;> are the uids of the live address spaces capable of it that are free,
+;;> and all of them.
+(define-record-type explanation
+  (make-explanation line free capable)
+  explanation?
+  (line explanation-line)
+  (free explanation-free)
+  (capable explanation-capable))
+
+;;> An explanation for each of \var{layouts}, in order.
 (define (explain-components layouts)
   (let ((live (map car (request 'all (sendable-lambda () #t)))))
     (map (lambda (i layout) (explain-component i layout live))
@@ -37,15 +45,16 @@
                             (sendable-lambda () (map topic-status exclusive)))))
          (silent (remove (lambda (uid) (assq uid answers))
                          (file-capable (apply append layout)))))
-    (list (string-append
-           "  component " (number->string i) " needs " (name layout) ": "
-           (if (and (null? answers) (null? silent))
-               "no address space of the lab is capable of it"
-               (join (append (map robot-state answers)
-                             (map (lambda (uid) (silent-state uid live)) silent))))
-           "\n")
-          (filter-map (lambda (a) (and (free? a) (car a))) answers)
-          (map car answers))))
+    (make-explanation
+     (string-append
+      "  component " (number->string i) " needs " (name layout) ": "
+      (if (and (null? answers) (null? silent))
+          "no address space of the lab is capable of it"
+          (join (append (map robot-state answers)
+                        (map (lambda (uid) (silent-state uid live)) silent))))
+      "\n")
+     (filter-map (lambda (a) (and (free? a) (car a))) answers)
+     (map car answers))))
 
 ;; When each component that needs a robot to itself has a free one, but
 ;; there are fewer free robots than such components, a line that says so.

@@ -129,15 +129,9 @@
 ;; The default on-error: tell, and let (error UID WHY) stand for the
 ;; result, so the other components' results still come back.
 (define (team-error uid e)
-  (let ((why (error-why e)))
+  (let ((why (error-message e)))
     (log-warn "component on " uid " failed: " why)
     (list 'error uid why)))
-
-;;> The WHY of a component's (error UID WHY): what \var{e}, the condition
-;;> it raised, says, as one line; a remote error's own message, since the
-;;> uid is said beside it.
-(define (error-why e)
-  (if (remote-error? e) (remote-error-message e) (error-message e)))
 
 ;;; Synchronization inside a team, MOVER's way
 ;;
@@ -199,6 +193,14 @@
       (or (c 'receive (local-aspace-uid) s)
           (error "team-receive: nothing came within" s)))))
 
+;; A value sent by team-send!, waiting at the coordinator for its member.
+(define-record-type letter
+  (make-letter to from value)
+  letter?
+  (to letter-to)
+  (from letter-from)
+  (value letter-value))
+
 ;;> A coordinator for a team, as a proxy: (COORDINATOR 'team) is its
 ;;> robots, which \var{team-of} answers, once they are chosen.  Release it
 ;;> with release-proxy! when the team is done.
@@ -226,12 +228,13 @@
             '()
             (with-lock lock missing))))
     (define (send to from value)
-      (change! (lambda () (set! inboxes (append inboxes (list (list to from value)))))))
+      (change! (lambda ()
+                 (set! inboxes (append inboxes (list (make-letter to from value)))))))
     (define (receive uid seconds)
       (wait-until (lambda ()
-                    (let ((m (assq uid inboxes)))
+                    (let ((m (find (lambda (m) (eq? (letter-to m) uid)) inboxes)))
                       (and m (begin (set! inboxes (remove (lambda (x) (eq? x m)) inboxes))
-                                    (cons (cadr m) (car (cddr m)))))))
+                                    (cons (letter-from m) (letter-value m))))))
                   seconds))
     (encap (lambda (op . args)
              (case op

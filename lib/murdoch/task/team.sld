@@ -5,7 +5,7 @@
   (export with-team on-list current-team with-team-proc-maker exec-on
           task-timeout t sort-list make-maxrandom
           with-coordinator team-barrier team-send! team-receive step-team
-          make-coordinator error-why)
+          make-coordinator)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
           (only (murdoch wire) error-message) (murdoch remote) (murdoch task progress)

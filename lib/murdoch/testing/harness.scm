@@ -10,6 +10,12 @@
 ;; would move this process and not its children.
 (unsetenv "MURDOCH_PORT_BASE")
 
+;; A test writes to children that may have died: a REPL past its time
+;; limit, an address space it killed.  SIGPIPE's default action would end
+;; the test without its summary, so it is ignored and the write raises,
+;; which the test reports.
+(set-signal-action! signal/pipe #f)
+
 ;;> The path of a file of the repository.
 (define (tool-path rel) (string-append top "/" rel))
 

@@ -50,8 +50,19 @@
 (define (remote-error-message e) (car (cddr (exception-irritants e))))
 
 ;;> What \var{e}, any raised object, says, as one line for a log or an
-;;> answer: a remote protocol error's own message, else condition-message's.
+;;> answer: a remote error's own message (its uid and procedure are its
+;;> irritants, for whoever names them), else condition-message's.
 (define (error-message e)
-  (if (and (remote-protocol-error? e) (not (stack-guard-tripped? (current-thread))))
+  (if (and (remote-error? e) (not (stack-guard-tripped? (current-thread))))
       (remote-error-message e)
       (condition-message e)))
+
+;;> As error-message, but a remote error's message follows the uid of the
+;;> address space it concerns, as \scheme{"praline: car: not a pair ()"}:
+;;> for an error that leaves the place that knows the uid, an answer to
+;;> another caller or the command line's ERROR line.
+(define (error-message-naming e)
+  (let ((uid (and (remote-error? e) (remote-error-uid e))))
+    (if uid
+        (string-append (symbol->string uid) ": " (error-message e))
+        (error-message e))))

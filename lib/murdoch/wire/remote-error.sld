@@ -2,7 +2,7 @@
 ;;> kind; the wire's own faults are its protocol kind.
 
 (define-library (murdoch wire remote-error)
-  (export remote-error protocol-fail error-message
+  (export remote-error protocol-fail error-message error-message-naming
           remote-error? remote-error-uid remote-error-message
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
           remote-protocol-error?)
