@@ -415,7 +415,7 @@
 (define (pair-share box side)
   (let* ((err (turn-error box))
          (ahead (- (clip err 20) (* turn-lead turn-rate))))
-    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1) (* 0.05 side ahead)) 0 1.6)))
+    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1) (* 0.05 side ahead)) 0.3 1.6)))
 
 ;; How fast the box turns, degrees a second, left positive, from the
 ;; watcher's views at least 0.3 s apart on this robot's clock.
@@ -504,9 +504,9 @@
          (off (offsets-to box axis offset)) (place (behind-at box axis offset))
          (stage (staging box axis offset (cadr view))))
     (if (and stage (or (< (distance (reckon) (car stage)) 150)
-                       (and (eq? (cdr stage) 'behind) (in-corridor? off))))
+                       (and (eq? (cdr stage) 'behind) (in-corridor? off 1))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (in-corridor? off))
+    (cond ((and (eq? docking 'behind) (in-corridor? off 2))
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
            (if (> (distance (reckon) place) 40)
@@ -522,9 +522,13 @@
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
 ;; it along the box's axis: behind it, and the nearer the face the nearer
 ;; the place's line, lest it come sideways into the face or its corner.
-(define (in-corridor? off)
+;; A robot already on its way in keeps to it in a corridor twice as wide
+;; (width 2, not 1): it turns to the axis before it drives (drive-along!),
+;; and one that fell out of a corridor it had only just entered turned back
+;; toward its staging point, and to and fro.
+(define (in-corridor? off width)
   (and (< -150 (car off) (+ stage-back 200))
-       (< (abs (cadr off)) (+ 50 (* 1/3 (max 0 (car off)))))))
+       (< (abs (cadr off)) (* width (+ 50 (* 1/3 (max 0 (car off))))))))
 
 ;; Where to come up to the place offset mm left of the middle from, as
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
