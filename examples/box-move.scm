@@ -42,6 +42,28 @@
 (define face-gap 40)                    ; between a place and the box's face
 (define push-speed 220)                 ; mm/s
 
+;;; Time, by the robot's own clock
+
+;; The team's control runs in rounds whose length the machine decides: a
+;; loaded machine makes them longer, and the simulator keeps its own pace
+;; against the wall clock.  So every wait and every "lately" here is in
+;; seconds of the robot's own clock (robot-time), never a count of rounds,
+;; and a motion command is bounded by the round it runs for (drive!).
+(define now #f)                         ; this round's start, robot seconds
+(define round-s 0.2)                    ; how long the last round took
+
+;; Starts a round: reads the clock and how long the round before took.
+(define (start-round!)
+  (let ((t (robot-time)))
+    (if now (set! round-s (clip (- t now) 0.05 2)))
+    (set! now t)))
+
+;; Sets the velocities, bounded so that a round as long as the last moves
+;; the robot at most 100 mm and turns it at most 20 degrees before it looks
+;; again: under load a command runs longer, on a view that grows staler.
+(define (drive! speed turn)
+  (set-velocity (clip speed (/ 100 round-s)) (clip turn (/ 20 round-s))))
+
 ;; The box as this robot sees it, (X Y HEADING) in the room, or #f.
 (define (see-box)
   (let ((seen (fiducials)))
@@ -162,8 +184,10 @@
 ;; keeps the box in view.
 (define (watch previous)
   (team-barrier 'push 120)
-  (let loop ((last #f) (where '()) (done 0) (n 0))
-    (let ((box (see-box)) (bodies (lost-bodies where n)))
+  (start-round!)
+  (let loop ((last #f) (where '()) (done 0) (began now))
+    (start-round!)
+    (let ((box (see-box)) (bodies (lost-bodies where)))
       (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
@@ -171,42 +195,41 @@
                     (step-team)))
       (thread-sleep! 0.15)
       (let* ((heard (all-heard)) (box (or box last))
-             (where (fold-at heard where n))
+             (where (fold-at heard where))
              (done (+ done (count (lambda (h) (eq? (cdr h) 'done)) heard))))
         (cond ((or (>= done 2) (and (>= done 1) box (arrived? box))) (or box 'lost-sight))
-              ((> n 3000) (error "watch: the pushers did not finish" done))
-              (else (loop box where done (+ n 1))))))))
+              ((> (- now began) 900) (error "watch: the pushers did not finish" done))
+              (else (loop box where done began)))))))
 
 ;; Every message waiting, (FROM . VALUE) each.
 (define (all-heard)
   (let ((heard (guard (e (#t #f)) (team-receive 0.01))))
     (if heard (cons heard (all-heard)) '())))
 
-;; where, a list of (UID X Y N), with each pusher's newest (at X Y), heard
-;; in the watcher's round N.
-(define (fold-at heard where n)
+;; where, a list of (UID X Y T), with each pusher's newest (at X Y), heard
+;; at T on the watcher's clock.
+(define (fold-at heard where)
   (fold (lambda (h where)
           (if (and (pair? (cdr h)) (eq? (car (cdr h)) 'at))
-              (cons (append (cons (car h) (cdr (cdr h))) (list n))
+              (cons (append (cons (car h) (cdr (cdr h))) (list now))
                     (remove (lambda (w) (eq? (car w) (car h))) where))
               where))
         where heard))
 
 ;; Where the pushers that left the team, or have not said where they are
-;; for 15 rounds (some 3 s; a pusher says it every quarter second or so),
-;; were last: a pusher lost with no spare to take its part stays in the
-;; team.
-(define (lost-bodies where n)
+;; for 3 s (a pusher says it every half second), were last: a pusher lost
+;; with no spare to take its part stays in the team.
+(define (lost-bodies where)
   (let ((team (step-team)))
     (map (lambda (w) (list (list-ref w 1) (list-ref w 2)))
-         (filter (lambda (w) (or (not (memq (car w) team)) (> (- n (list-ref w 3)) 15)))
+         (filter (lambda (w) (or (not (memq (car w) team)) (> (- now (list-ref w 3)) 3)))
                  where))))
 
 ;; Turns toward the box when it nears the edge of the finder's view.
 (define (keep-in-view box)
   (if box
       (let* ((me (reckon)) (bearing (wrap (- (heading-to me box) (list-ref me 2)))))
-        (set-velocity 0 (if (< (abs bearing) 30) 0 (clip bearing 30))))))
+        (drive! 0 (if (< (abs bearing) 30) 0 (clip bearing 30))))))
 
 ;;; The pushers
 
@@ -225,18 +248,20 @@
         (error "take-place: this robot's fiducial finder does not see the box"
                (local-aspace-uid) (reckon)))
     (sonar-start)
-    (let loop ((box first) (n 0))
+    (start-round!)
+    (let loop ((box first) (began now))
+      (start-round!)
       (cond ((at-place? box (* side pusher-offset))
              (stop-base)
              (rotate 'to (place-axis box))
              (list (local-aspace-uid) (role side)))
-            ((> n 1500)
+            ((> (- now began) 300)
              (stop-base)
              (error "take-place: found no way to its place behind the box"
                     (local-aspace-uid) (place-of box side)))
-            (else (approach! (list box '()) (* side pusher-offset) n)
+            (else (approach! (list box '()) (* side pusher-offset))
                   (thread-sleep! 0.1)
-                  (loop (or (see-box) box) (+ n 1)))))))
+                  (loop (or (see-box) box) began))))))
 
 ;; Whether this robot stands at the place offset mm left of the middle of
 ;; the box's rear face, against it; with slack (mm: it stood there the
@@ -250,13 +275,17 @@
         (and (< -150 (car off) 250) (< (abs (cadr off)) (car slack)) (< turn 35))
         (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
-;; What the pusher hears: the round its partner last said it was at the
-;; face ('here), and the last round it said how far it still had to come
-;; ((coming MM)).
-(define tick 0)
+;; What the pusher hears, on its own clock: when its partner last said it
+;; was at the face ('here), and when it last said how far it still had to
+;; come ((coming MM)); when the newest view came.
 (define partner-here -100)
 (define partner-coming -100)
 (define partner-coming-mm #f)
+(define view-at -100)
+
+;; How lately, in seconds, the partner said it was at the face, or coming.
+(define (here-age) (- now partner-here))
+(define (coming-age) (- now partner-coming))
 
 ;; The newest view the watcher sent, (BOX BODIES), or last when none came.
 (define (latest last)
@@ -264,10 +293,13 @@
     (if (not heard)
         last
         (let ((m (cdr heard)))
-          (cond ((and (pair? m) (eq? (car m) 'box)) (latest (cdr m)))
-                ((eq? m 'here) (set! partner-here tick) (latest last))
+          (cond ((and (pair? m) (eq? (car m) 'box))
+                 (set! view-at now)
+                 (note-turn! (cadr m))
+                 (latest (cdr m)))
+                ((eq? m 'here) (set! partner-here now) (latest last))
                 ((and (pair? m) (eq? (car m) 'coming))
-                 (set! partner-coming tick)
+                 (set! partner-coming now)
                  (set! partner-coming-mm (cadr m))
                  (latest last))
                 (else (latest last)))))))
@@ -278,39 +310,54 @@
 (define (push previous)
   (team-barrier 'push 120)
   (sonar-start)
+  (start-round!)
+  (set! view-at now)
   (let ((watcher (list-ref (step-team) 2)) (side (my-side))
-        (own (see-box)))
-    (let loop ((view (latest (and own (list own '())))) (at-face? #f) (n 0))
-      (set! tick n)
-      (if (= 0 (modulo n 5))
-          (let ((me (reckon)))
-            (set! team (step-team))
-            (team-send! watcher (list 'at (car me) (cadr me)))))
-      (thread-sleep! 0.05)
-      (let ((box (and view (car view))))
-        (cond
-         ((and box (arrived? box))
-          (stop-base)
-          (team-send! watcher 'done)
-          (list (local-aspace-uid) (role side)))
-         ((> n 6000)
-          (stop-base)
-          (team-send! watcher 'done)
-          (error "push: the box did not reach the goal" box))
-         ((not box) (stop-base) (loop (latest view) at-face? (+ n 1)))
-         (else
-          (let ((offset (push-offset view side)))
-            (cond ((at-place? box offset (and at-face? (if (alone?) 75 200)))
-                   (team-send! (partner) 'here)
-                   (steer! view side offset)
-                   (loop (latest view) #t (+ n 1)))
-                  (else
-                   (team-send! (partner)
-                               (list 'coming (if waypoint
-                                                 (distance (reckon) (place-of box side))
-                                                 1e9)))
-                   (approach! view offset n)
-                   (loop (latest view) #f (+ n 1)))))))))))
+        (own (see-box)) (began now))
+    (let loop ((view (latest (and own (list own '())))) (at-face? #f) (said -100))
+      (start-round!)
+      (let ((said (if (< (- now said) 0.5) said (begin (say-where! watcher) now)))
+            (seen (fresh view)))
+        (thread-sleep! 0.05)
+        (let ((box (and seen (car seen))))
+          (cond
+           ((and box (arrived? box))
+            (stop-base)
+            (team-send! watcher 'done)
+            (list (local-aspace-uid) (role side)))
+           ((> (- now began) 900)
+            (stop-base)
+            (team-send! watcher 'done)
+            (error "push: the box did not reach the goal" box))
+           ((not box) (stop-base) (loop (latest view) at-face? said))
+           (else
+            (let ((offset (push-offset seen side)))
+              (cond ((at-place? box offset (and at-face? (if (alone?) 75 200)))
+                     (team-send! (partner) 'here)
+                     (steer! seen side offset)
+                     (loop (latest view) #t said))
+                    (else
+                     (team-send! (partner)
+                                 (list 'coming (if waypoint
+                                                   (distance (reckon) (place-of box side))
+                                                   1e9)))
+                     (approach! seen offset)
+                     (loop (latest view) #f said)))))))))))
+
+;; Tells the watcher where this pusher is, and looks at who is in the team.
+(define (say-where! watcher)
+  (let ((me (reckon)))
+    (set! team (step-team))
+    (team-send! watcher (list 'at (car me) (cadr me)))))
+
+;; The watcher's view, while it is at most a second old; else this robot's
+;; own sighting of the box, with the bodies last told; else #f: a pusher
+;; does not push on a view older than that, however slow the round.
+(define (fresh view)
+  (if (< (- now view-at) 1)
+      view
+      (let ((own (see-box)))
+        (and own (list own (if view (cadr view) '()))))))
 
 ;; How many degrees left the box must turn to head for the path.
 (define (turn-error box)
@@ -325,36 +372,66 @@
 ;; wrong way: it comes up afresh to each new spot (approach!).
 (define lone-at #f)
 (define (push-offset view side)
-  (if (or (< (- tick partner-here) 4) (spare-on-its-way?))
+  (if (or (paired?) (spare-on-its-way?))
       (begin (set! lone-at #f) (* side pusher-offset))
       (let ((want (lone-offset (car view) (cadr view) side)))
         (cond ((not lone-at) (set! lone-at (* side pusher-offset)))
               ((or (not (alone?)) (> (abs (- want lone-at)) 80)) (set! lone-at want)))
         lone-at)))
 
-;; Whether this pusher has heard nothing from a partner for 60 rounds (some
-;; six seconds, long enough for a spare to be found and the watcher to
-;; know where the lost one lies): its partner was lost and no spare took
-;; its part.
-(define (alone?) (and (>= (- tick partner-here) 60) (>= (- tick partner-coming) 60)))
+;; Whether this pusher has heard nothing from a partner for 10 s (long
+;; enough for a spare to be found and the watcher to know where the lost
+;; one lies): its partner was lost and no spare took its part.
+(define (alone?) (and (>= (here-age) 10) (>= (coming-age) 10)))
+
+;; Whether the partner said lately (within 0.8 s) that it is at the face.
+(define (paired?) (< (here-age) 0.8))
 
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
-;; pushes harder.  A pusher alone (its partner has not said it is at the
-;; face for three rounds) turns the box by where it pushes (push-offset).
+;; pushes harder (pair-share).  A pusher alone (its partner has not said
+;; lately that it is at the face) turns the box by where it pushes
+;; (push-offset), and holds while the box turns faster than max-turn-rate.
 ;; A spare coming turns the box the most: once the spare has a way to its
 ;; place, the lone pusher holds at its own, leaving the spare's free.
 (define (steer! view side offset)
   (let ((box (car view)))
     (push-at! box (place-axis box) offset
-              (cond ((< (- tick partner-here) 4)
-                     (clip (- 1 (* 0.05 side (turn-error box))) 0.3 1.7))
+              (cond ((paired?) (pair-share box side))
                     ((spare-on-its-way?) 0)
+                    ((> (abs turn-rate) max-turn-rate) 0)
                     (else 0.5)))))
 
-;; Whether a spare said lately that it has a way to its place.
+;; A pusher's share of push-speed in a pair: both push less the further
+;; the box is turned off its way (forward at a third from 30 degrees off),
+;; so that it turns more than it goes; and one pushes more and the other
+;; less by how far the box must turn, up to 20 degrees, less what it will
+;; turn of that within turn-lead seconds at the rate it turns now, so that
+;; it comes round at a few degrees a second without swinging past the
+;; path: a box swung fast leaves the pushers behind their places, and on a
+;; slow machine the views come later and it swings further before they see it.
+(define turn-lead 1.5)
+(define max-turn-rate 8)                ; degrees a second, for a pusher alone
+(define (pair-share box side)
+  (let* ((err (turn-error box))
+         (ahead (- (clip err 20) (* turn-lead turn-rate))))
+    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1) (* 0.05 side ahead)) 0.3 1.6)))
+
+;; How fast the box turns, degrees a second, left positive, from the
+;; watcher's views at least 0.3 s apart on this robot's clock.
+(define turn-rate 0)
+(define rate-from #f)                   ; (SECONDS HEADING)
+(define (note-turn! box)
+  (let ((h (list-ref box 2)))
+    (cond ((not rate-from) (set! rate-from (list now h)))
+          ((>= (- now (car rate-from)) 0.3)
+           (set! turn-rate
+                 (/ (square-wrap (- h (cadr rate-from))) (- now (car rate-from))))
+           (set! rate-from (list now h))))))
+
+;; Whether a spare said lately (within 2 s) that it has a way to its place.
 (define (spare-on-its-way?)
-  (and (< (- tick partner-coming) 10) (< partner-coming-mm 1e8)))
+  (and (< (coming-age) 2) (< partner-coming-mm 1e8)))
 
 ;; Where a pusher alone pushes, mm left of the middle of the rear face:
 ;; 10 mm aside a degree the box must turn, to the right of the middle to
@@ -392,17 +469,23 @@
 ;; Sets the velocities that bring the robot, heading along axis, to a
 ;; point ahead and left of it (mm, in the axis's frame): forward at speed,
 ;; turning toward the point, or back when it is well behind.
+;; It moves only as far as it faces along the axis (facing), for a robot
+;; well off the axis that drives on leaves the way into its place sideways.
 (define (drive-along! axis ahead left speed)
   (let ((turn (wrap (- (+ axis (clip (* 0.15 left) 25)) (list-ref (reckon) 2)))))
-    (set-velocity (if (< ahead -80) (max -200 (* 2 ahead)) speed) (clip (* 2 turn) 40))))
+    (drive! (* (facing (- axis (list-ref (reckon) 2)))
+               (if (< ahead -80) (max -200 (* 2 ahead)) speed))
+            (clip (* 2 turn) 40))))
+
+;; How much of its speed a robot turn degrees off its way may drive at:
+;; all of it straight on, none from 60 degrees off.
+(define (facing turn) (max 0 (- (* 2 (cos (* (wrap turn) degrees))) 1)))
 
 ;; Sets the velocities that bring the robot to point p; it turns in place
 ;; first.
 (define (drive-to! p)
   (let* ((me (reckon)) (turn (wrap (- (heading-to me p) (list-ref me 2)))))
-    (set-velocity (* (min 300 (* 2 (distance me p)))
-                     (max 0 (- (* 2 (cos (* turn degrees))) 1)))
-                  (clip (* 2 turn) 60))))
+    (drive! (* (min 300 (* 2 (distance me p))) (facing turn)) (clip (* 2 turn) 60))))
 
 ;;; Finding a way to the place
 
@@ -415,31 +498,37 @@
 (define docking #f)             ; the staging point reached, while docking
 (define waypoint #f)
 
-(define (approach! view offset n)
+(define planned-at -100)
+(define (approach! view offset)
   (let* ((box (car view)) (axis (place-axis box))
          (off (offsets-to box axis offset)) (place (behind-at box axis offset))
          (stage (staging box axis offset (cadr view))))
     (if (and stage (or (< (distance (reckon) (car stage)) 150)
-                       (and (eq? (cdr stage) 'behind) (in-corridor? off))))
+                       (and (eq? (cdr stage) 'behind) (in-corridor? off 1))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (in-corridor? off))
+    (cond ((and (eq? docking 'behind) (in-corridor? off 2))
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
            (if (> (distance (reckon) place) 40)
                (drive-to! place)
-               (set-velocity 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
+               (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
           (else
            (set! docking #f)
-           (if (or (not waypoint) (= 0 (modulo n 5)))
-               (set! waypoint (and stage (plan-way (car stage) box (cadr view)))))
+           (if (or (not waypoint) (>= (- now planned-at) 0.8))
+               (begin (set! planned-at now)
+                      (set! waypoint (and stage (plan-way (car stage) box (cadr view))))))
            (if waypoint (drive-to! waypoint) (stop-base))))))
 
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
 ;; it along the box's axis: behind it, and the nearer the face the nearer
 ;; the place's line, lest it come sideways into the face or its corner.
-(define (in-corridor? off)
+;; A robot already on its way in keeps to it in a corridor twice as wide
+;; (width 2, not 1): it turns to the axis before it drives (drive-along!),
+;; and one that fell out of a corridor it had only just entered turned back
+;; toward its staging point, and to and fro.
+(define (in-corridor? off width)
   (and (< -150 (car off) (+ stage-back 200))
-       (< (abs (cadr off)) (+ 50 (* 1/3 (max 0 (car off)))))))
+       (< (abs (cadr off)) (* width (+ 50 (* 1/3 (max 0 (car off))))))))
 
 ;; Where to come up to the place offset mm left of the middle from, as
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or

@@ -49,7 +49,7 @@
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/robot/trip.scm)
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
-          reckon set-reckon-position! set-reckon-heading!
+          reckon set-reckon-position! set-reckon-heading! robot-time
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether! fiducials
           fiducial-id fiducial-range fiducial-bearing fiducial-orientation

@@ -94,6 +94,16 @@ LAB
   (let ((p (translate 100)))
     (test-assert "translate along the new heading" (near? (car p) 100 5))))
 
+(test-group "the robot's clock"
+  ;; robot-time is the simulator's T time, in seconds: it lies between two
+  ;; readings of T time around it, and runs on while the robot moves.
+  (let* ((before (car (trip-request moseley 'time))) (t (robot-time))
+         (after (car (trip-request moseley 'time))))
+    (test "between the simulator's own readings" '()
+      (if (<= (/ before 1000.) t (/ after 1000.)) '() (list before t after)))
+    (translate 50)
+    (test-assert "later after a motion" (> (robot-time) t))))
+
 (test-group "sensors"
   (sonar-start)
   (let ((r (sonar-read)))

@@ -360,6 +360,12 @@
     (let ((w (- a (* 360 (round (/ a 360))))))
       (if (<= w -180) (+ w 360) w))))
 
+;;> The robot's own clock, seconds: the simulator's time (`T time`), which
+;;> runs at its speed against the wall clock and slips when the machine is
+;;> too slow to keep up, so that a robot counting time by it keeps pace
+;;> with the world it moves in.
+(define (robot-time) (/ (car (request (robot) "time")) 1000.))
+
 ;;> Translation (mm/s) and rotation (deg/s) velocities, until changed.
 (define (set-velocity tv rv) (device 'base "vel" tv rv) #t)
 ;;> Stops the base at once: both velocities zero.

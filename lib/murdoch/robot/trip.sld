@@ -7,7 +7,7 @@
           current-robot set-current-robot!
           trip-error? trip-error-robot trip-error-code trip-error-text
           im goto-xy goto-goal rotate translate angle-to-heading set-velocity stop-base
-          reckon set-reckon-position! set-reckon-heading!
+          reckon set-reckon-position! set-reckon-heading! robot-time
           sonar-start sonar-stop sonar-read ir-read bumpers-read skirt-read
           buttons-read lights say battery-voltage tethered? set-tether! fiducials
           fiducial-id fiducial-range fiducial-bearing fiducial-orientation
