@@ -133,31 +133,29 @@
 (define *poller-port* #f)               ; on the epoll descriptor
 
 (define (watch! c)
-  (with-lock *connections-lock*
-    (lambda ()
-      (if (not *poller-port*) (start-poller!))
-      (let ((fd (port-fileno (connection-in c))))
-        (if (>= fd (vector-length *watched*))
-            (set! *watched* (vector-grow *watched* (* 2 (+ fd 1)))))
-        (connection-fd-set! c fd)
-        ;; Known before it is watched: the poller, a thread that may run
-        ;; between any two steps of this one, drops a ready descriptor it
-        ;; does not know, and with it the welcome that came first.
-        (vector-set! *watched* fd c)
-        (poller-watch! (connection-in c))))))
+  (connection-fd-set! c (port-fileno (connection-in c)))   ; before the poller sees it
+  (watch-port! (connection-in c) c))
 
 ;;> Watches the connection served on input port \var{in}, \var{s} to the
 ;;> serving side: the poller hands \scheme{(take s items)} what
 ;;> poller-frames! reads, and \scheme{(fault s e)} what it raises.
 ;;> Answers the descriptor.
 (define (watch-served! in s take fault)
+  (watch-port! in (make-watcher s take fault)))
+
+;; The poller reads input port in, its descriptor's entry in *watched*
+;; being entry; answers the descriptor.  The entry is set before epoll
+;; watches it: the poller, a thread that may run between any two steps of
+;; this one, drops a ready descriptor it does not know, and with it the
+;; welcome that came first.
+(define (watch-port! in entry)
   (with-lock *connections-lock*
     (lambda ()
       (if (not *poller-port*) (start-poller!))
       (let ((fd (port-fileno in)))
         (if (>= fd (vector-length *watched*))
             (set! *watched* (vector-grow *watched* (* 2 (+ fd 1)))))
-        (vector-set! *watched* fd (make-watcher s take fault))  ; before: see watch!
+        (vector-set! *watched* fd entry)
         (poller-watch! in)
         fd))))
 
