@@ -114,8 +114,7 @@
   (cond ((null? items) (await-whole! s))
         ((bytevector? (car items))
          (if (serving-greeting s)
-             (let ((message (check-message (open-served s (car items))
-                                           '(run apply answer abandon) "a call")))
+             (let ((message (open-served s (car items))))
                (if (memq (car message) '(run apply))
                    (hand-to-reader! s (cons message (cdr items)))
                    (begin (serve-notice s (greeting-uid (serving-greeting s)) message)
@@ -155,7 +154,7 @@
 ;; frame-timeout to come whole.
 (define (read-served s)
   (let ((x (next-served-frame s)))
-    (cond ((pair? x) x)                 ; opened by the poller
+    (cond ((pair? x) x)                 ; opened and checked by the poller
           ((bytevector? x) (open-served s x))
           ((eof-object? x) x)
           (else (protocol-fail "netstring" x)))))
@@ -171,15 +170,16 @@
           (serving-frames-set! s (poller-frames! (serving-fd s) (max-frame)))
           (next-served-frame s)))))
 
-;; The message of the frame whose payload is bytes, s's next.  It came
-;; whole: a deadline set for it is met (await-whole! sets one for the
-;; next when part of it waits).
+;; The message of the frame whose payload is bytes, s's next, checked to
+;; be one a caller may send.  It came whole: a deadline set for it is met
+;; (await-whole! sets one for the next when part of it waits).
 (define (open-served s bytes)
   (let* ((g (serving-greeting s))
          (count (+ 1 (greeting-count g))))
     (greeting-count-set! g count)
     (serving-deadline-set! s #f)
-    (open-frame bytes (greeting-nonce g) count)))
+    (check-message (open-frame bytes (greeting-nonce g) count)
+                   '(run apply answer abandon) "a call")))
 
 (define (janitor)
   (thread-sleep! janitor-seconds)
@@ -344,14 +344,14 @@
 ;; What a connection knows once its caller has said hello: who called,
 ;; the nonces each side MACs with, and the count of frames each way.
 (define-record-type greeting
-  (make-greeting uid caller-nonce nonce text write-lock)
+  (make-greeting uid caller-nonce nonce text write-lock answer count sent flushed)
   greeting?
   (uid greeting-uid)
   (caller-nonce greeting-caller-nonce)  ; our answers are MACed with it
   (nonce greeting-nonce)                ; the caller's frames are
   (text greeting-text)                  ; see frame-text
   (write-lock greeting-write-lock)
-  (answer greeting-answer greeting-answer-set!) ; a served call's (reply!)
+  (answer greeting-answer)              ; a served call's (reply!)
   (count greeting-count greeting-count-set!)    ; frames read
   (sent greeting-sent greeting-sent-set!)       ; frames written
   (flushed greeting-flushed greeting-flushed-set!)) ; sent when last flushed
@@ -363,11 +363,9 @@
      ;; Where the caller listens, learned from its hello.
      (learn-aspace! (make-aspace uid host port))
      (let ((g (make-greeting uid caller-nonce (random-hex 16) (open-output-string)
-                             (make-mutex))))
-       (greeting-answer-set! g (lambda (c kind value) (answer-call s c kind value)))
-       (greeting-count-set! g 0)
-       (greeting-sent-set! g 0)
-       (greeting-flushed-set! g 0)
+                             (make-mutex)
+                             (lambda (c kind value) (answer-call s c kind value))
+                             0 0 0)))
        (serving-greeting-set! s g)
        (serving-deadline-set! s #f)
        (serving-read-on-set! s (lambda () (serve-greeted s)))
@@ -386,8 +384,7 @@
   (let ((message (read-served s)))
     (unless (eof-object? message)
       (let ((g (serving-greeting s)))
-        (serve-frame r (greeting-uid g) (greeting-answer g)
-                     (check-message message '(run apply answer abandon) "a call")))
+        (serve-frame r (greeting-uid g) (greeting-answer g) message))
       (flush-if-idle! s)
       (if (reader? s) (read-on s r)))))
 
