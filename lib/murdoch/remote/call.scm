@@ -42,16 +42,16 @@
   (let ((c (new-call kind proc args)))
     (let ((deadline (+ (monotonic-seconds) (call-seconds c)))
           (g (make-gathering)))
-      (finish-call (start-call a c (call-tail c) deadline g) g deadline c))))
+      (finish-call (start-call a (call-tail c) deadline g) g deadline c))))
 
 ;; The text of call c's frames but their ids (message-without-id).
 (define (call-tail c)
   (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
 
-;; Call c sent to a, its frame's text but the id tail, its answer to come
+;; A call sent to a, its frame's text but the id tail, its answer to come
 ;; to gathering g.  A peer that cannot be connected to or sent to is
 ;; noted unreachable (connection.scm).
-(define (start-call a c tail deadline g)
+(define (start-call a tail deadline g)
   (send-call! (connection-to a deadline) tail g))
 
 ;; The answer to p, pending call c, by the deadline (on the monotonic
@@ -145,7 +145,7 @@
                               (make-result (aspace-uid a) #t
                                            (local-call (call-kind c) (call-proc c)
                                                        (call-args c)))
-                              (start-call a c tail deadline g)))
+                              (start-call a tail deadline g)))
                         aspaces)))
     (await-answers g (filter pending-call? started) deadline)
     (capture-each started-uid

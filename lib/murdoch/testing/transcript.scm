@@ -261,24 +261,19 @@
            (if (transcript-as t) (symbol->string (transcript-as t)) "")
            out)
      (lambda (pid in . _)
-       (let loop ((script (transcript-script t)))
-         (if (and (pair? script) (perform! (car script) t in out base lab-pid))
-             (loop (cdr script))))
-       (guard (e (#t #f)) (close-output-port in))
+       (for-each (lambda (item) (perform! item t in out base lab-pid))
+                 (transcript-script t))
+       (close-output-port in)
        (waitpid pid 0)))
     (file-text out)))
 
 ;; An input line is typed; a shell command waits for the REPL's answers
 ;; (at most 60 s), then runs with LAB_PID and MURDOCH_PORT_BASE set.
-;; Answers #f when the REPL has gone, so that nothing more is typed: its
-;; output, compared, shows where it stopped.
 (define (perform! item t in out base lab-pid)
   (cond
    ((string? item)
-    (guard (e (#t #f))
-      (write-string (string-append item "\n") in)
-      (flush-output-port in)
-      #t))
+    (write-string (string-append item "\n") in)
+    (flush-output-port in))
    (else
     (let ((k (car (cddr item))))
       (wait-until 60 (lambda ()
@@ -286,8 +281,7 @@
                          (> (prompt-count (prompt-of t output) output) k))))
       (system? "env" (string-append "LAB_PID=" (number->string lab-pid))
                (string-append "MURDOCH_PORT_BASE=" base)
-               "sh" "-c" (cadr item))
-      #t))))
+               "sh" "-c" (cadr item))))))
 
 ;; The REPL's prompt: its uid, which for a guest holds its process id.
 (define (prompt-of t output)
