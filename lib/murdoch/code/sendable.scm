@@ -277,39 +277,56 @@
                          (vector 'murdoch:global name))))
    ((and (not (opcode? p)) (closure-info p))
     => (lambda (info)
-         (let ((code (enc-closure info env depth left)))
-           (if (null? (cdr (sendable-info-source+names info)))
-               (know-encoding! p env #f code)
-               code))))
+         (let ((code (enc-closure info env depth left))
+               (source (info-capture-free-source info)))
+           (if source (know-encoding! source env #f code) code))))
    (else (send-fail "cannot send " (what-string what) ": it is "
                     (describe p)))))
 
-;; The encodings of procedures that do not change, kept by procedure: a
-;; global's, while its name is bound to it, and a closure's that captures
-;; no variable (and was not a global when first sent: one bound to a
-;; global name afterwards still goes as its source, which means the same
-;; there).  The same procedures are sent again and again (a request's,
-;; its user's closure).  At most max-known are kept, so that closures
-;; made and sent once are let go.  Global: a cache for every thread.
-(define max-known 4096)
-(define *known* (make-hash-table eq?))  ; procedure -> (env cell . code)
+;; The encodings of procedures that do not change: a global's, kept by
+;; the procedure while its name is bound to it, and a closure's that
+;; captures no variable, kept by its source (the quoted list the lambda
+;; carries, the same object however often the lambda is evaluated; one
+;; bound to a global name after it was first sent still goes as its
+;; source, which means the same there).  The same procedures are sent
+;; again and again: a request's, and its user's closure, made afresh for
+;; each request.  Kept by closure, those filled the table, and srfi 69
+;; keeps twelve buckets a key: a requester's heap grew to a gigabyte
+;; making room for the bucket vector (docs/speed.md).  At most max-known
+;; are kept, so that a program that sends ever new globals is let go.
+;; Global: a cache for every thread.
+(define max-known 512)
+(define *known* (make-hash-table eq?))  ; procedure or source -> (env cell . code)
 
 ;; hash-table-cell, and no let: docs/speed.md, What Chibi charges.
 (define (known-encoding p env)
-  (known-code (hash-table-cell *known* p #f) p env))
+  (or (known-code (hash-table-cell *known* p #f) p env)
+      (known-source-code (capture-free-source p) env)))
 
-;; The code of entry, (p . (env cell . code)), if it is still p's in env:
-;; a global's cell still holds p; a closure's cell is #f.
+(define (known-source-code source env)
+  (and source (known-code (hash-table-cell *known* source #f) #f env)))
+
+;; The code of entry, (key . (env cell . code)), if it is still p's in
+;; env: a global's cell still holds p; a closure's cell is #f.
 (define (known-code entry p env)
   (and entry
        (eq? (cadr entry) env)
        (or (not (car (cddr entry))) (eq? (cdr (car (cddr entry))) p))
        (cdr (cddr entry))))
 
-(define (know-encoding! p env cell code)
+;; The source and names of p, a closure that captures no variable, or #f.
+(define (capture-free-source p)
+  (and (not (opcode? p)) (info-capture-free-source (closure-info p))))
+
+(define (info-capture-free-source info)
+  (and info
+       (null? (cdr (sendable-info-source+names info)))
+       (sendable-info-source+names info)))
+
+(define (know-encoding! key env cell code)
   (if (>= (hash-table-size *known*) max-known)
       (set! *known* (make-hash-table eq?)))
-  (hash-table-set! *known* p (cons env (cons cell code)))
+  (hash-table-set! *known* key (cons env (cons cell code)))
   code)
 
 ;; A captured value is written inside the closure's vector, its list of
