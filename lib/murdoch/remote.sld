@@ -6,7 +6,7 @@
 (define-library (murdoch remote)
   (export aspace? aspace-uid aspace-host aspace-port make-aspace
           local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
-          learn-aspace! live-uids current-lab lab-environment
+          learn-aspace! live-uids live-aspaces live-aspace current-lab lab-environment
           remote-run! remote-apply remote-timeout set-remote-timeout!
           remote-apply-all remote-run-all! outcome-uid outcome-ok? outcome-value
           call-all broadcast-apply broadcast-run!

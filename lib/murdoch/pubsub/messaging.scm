@@ -152,9 +152,9 @@
 ;; other's), so it is sent there only: metrics ask each candidate point to
 ;; point, and would otherwise cost N messages each.
 (define (deliver kind topic proc . args)
-  (if (and (symbol? topic) (memq topic (live-uids)))
-      (call-all (list (uid->aspace topic)) kind proc args)
-      (apply (if (eq? kind 'run) broadcast-run! broadcast-apply) proc args)))
+  (cond ((and (symbol? topic) (live-aspace topic))
+         => (lambda (a) (call-all (list a) kind proc args)))
+        (else (apply (if (eq? kind 'run) broadcast-run! broadcast-apply) proc args))))
 
 ;;> Publishes a message (asynchronous, Figure 4.1): each live address
 ;;> space subscribed to every subject of \var{topic} applies \var{proc} to

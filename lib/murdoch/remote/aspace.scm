@@ -30,7 +30,8 @@
   (timeout membership-timeout membership-timeout-set!) ; remote-apply's default
   (peers membership-peers)              ; uid -> aspace, from lab and hellos
   (unreachable membership-unreachable)  ; uid -> #t: out of the live set
-  (peers-lock membership-peers-lock))   ; over peers and unreachable
+  (peers-lock membership-peers-lock)    ; over peers, unreachable and live
+  (live membership-live membership-live-set!)) ; the live set, #f once changed
 
 (define *membership* #f)
 
@@ -39,6 +40,10 @@
 
 (define (with-peers thunk)
   (with-lock (membership-peers-lock (joined)) thunk))
+
+;; A change to the peers or to who answers: the live set is made again
+;; when next asked for.  The caller holds the peers' lock.
+(define (peers-changed! m) (membership-live-set! m #f))
 
 ;;> The local address space.
 (define (local-aspace) (membership-local (joined)))
@@ -59,9 +64,17 @@
 
 ;;> The address space named \var{uid}.
 (define (uid->aspace uid)
-  (or (with-peers
-        (lambda () (hash-table-ref/default (membership-peers (joined)) uid #f)))
+  (or (known-aspace (joined) uid)
       (error "no address space of this uid is known" uid)))
+
+;; The lock without a dynamic-wind, since nothing under it raises: it and
+;; its closures cost a lookup 1.3 KB (docs/speed.md).
+(define (known-aspace m uid)
+  (let ((lock (membership-peers-lock m)))
+    (mutex-lock! lock)
+    (let ((a (hash-table-ref/default (membership-peers m) uid #f)))
+      (mutex-unlock! lock)
+      a)))
 
 ;;> The uids of every address space known here (the thesis's *uids*).
 (define (known-uids)
@@ -69,7 +82,9 @@
 
 (define (learn-aspace! a)
   (with-peers
-    (lambda () (hash-table-set! (membership-peers (joined)) (aspace-uid a) a))))
+    (lambda ()
+      (hash-table-set! (membership-peers (joined)) (aspace-uid a) a)
+      (peers-changed! (joined)))))
 
 ;;; Live membership
 ;;
@@ -82,24 +97,43 @@
 (define (note-unreachable! uid)
   (if (not (eq? uid (local-aspace-uid)))
       (with-peers
-        (lambda () (hash-table-set! (membership-unreachable (joined)) uid #t)))))
+        (lambda ()
+          (hash-table-set! (membership-unreachable (joined)) uid #t)
+          (peers-changed! (joined))))))
 
 ;; uid answers again, or a beacon of it came.
 (define (note-reachable! uid)
   (with-peers
-    (lambda () (hash-table-delete! (membership-unreachable (joined)) uid))))
+    (lambda ()
+      (hash-table-delete! (membership-unreachable (joined)) uid)
+      (peers-changed! (joined)))))
 
 ;; The uids taken out of the live set, for the prober to try again.
 (define (unreachable-uids)
   (with-peers (lambda () (hash-table-keys (membership-unreachable (joined))))))
 
 ;;> The uids of the address spaces that answer: the broadcast set.
-(define (live-uids)
+(define (live-uids) (map aspace-uid (live-aspaces)))
+
+;;> The address spaces that answer, this one among them: what a request
+;;> to all is sent to.  Kept until the peers or who answers change: made
+;;> from the tables each time, it cost a request to all 32 KB of garbage
+;;> in a lab of 4 and 120 KB in a lab of 16, twice (docs/speed.md).
+(define (live-aspaces)
   (let ((m (joined)))
-    (with-peers
-      (lambda ()
-        (remove (lambda (uid) (hash-table-ref/default (membership-unreachable m) uid #f))
-                (hash-table-keys (membership-peers m)))))))
+    (or (membership-live m)
+        (with-peers (lambda () (live-now! m))))))
+
+(define (live-now! m)
+  (let ((live (remove (lambda (a) (hash-table-ref/default (membership-unreachable m)
+                                                          (aspace-uid a) #f))
+                      (hash-table-values (membership-peers m)))))
+    (membership-live-set! m live)
+    live))
+
+;;> The live address space of \var{uid}, or #f.
+(define (live-aspace uid)
+  (find (lambda (a) (eq? (aspace-uid a) uid)) (live-aspaces)))
 
 ;;; The timeout
 
@@ -144,6 +178,7 @@
         (make-membership lab (utc-seconds) environment decode
                          (lab-setting lab 'timeout) (make-hash-table eq?)
                          (make-hash-table eq?) (make-mutex 'peers)))
+  (membership-live-set! *membership* #f)
   (membership-local-set! *membership* (make-aspace uid host port))
   (for-each (lambda (a)
               (learn-aspace! (make-aspace (lab-aspace-uid a) (lab-aspace-host a)

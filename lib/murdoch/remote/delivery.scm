@@ -23,7 +23,7 @@
   (check-not-abandoned (if (eq? kind 'run) "broadcast-run!" "broadcast-apply"))
   (let ((c (new-call kind proc args)))
     (or (multicast-call-all c)
-        (send-all (map uid->aspace (live-uids)) c))))
+        (send-all (live-aspaces) c))))
 
 ;;; Multicast
 
