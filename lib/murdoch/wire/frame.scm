@@ -134,11 +134,29 @@
 ;;> but its id, for \scheme{spliced-text}: a call to many peers differs only
 ;;> by its id, so its text is written once, not once a peer.
 (define (message-without-id kind fields)
-  (let ((out (open-output-string)))
-    (for-each (lambda (field) (write-char #\space out) (write-simple field out))
-              fields)
-    (write-char #\) out)
-    (cons (string-append "(" (symbol->string kind) " ") (get-output-string out))))
+  (cons (cdr (assq kind kind-heads)) (fields-text fields)))
+
+;; "(KIND " for each kind of the table, made once.
+(define kind-heads
+  (map (lambda (k) (cons (car k) (string-append "(" (symbol->string (car k)) " ")))
+       message-kinds))
+
+;; The text " FIELD ...)" of fields, written to one string port for every
+;; call, under its lock: a port made for each call cost it 9.7 KB of
+;; garbage (docs/speed.md).  Encoded values are plain data, whose writing
+;; raises nothing, so the lock needs no dynamic-wind.
+(define fields-port (open-output-string))
+(define fields-lock (make-mutex 'fields-text))
+
+(define (fields-text fields)
+  (mutex-lock! fields-lock)
+  (reset-output-string! fields-port)
+  (for-each (lambda (field) (write-char #\space fields-port) (write-simple field fields-port))
+            fields)
+  (write-char #\) fields-port)
+  (let ((text (get-output-string fields-port)))
+    (mutex-unlock! fields-lock)
+    text))
 
 ;;> The text of the message that \var{parts}, from message-without-id,
 ;;> and \var{id} make: the text frame-text would give.  The id's digits by
