@@ -71,9 +71,9 @@
 ;; its closures cost a lookup 1.3 KB (docs/speed.md).
 (define (known-aspace m uid)
   (let ((lock (membership-peers-lock m)))
-    (mutex-lock! lock)
+    (lock! lock)
     (let ((a (hash-table-ref/default (membership-peers m) uid #f)))
-      (mutex-unlock! lock)
+      (unlock! lock)
       a)))
 
 ;;> The uids of every address space known here (the thesis's *uids*).

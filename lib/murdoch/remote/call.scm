@@ -275,10 +275,10 @@
 ;; dynamic-wind: nothing under it raises, and every answer comes here.
 (define (datagram-calls-waiting-for id)
   (let ((lock (datagram-calls-lock *datagram-calls*)))
-    (mutex-lock! lock)
+    (lock! lock)
     (let ((waiting (hash-table-ref/default (datagram-calls-waiting *datagram-calls*)
                                            id '())))
-      (mutex-unlock! lock)
+      (unlock! lock)
       waiting)))
 
 ;; Nobody waits for the answers to datagram call id any longer.

@@ -74,10 +74,17 @@
 ;; The lock without a dynamic-wind: nothing under it raises, and this is
 ;; on the way of every call.
 (define (live-connection-to uid)
-  (mutex-lock! *connections-lock*)
-  (let ((c (hash-table-ref/default *connections* uid #f)))
-    (mutex-unlock! *connections-lock*)
-    (and c (connection-open? c) c)))
+  (lock! *connections-lock*)
+  (open-in (unlocked *connections-lock* (hash-table-cell *connections* uid #f))))
+
+(define (open-in cell)
+  (and cell (connection-open? (cdr cell)) (cdr cell)))
+
+;; value, once m is unlocked: for a value taken under a lock with no let,
+;; which would make a closure on the way of every call (docs/speed.md).
+(define (unlocked m value)
+  (unlock! m)
+  value)
 
 (define (connecting-lock uid)
   (with-lock *connections-lock*
@@ -257,9 +264,9 @@
   (let ((id (match (check-message answer '(ack value error) "an answer")
               ((kind id . value) id)))
         (lock (connection-write-lock c)))
-    (mutex-lock! lock)
+    (lock! lock)
     (let ((p (take-mailbox! (connection-pending c) id)))
-      (mutex-unlock! lock)
+      (unlock! lock)
       (if p (answer-call! p answer)))))   ; else the caller gave up
 
 ;; Close once; every call still waiting hears that the connection is lost.
@@ -288,20 +295,18 @@
 ;;> whose answer its gathering g will be handed; answers the pending call.
 ;;> Its id is drawn first, so that its text is made outside the lock.
 (define (send-call! c tail g)
-  (let* ((id (next-call-id! c))
-         (p (make-pending-call (connection-uid c) c id g #f)))
-    (send-counted! c (spliced-text tail id) p)
-    p))
+  (send-pending! c tail (make-pending-call (connection-uid c) c (next-call-id! c) g #f)))
+
+(define (send-pending! c tail p)
+  (send-counted! c (spliced-text tail (pending-call-id p)) p)
+  p)
 
 ;; An id no other call on c has; the lock without a dynamic-wind, since
 ;; nothing under it raises.
 (define (next-call-id! c)
-  (let ((lock (connection-write-lock c)))
-    (mutex-lock! lock)
-    (let ((id (+ 1 (connection-next-id c))))
-      (connection-next-id-set! c id)
-      (mutex-unlock! lock)
-      id)))
+  (lock! (connection-write-lock c))
+  (connection-next-id-set! c (+ 1 (connection-next-id c)))
+  (unlocked (connection-write-lock c) (connection-next-id c)))
 
 ;; Sends message, or its text, as c's next frame, under c's write lock,
 ;; with pending call p (or #f) in c's table.  A frame that fails to go
@@ -313,8 +318,8 @@
 (define (send-counted! c message p)
   (let ((lock (connection-write-lock c))
         (state 'before))
-    (dynamic-wind
-     (lambda () (mutex-lock! lock))
+    (wind
+     (lambda () (lock! lock))
      (lambda ()
        (if (not (connection-open? c))
            (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
@@ -332,7 +337,7 @@
        (unless (eq? state 'sent)
          (if (eq? state 'writing) (connection-open?-set! c #f))
          (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
-       (mutex-unlock! lock)
+       (unlock! lock)
        (if (and p (not (eq? state 'sent))) (note-unreachable! (connection-uid c)))))))
 
 ;;> Sends the answer to call id of a multicast datagram that a, its sender,

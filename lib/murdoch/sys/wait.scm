@@ -5,29 +5,78 @@
 ;; a mutex taken by a deadline: no loop sleeps and looks again.  (A wait
 ;; for a socket is the scheduler's port-wait!.)
 
+;;> Chibi's dynamic-wind: \scheme{(in)}, then \scheme{(body)}'s value,
+;;> with \scheme{(out)} run however body leaves.  Chibi's own makes 640 B
+;;> of garbage a call (the closures of its lets, and its point made by
+;;> the variadic vector); this one 64 (docs/speed.md), and every lock
+;;> and every call of the remote layer goes through one.  Its point is
+;;> Chibi's (init-7.scm: a vector of depth, in, out and parent, kept by
+;;> each thread in %dk), so call/cc and raise wind through it as through
+;;> dynamic-wind's.
+(define (wind in body out)
+  (in)
+  (wound (%dk) in body out))
+
+(define (wound here in body out)
+  (%dk (point! (make-vector 4) (+ 1 (vector-ref here 0)) in out here))
+  (unwound here out (body)))
+
+(define (unwound here out value)
+  (%dk here)
+  (out)
+  value)
+
+(define (point! p depth in out parent)
+  (vector-set! p 0 depth)
+  (vector-set! p 1 in)
+  (vector-set! p 2 out)
+  (vector-set! p 3 parent)
+  p)
+
+;;> \scheme{(mutex-lock! m)} and \scheme{(mutex-unlock! m)} of srfi 18,
+;;> for a mutex taken with no timeout and freed with no condition
+;;> variable.  srfi 18's take those as optional arguments, in a rest list
+;;> and a let that makes a closure: 224 B of garbage a pair, and a request
+;;> takes five pairs a peer (docs/speed.md).  These call the primitives
+;;> that srfi 18's call, and go on as they do when the mutex is held.
+(define (lock! m)
+  (or (%mutex-lock! m #f #t)
+      (begin (thread-yield!) (mutex-lock! m))))   ; as srfi 18's, once it failed
+
+(define (unlock! m) (%mutex-unlock! m #f #f))
+
+;; A procedure of the srfi 18 library that it does not export.
+(define (srfi-18-primitive name)
+  (eval name (module-env (find-module '(srfi 18)))))
+
+(define %mutex-lock! (srfi-18-primitive '%mutex-lock!))
+(define %mutex-unlock! (srfi-18-primitive '%mutex-unlock!))
+
 ;;> Applies \var{thunk} holding the mutex \var{m}, which it frees however
 ;;> thunk leaves.
 (define (with-lock m thunk)
-  (dynamic-wind (lambda () (mutex-lock! m)) thunk (lambda () (mutex-unlock! m))))
+  (wind (lambda () (lock! m)) thunk (lambda () (unlock! m))))
 
 ;; As with-lock, giving up with (too-late) when m is not free by the
 ;; deadline, on the monotonic clock.
 (define (with-lock-by m deadline too-late thunk)
   (if (mutex-lock! m (seconds-until deadline))
-      (dynamic-wind (lambda () #f) thunk (lambda () (mutex-unlock! m)))
+      (wind nothing thunk (lambda () (unlock! m)))
       (too-late)))
+
+(define (nothing) #f)
 
 ;; Seconds from now to deadline, none if it has passed.
 (define (seconds-until deadline)
   (max 0 (- deadline (monotonic-seconds))))
 
 ;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
-;; dynamic-wind, not a guard, on the path of every call (docs/speed.md).
+;; wind, not a guard, on the path of every call (docs/speed.md).
 (define (undo-on-raise undo thunk)
   (let ((done #f))
-    (dynamic-wind (lambda () #f)
-                  (lambda () (let ((value (thunk))) (set! done #t) value))
-                  (lambda () (if (not done) (undo))))))
+    (wind nothing
+          (lambda () (let ((value (thunk))) (set! done #t) value))
+          (lambda () (if (not done) (undo))))))
 
 ;; A one-shot mailbox: the reader thread puts an answer, the caller takes
 ;; it or gives up at its deadline.
@@ -43,20 +92,20 @@
   (%make-mailbox (make-mutex) (make-condition-variable) #f #f))
 
 (define (mailbox-put! mb value)
-  (mutex-lock! (mailbox-mutex mb))
+  (lock! (mailbox-mutex mb))
   (mailbox-value-set! mb value)
   (mailbox-full?-set! mb #t)
   (condition-variable-broadcast! (mailbox-condvar mb))
-  (mutex-unlock! (mailbox-mutex mb)))
+  (unlock! (mailbox-mutex mb)))
 
 ;; The mailbox's value, or (timed-out) once the deadline, on the monotonic
 ;; clock, has passed.  Chibi's SRFI-18 time objects count whole seconds, so
 ;; each wait is given as the seconds left.
 (define (mailbox-take mb deadline timed-out)
   (let loop ()
-    (mutex-lock! (mailbox-mutex mb))
+    (lock! (mailbox-mutex mb))
     (if (mailbox-full? mb)
-        (begin (mutex-unlock! (mailbox-mutex mb))
+        (begin (unlock! (mailbox-mutex mb))
                (mailbox-value mb))
         (let ((left (seconds-until deadline)))
           (cond
@@ -64,7 +113,7 @@
                  (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
             (loop))
            (else
-            (mutex-unlock! (mailbox-mutex mb))
+            (unlock! (mailbox-mutex mb))
             (timed-out)))))))
 
 ;;; Mailboxes by id: a connection's calls waiting for their answers
@@ -73,9 +122,14 @@
 ;;> for \var{id}, taken out of it; #f when it holds none.  The caller
 ;;> holds the lock that guards the table.
 (define (take-mailbox! table id)
-  (let ((mb (hash-table-ref/default table id #f)))
-    (hash-table-delete! table id)
-    mb))
+  (taken table id (hash-table-cell table id #f)))
+
+;; hash-table-cell, and no let: hash-table-ref/default makes a closure
+;; for its default, and a let here another (docs/speed.md).
+(define (taken table id cell)
+  (and cell
+       (begin (hash-table-delete! table id)
+              (cdr cell))))
 
 ;;> Every mailbox of \var{table}, taken out of it: the connection ended,
 ;;> and no answer will come to them.  The caller holds the table's lock.
@@ -106,27 +160,25 @@
 ;;> shows it has one.  No dynamic-wind, since put only sets a field, and
 ;;> no closure made: both would cost every answer (docs/speed.md).
 (define (gathering-put! g item value get put)
-  (let ((m (gathering-mutex g)))
-    (mutex-lock! m)
-    (when (not (get item))
-      (put item value)
-      (let ((got (+ 1 (gathering-got g))))
-        (gathering-got-set! g got)
-        (if (and (gathering-wanted g) (>= got (gathering-wanted g)))
-            (condition-variable-signal! (gathering-condvar g)))))
-    (mutex-unlock! m)))
+  (lock! (gathering-mutex g))
+  (when (not (get item))
+    (put item value)
+    (gathering-got-set! g (+ 1 (gathering-got g)))
+    (if (and (gathering-wanted g) (>= (gathering-got g) (gathering-wanted g)))
+        (condition-variable-signal! (gathering-condvar g))))
+  (unlock! (gathering-mutex g)))
 
 ;;> Waits until \var{n} answers have come, answering #t, or until the
 ;;> deadline, answering #f.
 (define (gathering-wait g n deadline)
   (let ((m (gathering-mutex g)))
     (let loop ()
-      (mutex-lock! m)
+      (lock! m)
       (gathering-wanted-set! g n)
       (if (>= (gathering-got g) n)
-          (begin (mutex-unlock! m) #t)
+          (begin (unlock! m) #t)
           (let ((left (seconds-until deadline)))
             (if (and (positive? left)
                      (mutex-unlock! m (gathering-condvar g) left))
                 (loop)
-                (begin (mutex-unlock! m) (>= (gathering-got g) n))))))))
+                (begin (unlock! m) (>= (gathering-got g) n))))))))

@@ -3,9 +3,10 @@
 ;;> scheduler)'s monotonic-seconds.
 
 (define-library (murdoch sys wait)
-  (export with-lock with-lock-by seconds-until undo-on-raise
+  (export lock! unlock! wind with-lock with-lock-by seconds-until undo-on-raise
           make-mailbox mailbox-put! mailbox-take
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)
-  (import (scheme base) (srfi 18) (srfi 69) (murdoch sys scheduler))
+  (import (scheme base) (only (chibi) %dk) (only (meta) find-module module-env)
+          (only (scheme eval) eval) (srfi 18) (srfi 69) (murdoch sys scheduler))
   (include "wait.scm"))

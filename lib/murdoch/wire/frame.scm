@@ -149,13 +149,13 @@
 (define fields-lock (make-mutex 'fields-text))
 
 (define (fields-text fields)
-  (mutex-lock! fields-lock)
+  (lock! fields-lock)
   (reset-output-string! fields-port)
   (for-each (lambda (field) (write-char #\space fields-port) (write-simple field fields-port))
             fields)
   (write-char #\) fields-port)
   (let ((text (get-output-string fields-port)))
-    (mutex-unlock! fields-lock)
+    (unlock! fields-lock)
     text))
 
 ;;> The text of the message that \var{parts}, from message-without-id,

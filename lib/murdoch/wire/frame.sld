@@ -10,7 +10,7 @@
           frame-fail parse-message protocol-fault? fault-message log-fault
           datagram-bytes open-datagram-text)
   (import (scheme base) (scheme write) (rename (only (chibi) read) (read read-datum))
-          (only (chibi) string-size) (only (srfi 18) make-mutex mutex-lock! mutex-unlock!)
+          (only (chibi) string-size) (only (srfi 18) make-mutex)
           (murdoch sys) (murdoch lab)
           (murdoch wire remote-error) (murdoch wire netstring) (murdoch wire hmac))
   (include "frame.scm"))

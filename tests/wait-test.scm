@@ -1,0 +1,84 @@
+;;; (murdoch sys wait): wind as Chibi's dynamic-wind, the locks the remote
+;;; layer takes on every call, undoing on a raise, and mailboxes by id.
+(import (scheme base) (scheme write) (srfi 18) (srfi 69) (chibi test)
+        (murdoch sys))
+
+;; What ran, in order, through (note! x).
+(define trail '())
+(define (note! x) (set! trail (cons x trail)))
+(define (trail-of thunk)
+  (set! trail '())
+  (guard (e (#t (note! (list 'raised e))))
+    (note! (list 'value (thunk))))
+  (reverse trail))
+
+(define (winding name body)
+  (wind (lambda () (note! (list 'in name))) body (lambda () (note! (list 'out name)))))
+
+(test-begin "wait")
+
+(test-group "wind, as dynamic-wind"
+  (test "in, body, out, and the body's value"
+      '((in a) (out a) (value 7))
+    (trail-of (lambda () (winding 'a (lambda () 7)))))
+  (test "out runs when the body raises"
+      '((in a) (out a) (raised boom))
+    (trail-of (lambda () (winding 'a (lambda () (raise 'boom))))))
+  (test "out runs when the body escapes by a continuation"
+      '((in a) (out a) (value escaped))
+    (trail-of (lambda () (call/cc (lambda (k) (winding 'a (lambda () (k 'escaped))))))))
+  (test "nested in Chibi's own dynamic-wind, each unwinds in turn"
+      '((in a) (in b) (out b) (out a) (raised boom))
+    (trail-of (lambda ()
+                (winding 'a (lambda ()
+                              (dynamic-wind (lambda () (note! '(in b)))
+                                            (lambda () (raise 'boom))
+                                            (lambda () (note! '(out b)))))))))
+  (test "in runs again when a continuation re-enters the body"
+      '((in a) (out a) (in a) (out a) (value 2))
+    (trail-of (lambda ()
+                (let ((k #f) (n 0))
+                  (winding 'a (lambda () (call/cc (lambda (c) (set! k c))) (set! n (+ n 1))))
+                  (if (< n 2) (k #f) n))))))
+
+(test-group "the locks"
+  (let ((m (make-mutex)))
+    (test "lock! takes a free mutex for this thread" #t
+      (begin (lock! m) (eq? (mutex-state m) (current-thread))))
+    (test "unlock! frees it" 'not-abandoned (begin (unlock! m) (mutex-state m)))
+    (test "a second thread's lock! waits until it is freed"
+        '(released got)
+      (let ((order '()))
+        (lock! m)
+        (let ((t (make-thread (lambda () (lock! m) (set! order (cons 'got order))
+                                      (unlock! m)))))
+          (thread-start! t)
+          (thread-sleep! 0.05)
+          (set! order (cons 'released order))
+          (unlock! m)
+          (thread-join! t)
+          (reverse order))))
+    (test "with-lock frees the mutex when its thunk raises" 'not-abandoned
+      (begin (guard (e (#t #f)) (with-lock m (lambda () (raise 'boom))))
+             (mutex-state m)))
+    (test "and srfi 18's mutex-lock! takes it after lock! and unlock!" #t
+      (begin (lock! m) (unlock! m) (mutex-lock! m) (mutex-unlock! m) #t))))
+
+(test-group "undo-on-raise"
+  (test "undo does not run when the thunk returns" '((value 3))
+    (trail-of (lambda () (undo-on-raise (lambda () (note! 'undone)) (lambda () 3)))))
+  (test "undo runs when the thunk raises" '(undone (raised boom))
+    (trail-of (lambda () (undo-on-raise (lambda () (note! 'undone))
+                                        (lambda () (raise 'boom)))))))
+
+(test-group "mailboxes by id"
+  (let ((table (make-hash-table eqv?)))
+    (hash-table-set! table 7 'seven)
+    (test "take-mailbox! answers the mailbox and takes it out" '(seven #f)
+      (let* ((taken (take-mailbox! table 7))
+             (left (hash-table-ref/default table 7 #f)))
+        (list taken left)))
+    (test "or #f for an id it does not hold" #f (take-mailbox! table 8))))
+
+(test-end)
+(test-exit)
