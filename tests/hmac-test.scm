@@ -136,5 +136,20 @@
   (hmac-sha256-sign key "(hello)" "n:"))
 (test-error "a text that is not a string"
   (hmac-sha256-sign key 'hello '()))
+;; A frame is written as the netstring of its signed text, with no string
+;; made of it: "LENGTH:" then the signed text, then ",".
+(define (written-frame t . parts)
+  (let ((out (open-output-string)))
+    (hmac-sha256-write! key t parts out)
+    (get-output-string out)))
+(test "a frame written is the netstring of the signed text"
+    (let ((signed (hmac-sha256-sign key "(caf\xe9; 1)" '("n:" 7 ":"))))
+      (string-append (number->string (bytevector-length (string->utf8 signed))) ":"
+                     signed ","))
+  (written-frame "(caf\xe9; 1)" "n:" 7 ":"))
+(test-error "a frame is not written to a closed port"
+  (let ((out (open-output-string)))
+    (close-port out)
+    (hmac-sha256-write! key "(hello)" '() out)))
 (test-end)
 (test-exit)

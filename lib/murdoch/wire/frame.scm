@@ -166,8 +166,7 @@
   (within-max-frame (string-append (car parts) (fixnum->decimal id) (cdr parts))))
 
 (define (write-frame! out text nonce count)
-  (write-netstring (hmac-sha256-sign (wire-key *wire*) text (list nonce ":" count ":"))
-                   out))
+  (hmac-sha256-write! (wire-key *wire*) text (list nonce ":" count ":") out))
 
 (define (send-frame! out text-port nonce count message)
   (write-frame! out (frame-text text-port message) nonce count)

@@ -157,18 +157,26 @@ static sexp hmac_sha256 (sexp ctx, sexp self, sexp key, sexp parts) {
   return sexp_c_string(ctx, text, 64);
 }
 
+/* The MAC, as hex digits in mac, under key of the parts followed by the
+ * tn bytes at tp: SEXP_VOID, or the exception. */
+static sexp mac_of_text (sexp ctx, sexp self, sexp key, sexp parts,
+                         const char *tp, long tn, char mac[64]) {
+  sexp res = hmac_begin_parts(ctx, self, key, parts);
+  if (res != SEXP_VOID) return res;
+  if (!EVP_MAC_update(mac_context, (const unsigned char *)tp, tn)
+      || !hmac_end(mac))
+    return libcrypto_failed(ctx, self);
+  return SEXP_VOID;
+}
+
 /* (hmac-sha256-sign key text parts): text, of tn bytes at tp, signed: a
  * string of the MAC under key of the parts followed by text, then text
  * itself.  One call where a frame took a MAC and a string-append. */
 static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp key,
                               const char *tp, long tn, sexp parts) {
   char mac[64];
-  sexp res;
-  res = hmac_begin_parts(ctx, self, key, parts);
+  sexp res = mac_of_text(ctx, self, key, parts, tp, tn, mac);
   if (res != SEXP_VOID) return res;
-  if (!EVP_MAC_update(mac_context, (const unsigned char *)tp, tn)
-      || !hmac_end(mac))
-    return libcrypto_failed(ctx, self);
   /* Built in place, as sexp_c_string builds a string: the collector does
    * not move the text, so tp stays good. */
   res = sexp_make_string(ctx, sexp_make_fixnum(64 + tn), SEXP_VOID);
@@ -178,6 +186,27 @@ static sexp hmac_sha256_sign (sexp ctx, sexp self, sexp key,
   sexp_string_data(res)[64 + tn] = '\0';
   sexp_update_string_index_lookup(ctx, res);
   return res;
+}
+
+/* (hmac-sha256-write! key text parts port): writes to port the netstring
+ * whose payload is text signed as hmac-sha256-sign signs it, "LENGTH:"
+ * MAC text ",", and makes nothing: the signed string and the netstring's
+ * writes in Scheme made 1.9 KB of garbage a frame. */
+static sexp hmac_sha256_write (sexp ctx, sexp self, sexp key, const char *tp,
+                               long tn, sexp parts, sexp port) {
+  char mac[64], length[32];
+  sexp res;
+  if (!sexp_oportp(port) || !sexp_port_openp(port))
+    return sexp_xtype_exception(ctx, self, "not an open output port", port);
+  res = mac_of_text(ctx, self, key, parts, tp, tn, mac);
+  if (res != SEXP_VOID) return res;
+  snprintf(length, sizeof length, "%ld:", 64 + tn);
+  if (sexp_write_string(ctx, length, port) < 0
+      || sexp_write_string_n(ctx, mac, 64, port) < 0
+      || sexp_write_string_n(ctx, tp, tn, port) < 0
+      || sexp_write_char(ctx, ',', port) < 0)
+    return sexp_user_exception(ctx, self, "cannot write the frame", port);
+  return SEXP_VOID;
 }
 
 /* (hmac-sha256-open key bytes end parts): the text that follows the 64

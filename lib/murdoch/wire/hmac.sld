@@ -8,6 +8,10 @@
 ;;> \var{text} signed: a string of the MAC under \var{key} of the list
 ;;> \var{parts} followed by \var{text}, then \var{text}.
 ;;>
+;;> \procedure{(hmac-sha256-write! key text parts port)}
+;;> Writes to the output \var{port} the netstring of \var{text} signed as
+;;> by hmac-sha256-sign, making no string of it.
+;;>
 ;;> \procedure{(hmac-sha256-open key bytes end parts)}
 ;;> The text of a signed message, the first \var{end} bytes of the
 ;;> bytevector \var{bytes}, as a string, when its MAC is that of the list
@@ -19,7 +23,7 @@
 ;;> its caller builds once, where a rest argument would be built again.
 
 (define-library (murdoch wire hmac)
-  (export hmac-sha256 hmac-sha256-sign hmac-sha256-open)
+  (export hmac-sha256 hmac-sha256-sign hmac-sha256-write! hmac-sha256-open)
   (import (scheme base))
   (include-shared "hmac")
   (begin
