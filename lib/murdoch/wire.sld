@@ -7,8 +7,9 @@
           check-datagram start-wire! frame-text message-without-id spliced-text
           write-frame! send-frame! read-frame
           open-frame max-frame frame-fail parse-message protocol-fault? fault-message
-          log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign hmac-sha256-write!
-          hmac-sha256-open open-multicast-socket read-netstring write-netstring
+          log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign
+          hmac-sha256-write! hmac-sha256-open open-multicast-socket read-netstring
+          write-netstring
           buffered-byte-count reset-output-string! nests-within? fixnum->decimal
           netstring-error? netstring-error-message remote-error protocol-fail
           error-message error-message-naming remote-error?
