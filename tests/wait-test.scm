@@ -38,7 +38,9 @@
       '((in a) (out a) (in a) (out a) (value 2))
     (trail-of (lambda ()
                 (let ((k #f) (n 0))
-                  (winding 'a (lambda () (call/cc (lambda (c) (set! k c))) (set! n (+ n 1))))
+                  (winding 'a (lambda ()
+                                (call/cc (lambda (c) (set! k c)))
+                                (set! n (+ n 1))))
                   (if (< n 2) (k #f) n))))))
 
 (test-group "the locks"
