@@ -3,8 +3,9 @@
 ;;> Its members are each a library of their own in wire/.
 
 (define-library (murdoch wire)
-  (export open-connection socket-port message-kinds make-message check-message
-          check-datagram start-wire! frame-text message-without-id spliced-text
+  (export open-connection socket-port message-kinds make-message message-id
+          check-message check-datagram start-wire! frame-text message-without-id
+          spliced-text
           write-frame! send-frame! read-frame
           open-frame max-frame frame-fail parse-message protocol-fault? fault-message
           log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign

@@ -76,19 +76,28 @@
 ;; What the answer of pending call p, of call c, says: the value, or a
 ;; remote-error; none came within c's seconds, and p is given up.
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
+;; Read by cond, not match or case, and no let: each makes closures, and
+;; every peer's answer comes here (docs/speed.md).
 (define (answer-value p c)
-  (let ((uid (pending-call-uid p))
-        (proc (call-proc c)))
-    (match (pending-call-answer p)
-      (#f (give-up! p) (timed-out uid proc (call-seconds c)))
-      (('ack . _) #t)
-      (('value id value) (decode-value value))
-      (('error id message)
-       (remote-error 'raised uid (describe-procedure proc) message))
-      (('lost)
-       (note-unreachable! uid)
-       (remote-error 'unreachable uid (describe-procedure proc)
-                     "connection lost")))))
+  (answer-says p (pending-call-answer p) c))
+
+(define (answer-says p answer c)
+  (cond ((not answer)
+         (give-up! p)
+         (timed-out (pending-call-uid p) (call-proc c) (call-seconds c)))
+        ((eq? (car answer) 'value) (decode-value (answer-field answer)))
+        ((eq? (car answer) 'ack) #t)
+        ((eq? (car answer) 'error)
+         (remote-error 'raised (pending-call-uid p) (describe-procedure (call-proc c))
+                       (answer-field answer)))
+        (else
+         (note-unreachable! (pending-call-uid p))
+         (remote-error 'unreachable (pending-call-uid p)
+                       (describe-procedure (call-proc c)) "connection lost"))))
+
+;; The value of a value answer, the message of an error answer: the field
+;; after the id.
+(define (answer-field answer) (car (cddr answer)))
 
 ;; The call of proc to uid has had no answer within seconds.
 (define (timed-out uid proc seconds)

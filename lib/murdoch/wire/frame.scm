@@ -88,6 +88,10 @@
       (protocol-fail "datagram" "not a datagram"))
   d)
 
+;;> The id of \var{message}, of a kind whose first field is its id (all
+;;> but hello, welcome, datagram and beacon), once check-message passed it.
+(define (message-id message) (cadr message))
+
 (define (fields-pass? values fields)
   (cond ((null? fields) (null? values))
         ((pair? values) (and ((cadr (car fields)) (car values))
