@@ -23,6 +23,7 @@
   (nonce connection-nonce connection-nonce-set!) ; the callee's
   (sent connection-sent connection-sent-set!)
   (next-id connection-next-id connection-next-id-set!)
+  (stage connection-stage connection-stage-set!) ; of the send under the lock
   (open? connection-open? connection-open?-set!))
 
 ;;> A call on its way to uid, or, with no connection, the answer of uid to
@@ -113,6 +114,7 @@
       (connection-nonce-set! c #f)
       (connection-sent-set! c 0)
       (connection-next-id-set! c 0)
+      (connection-stage-set! c 'sent)
       (connection-open?-set! c #t)
       (send-frame! (connection-out c) (connection-text c) "hello" 0
                    (let ((me (local-aspace)))
@@ -316,33 +318,39 @@
 ;; with pending call p (or #f) in c's table.  A frame that fails to go
 ;; out leaves the connection closed to calls; a message that cannot be
 ;; sent (too large, say) leaves it as it was.  Either way p is taken out,
-;; and its peer is noted unreachable.  One dynamic-wind for the lock and
-;; the undo: a dynamic-wind and the closures around it cost a call 2.5 to
-;; 3 us each (docs/speed.md).
+;; and its peer is noted unreachable.  One wind for the lock and the undo,
+;; its stage kept by the connection under the lock, and no let: each
+;; closure costs every peer of a request (docs/speed.md).
 (define (send-counted! c message p)
-  (let ((lock (connection-write-lock c))
-        (state 'before))
-    (wind
-     (lambda () (lock! lock))
-     (lambda ()
-       (if (not (connection-open? c))
-           (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
-       (let ((text (if (string? message)
-                       message
-                       (frame-text (connection-text c) message)))
-             (count (+ 1 (connection-sent c))))
-         (if p (hash-table-set! (connection-pending c) (pending-call-id p) p))
-         (connection-sent-set! c count)
-         (set! state 'writing)
-         (write-frame! (connection-out c) text (connection-nonce c) count)
-         (flush-output-port (connection-out c))
-         (set! state 'sent)))
-     (lambda ()
-       (unless (eq? state 'sent)
-         (if (eq? state 'writing) (connection-open?-set! c #f))
-         (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
-       (unlock! lock)
-       (if (and p (not (eq? state 'sent))) (note-unreachable! (connection-uid c)))))))
+  (wind (lambda () (lock! (connection-write-lock c)) (connection-stage-set! c 'before))
+        (lambda () (write-counted! c message p))
+        (lambda () (after-send! c p))))
+
+(define (write-counted! c message p)
+  (if (not (connection-open? c))
+      (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
+  (write-frame-text! c (if (string? message)
+                           message
+                           (frame-text (connection-text c) message))
+                     p))
+
+(define (write-frame-text! c text p)
+  (if p (hash-table-set! (connection-pending c) (pending-call-id p) p))
+  (connection-sent-set! c (+ 1 (connection-sent c)))
+  (connection-stage-set! c 'writing)
+  (write-frame! (connection-out c) text (connection-nonce c) (connection-sent c))
+  (flush-output-port (connection-out c))
+  (connection-stage-set! c 'sent))
+
+(define (after-send! c p)
+  (when (not (eq? (connection-stage c) 'sent))
+    (if (eq? (connection-stage c) 'writing) (connection-open?-set! c #f))
+    (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
+  (unlock-after-send! c p (eq? (connection-stage c) 'sent)))
+
+(define (unlock-after-send! c p sent?)
+  (unlock! (connection-write-lock c))
+  (if (and p (not sent?)) (note-unreachable! (connection-uid c))))
 
 ;;> Sends the answer to call id of a multicast datagram that a, its sender,
 ;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
