@@ -263,7 +263,7 @@
   (lock datagram-calls-lock)
   (next-id datagram-calls-next-id datagram-calls-next-id-set!))
 
-(define *datagram-calls* (make-datagram-calls (make-hash-table eqv?)
+(define *datagram-calls* (make-datagram-calls (make-hash-table eq?)
                                               (make-mutex 'datagram-calls) 0))
 
 (define (with-datagram-calls thunk)
@@ -283,12 +283,15 @@
 ;; The pending calls of datagram call id, or none.  The lock without a
 ;; dynamic-wind: nothing under it raises, and every answer comes here.
 (define (datagram-calls-waiting-for id)
-  (let ((lock (datagram-calls-lock *datagram-calls*)))
-    (lock! lock)
-    (let ((waiting (hash-table-ref/default (datagram-calls-waiting *datagram-calls*)
-                                           id '())))
-      (unlock! lock)
-      waiting)))
+  (lock! (datagram-calls-lock *datagram-calls*))
+  (cell-value (unlocked (datagram-calls-lock *datagram-calls*)
+                        (hash-table-cell (datagram-calls-waiting *datagram-calls*)
+                                         id #f))
+              '()))
+
+;; The value of a table's cell, or default for none: hash-table-cell, where
+;; hash-table-ref/default makes a closure (docs/speed.md).
+(define (cell-value cell default) (if cell (cdr cell) default))
 
 ;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
@@ -297,12 +300,24 @@
 
 ;; Hands an (answer ID KIND VALUE) frame from address space uid to the
 ;; call that waits for it; one for a call no longer waited for is dropped.
+;; A request's every answer by multicast comes here: no match, no let, no
+;; closure for find (docs/speed.md).
 (define (take-datagram-answer! uid message)
-  (match message
-    (('answer id kind value)
-     (let ((waiting (datagram-calls-waiting-for id)))
-       (cond ((find (lambda (p) (eq? (pending-call-uid p) uid)) waiting)
-              => (lambda (p) (answer-call! p (list kind id value)))))))))
+  (answer-datagram-call! (pending-of uid (datagram-calls-waiting-for
+                                          (message-id message)))
+                         message))
+
+;; The pending call of uid among ps, or #f.
+(define (pending-of uid ps)
+  (cond ((null? ps) #f)
+        ((eq? (pending-call-uid (car ps)) uid) (car ps))
+        (else (pending-of uid (cdr ps)))))
+
+;; The answer is given as a connection's: (KIND ID VALUE).
+(define (answer-datagram-call! p message)
+  (if p
+      (answer-call! p (list (car (cddr message)) (message-id message)
+                            (cadr (cddr message))))))
 
 ;;; The prober
 

@@ -81,11 +81,6 @@
 (define (open-in cell)
   (and cell (connection-open? (cdr cell)) (cdr cell)))
 
-;; value, once m is unlocked: for a value taken under a lock with no let,
-;; which would make a closure on the way of every call (docs/speed.md).
-(define (unlocked m value)
-  (unlock! m)
-  value)
 
 (define (connecting-lock uid)
   (with-lock *connections-lock*
@@ -108,7 +103,7 @@
     (let* ((nonce (random-hex 16))
            (c (make-connection (aspace-uid a) (car io) (cadr io)
                                (open-output-string) (make-mutex)
-                               (make-hash-table eqv?) nonce (make-mailbox))))
+                               (make-hash-table eq?) nonce (make-mailbox))))
       (connection-fd-set! c #f)
       (connection-received-set! c 0)
       (connection-nonce-set! c #f)
