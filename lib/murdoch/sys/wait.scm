@@ -77,12 +77,20 @@
   (max 0 (- deadline (monotonic-seconds))))
 
 ;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
-;; wind, not a guard, on the path of every call (docs/speed.md).
+;; wind point whose out is undo, taken off with no call when thunk
+;; returns: not a guard (a copy of the stack), and no flag set by the
+;; body for the out to read (closures), on the path of every call
+;; (docs/speed.md).
 (define (undo-on-raise undo thunk)
-  (let ((done #f))
-    (wind nothing
-          (lambda () (let ((value (thunk))) (set! done #t) value))
-          (lambda () (if (not done) (undo))))))
+  (undone-on-raise (%dk) undo thunk))
+
+(define (undone-on-raise here undo thunk)
+  (%dk (point! (make-vector 4) (+ 1 (vector-ref here 0)) nothing undo here))
+  (unwound-quietly here (thunk)))
+
+(define (unwound-quietly here value)
+  (%dk here)
+  value)
 
 ;; A one-shot mailbox: the reader thread puts an answer, the caller takes
 ;; it or gives up at its deadline.
@@ -175,16 +183,17 @@
   (unlock! (gathering-mutex g)))
 
 ;;> Waits until \var{n} answers have come, answering #t, or until the
-;;> deadline, answering #f.
+;;> deadline, answering #f.  No let or named let: a caller's every wait
+;;> comes here (docs/speed.md).
 (define (gathering-wait g n deadline)
-  (let ((m (gathering-mutex g)))
-    (let loop ()
-      (lock! m)
-      (gathering-wanted-set! g n)
-      (if (>= (gathering-got g) n)
-          (begin (unlock! m) #t)
-          (let ((left (seconds-until deadline)))
-            (if (and (positive? left)
-                     (mutex-unlock! m (gathering-condvar g) left))
-                (loop)
-                (begin (unlock! m) (>= (gathering-got g) n))))))))
+  (lock! (gathering-mutex g))
+  (gathering-wanted-set! g n)
+  (if (>= (gathering-got g) n)
+      (unlocked (gathering-mutex g) #t)
+      (gathering-wait-on g n deadline (seconds-until deadline))))
+
+(define (gathering-wait-on g n deadline left)
+  (if (and (positive? left)
+           (mutex-unlock! (gathering-mutex g) (gathering-condvar g) left))
+      (gathering-wait g n deadline)
+      (begin (unlock! (gathering-mutex g)) (>= (gathering-got g) n))))
