@@ -225,8 +225,7 @@
                     (per-run (lambda () (bare-decode (list-ref parsed 2))
                                (bare-decode (list-ref parsed 3)))))
             (report "receiver" "subject match, sandbox, user procedure"
-                    (per-run (lambda () (call-in-sandbox
-                                         (lambda () (apply receive-request args)))))
+                    (per-run (lambda () (call-in-sandbox receive-request args)))
                     (per-run (lambda () (apply user '())))
                     (per-run (lambda () (apply bare-receive args))))
             (report "receiver" "encode"

@@ -125,6 +125,17 @@
   (test "a parameter set by one call is not set for the next" '(#f 600)
     (begin (remote-apply (troy) (lambda () (remote-timeout 0.001) (task-timeout 0) #t))
            (remote-apply (troy) (lambda () (list (remote-timeout) (task-timeout))))))
+  (test "nor by one that raised after setting it" '(#f 600)
+    (begin (refusal (lambda () (remote-timeout 0.001) (task-timeout 0)
+                      (error "raised after setting them")))
+           (remote-apply (troy) (lambda () (list (remote-timeout) (task-timeout))))))
+  (test "what a call wrote before it raised reaches the process's output" #t
+    (begin (refusal (lambda () (display "written before raising") (error "raised")))
+           (wait-until 5 (lambda ()
+                           (text-contains? (troy-log) "written before raising")))))
+  (test "and what a run wrote before it raised" #t
+    (begin (remote-run! (troy) (lambda () (display "run wrote this") (error "raised")))
+           (wait-until 5 (lambda () (text-contains? (troy-log) "run wrote this")))))
   (test "the next call writes to the process's output" #t
     (begin (remote-apply (troy) (lambda () (display "written after the attack")
                                   (newline)))

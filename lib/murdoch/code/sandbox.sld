@@ -6,7 +6,7 @@
           make-logged-thread sized-make-vector sized-make-string
           sized-make-bytevector sized-make-list sized-list-tabulate
           sized-iota sized-read-bytevector sized-expt
-          call-in-sandbox sandbox-parameter! set-sandbox-ports!)
+          call-in-sandbox flush-call-ports! sandbox-parameter! set-sandbox-ports!)
   (import (scheme base) (scheme read) (scheme eval) (scheme file) (scheme inexact)
           (scheme write) (srfi 1) (srfi 18) (srfi 69)
           (only (chibi) env-parent identifier? identifier->symbol port-open?

@@ -307,13 +307,15 @@
 
 ;; Runs (read-on r) while this thread is s's reader, r its reading, under
 ;; one handler for the thread's life (docs/speed.md, What Chibi charges).
-;; An error in the call r runs is answered by (answer-error call e), any
-;; other by (other-failure e), which may raise to end the reader.
+;; An error in the call r runs is answered by (answer-error call e), once
+;; what the call wrote is flushed (see call-in-sandbox); any other by
+;; (other-failure e), which may raise to end the reader.
 (define (read-calls s read-on answer-error other-failure)
   (let ((r (make-reading s #f)))
     (let again ()
       (guard (e ((reading-call r)
                  => (lambda (c)
+                      (flush-call-ports!)
                       (reading-call-set! r #f)
                       (let ((still (inline-apply-ends! s)))
                         (answer-error c e)
@@ -441,17 +443,30 @@
     (('answer . _) (take-datagram-answer! uid message))
     (('abandon id) (abandon-call! s id))))
 
-;; The application call c asks for, as a thunk that runs it in the sandbox.
+;; The application run c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
-  (let ((proc (decode-value (served-call-proc-code c)))
-        (args (decode-value (served-call-args-code c))))
-    (if (not (procedure? proc))
-        (error "not a procedure" proc))
-    (lambda () (call-in-sandbox (lambda () (apply proc args))))))
+  (sandboxed-thunk (decode-value (served-call-proc-code c))
+                   (decode-value (served-call-args-code c))))
 
-;; What the application call c asks for answers, encoded to go back.
+(define (sandboxed-thunk proc args)
+  (check-procedure proc)
+  (lambda () (call-in-sandbox proc args)))
+
+;; What the application call c asks for answers, encoded to go back.  No
+;; thunk made for it, as decode-call makes (docs/speed.md, What Chibi
+;; charges).
 (define (encoded-result c)
-  (encode ((decode-call c)) (lab-environment) "the result"))
+  (encode (applied (decode-value (served-call-proc-code c))
+                   (decode-value (served-call-args-code c)))
+          (lab-environment) "the result"))
+
+(define (applied proc args)
+  (check-procedure proc)
+  (call-in-sandbox proc args))
+
+(define (check-procedure proc)
+  (if (not (procedure? proc))
+      (error "not a procedure" proc)))
 
 (define (peer-name sockaddr)
   (string-append (sockaddr-name sockaddr) ":"

@@ -34,7 +34,8 @@
 ;; raised (docs/speed.md).
 (define (work job)
   (let serve ((job job))
-    (guard (e (#t (log-warn "worker: " (error-message e))
+    (guard (e (#t (flush-call-ports!)
+                  (log-warn "worker: " (error-message e))
                   (let ((next (next-job)))
                     (if next (serve next)))))
       (let loop ((job job))
