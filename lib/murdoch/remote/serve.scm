@@ -81,7 +81,8 @@
 ;; Runs a reader's loop; the connection ends with it, unless the janitor
 ;; has given it a new reader meanwhile.
 (define (read-as-reader s thunk)
-  (guard (e (#t (log-fault (serving-peer s) e)))
+  (guard (e (#t (let-go-of-writes! s)
+                (log-fault (serving-peer s) e)))
     (thunk))
   (if (reader? s) (end-serving! s)))
 
@@ -378,8 +379,9 @@
 (define (serve-greeted s)
   (read-calls s (lambda (r) (read-on s r))
               (lambda (c e)
+                (let-go-of-writes! s)
                 (reply! c 'error (error-message-naming e))
-                (flush-if-idle! s))
+                (flush-if-idle! s (serving-greeting s)))
               raise))
 
 (define (read-on s r)
@@ -387,45 +389,55 @@
     (unless (eof-object? message)
       (let ((g (serving-greeting s)))
         (serve-frame r (greeting-uid g) (greeting-answer g) message))
-      (flush-if-idle! s)
+      (flush-if-idle! s (serving-greeting s))
       (if (reader? s) (read-on s r)))))
 
 ;; Answers served call c on s.
 (define (answer-call s c kind value)
-  (let ((id (served-call-id c)))
-    (answer! s (if (eq? kind 'ack)
-                   (make-message 'ack id)
-                   (make-message kind id value)))))
+  (answer! s (serving-greeting s)
+           (if (eq? kind 'ack)
+               (make-message 'ack (served-call-id c))
+               (make-message kind (served-call-id c) value))))
 
 ;; The reader's own answers wait in the port's buffer until it has read
 ;; every call that has arrived: a burst of calls is answered in one write.
-;; Answers from former readers go at once.
-(define (answer! s message)
-  (let ((g (serving-greeting s)))
-    (with-lock (greeting-write-lock g)
-      (lambda ()
-        (let ((frame (frame-text (greeting-text g) message))
-              (sent (+ 1 (greeting-sent g))))
-          (greeting-sent-set! g sent)
-          ;; A caller that left makes this raise, and the connection end.
-          (write-frame! (serving-out s) frame (greeting-caller-nonce g) sent))
-        (if (not (reader? s)) (flush! s))))))
+;; Answers from former readers go at once.  The write lock is taken
+;; without with-lock's dynamic-wind and closures (docs/speed.md, What
+;; Chibi charges): a raise under it, from a message too large or a caller
+;; that left, is let go of by the reader's handlers (let-go-of-writes!).
+(define (answer! s g message)
+  (mutex-lock! (greeting-write-lock g))
+  (write-answer! s g (frame-text (greeting-text g) message))
+  (if (not (reader? s)) (flush! s g))
+  (mutex-unlock! (greeting-write-lock g)))
+
+;; A caller that left makes this raise, and the connection end.
+(define (write-answer! s g frame)
+  (greeting-sent-set! g (+ 1 (greeting-sent g)))
+  (write-frame! (serving-out s) frame (greeting-caller-nonce g) (greeting-sent g)))
 
 ;; The caller holds the write lock.
-(define (flush! s)
-  (let ((g (serving-greeting s)))
-    (flush-output-port (serving-out s))
-    (greeting-flushed-set! g (greeting-sent g))))
+(define (flush! s g)
+  (flush-output-port (serving-out s))
+  (greeting-flushed-set! g (greeting-sent g)))
 
 ;; Nothing to flush after a frame that had no answer (the answers to our
 ;; own datagram calls, which a requester gets from every peer): no lock
 ;; taken for it.  Sent and flushed change under the write lock, and a
 ;; writer flushes or comes here after its write.
-(define (flush-if-idle! s)
-  (let ((g (serving-greeting s)))
-    (if (and (not (= (greeting-flushed g) (greeting-sent g)))
+(define (flush-if-idle! s g)
+  (when (and (not (= (greeting-flushed g) (greeting-sent g)))
              (null? (serving-frames s)))
-        (with-lock (greeting-write-lock g) (lambda () (flush! s))))))
+    (mutex-lock! (greeting-write-lock g))
+    (flush! s g)
+    (mutex-unlock! (greeting-write-lock g))))
+
+;; The write lock of s, should this thread hold it: a raise under it
+;; (see answer!) leaves it held.
+(define (let-go-of-writes! s)
+  (let ((g (serving-greeting s)))
+    (if (and g (eq? (mutex-state (greeting-write-lock g)) (current-thread)))
+        (mutex-unlock! (greeting-write-lock g)))))
 
 ;; Serves one frame from the caller uid, read by r: a call, which answer
 ;; answers, or one that needs no answer (serve-notice).
