@@ -9,7 +9,8 @@
           make-guarded-thread make-logged-thread sized-make-vector sized-make-string
           sized-make-bytevector sized-make-list sized-list-tabulate sized-iota
           sized-read-bytevector sized-expt call-in-sandbox flush-call-ports!
-          sandbox-parameter! set-sandbox-ports! sendable-lambda sendable-define sendable-procedure? encode
+          sandbox-parameter! set-sandbox-ports! sendable-lambda sendable-define
+          sendable-procedure? encode
           make-decoder send-error? abridged set-value-limits! make-proxy-ref proxy-ref?
           proxy-ref-uid proxy-ref-id make-proxy-procedure proxy-procedure-ref)
   (import (murdoch code abandon) (murdoch code sandbox) (murdoch code sendable)))
