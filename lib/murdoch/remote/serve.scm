@@ -152,35 +152,42 @@
 
 ;; The next message of s for its reader thread, or an eof object; waits
 ;; as long as need be for a frame to begin, then gives it the lab's
-;; frame-timeout to come whole.
+;; frame-timeout to come whole.  Here and down to answer-call, procedures
+;; of their own take what a let would bind, on the path of every call
+;; served (docs/speed.md, What Chibi charges).
 (define (read-served s)
-  (let ((x (next-served-frame s)))
-    (cond ((pair? x) x)                 ; opened and checked by the poller
-          ((bytevector? x) (open-served s x))
-          ((eof-object? x) x)
-          (else (protocol-fail "netstring" x)))))
+  (opened s (next-served-frame s)))
+
+(define (opened s x)
+  (cond ((pair? x) x)                   ; opened and checked by the poller
+        ((bytevector? x) (open-served s x))
+        ((eof-object? x) x)
+        (else (protocol-fail "netstring" x))))
 
 (define (next-served-frame s)
-  (let ((frames (serving-frames s)))
-    (if (pair? frames)
-        (begin (serving-frames-set! s (cdr frames))
-               (car frames))
-        (begin
-          (await-whole! s)
-          (port-wait! (serving-in s) 3600)
-          (serving-frames-set! s (poller-frames! (serving-fd s) (max-frame)))
-          (next-served-frame s)))))
+  (if (pair? (serving-frames s))
+      (first-frame! s (serving-frames s))
+      (begin
+        (await-whole! s)
+        (port-wait! (serving-in s) 3600)
+        (serving-frames-set! s (poller-frames! (serving-fd s) (max-frame)))
+        (next-served-frame s))))
+
+(define (first-frame! s frames)
+  (serving-frames-set! s (cdr frames))
+  (car frames))
 
 ;; The message of the frame whose payload is bytes, s's next, checked to
 ;; be one a caller may send.  It came whole: a deadline set for it is met
 ;; (await-whole! sets one for the next when part of it waits).
 (define (open-served s bytes)
-  (let* ((g (serving-greeting s))
-         (count (+ 1 (greeting-count g))))
-    (greeting-count-set! g count)
-    (serving-deadline-set! s #f)
-    (check-message (open-frame bytes (greeting-nonce g) count)
-                   '(run apply answer abandon) "a call")))
+  (open-counted s (serving-greeting s) bytes))
+
+(define (open-counted s g bytes)
+  (greeting-count-set! g (+ 1 (greeting-count g)))
+  (serving-deadline-set! s #f)
+  (check-message (open-frame bytes (greeting-nonce g) (greeting-count g))
+                 '(run apply answer abandon) "a call"))
 
 (define (janitor)
   (thread-sleep! janitor-seconds)
@@ -264,13 +271,21 @@
 
 (define (inline-apply-ends! s)
   (mutex-lock! (server-lock *server*))
-  (let ((still (reader? s)))
-    (serving-applying-set! s (remove (lambda (a) (eq? (cdr a) (current-thread)))
-                                     (serving-applying s)))
-    (if still (serving-busy-since-set! s #f))
-    (mutex-unlock! (server-lock *server*))
-    (if (abandoned?) (forget-abandoned! (current-thread)))
-    still))
+  (serving-applying-set! s (without-thread (serving-applying s) (current-thread)))
+  (apply-ended! s (reader? s)))
+
+(define (apply-ended! s still)
+  (if still (serving-busy-since-set! s #f))
+  (mutex-unlock! (server-lock *server*))
+  (if (abandoned?) (forget-abandoned! (current-thread)))
+  still)
+
+;; The entries of applying but thread's: remove's test would be a closure
+;; made for every apply (docs/speed.md, What Chibi charges).
+(define (without-thread applying thread)
+  (cond ((null? applying) '())
+        ((eq? (cdar applying) thread) (without-thread (cdr applying) thread))
+        (else (cons (car applying) (without-thread (cdr applying) thread)))))
 
 ;; The caller of apply id gave up on it: its thread is marked, to stop
 ;; where it next calls out (abandon.scm).  An apply already done is let be.
@@ -332,17 +347,21 @@
 (define (serve-call r c)
   (reading-call-set! r c)
   (if (eq? (served-call-kind c) 'run)
-      (let ((thunk (decode-call c)))
-        (reading-call-set! r #f)
-        (reply! c 'ack #t)
-        (run-in-worker thunk))
-      (let ((s (reading-serving r)))
-        (inline-apply-begins! s (served-call-id c))
-        ;; Answered while the call is r's: a value that cannot go back
-        ;; (too large, say) is answered with the error instead.
-        (reply! c 'value (encoded-result c))
-        (reading-call-set! r #f)
-        (inline-apply-ends! s))))
+      (serve-run r c (decode-call c))
+      (serve-apply r (reading-serving r) c)))
+
+(define (serve-run r c thunk)
+  (reading-call-set! r #f)
+  (reply! c 'ack #t)
+  (run-in-worker thunk))
+
+(define (serve-apply r s c)
+  (inline-apply-begins! s (served-call-id c))
+  ;; Answered while the call is r's: a value that cannot go back (too
+  ;; large, say) is answered with the error instead.
+  (reply! c 'value (encoded-result c))
+  (reading-call-set! r #f)
+  (inline-apply-ends! s))
 
 ;; What a connection knows once its caller has said hello: who called,
 ;; the nonces each side MACs with, and the count of frames each way.
@@ -385,12 +404,14 @@
               raise))
 
 (define (read-on s r)
-  (let ((message (read-served s)))
-    (unless (eof-object? message)
-      (let ((g (serving-greeting s)))
-        (serve-frame r (greeting-uid g) (greeting-answer g) message))
-      (flush-if-idle! s (serving-greeting s))
-      (if (reader? s) (read-on s r)))))
+  (serve-read! s r (read-served s)))
+
+(define (serve-read! s r message)
+  (unless (eof-object? message)
+    (serve-frame r (greeting-uid (serving-greeting s))
+                 (greeting-answer (serving-greeting s)) message)
+    (flush-if-idle! s (serving-greeting s))
+    (if (reader? s) (read-on s r))))
 
 ;; Answers served call c on s.
 (define (answer-call s c kind value)
@@ -443,10 +464,16 @@
 ;; answers, or one that needs no answer (serve-notice).
 (define (serve-frame r uid answer message)
   (if (memq (car message) '(run apply))
-      (match message
-        ((kind id proc-code args-code)
-         (serve-call r (make-served-call uid id kind proc-code args-code answer))))
+      (serve-call r (served-call-of message uid answer))
       (serve-notice (reading-serving r) uid message)))
+
+;; The served call that message, a run or an apply checked whole by
+;; open-served, asks for: its fields taken by their places in the wire's
+;; table of messages (wire/frame.scm), where match made 600 B of garbage
+;; a call (docs/speed.md, What Chibi charges).
+(define (served-call-of message uid answer)
+  (make-served-call uid (list-ref message 1) (car message) (list-ref message 2)
+                    (list-ref message 3) answer))
 
 ;; Serves a frame of s from uid that needs no answer: the answer to one
 ;; of our datagram calls, or an abandon.
