@@ -34,8 +34,12 @@
 
 (define (find-subscription topic) (subscription-in *subscriptions* topic))
 
+;; A loop of its own: find's test would be a closure made for every
+;; message addressed here (docs/speed.md, What Chibi charges).
 (define (subscription-in subscriptions topic)
-  (find (lambda (s) (eq? (subscription-topic s) topic)) subscriptions))
+  (cond ((null? subscriptions) #f)
+        ((eq? (subscription-topic (car subscriptions)) topic) (car subscriptions))
+        (else (subscription-in (cdr subscriptions) topic))))
 
 (define (add-subscription! topic)
   (if (not (find-subscription topic))
@@ -134,15 +138,22 @@
 ;; (the thesis says "proper subset"; it means subset).  It takes no lock:
 ;; it reads the list once, and then only the topics, which never change.
 ;; A subject subscribed as it is matches itself, wildcards included, and
-;; is the common case (all, a uid): found so, it costs no matcher.
+;; is the common case (all, a uid): found so, it costs no matcher, and
+;; no closure is made (docs/speed.md, What Chibi charges).
 (define (addressed-here? topic)
-  (let ((subscriptions *subscriptions*))
-    (every (lambda (pattern)
-             (or (subscription-in subscriptions pattern)
-                 (let ((matches? (subject-matcher pattern)))
-                   (any (lambda (s) (matches? (subscription-topic s)))
-                        subscriptions))))
-           (subject-list topic))))
+  (if (list? topic)
+      (subjects-here? *subscriptions* topic)
+      (subject-here? *subscriptions* topic)))
+
+(define (subjects-here? subscriptions subjects)
+  (or (null? subjects)
+      (and (subject-here? subscriptions (car subjects))
+           (subjects-here? subscriptions (cdr subjects)))))
+
+(define (subject-here? subscriptions pattern)
+  (or (subscription-in subscriptions pattern)
+      (let ((matches? (subject-matcher pattern)))
+        (any (lambda (s) (matches? (subscription-topic s))) subscriptions))))
 
 ;;; Sending
 
