@@ -20,15 +20,23 @@
 
 ;; Runs thunk in a worker; if it raises, the log says so.
 (define (run-in-worker thunk)
-  (let ((idle (with-lock *workers-lock*
-                (lambda ()
-                  (and (pair? *idle-workers*)
-                       (let ((mb (car *idle-workers*)))
-                         (set! *idle-workers* (cdr *idle-workers*))
-                         mb))))))
-    (if idle
-        (mailbox-put! idle thunk)
-        (spawn (lambda () (work thunk)) 'worker))))
+  (hand-over! (idle-worker) thunk))
+
+(define (hand-over! idle thunk)
+  (if idle
+      (mailbox-put! idle thunk)
+      (spawn (lambda () (work thunk)) 'worker)))
+
+;; The mailbox of a waiting worker, taken from the pool, or #f.  Here and
+;; in next-job the pool's lock is taken without with-lock's dynamic-wind
+;; and closures, on the path of every run served, where nothing under it
+;; raises (docs/speed.md, What Chibi charges).
+(define (idle-worker)
+  (mutex-lock! *workers-lock*)
+  (let ((mb (and (pair? *idle-workers*) (car *idle-workers*))))
+    (if mb (set! *idle-workers* (cdr *idle-workers*)))
+    (mutex-unlock! *workers-lock*)
+    mb))
 
 ;; One handler for the worker's whole life, entered again only after a job
 ;; raised (docs/speed.md).
@@ -38,19 +46,22 @@
                   (log-warn "worker: " (error-message e))
                   (let ((next (next-job)))
                     (if next (serve next)))))
-      (let loop ((job job))
-        (job)
-        (let ((next (next-job)))
-          (if next (loop next)))))))
+      (run-jobs job))))
+
+;; Runs job, then each next one that comes.
+(define (run-jobs job)
+  (job)
+  (let ((next (next-job)))
+    (if next (run-jobs next))))
 
 ;; The next job for this worker, or #f when none came within
 ;; worker-idle-seconds.
 (define (next-job)
   (let ((mb (make-mailbox)))
-    (with-lock *workers-lock*
-      (lambda () (set! *idle-workers* (cons mb *idle-workers*))))
-    (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds)
-                      (lambda () #f))
+    (mutex-lock! *workers-lock*)
+    (set! *idle-workers* (cons mb *idle-workers*))
+    (mutex-unlock! *workers-lock*)
+    (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds) no-job)
         ;; Timed out; but a caller may have taken this worker meanwhile, in
         ;; which case its procedure is on the way.
         (and (not (with-lock *workers-lock*
@@ -60,4 +71,6 @@
                                         (delete mb *idle-workers* eq?))
                                   #t)))))
              ;; The job is on its way; an hour is only a bound.
-             (mailbox-take mb (+ (monotonic-seconds) 3600) (lambda () #f))))))
+             (mailbox-take mb (+ (monotonic-seconds) 3600) no-job)))))
+
+(define (no-job) #f)
