@@ -415,21 +415,27 @@
 
 ;; Answers served call c on s.
 (define (answer-call s c kind value)
-  (answer! s (serving-greeting s)
-           (if (eq? kind 'ack)
-               (make-message 'ack (served-call-id c))
-               (make-message kind (served-call-id c) value))))
+  (if (eq? kind 'ack)
+      (answer! s (serving-greeting s) (make-message 'ack (served-call-id c)) #f)
+      (answer! s (serving-greeting s) (make-message kind (served-call-id c) value)
+               #t)))
 
 ;; The reader's own answers wait in the port's buffer until it has read
 ;; every call that has arrived: a burst of calls is answered in one write.
-;; Answers from former readers go at once.  The write lock is taken
-;; without with-lock's dynamic-wind and closures (docs/speed.md, What
-;; Chibi charges): a raise under it, from a message too large or a caller
-;; that left, is let go of by the reader's handlers (let-go-of-writes!).
-(define (answer! s g message)
+;; A value or an error, last? true, goes under the same lock when no call
+;; waits behind it, where flush-if-idle! would take the lock again; a
+;; run's ack waits for flush-if-idle!, after its worker has its procedure
+;; (flushed at once, it cost remote-runs a third of their throughput:
+;; docs/speed.md, Levers tried).  Answers from former readers go at once.
+;; The write lock is taken without with-lock's dynamic-wind and closures
+;; (docs/speed.md, What Chibi charges): a raise under it, from a message
+;; too large or a caller that left, is let go of by the reader's handlers
+;; (let-go-of-writes!).
+(define (answer! s g message last?)
   (mutex-lock! (greeting-write-lock g))
   (write-answer! s g (frame-text (greeting-text g) message))
-  (if (not (reader? s)) (flush! s g))
+  (if (or (not (reader? s)) (and last? (null? (serving-frames s))))
+      (flush! s g))
   (mutex-unlock! (greeting-write-lock g)))
 
 ;; A caller that left makes this raise, and the connection end.
