@@ -214,21 +214,21 @@
 ;; flag and its wake-up finds the janitor waiting.
 (define (rest-while-idle)
   (let ((m (server-janitor-mutex *server*)))
-    (mutex-lock! m)
+    (lock! m)
     (server-janitor-resting?-set! *server* #t)
     (cond ((pair? (serving-where (lambda (s) (or (serving-deadline s)
                                                  (serving-busy-since s)))
                                  +inf.0))
            (server-janitor-resting?-set! *server* #f)
-           (mutex-unlock! m))
+           (unlock! m))
           (else (mutex-unlock! m (server-janitor-wake *server*))))))
 
 (define (janitor-wanted!)
   (when (server-janitor-resting? *server*)
-    (mutex-lock! (server-janitor-mutex *server*))
+    (lock! (server-janitor-mutex *server*))
     (server-janitor-resting?-set! *server* #f)
     (condition-variable-signal! (server-janitor-wake *server*))
-    (mutex-unlock! (server-janitor-mutex *server*))))
+    (unlock! (server-janitor-mutex *server*))))
 
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
@@ -237,7 +237,7 @@
   (end-serving! s))
 
 (define (take-over! s)
-  (mutex-lock! (server-lock *server*))
+  (lock! (server-lock *server*))
   (when (serving-busy-since s)          ; its apply may just have ended
     (let ((t (make-guarded-thread
               (lambda () (read-as-reader s (serving-read-on s)))
@@ -245,38 +245,38 @@
       (serving-busy-since-set! s #f)
       (serving-thread-set! s t)
       (thread-start! t)))
-  (mutex-unlock! (server-lock *server*)))
+  (unlock! (server-lock *server*)))
 
 ;;> Run by an apply served here that runs long, a task's component say:
 ;;> its connection gets a new reader at once, so that the caller's next
 ;;> calls do not wait behind it for the janitor's takeover.
 (define (hand-over-connection!)
-  (mutex-lock! (server-lock *server*))
+  (lock! (server-lock *server*))
   (let ((s (find (lambda (s) (and (eq? (serving-thread s) (current-thread))
                                   (serving-busy-since s)))
                  (server-servings *server*))))
-    (mutex-unlock! (server-lock *server*))
+    (unlock! (server-lock *server*))
     (if s (take-over! s))))
 
 ;; Marks the start and the end of the reader's inline apply of call id;
 ;; ending answers whether this thread is still the reader.  Until it ends,
 ;; the thread is found by id when its caller gives up.
 (define (inline-apply-begins! s id)
-  (mutex-lock! (server-lock *server*))
+  (lock! (server-lock *server*))
   (serving-applying-set! s (cons (cons id (current-thread))
                                  (serving-applying s)))
   (serving-busy-since-set! s (monotonic-seconds))
-  (mutex-unlock! (server-lock *server*))
+  (unlock! (server-lock *server*))
   (janitor-wanted!))
 
 (define (inline-apply-ends! s)
-  (mutex-lock! (server-lock *server*))
+  (lock! (server-lock *server*))
   (serving-applying-set! s (without-thread (serving-applying s) (current-thread)))
   (apply-ended! s (reader? s)))
 
 (define (apply-ended! s still)
   (if still (serving-busy-since-set! s #f))
-  (mutex-unlock! (server-lock *server*))
+  (unlock! (server-lock *server*))
   (if (abandoned?) (forget-abandoned! (current-thread)))
   still)
 
@@ -427,16 +427,16 @@
 ;; run's ack waits for flush-if-idle!, after its worker has its procedure
 ;; (flushed at once, it cost remote-runs a third of their throughput:
 ;; docs/speed.md, Levers tried).  Answers from former readers go at once.
-;; The write lock is taken without with-lock's dynamic-wind and closures
-;; (docs/speed.md, What Chibi charges): a raise under it, from a message
-;; too large or a caller that left, is let go of by the reader's handlers
-;; (let-go-of-writes!).
+;; The write lock is taken by lock!, without with-lock's wind and
+;; closures (docs/speed.md, What Chibi charges): a raise under it, from a
+;; message too large or a caller that left, is let go of by the reader's
+;; handlers (let-go-of-writes!).
 (define (answer! s g message last?)
-  (mutex-lock! (greeting-write-lock g))
+  (lock! (greeting-write-lock g))
   (write-answer! s g (frame-text (greeting-text g) message))
   (if (or (not (reader? s)) (and last? (null? (serving-frames s))))
       (flush! s g))
-  (mutex-unlock! (greeting-write-lock g)))
+  (unlock! (greeting-write-lock g)))
 
 ;; A caller that left makes this raise, and the connection end.
 (define (write-answer! s g frame)
@@ -455,16 +455,16 @@
 (define (flush-if-idle! s g)
   (when (and (not (= (greeting-flushed g) (greeting-sent g)))
              (null? (serving-frames s)))
-    (mutex-lock! (greeting-write-lock g))
+    (lock! (greeting-write-lock g))
     (flush! s g)
-    (mutex-unlock! (greeting-write-lock g))))
+    (unlock! (greeting-write-lock g))))
 
 ;; The write lock of s, should this thread hold it: a raise under it
 ;; (see answer!) leaves it held.
 (define (let-go-of-writes! s)
   (let ((g (serving-greeting s)))
     (if (and g (eq? (mutex-state (greeting-write-lock g)) (current-thread)))
-        (mutex-unlock! (greeting-write-lock g)))))
+        (unlock! (greeting-write-lock g)))))
 
 ;; Serves one frame from the caller uid, read by r: a call, which answer
 ;; answers, or one that needs no answer (serve-notice).

@@ -28,14 +28,14 @@
       (spawn (lambda () (work thunk)) 'worker)))
 
 ;; The mailbox of a waiting worker, taken from the pool, or #f.  Here and
-;; in next-job the pool's lock is taken without with-lock's dynamic-wind
+;; in next-job the pool's lock is taken by lock!, without with-lock's wind
 ;; and closures, on the path of every run served, where nothing under it
 ;; raises (docs/speed.md, What Chibi charges).
 (define (idle-worker)
-  (mutex-lock! *workers-lock*)
+  (lock! *workers-lock*)
   (let ((mb (and (pair? *idle-workers*) (car *idle-workers*))))
     (if mb (set! *idle-workers* (cdr *idle-workers*)))
-    (mutex-unlock! *workers-lock*)
+    (unlock! *workers-lock*)
     mb))
 
 ;; One handler for the worker's whole life, entered again only after a job
@@ -58,9 +58,9 @@
 ;; worker-idle-seconds.
 (define (next-job)
   (let ((mb (make-mailbox)))
-    (mutex-lock! *workers-lock*)
+    (lock! *workers-lock*)
     (set! *idle-workers* (cons mb *idle-workers*))
-    (mutex-unlock! *workers-lock*)
+    (unlock! *workers-lock*)
     (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds) no-job)
         ;; Timed out; but a caller may have taken this worker meanwhile, in
         ;; which case its procedure is on the way.
