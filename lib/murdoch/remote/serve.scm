@@ -474,11 +474,11 @@
       (serve-notice (reading-serving r) uid message)))
 
 ;; The served call that message, a run or an apply checked whole by
-;; open-served, asks for: its fields taken by their places in the wire's
-;; table of messages (wire/frame.scm), where match made 600 B of garbage
-;; a call (docs/speed.md, What Chibi charges).
+;; open-served, asks for: its procedure and arguments taken by their
+;; places in the wire's table of messages (wire/frame.scm), where match
+;; made 600 B of garbage a call (docs/speed.md, What Chibi charges).
 (define (served-call-of message uid answer)
-  (make-served-call uid (list-ref message 1) (car message) (list-ref message 2)
+  (make-served-call uid (message-id message) (car message) (list-ref message 2)
                     (list-ref message 3) answer))
 
 ;; Serves a frame of s from uid that needs no answer: the answer to one
