@@ -61,6 +61,16 @@
 ;; a call itself, and the janitor gives the group a new listener when an
 ;; apply runs long.
 
+;; Serves call, unless #f, which answer answers.  A procedure of its own
+;; where a let made a closure for every datagram (docs/speed.md, What
+;; Chibi charges).
+(define (serve-group-call r call answer)
+  (if call
+      (serve-call r (make-served-call (uid->aspace (group-call-sender call))
+                                      (group-call-id call) (group-call-kind call)
+                                      (group-call-proc-code call)
+                                      (group-call-args-code call) answer))))
+
 ;;> Serves the calls that \scheme{(receive-call)} gives, the multicast
 ;;> group's: start-aspace! hands it to start-group!.  A call's error is
 ;;> its answer; any other failure drops the datagram.
@@ -75,12 +85,7 @@
   (define (answer c kind value)
     (send-datagram-answer! (served-call-caller c) (served-call-id c) kind value))
   (define (read-on r)
-    (let ((call (receive-call)))
-      (if call
-          (serve-call r (make-served-call (uid->aspace (group-call-sender call))
-                                          (group-call-id call) (group-call-kind call)
-                                          (group-call-proc-code call)
-                                          (group-call-args-code call) answer))))
+    (serve-group-call r (receive-call) answer)
     (if (reader? s) (read-on r)))
   (read-calls s read-on
               (lambda (c e)

@@ -128,33 +128,45 @@
   (send-beacons))
 
 ;;; Receiving
+;;
+;; On the path of every call that comes by the group, procedures of their
+;; own take what a let or a match would bind, no lock is taken by
+;; with-lock, and no table is read by hash-table-ref/default: each made a
+;; closure for every datagram (docs/speed.md, What Chibi charges).
 
 (define (receive-call)
-  (let* ((buffer (group-buffer *group*))
-         (n (receive! (group-socket *group*) buffer)))
+  (let ((n (receive! (group-socket *group*) (group-buffer *group*))))
     (and (>= n 0)
-         (match (open-datagram buffer n)
-           ((sender sequence body)
-            (with-lock (group-last-heard-lock *group*)
-              (lambda ()
-                (hash-table-set! (group-last-heard *group*) sender
-                                 (monotonic-seconds))))
-            ;; Else our own, looped back.
-            (and (not (eq? sender (local-aspace-uid)))
-                 (datagram-call sender body)))))))
+         (heard (open-datagram (group-buffer *group*) n)))))
+
+;; The call that datagram d carries, once its sender is heard from.
+(define (heard d)
+  (lock! (group-last-heard-lock *group*))
+  (hash-table-set! (group-last-heard *group*) (datagram-sender d) (monotonic-seconds))
+  (unlock! (group-last-heard-lock *group*))
+  ;; Else our own, looped back.
+  (and (not (eq? (datagram-sender d) (local-aspace-uid)))
+       (datagram-call (datagram-sender d) (datagram-body d))))
 
 ;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
 ;; bytes of buffer.
 (define (open-datagram buffer n)
-  (let ((d (check-datagram (open-datagram-text buffer n))))
-    (match d
-      ((sender sequence body)
-       (check-fresh sender sequence)
-       (hash-table-set! (group-last-sequence *group*) sender sequence)
-       d))))
+  (fresh-datagram (check-datagram (open-datagram-text buffer n))))
+
+(define (fresh-datagram d)
+  (check-fresh (datagram-sender d) (datagram-sequence d))
+  (hash-table-set! (group-last-sequence *group*) (datagram-sender d)
+                   (datagram-sequence d))
+  d)
+
+;; A datagram's fields, as check-datagram passed them.
+(define (datagram-sender d) (car d))
+(define (datagram-sequence d) (cadr d))
+(define (datagram-body d) (list-ref d 2))
 
 (define (check-fresh sender sequence)
-  (cond ((<= sequence (hash-table-ref/default (group-last-sequence *group*) sender 0))
+  (cond ((<= sequence (last-sequence (hash-table-cell (group-last-sequence *group*)
+                                                      sender #f)))
          (frame-fail "replayed or out of order"))
         ((< sequence (group-started *group*))
          (frame-fail "sent before this address space started"))
@@ -173,13 +185,26 @@
   (proc-code group-call-proc-code)
   (args-code group-call-args-code))
 
+;; The sequence last heard from a sender, in the cell of the table that
+;; keeps them, or 0.
+(define (last-sequence cell) (if cell (cdr cell) 0))
+
 ;; A beacon brings its sender (back) into the live set; a call is the
 ;; caller's to serve.
 (define (datagram-call sender body)
-  (match (check-message body '(beacon call) "a beacon or a call")
+  (group-call-of sender (check-message body '(beacon call) "a beacon or a call")))
+
+;; A call's fields taken by their places in the wire's table of messages
+;; (wire/frame.scm).
+(define (group-call-of sender message)
+  (if (eq? (car message) 'call)
+      (make-group-call sender (message-id message) (list-ref message 2)
+                       (list-ref message 3) (list-ref message 4))
+      (beacon-heard! sender message)))
+
+(define (beacon-heard! sender beacon)
+  (match beacon
     (('beacon uid host port)
      (learn-aspace! (make-aspace uid host port))
      (note-reachable! sender)
-     #f)
-    (('call id kind proc-code args-code)
-     (make-group-call sender id kind proc-code args-code))))
+     #f)))
