@@ -51,15 +51,24 @@
         (string-append (make-string (- width (string-length s)) #\0) s)
         s)))
 
+;; The line is made whole, then written by one write-string: written in
+;; pieces, it was cut into by another thread's line (log-test), and the lab
+;; script, which waits for an address space's "listening on", stopped a
+;; lab whose line came out inside a warning.
 (define (log-line level parts)
   (let ((err (current-error-port)))
-    (if *stamped?* (write-string (timestamp (utc-seconds)) err))
-    (write-string *log-name* err)
-    (write-string level err)
-    (for-each (lambda (p) (if (string? p) (write-string p err) (display p err)))
-              parts)
-    (newline err)
+    (write-string (line-text level parts) err)
     (flush-output-port err)))
+
+(define (line-text level parts)
+  (let ((out (open-output-string)))
+    (if *stamped?* (write-string (timestamp (utc-seconds)) out))
+    (write-string *log-name* out)
+    (write-string level out)
+    (for-each (lambda (p) (if (string? p) (write-string p out) (display p out)))
+              parts)
+    (newline out)
+    (get-output-string out)))
 
 ;;> Logs something worth knowing.
 (define (log-note . parts) (log-line ": " parts))
