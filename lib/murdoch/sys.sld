@@ -8,7 +8,7 @@
           set-process-name! poll-scheduler-installed? monotonic-seconds
           wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!
           poller-unwatch! poller-release! poller-buffered poller-ready poller-frames!
-          lock! unlock! unlocked wind with-lock with-lock-by
+          lock! unlock! unlocked cell-value wind with-lock with-lock-by
           seconds-until undo-on-raise make-mailbox mailbox-put! mailbox-take
           take-mailbox! take-all-mailboxes! make-gathering gathering-put! gathering-wait)
   (import (murdoch sys guard) (murdoch sys log) (murdoch sys process-name)

@@ -70,11 +70,9 @@
 ;; The lock without a dynamic-wind, since nothing under it raises: it and
 ;; its closures cost a lookup 1.3 KB (docs/speed.md).
 (define (known-aspace m uid)
-  (let ((lock (membership-peers-lock m)))
-    (lock! lock)
-    (let ((a (hash-table-ref/default (membership-peers m) uid #f)))
-      (unlock! lock)
-      a)))
+  (lock! (membership-peers-lock m))
+  (unlocked (membership-peers-lock m)
+            (cell-value (hash-table-cell (membership-peers m) uid #f) #f)))
 
 ;;> The uids of every address space known here (the thesis's *uids*).
 (define (known-uids)

@@ -289,10 +289,6 @@
                                          id #f))
               '()))
 
-;; The value of a table's cell, or default for none: hash-table-cell, where
-;; hash-table-ref/default makes a closure (docs/speed.md).
-(define (cell-value cell default) (if cell (cdr cell) default))
-
 ;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
   (with-datagram-calls

@@ -81,7 +81,6 @@
 (define (open-in cell)
   (and cell (connection-open? (cdr cell)) (cdr cell)))
 
-
 (define (connecting-lock uid)
   (with-lock *connections-lock*
     (lambda ()

@@ -165,8 +165,9 @@
 (define (datagram-body d) (list-ref d 2))
 
 (define (check-fresh sender sequence)
-  (cond ((<= sequence (last-sequence (hash-table-cell (group-last-sequence *group*)
-                                                      sender #f)))
+  (cond ((<= sequence (cell-value (hash-table-cell (group-last-sequence *group*)
+                                                   sender #f)
+                                  0))
          (frame-fail "replayed or out of order"))
         ((< sequence (group-started *group*))
          (frame-fail "sent before this address space started"))
@@ -184,10 +185,6 @@
   (kind group-call-kind)
   (proc-code group-call-proc-code)
   (args-code group-call-args-code))
-
-;; The sequence last heard from a sender, in the cell of the table that
-;; keeps them, or 0.
-(define (last-sequence cell) (if cell (cdr cell) 0))
 
 ;; A beacon brings its sender (back) into the live set; a call is the
 ;; caller's to serve.

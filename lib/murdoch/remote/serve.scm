@@ -490,28 +490,28 @@
 
 ;; The application run c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
-  (sandboxed-thunk (decode-value (served-call-proc-code c))
-                   (decode-value (served-call-args-code c))))
+  (sandboxed-thunk (served-procedure c) (served-arguments c)))
 
 (define (sandboxed-thunk proc args)
-  (check-procedure proc)
   (lambda () (call-in-sandbox proc args)))
 
 ;; What the application call c asks for answers, encoded to go back.  No
 ;; thunk made for it, as decode-call makes (docs/speed.md, What Chibi
 ;; charges).
 (define (encoded-result c)
-  (encode (applied (decode-value (served-call-proc-code c))
-                   (decode-value (served-call-args-code c)))
+  (encode (call-in-sandbox (served-procedure c) (served-arguments c))
           (lab-environment) "the result"))
 
-(define (applied proc args)
-  (check-procedure proc)
-  (call-in-sandbox proc args))
+;; The procedure and the arguments of served call c, decoded.
+(define (served-procedure c)
+  (checked-procedure (decode-value (served-call-proc-code c))))
 
-(define (check-procedure proc)
+(define (served-arguments c) (decode-value (served-call-args-code c)))
+
+(define (checked-procedure proc)
   (if (not (procedure? proc))
-      (error "not a procedure" proc)))
+      (error "not a procedure" proc))
+  proc)
 
 (define (peer-name sockaddr)
   (string-append (sockaddr-name sockaddr) ":"

@@ -3,7 +3,8 @@
 ;;> scheduler)'s monotonic-seconds.
 
 (define-library (murdoch sys wait)
-  (export lock! unlock! unlocked wind with-lock with-lock-by seconds-until undo-on-raise
+  (export lock! unlock! unlocked cell-value wind with-lock with-lock-by seconds-until
+          undo-on-raise
           make-mailbox mailbox-put! mailbox-take
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)

@@ -160,9 +160,7 @@
               (write-simple field fields-port))
             fields)
   (write-char #\) fields-port)
-  (let ((text (get-output-string fields-port)))
-    (unlock! fields-lock)
-    text))
+  (unlocked fields-lock (get-output-string fields-port)))
 
 ;;> The text of the message that \var{parts}, from message-without-id,
 ;;> and \var{id} make: the text frame-text would give.  The id's digits by
