@@ -319,10 +319,12 @@ static void test_dropped_base_stops(void)
     close(c.fd);
     dial(&d, 1);
     /* The base is free once the server has seen c go; it may still be
-     * slowing down then, so its status is read until it stands. */
-    for (k = 0; k < 100 && strcmp(ask(&d, "1 open base"), "1 ok") != 0; k++)
+     * slowing down then, so its status is read until it stands.  Each
+     * wait is up to 10 s, not 2: a clean clone's CI run on this 2-core
+     * machine once saw the base still moving after 2 s of each. */
+    for (k = 0; k < 500 && strcmp(ask(&d, "1 open base"), "1 ok") != 0; k++)
         usleep(20000);
-    for (k = 0; k < 100 && moving; k++) {
+    for (k = 0; k < 500 && moving; k++) {
         const char *r = ask(&d, "2 base status");
         if (sscanf(r, "2 ok %*f %*f %*f %lf %*f %d", &v, &moving) != 2)
             moving = 1;
