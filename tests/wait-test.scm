@@ -1,7 +1,7 @@
 ;;; (murdoch sys wait): wind as Chibi's dynamic-wind, the locks the remote
 ;;; layer takes on every call, undoing on a raise, and mailboxes by id.
 (import (scheme base) (scheme write) (srfi 18) (srfi 69) (chibi test)
-        (murdoch sys))
+        (only (chibi ast) gc) (murdoch sys))
 
 ;; What ran, in order, through (note! x).
 (define trail '())
@@ -100,6 +100,27 @@
     (let ((g (make-gathering)) (x (list #f)))
       (gathering-put! g x 'a car answer!)
       (gathering-wait g 2 (+ (monotonic-seconds) 0.1)))))
+
+(test-group "deadlines"
+  ;; (gc) answers the bytes it freed: what the thunk made, 1,000 times.
+  (define (bytes-each thunk)
+    (gc)
+    (do ((i 0 (+ i 1))) ((= i 1000)) (thunk))
+    (quotient (gc) 1000))
+  (define past (- (monotonic-seconds) 0.5))
+  (test "the seconds left before an exact deadline are inexact" #t
+    (inexact? (seconds-until (+ 10 (exact (floor (monotonic-seconds)))))))
+  (test "and none once it has passed" 0. (seconds-until 0))
+  (test "a mailbox's wait ends at an exact deadline" 'late
+    (mailbox-take (make-mailbox) (exact (floor (monotonic-seconds)))
+                  (lambda () 'late)))
+  ;; Chibi makes an inexact number that meets an exact one exact, a ratio
+  ;; of bignums: (positive? 0.25) made 3.5 KB, and every wait did so twice.
+  (test "a wait's deadline makes no ratio of bignums" #t
+    (let ((g (make-gathering)) (mb (make-mailbox)))
+      (< (max (bytes-each (lambda () (gathering-wait g 1 past)))
+              (bytes-each (lambda () (mailbox-take mb past (lambda () #f)))))
+         1000))))
 
 (test-group "mailboxes by id"
   (let ((table (make-hash-table eqv?)))

@@ -72,9 +72,13 @@
 
 (define (nothing) #f)
 
-;; Seconds from now to deadline, none if it has passed.
+;; Seconds from now to deadline, none if it has passed: inexact, and
+;; compared only with inexact zero, for Chibi makes an inexact number
+;; that meets an exact one exact, a ratio of bignums (docs/speed.md).
 (define (seconds-until deadline)
-  (max 0 (- deadline (monotonic-seconds))))
+  (not-below-zero (- (inexact deadline) (monotonic-seconds))))
+
+(define (not-below-zero x) (if (< x 0.) 0. x))
 
 ;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
 ;; wind point whose out is undo, taken off with no call when thunk
@@ -123,7 +127,7 @@
                (mailbox-value mb))
         (let ((left (seconds-until deadline)))
           (cond
-           ((and (positive? left)
+           ((and (> left 0.)
                  (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
             (loop))
            (else
@@ -198,7 +202,7 @@
       (gathering-wait-on g n deadline (seconds-until deadline))))
 
 (define (gathering-wait-on g n deadline left)
-  (if (and (positive? left)
+  (if (and (> left 0.)
            (mutex-unlock! (gathering-mutex g) (gathering-condvar g) left))
       (gathering-wait g n deadline)
       (begin (unlock! (gathering-mutex g)) (>= (gathering-got g) n))))
