@@ -3,7 +3,7 @@
 ;;> Its members are each a library of their own in sys/.
 
 (define-library (murdoch sys)
-  (export start-heap-guard! utc-seconds set-log-name! stamp-log-lines! log-note log-warn
+  (export start-heap-guard! heap-on-huge-pages! utc-seconds set-log-name! stamp-log-lines! log-note log-warn
           condition-message
           set-process-name! poll-scheduler-installed? monotonic-seconds
           wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!

@@ -46,6 +46,7 @@
   (stamp-log-lines!)
   (set-process-name! (string-append "murdoch-" (symbol->string uid)))
   (join-lab lab-file uid)
+  (heap-on-huge-pages!)
   (start-heap-guard!
    (lab-setting (current-lab) 'heap-max)
    (string-append "murdoch " (symbol->string uid) ": ERROR: the heap passed"

@@ -5,5 +5,5 @@
 ;;> lib/murdoch/sys/guard.stub and heap-watch.c, built into lib/murdoch/sys/guard.so by
 ;;> \scheme{make native}.
 (define-library (murdoch sys guard)
-  (export start-heap-guard!)
+  (export start-heap-guard! heap-on-huge-pages!)
   (include-shared "guard"))

@@ -23,6 +23,8 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <stdint.h>
 #include <unistd.h>
 
 static sexp_heap watched;
@@ -82,4 +84,28 @@ static sexp start_heap_guard (sexp ctx, sexp self, long bytes,
   }
   pthread_detach(thread);
   return SEXP_VOID;
+}
+
+/* (heap-on-huge-pages!): moves the heap onto 2 MB pages now.  An address
+ * space forked from the lab's loader shares the loader's heap, and the
+ * first write to each shared huge page splits it into 4 KB pages: every
+ * address space of a lab ran on 4 KB pages, which tools/chibi asks glibc
+ * to avoid (it says why).  The collector's first marks copy nearly all the
+ * heap anyway, so moving it costs no memory.  MADV_COLLAPSE is Linux 6.1's;
+ * answers #f when the kernel cannot, which leaves the heap as it was. */
+#ifndef MADV_COLLAPSE
+#define MADV_COLLAPSE 25
+#endif
+#define HUGE_PAGE ((uintptr_t)2 * 1024 * 1024)
+
+static sexp heap_on_huge_pages (sexp ctx, sexp self) {
+  sexp_heap h;
+  int all = 1;
+  for (h = sexp_context_heap(ctx); h; h = h->next) {
+    uintptr_t from = ((uintptr_t)h->data + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
+    uintptr_t to = ((uintptr_t)h->data + h->size) & ~(HUGE_PAGE - 1);
+    if (to > from && madvise((void *)from, to - from, MADV_COLLAPSE) != 0)
+      all = 0;
+  }
+  return sexp_make_boolean(all);
 }
