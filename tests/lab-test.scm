@@ -36,6 +36,18 @@
 ;; address spaces.
 (define (loader-of pid) (child-named pid "murdoch-loader"))
 
+;; Whether the kernel gives a process 2 MB pages when it asks (madvise).
+(define (huge-pages-on?)
+  (not (equal? "0" (command-output
+                    (list "sh" "-c" "grep -c '\\[always\\]\\|\\[madvise\\]' /sys/kernel/mm/transparent_hugepage/enabled")))))
+
+;; The kilobytes of process pid's memory on 2 MB pages.
+(define (huge-page-kb pid)
+  (string->number
+   (command-output
+    (list "sh" "-c" "awk '/^AnonHugePages:/ { print $2 }' /proc/$0/smaps_rollup"
+          (number->string pid)))))
+
 ;; The parent of process `pid`, as /proc has it.
 (define (parent-of pid)
   (string->number (command-output (list "ps" "-o" "ppid=" "-p" (number->string pid)))))
@@ -82,6 +94,11 @@
              (equal? (list loader loader)
                      (map (lambda (uid) (parent-of (child-named loader uid)))
                           '("murdoch-troy" "murdoch-praline"))))))
+    ;; The fork's first writes split the loader's 2 MB pages into 4 KB
+    ;; ones, unless the address space moves its heap (heap-on-huge-pages!).
+    (test "a forked address space's heap is on 2 MB pages, where the kernel has them"
+        (huge-pages-on?)
+      (< 2048 (huge-page-kb (child-named (loader-of pid) "murdoch-troy"))))
     (test "ps names each address space murdoch-UID" '(#t #t)
       (map (lambda (uid)
              (not (equal? "0" (command-output
