@@ -122,6 +122,21 @@
               (bytes-each (lambda () (mailbox-take mb past (lambda () #f)))))
          1000))))
 
+(test-group "a mailbox emptied for the next"
+  (let ((mb (make-mailbox)))
+    (mailbox-put! mb 'first)
+    (test "its taker has the first value" 'first
+      (mailbox-take mb (+ (monotonic-seconds) 5) (lambda () 'late)))
+    (mailbox-empty! mb)
+    (test "emptied, it waits again until its deadline" 'late
+      (mailbox-take mb (+ (monotonic-seconds) 0.05) (lambda () 'late)))
+    (test "and takes the next value that another thread puts" 'second
+      (begin
+        (thread-start! (make-thread (lambda ()
+                                      (thread-sleep! 0.05)
+                                      (mailbox-put! mb 'second))))
+        (mailbox-take mb (+ (monotonic-seconds) 30) (lambda () 'late))))))
+
 (test-group "mailboxes by id"
   (let ((table (make-hash-table eqv?)))
     (hash-table-set! table 7 'seven)

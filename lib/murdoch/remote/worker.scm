@@ -39,38 +39,41 @@
     mb))
 
 ;; One handler for the worker's whole life, entered again only after a job
-;; raised (docs/speed.md).
+;; raised (docs/speed.md).  The worker waits for each next job on one
+;; mailbox of its own.
 (define (work job)
-  (let serve ((job job))
-    (guard (e (#t (flush-call-ports!)
-                  (log-warn "worker: " (error-message e))
-                  (let ((next (next-job)))
-                    (if next (serve next)))))
-      (run-jobs job))))
+  (let ((mb (make-mailbox)))
+    (let serve ((job job))
+      (guard (e (#t (flush-call-ports!)
+                    (log-warn "worker: " (error-message e))
+                    (let ((next (next-job mb)))
+                      (if next (serve next)))))
+        (run-jobs job mb)))))
 
-;; Runs job, then each next one that comes.
-(define (run-jobs job)
+;; Runs job, then each next one that comes to mailbox mb.
+(define (run-jobs job mb)
   (job)
-  (let ((next (next-job)))
-    (if next (run-jobs next))))
+  (let ((next (next-job mb)))
+    (if next (run-jobs next mb))))
 
 ;; The next job for this worker, or #f when none came within
-;; worker-idle-seconds.
-(define (next-job)
-  (let ((mb (make-mailbox)))
-    (lock! *workers-lock*)
-    (set! *idle-workers* (cons mb *idle-workers*))
-    (unlock! *workers-lock*)
-    (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds) no-job)
-        ;; Timed out; but a caller may have taken this worker meanwhile, in
-        ;; which case its procedure is on the way.
-        (and (not (with-lock *workers-lock*
-                    (lambda ()
-                      (and (memq mb *idle-workers*)
-                           (begin (set! *idle-workers*
-                                        (delete mb *idle-workers* eq?))
-                                  #t)))))
-             ;; The job is on its way; an hour is only a bound.
-             (mailbox-take mb (+ (monotonic-seconds) 3600) no-job)))))
+;; worker-idle-seconds.  Its mailbox mb is in the pool only while it
+;; waits, so no caller can put to it while it is emptied.
+(define (next-job mb)
+  (mailbox-empty! mb)
+  (lock! *workers-lock*)
+  (set! *idle-workers* (cons mb *idle-workers*))
+  (unlock! *workers-lock*)
+  (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds) no-job)
+      ;; Timed out; but a caller may have taken this worker meanwhile, in
+      ;; which case its procedure is on the way.
+      (and (not (with-lock *workers-lock*
+                  (lambda ()
+                    (and (memq mb *idle-workers*)
+                         (begin (set! *idle-workers*
+                                      (delete mb *idle-workers* eq?))
+                                #t)))))
+           ;; The job is on its way; an hour is only a bound.
+           (mailbox-take mb (+ (monotonic-seconds) 3600) no-job))))
 
 (define (no-job) #f)

@@ -97,7 +97,8 @@
   value)
 
 ;; A one-shot mailbox: the reader thread puts an answer, the caller takes
-;; it or gives up at its deadline.
+;; it or gives up at its deadline.  Its taker may empty it for the next
+;; (mailbox-empty!), once no other thread can still put to it.
 (define-record-type mailbox
   (%make-mailbox mutex condvar value full?)
   mailbox?
@@ -116,23 +117,31 @@
   (condition-variable-broadcast! (mailbox-condvar mb))
   (unlock! (mailbox-mutex mb)))
 
+;;> Empties mailbox \var{mb}, for its taker to wait on again: a worker's
+;;> for its next job, say, instead of a new mutex and condition variable
+;;> for each.
+(define (mailbox-empty! mb)
+  (lock! (mailbox-mutex mb))
+  (mailbox-value-set! mb #f)
+  (mailbox-full?-set! mb #f)
+  (unlock! (mailbox-mutex mb)))
+
 ;; The mailbox's value, or (timed-out) once the deadline, on the monotonic
 ;; clock, has passed.  Chibi's SRFI-18 time objects count whole seconds, so
-;; each wait is given as the seconds left.
+;; each wait is given as the seconds left.  No named let: a worker's every
+;; job waits here (docs/speed.md).
 (define (mailbox-take mb deadline timed-out)
-  (let loop ()
-    (lock! (mailbox-mutex mb))
-    (if (mailbox-full? mb)
-        (begin (unlock! (mailbox-mutex mb))
-               (mailbox-value mb))
-        (let ((left (seconds-until deadline)))
-          (cond
-           ((and (> left 0.)
-                 (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
-            (loop))
-           (else
-            (unlock! (mailbox-mutex mb))
-            (timed-out)))))))
+  (lock! (mailbox-mutex mb))
+  (if (mailbox-full? mb)
+      (unlocked (mailbox-mutex mb) (mailbox-value mb))
+      (mailbox-wait mb deadline timed-out (seconds-until deadline))))
+
+(define (mailbox-wait mb deadline timed-out left)
+  (if (and (> left 0.)
+           (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
+      (mailbox-take mb deadline timed-out)
+      (begin (unlock! (mailbox-mutex mb))
+             (timed-out))))
 
 ;;; Mailboxes by id: a connection's calls waiting for their answers
 

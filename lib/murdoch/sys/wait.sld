@@ -5,7 +5,7 @@
 (define-library (murdoch sys wait)
   (export lock! unlock! unlocked cell-value wind with-lock with-lock-by seconds-until
           undo-on-raise
-          make-mailbox mailbox-put! mailbox-take
+          make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)
   (import (scheme base) (only (chibi) %dk) (only (meta) find-module module-env)
