@@ -29,11 +29,23 @@
 ;;                                         (murdoch sys scheduler), as an
 ;;                                         address space waits
 ;; The sender waits in ppoll in both.  bench/c-pingpong N is the same in C.
+;;
+;; Usage: tools/chibi bench/scheme-pingpong.scm phases N
+;;
+;; The same fan-out in ppoll, the sender's own CPU split between its two
+;; phases, per peer: writing the N frames, then reading the N echoes.  A
+;; multicast requester writes one datagram and reads the N answers, so
+;; the reading's share is the floor of its CPU over broadcast's:
+;;   bench: chibi-fanout-write-cpu-per-peer-NN VALUE us
+;;   bench: chibi-fanout-read-cpu-per-peer-NN VALUE us
+;;   bench: chibi-fanout-read-share-NN VALUE x
 
 (import (scheme base) (scheme write) (scheme eval) (scheme process-context)
         (srfi 1) (srfi 18) (srfi 132)
         (chibi net) (chibi filesystem) (chibi process)
-        (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
+        (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds
+              get-resource-usage resource-usage/self resource-usage-time
+              resource-usage-system-time)
         (murdoch wire netstring) (bench echo)
         (only (murdoch testing harness) listen-on-free-port free-port-base tool-path
               start-process! stop-all-processes!))
@@ -60,14 +72,26 @@
 
 ;; One frame to each (_ in out) of ios in turn, then each echo read.
 (define (fan-out ios)
+  (send-to-each ios)
+  (read-each ios))
+
+(define (send-to-each ios)
   (for-each (lambda (io)
               (write-netstring payload (car (cddr io)))
               (flush-output-port (car (cddr io))))
-            ios)
+            ios))
+
+(define (read-each ios)
   (for-each (lambda (io)
               (unless (equal? (read-netstring (cadr io) max-frame) payload)
                 (error "echo server sent back something else")))
             ios))
+
+;; This process's CPU so far, user and system, in microseconds.
+(define (cpu-us)
+  (let ((r (get-resource-usage resource-usage/self)))
+    (define (us tv) (+ (* 1000000. (timeval-seconds tv)) (timeval-microseconds tv)))
+    (+ (us (resource-usage-time r)) (us (resource-usage-system-time r)))))
 
 (define (median-time thunk trips warm-up)
   (do ((i 0 (+ i 1))) ((= i warm-up)) (thunk))
@@ -146,9 +170,9 @@
     (or (guard (e ((> tries 0) #f)) (open-net-io "127.0.0.1" port))
         (begin (thread-sleep! 0.1) (try (- tries 1))))))
 
-;; The fan-out to n echo servers started as processes of their own
-;; (bench/echo-server.scm).
-(define (measure-fan-out n wait)
+;; (measure ios) with ios connected to n echo servers started as
+;; processes of their own (bench/echo-server.scm).
+(define (with-echo-servers n wait measure)
   (environment '(murdoch sys scheduler))
   (let ((base (free-port-base)))
     (for-each (lambda (i)
@@ -158,11 +182,33 @@
                                 "/dev/null"))
               (iota n))
     (guard (e (#t (stop-all-processes!) (raise e)))
-      (let ((ios (map (lambda (i) (connect-to-server (+ base i))) (iota n))))
-        (let ((median (median-time (lambda () (fan-out ios))
-                                   (quotient 20000 n) (quotient 1000 n))))
-          (stop-all-processes!)
-          median)))))
+      (let* ((ios (map (lambda (i) (connect-to-server (+ base i))) (iota n)))
+             (result (measure ios)))
+        (stop-all-processes!)
+        result))))
+
+(define (measure-fan-out n wait)
+  (with-echo-servers n wait
+    (lambda (ios)
+      (median-time (lambda () (fan-out ios)) (quotient 20000 n) (quotient 1000 n)))))
+
+;; The sender's CPU per peer writing, and reading, over rounds of the
+;; fan-out after a warm-up: (write-us . read-us).
+(define (measure-phases n)
+  (with-echo-servers n "poll"
+    (lambda (ios)
+      (let ((rounds (quotient 32000 n)) (write-us 0.) (read-us 0.))
+        (do ((i 0 (+ i 1))) ((= i (quotient 1000 n))) (fan-out ios))
+        (do ((i 0 (+ i 1))) ((= i rounds))
+          (let ((t0 (cpu-us)))
+            (send-to-each ios)
+            (let ((t1 (cpu-us)))
+              (read-each ios)
+              (set! write-us (+ write-us (- t1 t0)))
+              (set! read-us (+ read-us (- (cpu-us) t1))))))
+        (cons (/ write-us rounds n) (/ read-us rounds n))))))
+
+(define (round1 x) (/ (round (* 10 x)) 10.))
 
 (define (report name value . unit)
   (display "bench: ") (display name) (display " ")
@@ -171,6 +217,17 @@
 
 (let ((args (cdr (command-line))))
   (cond
+   ((and (pair? args) (equal? (car args) "phases"))
+    (let* ((n (string->number (cadr args)))
+           (phases (measure-phases n))
+           (suffix (string-append "-N" (number->string n))))
+      (report (string-append "chibi-fanout-write-cpu-per-peer" suffix)
+              (round1 (car phases)))
+      (report (string-append "chibi-fanout-read-cpu-per-peer" suffix)
+              (round1 (cdr phases)))
+      (report (string-append "chibi-fanout-read-share" suffix)
+              (/ (round (* 100 (/ (cdr phases) (+ (car phases) (cdr phases))))) 100.)
+              "x")))
    ((and (pair? args) (equal? (car args) "fanout"))
     (let* ((n (string->number (cadr args)))
            (poll? (pair? (cddr args))))
