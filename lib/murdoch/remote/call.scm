@@ -259,7 +259,7 @@
 (define-record-type datagram-calls
   (make-datagram-calls waiting lock next-id)
   datagram-calls?
-  (waiting datagram-calls-waiting)      ; id -> (pending-call ...)
+  (waiting datagram-calls-waiting)      ; id -> (places . pending-calls vector)
   (lock datagram-calls-lock)
   (next-id datagram-calls-next-id datagram-calls-next-id-set!))
 
@@ -269,25 +269,59 @@
 (define (with-datagram-calls thunk)
   (with-lock (datagram-calls-lock *datagram-calls*) thunk))
 
-;; A new datagram call's id, whose answers from each of uids will come to
-;; gathering g; answers it and their pending calls, in the order of uids.
-(define (expect-answers! uids g)
+;; Whom a datagram call waits for: the live set but this address space,
+;; and each one's place among them, by which an answer finds its pending
+;; call (a search of the list took a step a peer per answer, and a table
+;; made per call remade its buckets as it grew).  Kept while the live set
+;; is the same list (live-aspaces keeps it until it changes).
+(define-record-type others
+  (make-others live uids places)
+  others?
+  (live others-live)                    ; the live-aspaces list, this made of
+  (uids others-uids)                    ; the live uids but ours
+  (places others-places))               ; uid -> its place in uids
+
+(define *others* (make-others #f '() (make-hash-table eq?)))
+
+;;> The others that a datagram call to the live set waits for answers from
+;;> (expect-answers!).
+(define (datagram-others)
+  (if (eq? (others-live *others*) (live-aspaces))
+      *others*
+      (others-now! (live-aspaces))))
+
+(define (others-now! live)
+  (let* ((uids (remove (lambda (uid) (eq? uid (local-aspace-uid)))
+                       (map aspace-uid live)))
+         (o (make-others live uids (make-hash-table eq?))))
+    (for-each (lambda (uid i) (hash-table-set! (others-places o) uid i))
+              uids (iota (length uids)))
+    (set! *others* o)
+    o))
+
+;; A new datagram call's id, whose answers from each of the others o
+;; (datagram-others) will come to gathering g; answers it and their
+;; pending calls, in the order of o's uids.
+(define (expect-answers! o g)
   (with-datagram-calls
     (lambda ()
       (let* ((id (+ 1 (datagram-calls-next-id *datagram-calls*)))
-             (ps (map (lambda (uid) (make-pending-call uid #f id g #f)) uids)))
+             (ps (map (lambda (uid) (make-pending-call uid #f id g #f))
+                      (others-uids o))))
         (datagram-calls-next-id-set! *datagram-calls* id)
-        (hash-table-set! (datagram-calls-waiting *datagram-calls*) id ps)
+        (hash-table-set! (datagram-calls-waiting *datagram-calls*) id
+                         (cons (others-places o) (list->vector ps)))
         (cons id ps)))))
 
-;; The pending calls of datagram call id, or none.  The lock without a
-;; dynamic-wind: nothing under it raises, and every answer comes here.
+;; What datagram call id waits for, (places . pending-calls), or #f.  The
+;; lock without a dynamic-wind: nothing under it raises, and every answer
+;; comes here.
 (define (datagram-calls-waiting-for id)
   (lock! (datagram-calls-lock *datagram-calls*))
   (cell-value (unlocked (datagram-calls-lock *datagram-calls*)
                         (hash-table-cell (datagram-calls-waiting *datagram-calls*)
                                          id #f))
-              '()))
+              #f))
 
 ;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
@@ -295,19 +329,23 @@
     (lambda () (hash-table-delete! (datagram-calls-waiting *datagram-calls*) id))))
 
 ;; Hands an (answer ID KIND VALUE) frame from address space uid to the
-;; call that waits for it; one for a call no longer waited for is dropped.
-;; A request's every answer by multicast comes here: no match, no let, no
-;; closure for find (docs/speed.md).
+;; call that waits for it; one for a call no longer waited for, or from
+;; an address space it was not sent to, is dropped.  A request's every
+;; answer by multicast comes here: no match, no let, no closure
+;; (docs/speed.md).
 (define (take-datagram-answer! uid message)
   (answer-datagram-call! (pending-of uid (datagram-calls-waiting-for
                                           (message-id message)))
                          message))
 
-;; The pending call of uid among ps, or #f.
-(define (pending-of uid ps)
-  (cond ((null? ps) #f)
-        ((eq? (pending-call-uid (car ps)) uid) (car ps))
-        (else (pending-of uid (cdr ps)))))
+;; The pending call of uid in waiting, (places . pending-calls), or #f.
+(define (pending-of uid waiting)
+  (and waiting
+       (pending-at (cell-value (hash-table-cell (car waiting) uid #f) #f)
+                   (cdr waiting))))
+
+(define (pending-at place pending-calls)
+  (and place (vector-ref pending-calls place)))
 
 ;; The answer is given as a connection's: (KIND ID VALUE).
 (define (answer-datagram-call! p message)

@@ -7,7 +7,8 @@
           new-call call? call-kind call-proc call-args call-proc-code call-args-code
           call-seconds call-all make-result result? result-uid result-ok? result-value
           encode-arguments send-all local-call capture
-          capture-each await-answers answer-value expect-answers! forget-answers!
+          capture-each await-answers answer-value datagram-others
+          expect-answers! forget-answers!
           take-datagram-answer! prober)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (chibi match) (murdoch sys)
           (murdoch wire) (murdoch code) (murdoch remote aspace)

@@ -31,10 +31,8 @@
 ;; answers send-all's results, or #f to send the broadcast way.
 (define (multicast-call-all c)
   (and (eq? (delivery-mode) 'multicast)
-       (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
-                              (live-uids)))
-              (g (make-gathering))
-              (expected (expect-answers! others g))
+       (let* ((g (make-gathering))
+              (expected (expect-answers! (datagram-others) g))
               (id (car expected))
               (waiting (cdr expected)))
          (define (forget!) (forget-answers! id))
