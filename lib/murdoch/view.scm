@@ -261,7 +261,7 @@
       (mutex-lock! (feed-lock feed))
       (let ((new (filter (lambda (r) (>= (car r) next)) (feed-recent feed)))
             (left (seconds-until deadline)))
-        (cond ((or (pair? new) (zero? left))
+        (cond ((or (pair? new) (= left 0.))   ; inexact: see seconds-until
                (mutex-unlock! (feed-lock feed))
                (reverse new))
               (else
