@@ -80,6 +80,11 @@
 
 (define (not-below-zero x) (if (< x 0.) 0. x))
 
+;; Frees m and waits on cv for left seconds, from seconds-until; #f when
+;; none were left, or they ran out.
+(define (waited? m cv left)
+  (and (> left 0.) (mutex-unlock! m cv left)))
+
 ;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
 ;; wind point whose out is undo, taken off with no call when thunk
 ;; returns: not a guard (a copy of the stack), and no flag set by the
@@ -137,8 +142,7 @@
       (mailbox-wait mb deadline timed-out (seconds-until deadline))))
 
 (define (mailbox-wait mb deadline timed-out left)
-  (if (and (> left 0.)
-           (mutex-unlock! (mailbox-mutex mb) (mailbox-condvar mb) left))
+  (if (waited? (mailbox-mutex mb) (mailbox-condvar mb) left)
       (mailbox-take mb deadline timed-out)
       (begin (unlock! (mailbox-mutex mb))
              (timed-out))))
@@ -211,7 +215,6 @@
       (gathering-wait-on g n deadline (seconds-until deadline))))
 
 (define (gathering-wait-on g n deadline left)
-  (if (and (> left 0.)
-           (mutex-unlock! (gathering-mutex g) (gathering-condvar g) left))
+  (if (waited? (gathering-mutex g) (gathering-condvar g) left)
       (gathering-wait g n deadline)
       (begin (unlock! (gathering-mutex g)) (>= (gathering-got g) n))))
