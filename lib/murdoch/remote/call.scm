@@ -350,8 +350,12 @@
 ;; The answer is given as a connection's: (KIND ID VALUE).
 (define (answer-datagram-call! p message)
   (if p
-      (answer-call! p (list (car (cddr message)) (message-id message)
-                            (cadr (cddr message))))))
+      (answer-call! p (list (datagram-answer-kind message) (message-id message)
+                            (datagram-answer-value message)))))
+
+;; The fields of an (answer ID KIND VALUE) message after its id.
+(define (datagram-answer-kind message) (list-ref message 2))
+(define (datagram-answer-value message) (list-ref message 3))
 
 ;;; The prober
 
