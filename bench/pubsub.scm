@@ -31,12 +31,10 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme time) (scheme eval)
         (scheme process-context) (scheme file) (srfi 1) (srfi 132)
         (only (chibi process) current-process-id system?)
-        (only (chibi time) get-resource-usage resource-usage/self
-              resource-usage-time resource-usage-system-time
-              timeval-seconds timeval-microseconds)
         (only (murdoch robot trip) split-words) (scheme read)
         (only (chibi string) string-prefix?)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
+        (bench clock))
 
 (define (aspace-clause i)
   (let ((name (string->symbol (string-append "w" (number->string i)))))
@@ -163,21 +161,13 @@
 (define (lab-cpu-seconds)
   (apply + (cpu-seconds (current-process-id)) (map cpu-seconds lab-pids)))
 
-;; Seconds of CPU, user and system, that this process has used, to the
-;; microsecond (getrusage).
-(define (own-cpu-seconds)
-  (let ((r (get-resource-usage resource-usage/self)))
-    (define (seconds tv)
-      (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.)))
-    (+ (seconds (resource-usage-time r)) (seconds (resource-usage-system-time r)))))
-
 ;; Microseconds of this process's own CPU, the requester's, per request:
 ;; what multicast saves on a real network, where each receiver has a CPU
 ;; of its own.  All its threads count: those that read the answers too.
 (define (request-sender-cpu-us runs)
-  (let ((before (own-cpu-seconds)))
+  (let ((before (own-cpu-us)))
     (do ((i 0 (+ i 1))) ((= i runs)) (request 'all (lambda () #t)))
-    (/ (* 1000000 (- (own-cpu-seconds) before)) runs)))
+    (/ (- (own-cpu-us) before) runs)))
 
 ;; Microseconds of CPU, in the whole lab, per request per address space.
 (define (request-cpu-us n runs)

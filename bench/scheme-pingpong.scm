@@ -43,10 +43,8 @@
 (import (scheme base) (scheme write) (scheme eval) (scheme process-context)
         (srfi 1) (srfi 18) (srfi 132)
         (chibi net) (chibi filesystem) (chibi process)
-        (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds
-              get-resource-usage resource-usage/self resource-usage-time
-              resource-usage-system-time)
-        (murdoch wire netstring) (bench echo)
+        (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
+        (murdoch wire netstring) (bench echo) (bench clock)
         (only (murdoch testing harness) listen-on-free-port free-port-base tool-path
               start-process! stop-all-processes!))
 
@@ -87,11 +85,6 @@
                 (error "echo server sent back something else")))
             ios))
 
-;; This process's CPU so far, user and system, in microseconds.
-(define (cpu-us)
-  (let ((r (get-resource-usage resource-usage/self)))
-    (define (us tv) (+ (* 1000000. (timeval-seconds tv)) (timeval-microseconds tv)))
-    (+ (us (resource-usage-time r)) (us (resource-usage-system-time r)))))
 
 (define (median-time thunk trips warm-up)
   (do ((i 0 (+ i 1))) ((= i warm-up)) (thunk))
@@ -200,12 +193,12 @@
       (let ((rounds (quotient 32000 n)) (write-us 0.) (read-us 0.))
         (do ((i 0 (+ i 1))) ((= i (quotient 1000 n))) (fan-out ios))
         (do ((i 0 (+ i 1))) ((= i rounds))
-          (let ((t0 (cpu-us)))
+          (let ((t0 (own-cpu-us)))
             (send-to-each ios)
-            (let ((t1 (cpu-us)))
+            (let ((t1 (own-cpu-us)))
               (read-each ios)
               (set! write-us (+ write-us (- t1 t0)))
-              (set! read-us (+ read-us (- (cpu-us) t1))))))
+              (set! read-us (+ read-us (- (own-cpu-us) t1))))))
         (cons (/ write-us rounds n) (/ read-us rounds n))))))
 
 (define (round1 x) (/ (round (* 10 x)) 10.))

@@ -33,16 +33,13 @@
         (srfi 1) (srfi 18) (srfi 69) (srfi 132)
         (chibi net) (chibi process) (chibi filesystem)
         (only (chibi) read) (rename (only (chibi) equal?) (equal? chibi-equal?))
-        (only (chibi time) get-resource-usage resource-usage/self
-              resource-usage-time resource-usage-system-time
-              timeval-seconds timeval-microseconds)
         (only (murdoch robot trip) split-words)
         (murdoch) (murdoch cli command) (murdoch testing harness)
         (murdoch wire netstring) (murdoch wire hmac) (murdoch wire frame)
         (murdoch code sendable) (murdoch remote aspace) (murdoch code sandbox)
         (murdoch lab) (murdoch sys scheduler)
         (only (murdoch remote call) encode-arguments)
-        (bench echo))
+        (bench echo) (bench clock))
 
 (define lab (make-test-lab '((aspace bencher) (aspace troy))))
 (define key (lab-key (read-lab (test-lab-file lab))))
@@ -53,11 +50,6 @@
 (join-lab (test-lab-file lab) 'bencher)
 
 ;;; Clocks
-
-(define (own-cpu-us)
-  (let ((r (get-resource-usage resource-usage/self)))
-    (define (us tv) (+ (* 1000000. (timeval-seconds tv)) (timeval-microseconds tv)))
-    (+ (us (resource-usage-time r)) (us (resource-usage-system-time r)))))
 
 ;; Microseconds of CPU that process pid has used (its scheduler's count).
 (define (process-cpu-us pid)
