@@ -46,6 +46,9 @@
   (stamp-log-lines!)
   (set-process-name! (string-append "murdoch-" (symbol->string uid)))
   (join-lab lab-file uid)
+  ;; After the join, not at the fork: the kernel will not collapse pages
+  ;; still shared with the loader, and the join's collections have made
+  ;; them this process's own (heap-watch.c).
   (heap-on-huge-pages!)
   (start-heap-guard!
    (lab-setting (current-lab) 'heap-max)
