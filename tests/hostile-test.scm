@@ -9,7 +9,8 @@
         (only (chibi process) kill current-process-id)
         (only (chibi filesystem) directory-files)
         (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
-        (murdoch wire multicast) (murdoch testing harness) (murdoch testing raw))
+        (murdoch wire multicast) (only (murdoch wire) datagram-head datagram-from?)
+        (murdoch testing harness) (murdoch testing raw))
 
 (define shared-code "
 (define *counter* 0)
@@ -401,6 +402,31 @@
                              (let ((c (list (counter-of 'troy) (counter-of 'beta))))
                                (and (equal? c '(1 1)) c))))))
     (still-fine "after the replays")))
+
+;; An address space's own datagrams, looped back to it, are dropped by the
+;; sender named at their head, before their MAC is checked and their text
+;; read: a forged one in troy's name is never read by troy, and beta, who
+;; reads it, drops it for its MAC.
+(define (log-lines-with uid word)
+  (count (lambda (line) (text-contains? line word))
+         (read-lines (string-append (test-lab-directory lab) "/"
+                                    (symbol->string uid) ".log"))))
+
+(test-group "a datagram in one's own name is not read"
+  (let ((forged (string->utf8 (string-append (make-string 64 #\0)
+                                             "(troy 1 (beacon troy \"x\" 1))")))
+        (troy-before (log-lines-with 'troy "bad MAC"))
+        (beta-before (log-lines-with 'beta "bad MAC")))
+    (replay! forged)
+    (test "another member reads it, and drops it for its MAC" #t
+      (wait-until 5 (lambda () (> (log-lines-with 'beta "bad MAC") beta-before))))
+    (test "the one it names drops it unread" troy-before
+      (log-lines-with 'troy "bad MAC"))
+    (test "the head is read as it is written" '(#t #f #f)
+      (list (datagram-from? forged (bytevector-length forged) (datagram-head 'troy))
+            (datagram-from? forged (bytevector-length forged) (datagram-head 'tro))
+            (datagram-from? forged 68 (datagram-head 'troy))))
+    (still-fine "after a datagram in its name")))
 
 ;; A write to a socket whose other end is gone raises SIGPIPE, whose
 ;; default action ends the process without a word (exit 141): an address

@@ -8,7 +8,8 @@
           spliced-text
           write-frame! send-frame! read-frame
           open-frame max-frame frame-fail parse-message protocol-fault? fault-message
-          log-fault datagram-bytes open-datagram-text hmac-sha256 hmac-sha256-sign
+          log-fault datagram-bytes open-datagram-text datagram-head datagram-from?
+          hmac-sha256 hmac-sha256-sign
           hmac-sha256-write! hmac-sha256-open open-multicast-socket read-netstring
           write-netstring
           buffered-byte-count reset-output-string! nests-within? fixnum->decimal

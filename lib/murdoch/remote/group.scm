@@ -34,12 +34,13 @@
 ;; #f while the lab's delivery is broadcast.  Global: one per process,
 ;; shared by its senders, its listener and its beacons.
 (define-record-type group
-  (make-group socket address buffer window started sequence sequence-lock
+  (make-group socket address buffer own-head window started sequence sequence-lock
               last-sequence last-heard last-heard-lock)
   group?
   (socket group-socket)
   (address group-address)               ; the group's address and port
   (buffer group-buffer)                 ; each datagram is received into it
+  (own-head group-own-head)             ; datagram-head of our own uid
   (window group-window)                 ; the lab's frame-timeout, seconds
   (started group-started)               ; (wall-microseconds) at start-group!
   (sequence group-sequence group-sequence-set!) ; of the last datagram sent
@@ -75,6 +76,7 @@
                           (get-address-info group port)
                           ;; One buffer (docs/speed.md, What Chibi charges).
                           (make-bytevector 65536)
+                          (datagram-head (aspace-uid (local-aspace)))
                           (lab-setting lab 'frame-timeout) (wall-microseconds)
                           0 (make-mutex 'sequence) (make-hash-table eq?)
                           (make-hash-table eq?) (make-mutex 'last-heard)))
@@ -137,14 +139,18 @@
 (define (receive-call)
   (let ((n (receive! (group-socket *group*) (group-buffer *group*))))
     (and (>= n 0)
+         (not (datagram-from? (group-buffer *group*) n (group-own-head *group*)))
          (heard (open-datagram (group-buffer *group*) n)))))
 
-;; The call that datagram d carries, once its sender is heard from.
+;; The call that datagram d carries, once its sender is heard from.  Our
+;; own datagrams, looped back, are dropped before (receive-call), unread:
+;; a multicast requester read its every call back.  One that names us
+;; otherwise written (only a holder of the key could send it) is dropped
+;; here.  Our own uid thus has no last-heard, and never leaves the live set.
 (define (heard d)
   (lock! (group-last-heard-lock *group*))
   (hash-table-set! (group-last-heard *group*) (datagram-sender d) (monotonic-seconds))
   (unlock! (group-last-heard-lock *group*))
-  ;; Else our own, looped back.
   (and (not (eq? (datagram-sender d) (local-aspace-uid)))
        (datagram-call (datagram-sender d) (datagram-body d))))
 

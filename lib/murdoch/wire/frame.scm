@@ -246,3 +246,23 @@
 ;;> The message of the authentic datagram in the first n bytes of buffer.
 (define (open-datagram-text buffer n)
   (parse-message (authentic-text buffer n '("mcast:"))))
+
+;;> The bytes that begin the text of a datagram from \var{uid}, for
+;;> datagram-from?.
+(define (datagram-head uid)
+  (string->utf8 (string-append "(" (call-with-output-string
+                                     (lambda (o) (write-simple uid o)))
+                               " ")))
+
+;;> Whether the datagram in the first \var{n} bytes of \var{buffer} says,
+;;> unchecked, that it comes from the sender whose datagram-head is
+;;> \var{head}: a look before its MAC is checked and its text read.
+(define (datagram-from? buffer n head)
+  (bytes-at? buffer 64 n head 0))
+
+(define (bytes-at? buffer at n head i)
+  (cond ((= i (bytevector-length head)) #t)
+        ((>= (+ at i) n) #f)
+        ((= (bytevector-u8-ref buffer (+ at i)) (bytevector-u8-ref head i))
+         (bytes-at? buffer at n head (+ i 1)))
+        (else #f)))

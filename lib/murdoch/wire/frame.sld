@@ -8,9 +8,9 @@
           send-frame! read-frame
           open-frame max-frame
           frame-fail parse-message protocol-fault? fault-message log-fault
-          datagram-bytes open-datagram-text)
+          datagram-bytes open-datagram-text datagram-head datagram-from?)
   (import (scheme base) (scheme write) (rename (only (chibi) read) (read read-datum))
-          (only (chibi) string-size) (only (srfi 18) make-mutex)
+          (only (chibi) string-size call-with-output-string) (only (srfi 18) make-mutex)
           (murdoch sys) (murdoch lab)
           (murdoch wire remote-error) (murdoch wire netstring) (murdoch wire hmac))
   (include "frame.scm"))
