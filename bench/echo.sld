@@ -4,6 +4,6 @@
 
 (define-library (bench echo)
   (export echo-connection)
-  (import (scheme base) (srfi 151) (chibi net) (chibi filesystem)
+  (import (scheme base) (srfi 18) (srfi 151) (chibi net) (chibi filesystem)
           (murdoch wire netstring))
   (include "echo.scm"))

@@ -32,17 +32,23 @@
 ;;
 ;; Usage: tools/chibi bench/scheme-pingpong.scm phases N
 ;;
+;; The floor of a multicast requester's CPU over a broadcasting one's.
 ;; The same fan-out in ppoll, the sender's own CPU split between its two
-;; phases, per peer: writing the N frames, then reading the N echoes.  A
-;; multicast requester writes one datagram and reads the N answers, so
-;; the reading's share is the floor of its CPU over broadcast's:
+;; phases, per peer: writing the N frames, then reading the N echoes.  In
+;; rounds taking turns with those, the same servers answer one multicast
+;; datagram instead, each on its connection, as an address space answers
+;; a multicast call; the sender is a member of the group, as a requester
+;; is, and reads its own datagram back.  The datagram's sending per peer
+;; (the kernel delivers it to N sockets), and the multicast round's CPU
+;; over the fan-out's:
 ;;   bench: chibi-fanout-write-cpu-per-peer-NN VALUE us
 ;;   bench: chibi-fanout-read-cpu-per-peer-NN VALUE us
-;;   bench: chibi-fanout-read-share-NN VALUE x
+;;   bench: chibi-mcast-send-cpu-per-peer-NN VALUE us
+;;   bench: chibi-mcast-over-fanout-cpu-NN VALUE x
 
 (import (scheme base) (scheme write) (scheme eval) (scheme process-context)
         (srfi 1) (srfi 18) (srfi 132)
-        (chibi net) (chibi filesystem) (chibi process)
+        (chibi net) (chibi filesystem) (chibi process) (murdoch wire multicast)
         (only (chibi time) get-time-of-day timeval-seconds timeval-microseconds)
         (murdoch wire netstring) (bench echo) (bench clock)
         (only (murdoch testing harness) listen-on-free-port free-port-base tool-path
@@ -164,44 +170,91 @@
         (begin (thread-sleep! 0.1) (try (- tries 1))))))
 
 ;; (measure ios) with ios connected to n echo servers started as
-;; processes of their own (bench/echo-server.scm).
-(define (with-echo-servers n wait measure)
+;; processes of their own (bench/echo-server.scm); with group, its
+;; address, they also answer the datagrams sent to it at port
+;; (group-port base n) as (measure ios group-socket) sends them.
+(define (with-echo-servers n wait measure . group)
   (environment '(murdoch sys scheduler))
-  (let ((base (free-port-base)))
+  (let* ((base (free-port-base))
+         (group-args (if (pair? group)
+                         (list (car group) (number->string (group-port base n)))
+                         '()))
+         (group-socket (and (pair? group)
+                            (open-multicast-socket (car group) (group-port base n)
+                                                   "127.0.0.1"))))
     (for-each (lambda (i)
-                (start-process! (list (tool-path "tools/chibi")
-                                      (tool-path "bench/echo-server.scm")
-                                      (number->string (+ base i)) wait)
+                (start-process! (append (list (tool-path "tools/chibi")
+                                              (tool-path "bench/echo-server.scm")
+                                              (number->string (+ base i)) wait)
+                                        group-args)
                                 "/dev/null"))
               (iota n))
     (guard (e (#t (stop-all-processes!) (raise e)))
       (let* ((ios (map (lambda (i) (connect-to-server (+ base i))) (iota n)))
-             (result (measure ios)))
+             (result (if group-socket
+                         (measure ios (cons group-socket
+                                            (get-address-info (car group)
+                                                              (group-port base n))))
+                         (measure ios))))
         (stop-all-processes!)
         result))))
+
+;; The group's port, past the n servers' in the port base's range.
+(define (group-port base n) (+ base n))
+
+;; An address no lab of the tests or benches uses; the port base keeps
+;; two runs at once apart.
+(define floor-group "239.255.77.11")
 
 (define (measure-fan-out n wait)
   (with-echo-servers n wait
     (lambda (ios)
       (median-time (lambda () (fan-out ios)) (quotient 20000 n) (quotient 1000 n)))))
 
-;; The sender's CPU per peer writing, and reading, over rounds of the
-;; fan-out after a warm-up: (write-us . read-us).
+;; The sender's CPU per peer over rounds after a warm-up, each fan-out
+;; followed by a multicast round: (write-us read-us mcast-send-us
+;; mcast-us), the last two the datagram's sending and the whole round.
 (define (measure-phases n)
   (with-echo-servers n "poll"
-    (lambda (ios)
-      (let ((rounds (quotient 32000 n)) (write-us 0.) (read-us 0.))
-        (do ((i 0 (+ i 1))) ((= i (quotient 1000 n))) (fan-out ios))
+    (lambda (ios group)
+      (let ((rounds (quotient 32000 n)) (write-us 0.) (read-us 0.)
+            (send-us 0.) (mcast-us 0.))
+        (do ((i 0 (+ i 1))) ((= i (quotient 1000 n)))
+          (fan-out ios)
+          (multicast-round ios group))
         (do ((i 0 (+ i 1))) ((= i rounds))
           (let ((t0 (own-cpu-us)))
             (send-to-each ios)
             (let ((t1 (own-cpu-us)))
               (read-each ios)
-              (set! write-us (+ write-us (- t1 t0)))
-              (set! read-us (+ read-us (- (own-cpu-us) t1))))))
-        (cons (/ write-us rounds n) (/ read-us rounds n))))))
+              (let ((t2 (own-cpu-us)))
+                (send-datagram group)
+                (let ((t3 (own-cpu-us)))
+                  (read-datagram-answers ios group)
+                  (set! write-us (+ write-us (- t1 t0)))
+                  (set! read-us (+ read-us (- t2 t1)))
+                  (set! send-us (+ send-us (- t3 t2)))
+                  (set! mcast-us (+ mcast-us (- (own-cpu-us) t2))))))))
+        (map (lambda (us) (/ us rounds n)) (list write-us read-us send-us mcast-us))))
+    floor-group))
+
+;; One datagram to the servers' group, (socket . address), then each
+;; answer read, and the sender's own datagram, looped back to it.
+(define (multicast-round ios group)
+  (send-datagram group)
+  (read-datagram-answers ios group))
+
+(define (send-datagram group)
+  (send (car group) payload 0 (cdr group)))
+
+(define own-datagram (make-bytevector max-frame))
+
+(define (read-datagram-answers ios group)
+  (read-each ios)
+  (receive! (car group) own-datagram))
 
 (define (round1 x) (/ (round (* 10 x)) 10.))
+(define (round2 x) (/ (round (* 100 x)) 100.))
 
 (define (report name value . unit)
   (display "bench: ") (display name) (display " ")
@@ -217,10 +270,11 @@
       (report (string-append "chibi-fanout-write-cpu-per-peer" suffix)
               (round1 (car phases)))
       (report (string-append "chibi-fanout-read-cpu-per-peer" suffix)
-              (round1 (cdr phases)))
-      (report (string-append "chibi-fanout-read-share" suffix)
-              (/ (round (* 100 (/ (cdr phases) (+ (car phases) (cdr phases))))) 100.)
-              "x")))
+              (round1 (cadr phases)))
+      (report (string-append "chibi-mcast-send-cpu-per-peer" suffix)
+              (round1 (list-ref phases 2)))
+      (report (string-append "chibi-mcast-over-fanout-cpu" suffix)
+              (round2 (/ (list-ref phases 3) (+ (car phases) (cadr phases)))) "x")))
    ((and (pair? args) (equal? (car args) "fanout"))
     (let* ((n (string->number (cadr args)))
            (poll? (pair? (cddr args))))
