@@ -170,9 +170,10 @@
         (begin (thread-sleep! 0.1) (try (- tries 1))))))
 
 ;; (measure ios) with ios connected to n echo servers started as
-;; processes of their own (bench/echo-server.scm); with group, its
-;; address, they also answer the datagrams sent to it at port
-;; (group-port base n) as (measure ios group-socket) sends them.
+;; processes of their own (bench/echo-server.scm).  With a group address
+;; they also answer the datagrams sent to it, at port (group-port base
+;; n), and measure is applied to ios and (socket . address): a socket on
+;; the group, and where to send to it.
 (define (with-echo-servers n wait measure . group)
   (environment '(murdoch sys scheduler))
   (let* ((base (free-port-base))
