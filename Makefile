@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test test-box-faults bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
+.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
 	demo demo-box clean
 
 all: deps
@@ -17,12 +17,6 @@ include lib/native.mk
 
 test: all
 	tests/run
-
-# The box team with a pusher killed and no spare (docs/box-move.md): a
-# minute or so, kept out of `make test` for that suite's 12 minutes; the
-# cases with a spare are in `make test`.
-test-box-faults: all
-	tests/run tests/box-faults/*-test.scm
 
 bench: all
 	bench/run
