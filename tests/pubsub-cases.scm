@@ -28,6 +28,10 @@
 (define (reserve-and-stall)
   (request-exclusive '((wheel) ()) 'doomed inside!)
   (thread-sleep! 3600))
+;; The askings of request-components, in the order they were asked.
+(define *asked* '())
+(define (note-asked! k) (set! *asked* (cons k *asked*)) k)
+(define (asked-order) (let ((order (reverse *asked*))) (set! *asked* '()) order))
 ")
 
 
@@ -180,6 +184,17 @@
     (let ((ps (request-exclusive 'wheel 'task3 (lambda () 1))))
       (for-each (lambda (p) ((cadr p) #f)) ps)
       (map car ps))))
+
+(test-group "request-components takes the components in order"
+  (let ((asking (lambda (k) (lambda () (note-asked! k))))
+        (note-asked! (lab-proc 'note-asked!)))
+    (request-components 'in-order
+                        (map (lambda (k)
+                               (list 'non-exclusive '(() (foo)) (lambda () #t)
+                                     (list (asking k))))
+                             '(1 2 3)))
+    (test "each address space asks the first component's first" '(1 2 3)
+      (at 'a (lab-proc 'asked-order)))))
 
 (test-group "request-non-exclusive"
   (let* ((r1 (request-non-exclusive 'foo 'reader1 (lambda () 'read1)))
