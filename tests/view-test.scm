@@ -457,9 +457,15 @@
                      (list (lambda () (thread-sleep! 30) 'slept)))\n")
   (let* ((pose (start-pose! "cut-off.scm"))
          (winner (wait-until 30 (lambda () (starts-on (in-dir "cut-off.scm.out") 1)))))
-    ;; Killed once the view has seen it run: a robot that dies takes with
-    ;; it what the view had not yet seen.
-    (wait-until 20 (lambda () (task-named-in (state) "cut-off")))
+    ;; Killed once the view has seen it run, by its number, on the
+    ;; winner: a robot that dies takes with it what the view had not yet
+    ;; seen (the task alone seen, a loaded machine once left the view its
+    ;; robot's reservation, with no number).
+    (wait-until 20 (lambda ()
+                     (let ((t (task-named-in (state) "cut-off")))
+                       (and t (member (list 1 winner)
+                                      (map (lambda (c) (list (car c) (cadr c)))
+                                           (component-ends t)))))))
     (system? (tool-path "tools/kill-aspace") (number->string lab-pid) (or winner "none"))
     (reap! pose)
     (let ((t (task-over state "cut-off")))
