@@ -7,11 +7,11 @@
 ;; GROUP (poll only), it also joins it and writes each datagram's bytes
 ;; back on that connection, as an address space answers a multicast call.
 ;; "poll" waits in ppoll through (murdoch sys scheduler), as an address
-;; space waits; "block" reads in the kernel.  A file of its own, importing only what it uses:
-;; started from bench/scheme-pingpong.scm, which imports (murdoch
-;; testing), each server took 1.3 s of CPU to start instead of 0.3 s, 85 s
-;; for a lab of 64 on two cores, and a loaded machine then had the first
-;; server late past the sender's patience.
+;; space waits; "block" reads in the kernel.  A file of its own, importing
+;; only what it uses: started from bench/scheme-pingpong.scm, which
+;; imports (murdoch testing), each server took 1.3 s of CPU to start
+;; instead of 0.3 s, 85 s for a lab of 64 on two cores, and a loaded
+;; machine then had the first server late past the sender's patience.
 
 (import (scheme base) (scheme eval) (scheme process-context)
         (chibi net) (murdoch wire multicast) (bench echo))
