@@ -26,7 +26,8 @@
   (directory test-lab-directory)
   (port-base test-lab-port-base))
 
-;; The first line \var{cmd} prints; an error when it prints none.
+;; The first line \var{cmd} prints; an error when it prints none, which
+;; gives how it ended (its wait status: 9 for SIGKILL, 256 for exit 1).
 ;; (chibi process)'s call-with-process-io will not do: it closes the
 ;; parent's ends of its pipes with close-file-descriptor, which leaves
 ;; their filenos marked open, and the collector later closes those
@@ -43,18 +44,30 @@
      (else
       (close-port (open-output-file-descriptor (cadr pipe)))
       (let* ((out (open-input-file-descriptor (car pipe)))
-             (line (read-line out)))
+             (line (if (negative? pid) (eof-object) (read-line out))))
         (close-port out)
-        (waitpid pid 0)
-        (if (eof-object? line) (error "a command printed nothing" cmd))
-        line)))))
+        (if (negative? pid) (error "cannot fork for" cmd))
+        (let ((status (cadr (waitpid pid 0))))
+          (if (eof-object? line)
+              (error "a command printed nothing; its wait status:" cmd status))
+          line))))))
 
-;;> A fresh folder of its own under $TMPDIR, made with mktemp -d.
+;;> A fresh folder of its own under $TMPDIR, readable by its owner alone,
+;;> as mktemp -d makes one but with no process to start: this process's
+;;> id and a count name it, and a name a process before took is passed.
 (define (temporary-directory)
-  (let* ((base (or (get-environment-variable "TMPDIR") "/tmp"))
-         (dir (command-output
-               (list "mktemp" "-d" (string-append base "/murdoch-test.XXXXXX")))))
-    dir))
+  (let ((base (or (get-environment-variable "TMPDIR") "/tmp")))
+    (let loop ((tries 0))
+      (set! folders-made (+ folders-made 1))
+      (let ((dir (string-append base "/murdoch-test."
+                                (number->string (current-process-id)) "."
+                                (number->string folders-made))))
+        (cond ((create-directory dir #o700) dir)
+              ((< tries 100) (loop (+ tries 1)))
+              (else (error "cannot make a folder" dir
+                           (integer->error-string (errno)))))))))
+
+(define folders-made 0)
 
 ;;> A port base B such that nothing listens on B to B + 199, claimed for
 ;;> as long as this process lives, or, given a \var{folder}, as long as

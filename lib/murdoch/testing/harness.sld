@@ -18,6 +18,7 @@
           (only (murdoch remote) remote-error? remote-error-message)
           (only (chibi test) test-failure-count)
           (only (chibi filesystem) delete-file-hierarchy current-directory directory-files
+                create-directory
                 open-input-file-descriptor open-output-file-descriptor
                 open-pipe duplicate-file-descriptor-to))
   (include "harness.scm"))
