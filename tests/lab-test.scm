@@ -52,6 +52,14 @@
 (define (parent-of pid)
   (string->number (command-output (list "ps" "-o" "ppid=" "-p" (number->string pid)))))
 
+;; Whether process pid has ended: it is gone, or a zombie its new parent
+;; has yet to reap.
+(define (ended? pid)
+  (let ((stat (guard (e (#t #f))
+                (file-text (string-append "/proc/" (number->string pid) "/stat")))))
+    (or (not stat)
+        (text-contains? stat ") Z "))))
+
 ;; The lines `bin/murdoch COMMAND LAB ARG ...` prints.
 (define (command-lines command . args)
   (let ((out (in-dir "command.out")))
@@ -261,6 +269,16 @@
       (text-contains? (file-text (in-dir "lab5.out")) "the loader"))
     (test "and stops the address spaces" '(#f #f)
       (map listening? (list base (+ base 1))))))
+
+(test-group "a lab killed outright leaves no address space behind"
+  ;; No SIGTERM for the lab to stop them by: its loader reads the end of
+  ;; its requests and ends, and they end with it.
+  (let* ((pid (start-lab! (in-dir "lab7.out")))
+         (troy (child-named (loader-of pid) "murdoch-troy")))
+    (kill pid signal/kill)
+    (reap! pid)
+    (test "its address spaces end" #t (wait-until 10 (lambda () (ended? troy))))
+    (test "and stop listening" '(#f #f) (map listening? (list base (+ base 1))))))
 
 (test-group "a child that cannot start stops the lab, with its ERROR line"
   ;; troy's port is taken before the lab starts.

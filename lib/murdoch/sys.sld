@@ -1,15 +1,15 @@
 ;;> The process: green threads over ppoll, the heap guard, the process's
-;;> name, one-line logs, and one clock and one way to wait.
+;;> name and the signal it ends by when its parent does, one-line logs, and one clock and one way to wait.
 ;;> Its members are each a library of their own in sys/.
 
 (define-library (murdoch sys)
   (export start-heap-guard! heap-on-huge-pages! utc-seconds set-log-name! stamp-log-lines! log-note log-warn
           condition-message
-          set-process-name! poll-scheduler-installed? monotonic-seconds
+          set-process-name! set-parent-death-signal! poll-scheduler-installed? monotonic-seconds
           wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!
           poller-unwatch! poller-release! poller-buffered poller-ready poller-frames!
           lock! unlock! unlocked cell-value wind with-lock with-lock-by
           seconds-until undo-on-raise make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes! make-gathering gathering-put! gathering-wait)
-  (import (murdoch sys guard) (murdoch sys log) (murdoch sys process-name)
+  (import (murdoch sys guard) (murdoch sys log) (murdoch sys process)
           (murdoch sys scheduler) (murdoch sys wait)))

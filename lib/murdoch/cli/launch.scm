@@ -136,10 +136,17 @@
 
 ;; Forks address space uid; the child leaves the loader's requests to it,
 ;; writes to log and reads nothing, as sh's `>>LOG 2>&1 &` would have it.
+;; It dies with the loader: bin/murdoch-lab signals only children of the
+;; loader (its pid, once the loader is gone, may be anybody's), and a lab
+;; killed outright, whose loader then ends, leaves none behind.  A loader
+;; that died before the child asked for that is seen in its parent.
 (define (fork-aspace uid log in out start-aspace)
-  (let ((pid (fork)))
+  (let* ((loader (current-process-id))
+         (pid (fork)))
     (cond
      ((zero? pid)
+      (set-parent-death-signal! signal/kill)
+      (if (not (= (parent-process-id) loader)) (exit 1))
       (close-port in)
       (close-port out)
       (redirect! 0 "/dev/null" open/read)

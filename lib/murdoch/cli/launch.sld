@@ -5,8 +5,8 @@
   (export lab-lines run-lab run-pose run-demo run-status run-check)
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context) (srfi 1)
-          (only (chibi process) execute current-process-id fork waitpid wait/no-hang
-                set-signal-action! signal/interrupt signal/quit)
+          (only (chibi process) execute current-process-id parent-process-id fork waitpid
+                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill)
           (only (chibi filesystem) open-pipe open open/read open/write open/append
                 open/create duplicate-file-descriptor-to set-file-descriptor-flags!
                 open-input-file-descriptor open-output-file-descriptor)
@@ -14,7 +14,7 @@
           (only (srfi 27) random-source-pseudo-randomize! default-random-source)
           (only (scheme time) current-second)
           (only (srfi 151) bitwise-and bitwise-ior arithmetic-shift)
-          (only (murdoch sys) set-process-name!) (murdoch lab)
+          (only (murdoch sys) set-process-name! set-parent-death-signal!) (murdoch lab)
           (murdoch cli command) (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment)
           (only (murdoch status) write-lab-status)
