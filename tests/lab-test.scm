@@ -270,15 +270,20 @@
     (test "and stops the address spaces" '(#f #f)
       (map listening? (list base (+ base 1))))))
 
-(test-group "a lab killed outright leaves no address space behind"
+(test-group "a lab killed outright leaves nothing behind"
   ;; No SIGTERM for the lab to stop them by: its loader reads the end of
-  ;; its requests and ends, and they end with it.
-  (let* ((pid (start-lab! (in-dir "lab7.out")))
-         (troy (child-named (loader-of pid) "murdoch-troy")))
+  ;; its requests and ends, and the address spaces end with it; the view
+  ;; ends with the lab's process.
+  (let* ((pid (start-murdoch-lab! (list "--logs" (in-dir "logs7") "--view"
+                                        (test-lab-file lab))
+                                  (in-dir "lab7.out")))
+         (troy (child-named (loader-of pid) "murdoch-troy"))
+         (view (child-named pid "murdoch-view")))
     (kill pid signal/kill)
     (reap! pid)
     (test "its address spaces end" #t (wait-until 10 (lambda () (ended? troy))))
-    (test "and stop listening" '(#f #f) (map listening? (list base (+ base 1))))))
+    (test "and stop listening" '(#f #f) (map listening? (list base (+ base 1))))
+    (test "and so does its view" #t (and view (wait-until 10 (lambda () (ended? view)))))))
 
 (test-group "a child that cannot start stops the lab, with its ERROR line"
   ;; troy's port is taken before the lab starts.

@@ -228,14 +228,20 @@
                       (list (tool-path "bin/murdoch") "lab")
                       args)
               out)))
-    (wait-until 90 (lambda ()
-                     (let ((text (file-text out)))
-                       (or (text-contains? text "lab: ready")
-                           (text-contains? text "stopping the lab")
-                           (text-contains? text "ERROR")))))
-    (if (not (text-contains? (file-text out) "lab: ready"))
-        (begin (stop-process! pid)
-               (error "the lab did not start" (file-text out))))
+    (let ((ended #f))
+      (wait-until 90 (lambda ()
+                       (let ((text (file-text out)))
+                         (or (text-contains? text "lab: ready")
+                             (text-contains? text "stopping the lab")
+                             (text-contains? text "ERROR")
+                             ;; A usage error, say, says no ERROR.
+                             (begin (set! ended (positive? (car (waitpid pid wait/no-hang))))
+                                    ended)))))
+      (if (not (text-contains? (file-text out) "lab: ready"))
+          (begin (if ended
+                     (set! *children* (remove-pid pid *children*))
+                     (stop-process! pid))
+                 (error "the lab did not start" (file-text out)))))
     pid))
 
 ;;> The median time in seconds of \var{runs} calls of \var{thunk}: the
