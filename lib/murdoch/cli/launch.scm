@@ -136,10 +136,11 @@
 
 ;; Forks address space uid; the child leaves the loader's requests to it,
 ;; writes to log and reads nothing, as sh's `>>LOG 2>&1 &` would have it.
-;; It dies with the loader: bin/murdoch-lab signals only children of the
-;; loader (its pid, once the loader is gone, may be anybody's), and a lab
-;; killed outright, whose loader then ends, leaves none behind.  A loader
-;; that died before the child asked for that is seen in its parent.
+;; It dies with the loader: bin/murdoch-lab signals only the loader's
+;; children, so one the loader's death left behind would be out of its
+;; reach, and a lab killed outright, whose loader then ends, leaves none
+;; behind.  A loader that died before the child asked is seen in its
+;; parent.
 (define (fork-aspace uid log in out start-aspace)
   (let* ((loader (current-process-id))
          (pid (fork)))
