@@ -2,7 +2,8 @@
 ;;; line with the usage, exit 2, and no stack trace.
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
         (only (chibi process) system)
-        (only (chibi filesystem) delete-file-hierarchy)
+        (only (chibi filesystem) delete-file-hierarchy open-input-file-descriptor)
+        (only (chibi net) make-listener-socket get-address-info)
         (chibi json) (murdoch testing harness))
 
 (define dir (temporary-directory))
@@ -237,7 +238,17 @@
     (test "a task nobody takes: exit non-zero" #t (positive? (status r)))
     (test "its output is shown" #t (text-contains? (cadr r) "not-enough-takers"))
     (test "and the demo says so" #t
-      (text-contains? (cadr r) "the task did not complete"))))
+      (text-contains? (cadr r) "the task did not complete")))
+  ;; troy's port is taken: the lab stops at once, and the demo, which
+  ;; watches its child by /proc rather than kill -0, says so and ends.
+  (let* ((squatter (make-listener-socket
+                    (get-address-info "127.0.0.1" (test-lab-port-base demo-lab)) 5))
+         (r (demo "camera.scm")))
+    (close-port (open-input-file-descriptor squatter))
+    (test "a lab that cannot start: exit non-zero" #t (positive? (status r)))
+    (test "and the demo says so, with the lab's word on it" '(#t #t)
+      (list (text-contains? (cadr r) "demo: the lab did not start")
+            (text-contains? (cadr r) "troy died")))))
 
 (test-end)
 (remove-test-lab! demo-lab)
