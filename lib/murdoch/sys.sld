@@ -1,5 +1,6 @@
 ;;> The process: green threads over ppoll, the heap guard, the process's
-;;> name and the signal it ends by when its parent does, one-line logs, and one clock and one way to wait.
+;;> name and the signal it ends by when its parent does, one-line logs,
+;;> and one clock and one way to wait.
 ;;> Its members are each a library of their own in sys/.
 
 (define-library (murdoch sys)

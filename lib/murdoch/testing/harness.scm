@@ -43,14 +43,15 @@
       (exit 127))
      (else
       (close-port (open-output-file-descriptor (cadr pipe)))
-      (let* ((out (open-input-file-descriptor (car pipe)))
-             (line (if (negative? pid) (eof-object) (read-line out))))
-        (close-port out)
-        (if (negative? pid) (error "cannot fork for" cmd))
-        (let ((status (cadr (waitpid pid 0))))
-          (if (eof-object? line)
-              (error "a command printed nothing; its wait status:" cmd status))
-          line))))))
+      (let ((out (open-input-file-descriptor (car pipe))))
+        (if (negative? pid)
+            (begin (close-port out) (error "cannot fork for" cmd)))
+        (let ((line (read-line out)))
+          (close-port out)
+          (let ((status (cadr (waitpid pid 0))))
+            (if (eof-object? line)
+                (error "a command printed nothing; its wait status:" cmd status))
+            line)))))))
 
 ;;> A fresh folder of its own under $TMPDIR, readable by its owner alone,
 ;;> as mktemp -d makes one but with no process to start: this process's
@@ -173,6 +174,11 @@
     (set! *children* (remove-pid pid *children*))
     status))
 
+;; Whether \var{pid} has ended; if so it is reaped, as reap! would.
+(define (reaped-if-ended! pid)
+  (and (positive? (car (waitpid pid wait/no-hang)))
+       (begin (set! *children* (remove-pid pid *children*)) #t)))
+
 (define (remove-pid pid ls)
   (cond ((null? ls) '()) ((= pid (car ls)) (cdr ls))
         (else (cons (car ls) (remove-pid pid (cdr ls))))))
@@ -228,20 +234,16 @@
                       (list (tool-path "bin/murdoch") "lab")
                       args)
               out)))
-    (let ((ended #f))
-      (wait-until 90 (lambda ()
-                       (let ((text (file-text out)))
-                         (or (text-contains? text "lab: ready")
-                             (text-contains? text "stopping the lab")
-                             (text-contains? text "ERROR")
-                             ;; A usage error, say, says no ERROR.
-                             (begin (set! ended (positive? (car (waitpid pid wait/no-hang))))
-                                    ended)))))
-      (if (not (text-contains? (file-text out) "lab: ready"))
-          (begin (if ended
-                     (set! *children* (remove-pid pid *children*))
-                     (stop-process! pid))
-                 (error "the lab did not start" (file-text out)))))
+    (wait-until 90 (lambda ()
+                     (let ((text (file-text out)))
+                       (or (text-contains? text "lab: ready")
+                           (text-contains? text "stopping the lab")
+                           (text-contains? text "ERROR")
+                           ;; A usage error, say, says no ERROR.
+                           (reaped-if-ended! pid)))))
+    (if (not (text-contains? (file-text out) "lab: ready"))
+        (begin (if (memv pid *children*) (stop-process! pid))
+               (error "the lab did not start" (file-text out))))
     pid))
 
 ;;> The median time in seconds of \var{runs} calls of \var{thunk}: the
