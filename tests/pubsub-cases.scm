@@ -258,7 +258,16 @@
   (test "a load that falls brings idle" #t
     (wait-until 10 (lambda () (and (memq 'idle (at 'c subscriptions)) #t))))
   (test "get-system-load answers a string, as the thesis's" "0.1"
-    (at 'a get-system-load)))
+    (at 'a get-system-load))
+  (test "a load that changed is answered as it is now" "0.1"
+    (at 'c get-system-load))
+  (test "a caller that changes the string it got changes no later answer" "0.1"
+    (at 'a (lambda ()
+             (string-set! (get-system-load) 0 #\9)
+             (get-system-load))))
+  (test "without a load clause, the load is /proc/loadavg's" #t
+    (let ((load (string->number (get-system-load))))  ; the tester has none
+      (and (real? load) (>= load 0)))))
 
 (test-group "membership"
   (test "a peer that is killed is not counted" '(b c tester)

@@ -35,17 +35,30 @@
 ;; its monitor-period, and where the load comes from.  Global: the
 ;; monitors are the thesis's procedures of no arguments.
 (define-record-type monitoring
-  (make-monitoring period load-source)
+  (make-monitoring period load-source last-load)
   monitoring?
   (period monitoring-period)            ; seconds between looks
-  (load-source monitoring-load-source)) ; a thunk answering a number
+  (load-source monitoring-load-source)  ; a thunk answering a number
+  (last-load monitoring-last-load monitoring-last-load-set!)) ; (LOAD . TEXT)
 
 (define *monitoring* #f)
 
 ;;> This machine's load as a string, e.g. "0.42": from the lab's (load ...)
 ;;> clause, else the one-minute average of /proc/loadavg.
 (define (get-system-load)
-  (number->string ((monitoring-load-source *monitoring*))))
+  (string-copy (load-text ((monitoring-load-source *monitoring*)))))
+
+;; The text of load, kept while the load stays the same: every negotiation
+;; asks each idle address space for it, and Chibi's number->string makes a
+;; string port each time (docs/speed.md).  Copied out, as received code
+;; may change the string it is given.
+(define (load-text load)
+  (let ((last (monitoring-last-load *monitoring*)))
+    (if (eqv? load (car last))
+        (cdr last)
+        (let ((text (number->string load)))
+          (monitoring-last-load-set! *monitoring* (cons load text))
+          text))))
 
 (define (start-thread! name thunk)
   (thread-start! (make-logged-thread thunk name)))
@@ -103,7 +116,7 @@
 (define (load-source clause)
   (let ((start (monotonic-seconds)))
     (cond
-     ((not clause) read-loadavg)
+     ((not clause) (loadavg-reader))
      ((number? (cadr clause)) (lambda () (cadr clause)))
      (else
       (let ((steps (cadr clause)))
@@ -117,6 +130,18 @@
   (call-with-input-file "/proc/loadavg"
     (lambda (in) (read in))))
 
+;; read-loadavg, read again a second after the last reading at most: the
+;; kernel updates the average every five seconds, and every negotiation
+;; asks for it (a file port and three system calls each time).
+(define (loadavg-reader)
+  (let ((read-at #f) (load #f))
+    (lambda ()
+      (let ((now (monotonic-seconds)))
+        (when (or (not read-at) (> now (+ read-at 1)))
+          (set! load (read-loadavg))
+          (set! read-at now))
+        load))))
+
 ;;> Sets up this address space's subscriptions and monitors from its lab
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
 ;;> capabilities; idle through load-monitor; untethered through
@@ -124,7 +149,8 @@
 (define (initialize-subscriptions! lab entry)
   (set! *monitoring*
         (make-monitoring (lab-setting lab 'monitor-period)
-                         (load-source (and entry (lab-aspace-clause entry 'load)))))
+                         (load-source (and entry (lab-aspace-clause entry 'load)))
+                         (cons #f "")))
   (for-each subscribe (list 'all (local-aspace-uid)))
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
