@@ -135,6 +135,12 @@
            "(battery \"full\"): battery takes volts, a positive number")
   (mistake "a wall of three numbers" "(lab x (world (wall 0 0 1000)))"
            "(wall 0 0 1000): wall takes x1 y1 x2 y2")
+  (mistake "a box of negative depth" "(lab x (world (box 0 0 600 -600 0)))"
+           "(box 0 0 600 -600 0): box takes x y width depth heading")
+  (mistake "a box with no mass" "(lab x (world (box 0 0 600 600 0 0)))"
+           "width, depth and mass above 0")
+  (mistake "a wall with no thickness" "(lab x (world (wall 0 0 1000 0 0)))"
+           "the thickness above 0")
   (mistake "a workstation's position" "(lab x (aspace a (position 0 0)))"
            "(position 0 0): position takes x y heading")
   (mistake "a scripted load" "(lab x (aspace a (load ((0 high)))))"

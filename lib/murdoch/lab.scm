@@ -160,6 +160,15 @@
   (make-reader (lambda (xs) (and (<= low (length xs) high) (every real? xs))) what))
 
 (define (positive-real? x) (and (real? x) (positive? x)))
+
+;; As reals, where the values at the places given, when there, are above 0:
+;; a size or a mass (Box2D takes a negative one without a word).
+(define (sized-reals low high places what)
+  (make-reader (lambda (xs)
+                 (and (<= low (length xs) high) (every real? xs)
+                      (every (lambda (i) (or (>= i (length xs)) (positive? (list-ref xs i))))
+                             places)))
+               what))
 (define (non-negative? x) (and (real? x) (>= x 0)))
 (define (port-number? x) (and (exact-integer? x) (< 0 x 65536)))
 
@@ -185,9 +194,13 @@
     (load . ,(values-of 1 load-value? "a number, or ((SECONDS LOAD) ...)"))))
 
 (define world-table
-  `((wall . ,(reals 4 5 "x1 y1 x2 y2 and a thickness if not 50: four or five numbers"))
-    (box . ,(reals 5 6 (string-append "x y width depth heading and a mass if not 5:"
-                                      " five or six numbers")))
+  `((wall . ,(sized-reals 4 5 '(4) (string-append "x1 y1 x2 y2 and a thickness if not 50:"
+                                                  " four or five numbers, the thickness"
+                                                  " above 0")))
+    (box . ,(sized-reals 5 6 '(2 3 5)
+                         (string-append "x y width depth heading and a mass if not 5:"
+                                        " five or six numbers, width, depth and mass"
+                                        " above 0")))
     (friction . ,(values-of 1 non-negative? "a number"))))
 
 (define simulator-table

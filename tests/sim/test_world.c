@@ -1,7 +1,9 @@
 /* Physics and sensing, through world.h directly (no sockets): the figures the
  * issue asks for, in a room small enough to reason about. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "check.h"
 #include "../../sim/world.h"
 
@@ -456,8 +458,40 @@ static void test_against_box2d(void)
     CHECK("the grid's ranges match Box2D's ray casts within 1 mm", agree);
 }
 
+/* The simulator reads its lab file itself: a size or a mass of 0 or less
+ * is refused there too, not handed to Box2D. */
+static int loads(const char *text)
+{
+    char path[] = "/tmp/murdoch-test-world.XXXXXX", err[256];
+    int fd = mkstemp(path), rc;
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    lab l;
+    if (!f)
+        return -2;
+    fputs(text, f);
+    fclose(f);
+    rc = lab_load(path, &l, err, sizeof err);
+    unlink(path);
+    if (rc == 0)
+        lab_free(&l);
+    return rc;
+}
+
+static void test_sizes_read(void)
+{
+    CHECK("a box as the lab file gives it",
+          loads("(lab x (world (box 0 0 600 400 30 2)))") == 0);
+    CHECK("a box of negative depth is refused",
+          loads("(lab x (world (box 0 0 600 -400 30)))") != 0);
+    CHECK("a box of no mass is refused",
+          loads("(lab x (world (box 0 0 600 400 30 0)))") != 0);
+    CHECK("a wall of no thickness is refused",
+          loads("(lab x (world (wall 0 0 1000 0 0)))") != 0);
+}
+
 int main(void)
 {
+    test_sizes_read();
     test_goto();
     test_odometry_frame();
     test_sonar_wall();
