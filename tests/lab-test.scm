@@ -183,7 +183,21 @@
                                (list (lambda () (car '()))))\n"
                         out)))
       (test "a task whose component failed: pose exits 1" 1
-        (command-status "pose" (in-dir "failing.scm"))))
+        (command-status "pose" (in-dir "failing.scm")))
+      (call-with-output-file (in-dir "typo.scm")
+        (lambda (out)
+          (write-string ";; load-metric, mistyped\n(list 'where 1 (list (list '() (list 'camera)))
+                               (list load-metrc) (list (lambda () 1)))\n"
+                        out)))
+      (test "a name mistyped in a task file: its file, its form's line, the nearest name"
+          #t
+        (any (lambda (line)
+               (text-contains? line (string-append (in-dir "typo.scm") ":2: load-metrc"
+                                                   " is not defined; did you mean"
+                                                   " load-metric?")))
+             (pose-output "typo.scm")))
+      (test "and pose exits non-zero" #f
+        (zero? (command-status "pose" (in-dir "typo.scm")))))
     (test "status: each address space, up" '(#t #t)
       (let ((lines (command-lines "status")))
         (map (lambda (uid)

@@ -183,8 +183,9 @@
                            lab-file)))
 
 ;;> `murdoch pose LAB FILE`: joins the lab as a guest, evaluates the forms
-;;> of \var{task-file} in a REPL's environment, poses the task its last
-;;> form names (see task-of), and writes the result.  pose-task's progress
+;;> of \var{task-file} in a REPL's environment (a form that raises is
+;;> named by the file and its line, with the REPL's hints), poses the task
+;;> its last form names (see task-of), and writes the result.  pose-task's progress
 ;;> lines go to the standard output as it works.  Exits 0 when the task
 ;;> completed, else 1: not-enough-takers, or a component that failed.
 (define (run-pose lab-file task-file)
@@ -247,15 +248,21 @@
 ;;> form, or, when that form defines a procedure of no arguments, what the
 ;;> procedure answers, as the thesis's \scheme{(define (dual-sonar-task) ...)}.
 (define (task-of file env)
-  (let* ((forms (call-with-input-file file read-all))
-         (last-value (fold (lambda (form acc) (eval form env)) #f forms))
-         (last-form (and (pair? forms) (last forms))))
+  (let* ((entries (car (read-source file)))     ; ((FORM . LINE) ...)
+         (last-value (fold (lambda (entry acc) (eval-at file entry env)) #f entries))
+         (last-entry (and (pair? entries) (last entries)))
+         (last-form (and last-entry (car last-entry))))
     (if (and (pair? last-form) (eq? (car last-form) 'define)
              (pair? (cadr last-form)) (null? (cdr (cadr last-form))))
-        (eval (cadr last-form) env)
+        (eval-at file (cons (cadr last-form) (cdr last-entry)) env)
         last-value)))
 
-(define (read-all in)
-  (let loop ((acc '()))
-    (let ((form (read in)))
-      (if (eof-object? form) (reverse acc) (loop (cons form acc))))))
+;; The value of entry's form in env, evaluated as the REPL does, with its
+;; hints (a name mistyped, the nearest one); an error names the file and
+;; the line of the form, as a lab's code file's does.
+(define (eval-at file entry env)
+  (guard (e ((error-object? e)
+             (error (string-append file ":" (number->string (cdr entry)) ": "
+                                   (error-message e)))))
+    (eval-with-hints (car entry) env)))
+
