@@ -173,7 +173,21 @@
   (test "a code file that raises as it loads: its file, line and error" #t
     (let ((r (murdoch "check" (string-append dir "/code2.scm"))))
       (and (= 2 (status r))
-           (text-contains? (first-line r) "/raises.scm:2: car: not a pair ()")))))
+           (text-contains? (first-line r) "/raises.scm:2: car: not a pair ()"))))
+  ;; Loading lets a name that nothing defines pass, in a procedure's body
+  ;; or a later form's: only a robot running it would say.
+  (write-file "typo.scm" (string-append "(define (f) (g))\n(define (g) 'quoted-name)\n"
+                                        ";; load-metric, mistyped\n"
+                                        "(define (h)\n  (let loop ((i 3))\n"
+                                        "    (if (> i 0) (loop (- i 1)) (lod-metric))))\n"))
+  (write-file "code3.scm" "(lab x (code \"typo.scm\"))\n")
+  (test "a name that a code file uses and nothing defines: its file, line, nearest name"
+      #t
+    (let ((r (murdoch "check" (string-append dir "/code3.scm"))))
+      (and (= 2 (status r))
+           (text-contains? (first-line r)
+                           (string-append "/typo.scm:4: lod-metric is used but not"
+                                          " defined; did you mean load-metric?"))))))
 
 ;; A lab of workstations, which needs no simulator, and two tasks: one
 ;; that troy takes, and one that nobody can.

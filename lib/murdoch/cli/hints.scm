@@ -74,7 +74,7 @@
   (let* ((text (symbol->string name))
          (uids (map symbol->string (known-uids)))
          (near-uid (nearest-name text uids))
-         (near (nearest-name text (map symbol->string (defined-names env)))))
+         (near (nearest-name text (map symbol->string (visible-names env)))))
     (make-exception
      'undefined
      (string-append text " is not defined"
@@ -87,20 +87,6 @@
                           (near (string-append "; did you mean " near "?"))
                           (else "")))
      '() #f #f)))
-
-;; Every name env and the environments it imports from define.
-(define (defined-names env)
-  (let loop ((env env) (acc '()))
-    (if env (loop (env-parent env) (append (env-exports env) acc)) acc)))
-
-;; The name of names nearest text, at most two edits away and less than
-;; half of it, or #f.
-(define (nearest-name text names)
-  (let ((near (find-nearest-edits text names)))
-    (and (pair? near)
-         (let ((d (edit-distance text (car near))))
-           (and (<= d 2) (< (* 2 d) (string-length text))))
-         (car near))))
 
 (define (nearest text names)
   (cond ((nearest-name text names)

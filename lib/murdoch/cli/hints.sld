@@ -5,11 +5,11 @@
 (define-library (murdoch cli hints)
   (export eval-with-hints)
   (import (scheme base) (scheme eval)
-          (only (chibi) make-exception exception? exception-kind env-parent env-exports
-                identifier? identifier->symbol)
-          (only (chibi edit-distance) find-nearest-edits edit-distance)
+          (only (chibi) make-exception exception? exception-kind identifier?
+                identifier->symbol)
+          (only (chibi edit-distance) edit-distance)
           (only (murdoch remote) known-uids)
           (only (chibi ast) exception-source procedure-arity procedure-variadic?
                 procedure-name)
-          (murdoch wire) (only (murdoch code) send-error?))
+          (murdoch wire) (only (murdoch code) send-error? visible-names nearest-name))
   (include "hints.scm"))

@@ -174,7 +174,8 @@
 ;;> code, as an address space does: a mistake in either is an error that
 ;;> names the file and the line.  Starts nothing.
 (define (run-check lab-file)
-  (make-lab-environment (read-lab lab-file))
+  (let ((lab (read-lab lab-file)))
+    (check-lab-code lab (make-lab-environment lab)))
   (write-string (string-append lab-file ": no mistakes found\n")))
 
 ;;> `murdoch demo LAB`: becomes bin/murdoch-demo, found in \var{bin}.
@@ -184,9 +185,9 @@
 
 ;;> `murdoch pose LAB FILE`: joins the lab as a guest, evaluates the forms
 ;;> of \var{task-file} in a REPL's environment (a form that raises is
-;;> named by the file and its line, with the REPL's hints), poses the task
-;;> its last form names (see task-of), and writes the result.  pose-task's progress
-;;> lines go to the standard output as it works.  Exits 0 when the task
+;;> named by the file and its line, with the REPL's hints), poses the
+;;> task its last form names (see task-of), and writes the result.
+;;> pose-task's progress lines go to the standard output as it works.  Exits 0 when the task
 ;;> completed, else 1: not-enough-takers, or a component that failed.
 (define (run-pose lab-file task-file)
   (let* ((lab (read-lab lab-file))

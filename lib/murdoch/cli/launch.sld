@@ -17,7 +17,7 @@
           (only (murdoch sys) set-process-name! set-parent-death-signal!) (murdoch lab)
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch wire) error-message) (only (murdoch remote) remote-timeout)
-          (only (murdoch code) make-lab-environment)
+          (only (murdoch code) make-lab-environment check-lab-code)
           (only (murdoch status) write-lab-status)
           (only (murdoch task) status-state step-status? step-status-entries))
   (include "launch.scm"))

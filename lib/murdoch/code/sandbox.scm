@@ -303,6 +303,71 @@
               (lab-code-files lab))
     env))
 
+;;> Raises for the first name that the lab's code files use but neither
+;;> define nor import, naming the file and the line of the first form
+;;> that uses it, and the nearest defined name: a typo in a procedure's
+;;> body, which loading lets pass, would otherwise show only when a robot
+;;> runs it.  \var{env} is the lab's environment, made from \var{lab}.
+(define (check-lab-code lab env)
+  (let ((undefined (undefined-names env)))
+    (if (pair? undefined)
+        (for-each (lambda (file)
+                    (let ((path (lab-path lab file)))
+                      (for-each (lambda (entry) (check-uses path entry undefined env))
+                                (car (read-source path)))))
+                  (lab-code-files lab)))))
+
+(define (check-uses file entry undefined env)
+  (let ((name (find (lambda (name) (mentions? (car entry) name)) undefined)))
+    (if name
+        (error (string-append file ":" (number->string (cdr entry)) ": "
+                              (symbol->string name) " is used but not defined"
+                              (nearest-defined name env))))))
+
+;; The names that code compiled in env refers to and nothing defines, as
+;; Chibi's own warn-undefs finds them, which writes them as warnings.
+(define (undefined-names env)
+  (let ((out (open-output-string)))
+    (parameterize ((current-error-port out))
+      (warn-undefs env #f #f))
+    (let ((in (open-input-string (get-output-string out))))
+      (let loop ((names '()))
+        (let ((line (read-line in)))
+          (if (eof-object? line)
+              (reverse names)
+              (loop (if (string-prefix? undefined-warning line)
+                        (cons (string->symbol
+                               (substring line (string-length undefined-warning)
+                                          (string-length line)))
+                              names)
+                        names))))))))
+
+(define undefined-warning "WARNING: reference to undefined variable: ")
+
+(define (mentions? form name)
+  (cond ((pair? form) (or (mentions? (car form) name) (mentions? (cdr form) name)))
+        ((vector? form) (any (lambda (x) (mentions? x name)) (vector->list form)))
+        (else (eq? form name))))
+
+(define (nearest-defined name env)
+  (let ((near (nearest-name (symbol->string name)
+                            (map symbol->string (visible-names env)))))
+    (if near (string-append "; did you mean " near "?") "")))
+
+;;> The names defined in \var{env} and in the environments it imports from.
+(define (visible-names env)
+  (let loop ((env env) (acc '()))
+    (if env (loop (env-parent env) (append (env-exports env) acc)) acc)))
+
+;;> The string of \var{names} nearest \var{text}, at most two edits away
+;;> and less than half of it, or #f: for "did you mean".
+(define (nearest-name text names)
+  (let ((near (find-nearest-edits text names)))
+    (and (pair? near)
+         (let ((d (edit-distance text (car near))))
+           (and (<= d 2) (< (* 2 d) (string-length text))))
+         (car near))))
+
 ;;> The lab's code files, as its (code ...) clause names them.
 (define (lab-code-files lab)
   (lab-setting lab 'code))
