@@ -332,8 +332,18 @@
 ;;> Reserves and promises, if addressed here and free: (#t uid promise)
 ;;> or (#f uid).
 (define (receive-request-exclusive topiclist task-name uid proc args)
-  (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
-               proc args))
+  (if (and (subscribed-to-all? (car topiclist)) (subscribed-to-all? (cadr topiclist)))
+      (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
+                   proc args)
+      (list #f (local-aspace-uid))))
+
+;; Whether every one of subjects is subscribed here: an address space
+;; that lacks one answers at once, without the lock and the reservation's
+;; checks (most of a lab, for a robot's component).  Read without the
+;; lock, as addressed-here? reads: the list is replaced, not changed.
+(define (subscribed-to-all? subjects)
+  (or (null? subjects)
+      (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
 
 ;;> The shared counterpart of receive-request-exclusive.
 (define (receive-request-non-exclusive topics task-name uid proc args)
