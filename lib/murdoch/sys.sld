@@ -10,7 +10,7 @@
           wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!
           poller-unwatch! poller-release! poller-buffered poller-ready poller-frames!
           lock! unlock! unlocked cell-value wind with-lock with-lock-by
-          seconds-until undo-on-raise make-mailbox mailbox-put! mailbox-take mailbox-empty!
+          seconds-until undo-on-raise map-guarded make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes! make-gathering gathering-put! gathering-wait)
   (import (murdoch sys guard) (murdoch sys log) (murdoch sys process)
           (murdoch sys scheduler) (murdoch sys wait)))

@@ -187,20 +187,9 @@
   (make-result uid #f (error-message e)))
 
 ;;> (map entry items); an item whose entry raised gives the result of
-;;> its failure, for the uid (uid-of item).  The handler is entered once,
-;;> and again after each failure only (docs/speed.md, What Chibi charges).
+;;> its failure, for the uid (uid-of item).
 (define (capture-each uid-of entry items)
-  (let ((done '()) (rest items))
-    (let run ()
-      (guard (e (#t (set! done (cons (failure-result (uid-of (car rest)) e) done))
-                    (set! rest (cdr rest))
-                    (run)))
-        (let loop ()
-          (when (pair? rest)
-            (set! done (cons (entry (car rest)) done))
-            (set! rest (cdr rest))
-            (loop)))))
-    (reverse done)))
+  (map-guarded entry items (lambda (item e) (failure-result (uid-of item) e))))
 
 (define (encode-arguments args)
   (let loop ((args args) (i 1) (acc '()))

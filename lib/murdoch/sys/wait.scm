@@ -101,6 +101,23 @@
   (%dk here)
   value)
 
+;;> (map proc items), where an item whose (proc item) raises gives
+;;> (on-raise item e): the handler is entered once, and again after each
+;;> raise only, where a guard for each item copied the stack for each
+;;> (docs/speed.md, What Chibi charges).
+(define (map-guarded proc items on-raise)
+  (let ((done '()) (rest items))
+    (let run ()
+      (guard (e (#t (set! done (cons (on-raise (car rest) e) done))
+                    (set! rest (cdr rest))
+                    (run)))
+        (let loop ()
+          (when (pair? rest)
+            (set! done (cons (proc (car rest)) done))
+            (set! rest (cdr rest))
+            (loop)))))
+    (reverse done)))
+
 ;; A one-shot mailbox: the reader thread puts an answer, the caller takes
 ;; it or gives up at its deadline.  Its taker may empty it for the next
 ;; (mailbox-empty!), once no other thread can still put to it.

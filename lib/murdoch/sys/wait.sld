@@ -4,7 +4,7 @@
 
 (define-library (murdoch sys wait)
   (export lock! unlock! unlocked cell-value wind with-lock with-lock-by seconds-until
-          undo-on-raise
+          undo-on-raise map-guarded
           make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)

@@ -167,8 +167,8 @@
           (cond ((not measure) (cons response (loop (cdr keys) k)))
                 ((and asked (asking? measure))
                  (cons (measured-told (map car response)
-                                      (map (lambda (e) (asked-score measure asked e k))
-                                           response))
+                                      (map-guarded (lambda (e) (asked-score measure asked e k))
+                                                   response unscored))
                        (loop (cdr keys) (+ k 1))))
                 (else
                  (cons (measured-told (map car response)
@@ -186,7 +186,7 @@
         +inf.0)))
 
 (define (measured-told uids measures)
-  (progress "  measured " (map list uids measures))
+  (if (pose-task-progress) (progress "  measured " (map list uids measures)))
   measures)
 
 ;; The procedures that a candidate is asked for the measures among keys,
@@ -208,9 +208,10 @@
 ;; its answer does not score) measures +inf.0, and so comes last.
 (define (measure-all measure uids)
   (if (asking? measure)
-      (map (lambda (o)
-             (score measure (outcome-ok? o) (and (outcome-ok? o) (outcome-value o))))
-           (remote-apply-all (map uid->aspace uids) (asking-proc measure)))
+      (map-guarded (lambda (o)
+                     (score measure (outcome-ok? o) (and (outcome-ok? o) (outcome-value o))))
+                   (remote-apply-all (map uid->aspace uids) (asking-proc measure))
+                   unscored)
       (map thread-join!
            (map (lambda (uid)
                   (thread-start!
@@ -218,10 +219,13 @@
                 uids))))
 
 ;; An asking measure's score of a candidate's answer, when ok?; +inf.0
-;; when it gave none, or one that does not score.
+;; when it gave none, or one that is not a number.  The score is the
+;; user's code: it may raise, for map-guarded to score unscored.
 (define (score measure ok? answer)
-  (let ((score (and ok? (guard (e (#t #f)) ((asking-score measure) answer)))))
+  (let ((score (and ok? ((asking-score measure) answer))))
     (if (real? score) score +inf.0)))
+
+(define (unscored candidate e) +inf.0)
 
 (define (shuffle ls)
   (map cdr (list-sort (lambda (a b) (< (car a) (car b)))

@@ -10,6 +10,7 @@
           measured-response asking-procs sort-measured shuffle)
   (import (scheme base) (scheme inexact) (scheme cxr) (srfi 1) (srfi 18) (srfi 27)
           (srfi 132) (only (chibi ast) procedure-code procedure-vars opcode?)
+          (only (murdoch sys) map-guarded)
           (murdoch code) (murdoch remote) (murdoch pubsub) (murdoch robot)
           (murdoch task progress))
   (include "metric.scm"))
