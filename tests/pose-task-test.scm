@@ -175,6 +175,19 @@
                                      (lambda (uid) (if (eq? uid 'near) 'none 1))))
              (list who-am-i)))
 
+(test "a candidate whose score raises comes last, and the others are scored" '(far)
+  (pose-task 'score-raises 1 (list '((mobile) ()))
+             (list (metric-by-asking local-aspace-uid
+                                     (lambda (uid) (if (eq? uid 'near) (car '()) 1))))
+             (list who-am-i)))
+(test "and when every score raises, the task is still placed" #t
+  (and (memq (car (pose-task 'scores-raise 1 (list '((mobile) ()))
+                             (list (metric-by-asking local-aspace-uid
+                                                     (lambda (uid) (car '()))))
+                             (list who-am-i)))
+             '(near far))
+       #t))
+
 ;; pose-task's round: one message to each address space for all the
 ;; components, each candidate's promise with its answers to the askings.
 (define (round-of components)
