@@ -166,9 +166,11 @@
 (define (sized-reals low high places what)
   (make-reader (lambda (xs)
                  (and (<= low (length xs) high) (every real? xs)
-                      (every (lambda (i) (or (>= i (length xs)) (positive? (list-ref xs i))))
+                      (every (lambda (i)
+                               (or (>= i (length xs)) (positive? (list-ref xs i))))
                              places)))
                what))
+
 (define (non-negative? x) (and (real? x) (>= x 0)))
 (define (port-number? x) (and (exact-integer? x) (< 0 x 65536)))
 

@@ -187,8 +187,9 @@
 ;;> of \var{task-file} in a REPL's environment (a form that raises is
 ;;> named by the file and its line, with the REPL's hints), poses the
 ;;> task its last form names (see task-of), and writes the result.
-;;> pose-task's progress lines go to the standard output as it works.  Exits 0 when the task
-;;> completed, else 1: not-enough-takers, or a component that failed.
+;;> pose-task's progress lines go to the standard output as it works.
+;;> Exits 0 when the task completed, else 1: not-enough-takers, or a
+;;> component that failed.
 (define (run-pose lab-file task-file)
   (let* ((lab (read-lab lab-file))
          (uid (string->symbol (string-append

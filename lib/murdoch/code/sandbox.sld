@@ -1,7 +1,8 @@
 ;;> The sandbox: the environment received code runs in, and the dynamic
 ;;> extent each received call runs in.
 (define-library (murdoch code sandbox)
-  (export make-lab-environment make-repl-environment lab-code-files check-lab-code visible-names nearest-name
+  (export make-lab-environment make-repl-environment lab-code-files check-lab-code
+          visible-names nearest-name
           guarded-set! guarded-thread-terminate! make-guarded-thread
           make-logged-thread sized-make-vector sized-make-string
           sized-make-bytevector sized-make-list sized-list-tabulate

@@ -268,9 +268,10 @@
 
 ;; rows, each receiver's result, with the value of one that is not n
 ;; entries (answer asked) made a failure: each row is checked once, and
-;; each component's column then read from it by procedures of their own,
-;; where a closure for each receiver and component cost a negotiation of
-;; 64 a tenth of a millisecond of the poser's CPU (docs/speed.md).
+;; each component's column then read from it by procedures of their own:
+;; checked again for each component, with closures for each receiver, the
+;; rows cost the poser of a negotiation of 64 0.45 ms of CPU where they
+;; now cost 0.07, while the lab waits (docs/speed.md).
 (define (checked-rows rows n)
   (cond ((null? rows) '())
         ((or (not (result-ok? (car rows))) (row-of? (result-value (car rows)) n))
