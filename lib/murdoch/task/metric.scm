@@ -186,7 +186,7 @@
         +inf.0)))
 
 (define (measured-told uids measures)
-  (if (pose-task-progress) (progress "  measured " (map list uids measures)))
+  (progress "  measured " (map list uids measures))
   measures)
 
 ;; The procedures that a candidate is asked for the measures among keys,

@@ -196,11 +196,10 @@
          (round (request-components (pose-name task) (round-components task)))
          (responses (map without-excluded type-list (map car round))))
     (pose-tried-set! task (append-map (lambda (r) (map car r)) responses))
-    (if (pose-task-progress)
-        (for-each (lambda (i layout response)
-                    (progress "  component " i " needs " layout ": candidates "
-                              (map car response)))
-                  (iota (length responses) 1) (pose-layouts task) responses))
+    (for-each (lambda (i layout response)
+                (progress "  component " i " needs " layout ": candidates "
+                          (map car response)))
+              (iota (length responses) 1) (pose-layouts task) responses)
     (let ((winners (and (not (any null? responses))
                         (choose (map measured-response responses (pose-keys-list task)
                                      (map cadr round))
