@@ -356,18 +356,8 @@
 ;;> Reserves and promises, if addressed here and free: (#t uid promise)
 ;;> or (#f uid).
 (define (receive-request-exclusive topiclist task-name uid proc args)
-  (if (and (subscribed-to-all? (car topiclist)) (subscribed-to-all? (cadr topiclist)))
-      (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
-                   proc args)
-      (list #f (local-aspace-uid))))
-
-;; Whether every one of subjects is subscribed here: an address space
-;; that lacks one answers at once, without the lock and the reservation's
-;; checks (most of a lab, for a robot's component).  Read without the
-;; lock, as addressed-here? reads: the list is replaced, not changed.
-(define (subscribed-to-all? subjects)
-  (or (null? subjects)
-      (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
+  (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
+               proc args))
 
 ;;> The shared counterpart of receive-request-exclusive.
 (define (receive-request-non-exclusive topics task-name uid proc args)
@@ -458,31 +448,44 @@
   (let ((subs (map find-subscription topics)))
     (and (every (lambda (s) (and s (ok? s))) subs) subs)))
 
+;; Whether every one of subjects is subscribed here, by its own name: an
+;; address space that lacks one reserves nothing, and is told so without
+;; the lock and the reservation's checks (most of a lab, for a robot's
+;; component).  Read without the lock, as addressed-here? reads: the
+;; list is replaced, not changed.
+(define (subscribed-to-all? subjects)
+  (or (null? subjects)
+      (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
+
 (define (reserve! exclusive non-exclusive task uid)
-  (with-subscriptions
-    (lambda ()
-      (let ((ex (and (not (and (pair? exclusive) (offered-elsewhere? uid)))
-                     (subscriptions-if exclusive (lambda (s) (free-for? s task)))))
-            (non (subscriptions-if non-exclusive
-                                   (lambda (s) (not-held-by-another? s task)))))
-        (and ex non
-             (begin
-               (for-each (lambda (s)
-                           (hold! s task)
-                           (add-subscription!
-                            (in-use-subject (subscription-topic s))))
-                         ex)
-               (new-reservation! task exclusive '())))))))
+  (and
+   (subscribed-to-all? exclusive) (subscribed-to-all? non-exclusive)
+   (with-subscriptions
+     (lambda ()
+       (let ((ex (and (not (and (pair? exclusive) (offered-elsewhere? uid)))
+                      (subscriptions-if exclusive (lambda (s) (free-for? s task)))))
+             (non (subscriptions-if non-exclusive
+                                    (lambda (s) (not-held-by-another? s task)))))
+         (and ex non
+              (begin
+                (for-each (lambda (s)
+                            (hold! s task)
+                            (add-subscription!
+                             (in-use-subject (subscription-topic s))))
+                          ex)
+                (new-reservation! task exclusive '()))))))))
 
 (define (reserve-shared! topics task)
-  (with-subscriptions
-    (lambda ()
-      (let ((subs (subscriptions-if
-                   topics
-                   (lambda (s) (memq (subscription-status s) '(() shared))))))
-        (and subs
-             (begin (for-each (lambda (s) (hold! s 'shared)) subs)
-                    (new-reservation! task '() topics)))))))
+  (and
+   (subscribed-to-all? topics)
+   (with-subscriptions
+     (lambda ()
+       (let ((subs (subscriptions-if
+                    topics
+                    (lambda (s) (memq (subscription-status s) '(() shared))))))
+         (and subs
+              (begin (for-each (lambda (s) (hold! s 'shared)) subs)
+                     (new-reservation! task '() topics))))))))
 
 (define (new-reservation! task exclusive shared)
   (let ((r (make-reservation task exclusive shared
