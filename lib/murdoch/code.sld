@@ -6,7 +6,7 @@
   (export abandon-thread! forget-abandoned! abandoned? check-not-abandoned
           abandoned-error? despite-abandonment with-wake-on-abandon make-lab-environment
           make-repl-environment lab-code-files check-lab-code visible-names nearest-name
-          guarded-set! guarded-thread-terminate!
+          at-form-line guarded-set! guarded-thread-terminate!
           make-guarded-thread make-logged-thread sized-make-vector sized-make-string
           sized-make-bytevector sized-make-list sized-list-tabulate sized-iota
           sized-read-bytevector sized-expt call-in-sandbox flush-call-ports!

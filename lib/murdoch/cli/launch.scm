@@ -263,8 +263,5 @@
 ;; hints (a name mistyped, the nearest one); an error names the file and
 ;; the line of the form, as a lab's code file's does.
 (define (eval-at file entry env)
-  (guard (e ((error-object? e)
-             (error (string-append file ":" (number->string (cdr entry)) ": "
-                                   (error-message e)))))
-    (eval-with-hints (car entry) env)))
+  (at-form-line file entry (lambda () (eval-with-hints (car entry) env))))
 

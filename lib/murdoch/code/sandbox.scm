@@ -320,9 +320,10 @@
 (define (check-uses file entry undefined env)
   (let ((name (find (lambda (name) (mentions? (car entry) name)) undefined)))
     (if name
-        (error (string-append file ":" (number->string (cdr entry)) ": "
-                              (symbol->string name) " is used but not defined"
-                              (nearest-defined name env))))))
+        (error (form-line-text file entry
+                               (string-append (symbol->string name)
+                                              " is used but not defined"
+                                              (nearest-defined name env)))))))
 
 ;; The names that code compiled in env refers to and nothing defines, as
 ;; Chibi's own warn-undefs finds them, which writes them as warnings.
@@ -396,12 +397,18 @@
 ;; Evaluates each form of file in env, as a load would; an error, in
 ;; reading or in evaluating, names the file and the line of its form.
 (define (load-into file env)
-  (for-each (lambda (entry)
-              (guard (e ((error-object? e)
-                         (error (string-append file ":" (number->string (cdr entry))
-                                               ": " (error-line e)))))
-                (eval (car entry) env)))
+  (for-each (lambda (entry) (at-form-line file entry (lambda () (eval (car entry) env))))
             (car (read-source file))))
+
+;;> (thunk), where an error it raises is raised again as one line that
+;;> names \var{file} and the line of \var{entry}, a (FORM . LINE) of
+;;> read-source: for the forms of a lab's code file or a task file.
+(define (at-form-line file entry thunk)
+  (guard (e ((error-object? e) (error (form-line-text file entry (error-line e)))))
+    (thunk)))
+
+(define (form-line-text file entry text)
+  (string-append file ":" (number->string (cdr entry)) ": " text))
 
 ;; An error's message and irritants, on one line.
 (define (error-line e)

@@ -2,7 +2,7 @@
 ;;> extent each received call runs in.
 (define-library (murdoch code sandbox)
   (export make-lab-environment make-repl-environment lab-code-files check-lab-code
-          visible-names nearest-name
+          visible-names nearest-name at-form-line
           guarded-set! guarded-thread-terminate! make-guarded-thread
           make-logged-thread sized-make-vector sized-make-string
           sized-make-bytevector sized-make-list sized-list-tabulate
