@@ -35,6 +35,13 @@
 (define (clauses-named name clauses)
   (filter (lambda (c) (and (pair? c) (eq? (car c) name))) clauses))
 
+;; A code file the lab names: by an absolute path, or one relative to the
+;; lab's folder.
+(define (code-path lab file)
+  (if (and (> (string-length file) 0) (char=? (string-ref file 0) #\/))
+      file
+      (string-append (folder-of lab) file)))
+
 ;; The lab's code files, read into an environment of their own: the lab's
 ;; code is written for the lab's environment, not as a library, and only
 ;; the path's definitions are used here.
@@ -42,7 +49,7 @@
   (let ((env (mutable-environment '(scheme base) '(scheme inexact))))
     (for-each (lambda (file)
                 (for-each (lambda (form) (eval form env))
-                          (read-all (string-append (folder-of lab) file))))
+                          (read-all (code-path lab file))))
               (append-map cdr (clauses-named 'code (lab-clauses lab))))
     env))
 

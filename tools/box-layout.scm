@@ -264,6 +264,7 @@
       (cond (why
              (display (string-append "box-layout: seed " (number->string seed)
                                      ": refused: " why "\n"))
+             (flush-output-port)
              (exit 3))
             (else
              (create-directory* dir)
@@ -274,6 +275,7 @@
                                      " after "
                                      (number->string (/ (round (* 10 (uniform 2 12))) 10))
                                      " s\n"))
+             (flush-output-port)
              (exit 0))))))
 
 (main (cdr (command-line)))
