@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
+.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched bench-box \
 	demo demo-box clean
 
 all: deps
@@ -39,6 +39,11 @@ bench-chaos: all
 
 bench-sched: all
 	tools/chibi bench/sched.scm
+
+# The box team on generated layouts (docs/box-move.md): BOX_RUNS (20)
+# without a fault, BOX_FAULT_RUNS (10) with one, from seed BOX_SEED (1) on.
+bench-box: all
+	tools/chibi bench/box.scm
 
 demo: all
 	bin/murdoch demo examples/tulane-lab.scm

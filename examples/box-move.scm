@@ -241,27 +241,119 @@
 (define (partner) (list-ref team (if (eq? (local-aspace-uid) (car team)) 1 0)))
 
 ;; Finds its way to its place behind the box, as it sees the box (which
-;; stays put meanwhile); fails when it has never seen it.
+;; stays put meanwhile), on the side agreed with the other pusher.  Until
+;; it first sees the box, the user's word stands in for a sighting: the box
+;; starts at the path's start.  A sighting is checked before the robot
+;; drives by it (sane-sighting?); it drives by one at most a second old,
+;; else it turns to where it last saw the box and looks again (look-for!).
+;; It fails when it has come no nearer its place for stall-seconds.
 (define (take-place previous)
-  (let ((side (my-side)) (first (see-box)))
-    (if (not first)
-        (error "take-place: this robot's fiducial finder does not see the box"
-               (local-aspace-uid) (reckon)))
-    (sonar-start)
-    (start-round!)
-    (let loop ((box first) (began now))
+  (sonar-start)
+  (start-round!)
+  (reset-progress!)
+  (let* ((first (see-box)) (side (agree-side (my-side) (or first (path-start-box)))))
+    (let loop ((box (or first (path-start-box))) (seen-at (if first now -100)))
       (start-round!)
-      (cond ((at-place? box (* side pusher-offset))
-             (stop-base)
-             (rotate 'to (place-axis box))
-             (list (local-aspace-uid) (role side)))
-            ((> (- now began) 300)
-             (stop-base)
-             (error "take-place: found no way to its place behind the box"
-                    (local-aspace-uid) (place-of box side)))
-            (else (approach! (list box '()) (* side pusher-offset))
-                  (thread-sleep! 0.1)
-                  (loop (or (see-box) box) began))))))
+      (let* ((sighting (see-box))
+             (ok? (and sighting (sane-sighting? sighting box seen-at)))
+             (box (if ok? sighting box))
+             (seen-at (if ok? now seen-at))
+             (fresh? (< (- now seen-at) 1)))
+        (cond ((and fresh? (at-place? box (* side pusher-offset)))
+               (stop-base)
+               (rotate 'to (place-axis box))
+               (list (local-aspace-uid) (role side)))
+              ((stalled? (and fresh? (distance (reckon) (place-of box side))))
+               (stop-base)
+               (error (string-append "take-place: no nearer its place behind the box in "
+                                     (number->string stall-seconds) " s: " held)
+                      (local-aspace-uid) (rounded (reckon)) 'box (rounded box)
+                      'place (rounded (place-of box side))))
+              (fresh? (approach! (list box '()) (* side pusher-offset)))
+              (else (look-for! box)))
+        (thread-sleep! 0.1)
+        (loop box seen-at)))))
+
+;; Whether a sighting of the box may be driven by: it does not put the box
+;; on this robot, and, after a sighting within the last 2 s, the box has
+;; not leapt more than 300 mm since.  One that is not is looked at again,
+;; and after 2 s the next is taken as it is, for the box may really have
+;; been knocked away.
+(define (sane-sighting? sighting last seen-at)
+  (and (> (box-clearance (reckon) sighting) (- body-radius 60))
+       (or (> (- now seen-at) 2) (< (distance sighting last) 300))))
+
+;; How far point p lies outside the box's square: 0 inside it.
+(define (box-clearance p box)
+  (let* ((a (* (list-ref box 2) degrees))
+         (dx (- (car p) (car box))) (dy (- (cadr p) (cadr box)))
+         (u (max 0 (- (abs (+ (* dx (cos a)) (* dy (sin a)))) box-half)))
+         (v (max 0 (- (abs (- (* dy (cos a)) (* dx (sin a)))) box-half))))
+    (sqrt (+ (* u u) (* v v)))))
+
+;; Looks for the box, last seen (or said to be) at box: turns to face it;
+;; facing it and still not seeing it (another robot hides it, or it is out
+;; of the finder's range), comes nearer it along a planned way, or, when
+;; what it last saw puts the box on this robot, turns on to look about.
+(define (look-for! box)
+  (let* ((me (reckon)) (bearing (wrap (- (heading-to me box) (list-ref me 2)))))
+    (cond ((> (abs bearing) 30)
+           (set! held "it does not see the box, and turns to where it was last seen")
+           (drive! 0 (clip (* 2 bearing) 40)))
+          ((> (box-clearance me box) (- body-radius 60))
+           (set! held "it does not see the box where it was last seen, and goes nearer")
+           (approach! (list box '()) 0))
+          (else
+           (set! held "it does not see the box, and looks about")
+           (drive! 0 30)))))
+
+;; The pushers' sides: the one that stands further left of the box's axis
+;; (as each sees the box) takes the left place, so that the two do not
+;; cross each other's way to them, whichever the negotiation gave which.
+;; Each tells the other where it stands; one that hears nothing within 10 s
+;; keeps the side it was given.
+(define (agree-side side box)
+  (let* ((team (step-team))
+         (other (if (eq? (local-aspace-uid) (car team)) (cadr team) (car team)))
+         (me (reckon)) (a (* degrees (place-axis box)))
+         (mine (- (* (- (cadr me) (cadr box)) (cos a)) (* (- (car me) (car box)) (sin a)))))
+    (team-send! other (list 'left-of-axis mine))
+    (let wait ((left 10))
+      (let ((heard (and (> left 0) (guard (e (#t #f)) (team-receive left)))))
+        (cond ((not heard) side)
+              ((and (eq? (car heard) other) (pair? (cdr heard))
+                    (eq? (cadr heard) 'left-of-axis))
+               (let ((theirs (list-ref heard 2)))
+                 (cond ((> mine theirs) 1) ((< mine theirs) -1) (else side))))
+              (else (wait (- left 1))))))))
+
+(define (rounded xs) (map (lambda (x) (exact (round x))) xs))
+
+;;; No spinning: a robot that comes no nearer its end for stall-seconds of
+;;; its own clock stops, and its part fails saying what held it.
+
+(define stall-seconds 60)
+(define best-to-go #f)                  ; mm still to go, the least so far
+(define progress-at 0)                  ; when it last fell by 100 mm
+(define held "")                        ; what holds the robot, in words
+
+(define (reset-progress!)
+  (set! best-to-go #f)
+  (set! progress-at now)
+  (set! held "nothing it could tell"))
+
+;; Whether the robot has made no progress for stall-seconds: to-go (mm
+;; still to go, or #f when it cannot tell this round) has not fallen 100 mm
+;; below the least it was.
+(define (stalled? to-go)
+  (if (and to-go (or (not best-to-go) (< to-go (- best-to-go 100))))
+      (begin (set! best-to-go to-go) (set! progress-at now)))
+  (> (- now progress-at) stall-seconds))
+
+;; How far the box still has to go along the path, mm.
+(define (path-to-go box)
+  (let ((legs (nearest-legs box)))
+    (- (path-length legs) (leg-position box (car legs) (cadr legs)))))
 
 ;; Whether this robot stands at the place offset mm left of the middle of
 ;; the box's rear face, against it; with slack (mm: it stood there the
@@ -312,8 +404,9 @@
   (sonar-start)
   (start-round!)
   (set! view-at now)
+  (reset-progress!)
   (let ((watcher (list-ref (step-team) 2)) (side (my-side))
-        (own (see-box)) (began now))
+        (own (see-box)))
     (let loop ((view (latest (and own (list own '())))) (at-face? #f) (said -100))
       (start-round!)
       (let ((said (if (< (- now said) 0.5) said (begin (say-where! watcher) now)))
@@ -325,10 +418,13 @@
             (stop-base)
             (team-send! watcher 'done)
             (list (local-aspace-uid) (role side)))
-           ((> (- now began) 900)
+           ((stalled? (and box (team-to-go box side at-face?)))
             (stop-base)
             (team-send! watcher 'done)
-            (error "push: the box did not reach the goal" box))
+            (error (string-append "push: the box came no nearer its goal in "
+                                  (number->string stall-seconds) " s: "
+                                  (what-holds box at-face?))
+                   (local-aspace-uid) (rounded (reckon)) 'box (and box (rounded box))))
            ((not box) (stop-base) (loop (latest view) at-face? said))
            (else
             (let ((offset (push-offset seen side)))
@@ -343,6 +439,28 @@
                                                    1e9)))
                      (approach! seen offset)
                      (loop (latest view) #f said)))))))))))
+
+;; How far the team still has to go, mm, for the watchdog (stalled?): the
+;; box along its path, this pusher to its place while it is not at the
+;; face, and a spare on its way to its own, as it last said.
+(define (team-to-go box side at-face?)
+  (+ (path-to-go box)
+     (if at-face? 0 (distance (reckon) (place-of box side)))
+     (if (spare-on-its-way?) partner-coming-mm 0)))
+
+;; What holds a pusher whose box has come no nearer its goal, in words.
+(define (what-holds box at-face?)
+  (cond ((not box) "neither this pusher nor the watcher sees the box")
+        ((> (abs (turn-error box)) 45)
+         (string-append "the box is turned " (number->string (exact (round (turn-error box))))
+                        " degrees away from its way"))
+        ((not at-face?)
+         (if waypoint
+             "this pusher cannot come up to its place at the box"
+             "this pusher finds no way to its place at the box"))
+        ((spare-on-its-way?) "it waits for a spare that does not come")
+        ((alone?) "it pushes alone: its partner was lost and no spare took its place")
+        (else "the box does not move as it is pushed")))
 
 ;; Tells the watcher where this pusher is, and looks at who is in the team.
 (define (say-where! watcher)
@@ -506,7 +624,10 @@
     (if (and stage (or (< (distance (reckon) (car stage)) 150)
                        (and (eq? (cdr stage) 'behind) (in-corridor? off 1))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (in-corridor? off 2))
+    (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box))
+           (set! held "something stands in its way into its place")
+           (stop-base))
+          ((and (eq? docking 'behind) (in-corridor? off 2))
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
            (if (> (distance (reckon) place) 40)
@@ -517,7 +638,18 @@
            (if (or (not waypoint) (>= (- now planned-at) 0.8))
                (begin (set! planned-at now)
                       (set! waypoint (and stage (plan-way (car stage) box (cadr view))))))
+           (if (not waypoint) (set! held "it finds no way to its place past the box and what its sonar hears"))
            (if waypoint (drive-to! waypoint) (stop-base))))))
+
+;; Whether the sonar hears something other than the box within 200 mm
+;; ahead of the robot's body: another robot on the way into its place,
+;; which it would push into the box.
+(define (blocked-ahead? box)
+  (let ((me (reckon)))
+    (any (lambda (e)
+           (and (< (distance e me) (+ body-radius 200))
+                (< (abs (wrap (- (heading-to me e) (list-ref me 2)))) 35)))
+         (echoes me box))))
 
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
 ;; it along the box's axis: behind it, and the nearer the face the nearer

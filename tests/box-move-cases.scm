@@ -11,26 +11,48 @@
 ;;; the task must say that the lost pusher's component failed with no
 ;;; other robot to take it.  The including file imports what it needs.
 
-;; The demo's output, and whether it exited 0, for LAB with FAULT ("" for
-;; none, or a role: inside, outside).  Its robots steer in real time
-;; against the simulator's clock, so it runs ahead of the tests beside it
-;; (nice -10, as root; as another user nice says it cannot, and the demo
-;; runs as usual): two runs of the suite at once once left the spare of
-;; FAULT=2 too late at the box.
-(define (run-demo lab fault)
+;; The demo's output, and whether it exited 0, for LAB (relative to the
+;; top, or absolute) with FAULT ("" for none, or a role: inside, outside),
+;; killed after (seconds after step 1 is done; default 3).  Its robots steer
+;; in real time against the simulator's clock, so it runs ahead of the tests
+;; beside it (nice -10, as root; as another user nice says it cannot, and
+;; the demo runs as usual): two runs of the suite at once once left the
+;; spare of FAULT=2 too late at the box.
+(define (run-demo lab fault . after)
   (let* ((dir (temporary-directory)) (out (string-append dir "/demo.out"))
          (status
           (system? "sh" "-c"
                    (string-append
-                    "cd \"$0\" && MURDOCH_PORT_BASE=$1 MURDOCH_DEMO_FAULT=$4"
+                    "cd \"$0\" && MURDOCH_PORT_BASE=$1 MURDOCH_DEMO_FAULT=$4 MURDOCH_DEMO_FAULT_AFTER=$6"
                     " MURDOCH_DEMO_TASK=\"$2/examples/pose-box-move.scm\""
                     " MURDOCH_DEMO_JUDGE=\"$2/examples/box-judge.scm\""
-                    " nice -n -10 timeout -s KILL 280 \"$2/bin/murdoch\" demo \"$2/$5\" >\"$3\" 2>&1")
+                    " nice -n -10 timeout -s KILL 280 \"$2/bin/murdoch\" demo \"$5\" >\"$3\" 2>&1")
                    dir (number->string (free-port-base dir)) (tool-path ".") out
-                   fault lab))
+                   fault (if (char=? (string-ref lab 0) #\/) lab (tool-path lab))
+                   (number->string (if (pair? after) (car after) 3))))
          (text (file-text out)))
     (delete-file-hierarchy dir)
     (cons status text)))
+
+;; Draws seed's layout (tools/box-layout.scm) into a fresh folder: the
+;; folder and the generator's words, or #f and its words when it refused.
+(define (generated-layout seed)
+  (let* ((dir (temporary-directory)) (out (string-append dir "/layout.out"))
+         (ok? (system? "sh" "-c" "\"$0\" \"$1\" \"$2\" \"$3\" >\"$4\" 2>&1"
+                       (tool-path "tools/chibi") (tool-path "tools/box-layout.scm")
+                       (number->string seed) dir out)))
+    (cons (and ok? dir) (file-text out))))
+
+;; The number after "box-layout: fault ROLE after" in a layout's words.
+(define (layout-fault words)
+  (any (lambda (line)
+         (let ((prefix "box-layout: fault "))
+           (and (text-contains? line prefix)
+                (let ((in (open-input-string
+                           (substring line (string-length prefix) (string-length line)))))
+                  (let* ((role (read in)) (after (begin (read in) (read in))))
+                    (list (symbol->string role) after))))))
+       (text-lines words)))
 
 ;; The number after "bench: NAME " in text, or #f.
 (define (bench text name)
@@ -44,11 +66,14 @@
 
 ;; One case: LAB's demo with FAULT, its assertions in a group of their own;
 ;; spare? (by default #t) whether LAB has a robot to take a lost pusher's
-;; place.
-(define (box-case lab fault . spare?)
-  (let* ((run (run-demo lab fault)) (status (car run)) (text (cdr run))
-         (name (if (string=? fault "") "box-move" "box-move-fault"))
-         (spare? (or (null? spare?) (car spare?))))
+;; place; after, when the fault comes (run-demo).
+(define (box-case lab fault . options)
+  (let* ((spare? (or (null? options) (car options)))
+         (run (apply run-demo lab fault (if (and (pair? options) (pair? (cdr options)))
+                                            (cdr options)
+                                            '())))
+         (status (car run)) (text (cdr run))
+         (name (if (string=? fault "") "box-move" "box-move-fault")))
     (test-group (string-append lab (if (string=? fault "")
                                        ""
                                        (string-append ", " fault " pusher killed")))
@@ -83,6 +108,20 @@
       (test "the demo says so by its exit status" spare? status))
     (if (not (and (eq? status spare?) (text-contains? text "within 300 mm and 20")))
         (show-failed-run text))))
+
+;; A generated layout's case (tools/box-layout.scm): seed's lab, with its
+;; fault (its role and time) when fault? is true.
+(define (generated-box-case seed fault?)
+  (let* ((made (generated-layout seed)) (dir (car made)))
+    (test-group (string-append "seed " (number->string seed))
+      (test-assert "tools/box-layout.scm draws a layout" dir)
+      (display (cdr made))
+      (if dir
+          (let ((fault (layout-fault (cdr made))))
+            (if fault?
+                (box-case (string-append dir "/lab.scm") (car fault) #t (cadr fault))
+                (box-case (string-append dir "/lab.scm") ""))
+            (delete-file-hierarchy dir))))))
 
 ;; A failed run's output, its judge's verdict first: tests/run shows only
 ;; a few lines after a failure.
