@@ -64,6 +64,13 @@
 (define (drive! speed turn)
   (set-velocity (clip speed (/ 100 round-s)) (clip turn (/ 20 round-s))))
 
+;; Turns the robot in place to heading, unless it nearly faces it: a
+;; rotation of a hundredth of a degree may never be seen to end, for the
+;; simulator lets a body that barely turns fall asleep.
+(define (turn-to! heading)
+  (if (> (abs (wrap (- heading (list-ref (reckon) 2)))) 2)
+      (rotate 'to heading)))
+
 ;; The box as this robot sees it, (X Y HEADING) in the room, or #f.
 (define (see-box)
   (let ((seen (fiducials)))
@@ -176,7 +183,7 @@
 ;;; The watcher
 
 (define (watch-place previous)
-  (rotate 'to (heading-to (reckon) (car box-path)))
+  (turn-to! (heading-to (reckon) (car box-path)))
   (local-aspace-uid))
 
 ;; Tells the pushers where the box is, and where the bodies of lost pushers
@@ -261,7 +268,7 @@
              (fresh? (< (- now seen-at) 1)))
         (cond ((and fresh? (at-place? box (* side pusher-offset)))
                (stop-base)
-               (rotate 'to (place-axis box))
+               (turn-to! (place-axis box))
                (list (local-aspace-uid) (role side)))
               ((stalled? (and fresh? (distance (reckon) (place-of box side))))
                (stop-base)
@@ -624,7 +631,7 @@
     (if (and stage (or (< (distance (reckon) (car stage)) 150)
                        (and (eq? (cdr stage) 'behind) (in-corridor? off 1))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box))
+    (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box axis))
            (set! held "something stands in its way into its place")
            (stop-base))
           ((and (eq? docking 'behind) (in-corridor? off 2))
@@ -641,14 +648,16 @@
            (if (not waypoint) (set! held "it finds no way to its place past the box and what its sonar hears"))
            (if waypoint (drive-to! waypoint) (stop-base))))))
 
-;; Whether the sonar hears something other than the box within 200 mm
-;; ahead of the robot's body: another robot on the way into its place,
-;; which it would push into the box.
-(define (blocked-ahead? box)
-  (let ((me (reckon)))
+;; Whether the sonar hears something other than the box in the robot's
+;; way along axis, within 150 mm of its body: another robot on the way into
+;; its place, which it would push into the box.
+(define (blocked-ahead? box axis)
+  (let ((me (reckon)) (a (* axis degrees)))
     (any (lambda (e)
-           (and (< (distance e me) (+ body-radius 200))
-                (< (abs (wrap (- (heading-to me e) (list-ref me 2)))) 35)))
+           (let* ((dx (- (car e) (car me))) (dy (- (cadr e) (cadr me)))
+                  (ahead (+ (* dx (cos a)) (* dy (sin a))))
+                  (aside (- (* dy (cos a)) (* dx (sin a)))))
+             (and (< 0 ahead (+ body-radius 150)) (< (abs aside) (- body-radius 40)))))
          (echoes me box))))
 
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
@@ -664,12 +673,15 @@
 
 ;; Where to come up to the place offset mm left of the middle from, as
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
-;; nearer, or out to its side, whichever first is clear of the bodies;
-;; beside it, 450 mm out, when a body lies right behind it.  #f when the
-;; place itself is not clear.
+;; nearer, or out to its side, whichever first is clear of the bodies and
+;; of what the sonar hears (a wall behind the box); beside it, 450 mm out,
+;; when a body lies right behind it.  #f when the place itself is not clear.
 (define (staging box axis offset bodies)
-  (let ((out (if (< offset 0) -1 1)))
-    (define (clear p kind) (and (clear-of? bodies (list p)) (cons p kind)))
+  (let ((out (if (< offset 0) -1 1)) (heard (echoes (reckon) box)))
+    (define (clear p kind)
+      (and (clear-of? bodies (list p))
+           (every (lambda (e) (> (distance e p) (+ body-radius 120))) heard)
+           (cons p kind)))
     (and (clear-of? bodies (list (behind-at box axis offset)) -40)
          (or (any (lambda (back)
                     (clear (behind-at box axis offset

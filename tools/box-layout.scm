@@ -144,8 +144,9 @@
 
 ;; Why the team cannot do the layout, or #f.  The box, turned any way, and
 ;; its pushers behind it must keep off the walls all along the path; a
-;; pusher needs room behind the box to come up to it; and each robot must
-;; stand clear (robot-trouble).
+;; pusher needs room behind the box at the start to come up to it, along
+;; the box's axis from 250 mm behind its place; and each robot must stand
+;; clear (robot-trouble).
 (define (refusal layout)
   (let-values (((w d side mass box-heading path bends robots) (apply values layout)))
     (let* ((half (/ side 2))
@@ -162,21 +163,24 @@
                                      " needs " (mm-words sweep))))
                path names)
           ;; Where each pusher stands along each leg, and at the start the
-          ;; staging points it comes up from, 450 mm further back.
+          ;; nearest point it comes up from (box-move.scm's staging), 250 mm
+          ;; further back, clear of the sonar's echoes of the wall.
           (any (lambda (leg)
                  (let ((h (heading-to (car leg) (cadr leg))))
-                   (any (lambda (p back)
+                   (any (lambda (p back need what)
                           (any (lambda (o)
                                  (let ((q (towards (towards p (+ h 180) back) (+ h 90) o)))
-                                   (and (< (clearance q w d) (+ radius 100))
-                                        (string-append "a pusher's place behind the box at "
+                                   (and (< (clearance q w d) need)
+                                        (string-append "a pusher's " what " behind the box at "
                                                        (point-words p) ", " (point-words q)
                                                        ", is " (mm-words (clearance q w d))
-                                                       " from a wall; a robot needs "
-                                                       (mm-words (+ radius 100))))))
+                                                       " from a wall; it needs "
+                                                       (mm-words need)))))
                                '(-170 170)))
                         (list (car leg) (cadr leg) (car leg))
-                        (list behind behind (+ behind 450)))))
+                        (list behind behind (+ behind 250))
+                        (list (+ radius 100) (+ radius 100) (+ radius 170))
+                        '("place" "place" "way in"))))
                legs)
           (let loop ((rs robots) (before '()))
             (and (pair? rs)
