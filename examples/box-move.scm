@@ -276,10 +276,10 @@
                                      (number->string stall-seconds) " s: " held)
                       (local-aspace-uid) (rounded (reckon)) 'box (rounded box)
                       'place (rounded (place-of box side))))
-              (fresh? (approach! (list box '()) (* side pusher-offset)))
-              (else (look-for! box)))
-        (thread-sleep! 0.1)
-        (loop box seen-at)))))
+              (else
+               (if fresh? (approach! (list box '()) (* side pusher-offset)) (look-for! box))
+               (thread-sleep! 0.1)
+               (loop box seen-at)))))))
 
 ;; Whether a sighting of the box may be driven by: it does not put the box
 ;; on this robot, and, after a sighting within the last 2 s, the box has
@@ -432,7 +432,11 @@
                                   (number->string stall-seconds) " s: "
                                   (what-holds box at-face?))
                    (local-aspace-uid) (rounded (reckon)) 'box (and box (rounded box))))
-           ((not box) (stop-base) (loop (latest view) at-face? said))
+           ;; Seeing no box, and told of none lately: a spare far off looks
+           ;; for it where it was last told of.
+           ((not box)
+            (if (and view (not at-face?)) (look-for! (car view)) (stop-base))
+            (loop (latest view) at-face? said))
            (else
             (let ((offset (push-offset seen side)))
               (cond ((at-place? box offset (and at-face? (if (alone?) 75 200)))
