@@ -479,11 +479,13 @@
     (set! team (step-team))
     (team-send! watcher (list 'at (car me) (cadr me)))))
 
-;; The watcher's view, while it is at most a second old; else this robot's
-;; own sighting of the box, with the bodies last told; else #f: a pusher
-;; does not push on a view older than that, however slow the round.
+;; The watcher's view, while it is at most a second old and does not put
+;; the box on this robot; else this robot's own sighting of the box, with
+;; the bodies last told; else #f: a pusher does not push on a view older
+;; than that, however slow the round.
 (define (fresh view)
-  (if (< (- now view-at) 1)
+  (if (and view (< (- now view-at) 1)
+           (> (box-clearance (reckon) (car view)) (- body-radius 60)))
       view
       (let ((own (see-box)))
         (and own (list own (if view (cadr view) '()))))))
@@ -635,7 +637,7 @@
     (if (and stage (or (< (distance (reckon) (car stage)) 150)
                        (and (eq? (cdr stage) 'behind) (in-corridor? off 1))))
         (set! docking (cdr stage)))
-    (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box axis))
+    (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box axis place))
            (set! held "something stands in its way into its place")
            (stop-base))
           ((and (eq? docking 'behind) (in-corridor? off 2))
@@ -652,16 +654,17 @@
            (if (not waypoint) (set! held "it finds no way to its place past the box and what its sonar hears"))
            (if waypoint (drive-to! waypoint) (stop-base))))))
 
-;; Whether the sonar hears something other than the box in the robot's
-;; way along axis, within 150 mm of its body: another robot on the way into
-;; its place, which it would push into the box.
-(define (blocked-ahead? box axis)
+;; Whether the sonar hears something other than the box in the way into
+;; the place along axis: within 150 mm ahead of the robot's body and 100
+;; mm of the place's line, where another robot would be pushed into the
+;; box.  The other pusher at its own place, 340 mm aside, is not in it.
+(define (blocked-ahead? box axis place)
   (let ((me (reckon)) (a (* axis degrees)))
     (any (lambda (e)
-           (let* ((dx (- (car e) (car me))) (dy (- (cadr e) (cadr me)))
-                  (ahead (+ (* dx (cos a)) (* dy (sin a))))
-                  (aside (- (* dy (cos a)) (* dx (sin a)))))
-             (and (< 0 ahead (+ body-radius 150)) (< (abs aside) (- body-radius 40)))))
+           (let ((ahead (+ (* (- (car e) (car me)) (cos a)) (* (- (cadr e) (cadr me)) (sin a))))
+                 (aside (- (* (- (cadr e) (cadr place)) (cos a))
+                           (* (- (car e) (car place)) (sin a)))))
+             (and (< 0 ahead (+ body-radius 150)) (< (abs aside) 100))))
          (echoes me box))))
 
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
