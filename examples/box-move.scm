@@ -91,13 +91,24 @@
 
 
 ;; Whether the box has reached the goal: near it, or past it along the
-;; path's last leg.
+;; path's last leg and within 250 mm of that leg's line.
 (define (arrived? box)
+  (let ((off (goal-offsets box)))
+    (or (< (distance box (goal)) 120)
+        (and (>= (car off) -60) (< (abs (cadr off)) 250)))))
+
+;; How far the box is past the goal along the last leg, and to its left.
+(define (goal-offsets box)
   (let* ((g (goal)) (from (list-ref box-path (max 0 (- (length box-path) 2))))
-         (d (* degrees (heading-to from g))))
-    (or (< (distance box g) 120)
-        (>= (+ (* (- (car box) (car g)) (cos d)) (* (- (cadr box) (cadr g)) (sin d)))
-            -60))))
+         (d (* degrees (heading-to from g)))
+         (dx (- (car box) (car g))) (dy (- (cadr box) (cadr g))))
+    (list (+ (* dx (cos d)) (* dy (sin d))) (- (* dy (cos d)) (* dx (sin d))))))
+
+;; Whether the box has gone past the goal wide of it: it cannot be pushed
+;; back.
+(define (passed-wide? box)
+  (let ((off (goal-offsets box)))
+    (and (>= (car off) -60) (>= (abs (cadr off)) 250))))
 
 ;; The place behind the box, pushing toward d degrees, offset mm to the
 ;; left of its centre line and back mm behind its centre (by default a
@@ -425,6 +436,13 @@
             (stop-base)
             (team-send! watcher 'done)
             (list (local-aspace-uid) (role side)))
+           ((and box (passed-wide? box))
+            (stop-base)
+            (team-send! watcher 'done)
+            (error (string-append "push: the box passed its goal "
+                                  (number->string (exact (round (abs (cadr (goal-offsets box))))))
+                                  " mm to its side, and cannot be pushed back")
+                   (local-aspace-uid) 'box (rounded box)))
            ((stalled? (and box (team-to-go box side at-face?)))
             (stop-base)
             (team-send! watcher 'done)

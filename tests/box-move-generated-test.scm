@@ -1,4 +1,4 @@
-;;; The box team on the layout of seed 1 (a box north-east, a path of three legs bending left),
+;;; The box team on the layout of seed 1 (a box in the south-east, a path of three legs bending left twice),
 ;;; drawn by tools/box-layout.scm: a layout no example has, which the
 ;;; team knows only by what its robots sense and the path the user gives.
 ;;; One case a file: tests/run gives each file 300 s.  tests/box-move-cases.scm.
