@@ -480,16 +480,21 @@
 ;; What holds a pusher whose box has come no nearer its goal, in words.
 (define (what-holds box at-face?)
   (cond ((not box) "neither this pusher nor the watcher sees the box")
-        ((> (abs (turn-error box)) 45)
-         (string-append "the box is turned " (number->string (exact (round (turn-error box))))
-                        " degrees away from its way"))
         ((not at-face?)
-         (if waypoint
-             "this pusher cannot come up to its place at the box"
-             "this pusher finds no way to its place at the box"))
+         (string-append (if waypoint
+                            "this pusher cannot come up to its place at the box"
+                            "this pusher finds no way to its place at the box")
+                        (turned-words box)))
+        ((> (abs (turn-error box)) 45)
+         (string-append "the box is turned away from its way" (turned-words box)))
         ((spare-on-its-way?) "it waits for a spare that does not come")
         ((alone?) "it pushes alone: its partner was lost and no spare took its place")
         (else "the box does not move as it is pushed")))
+
+;; How far the box must turn to head for its path, in words.
+(define (turned-words box)
+  (string-append " (it must turn " (number->string (exact (round (turn-error box))))
+                 " degrees to head for its path)"))
 
 ;; Tells the watcher where this pusher is, and looks at who is in the team.
 (define (say-where! watcher)
@@ -542,12 +547,16 @@
 ;; lately that it is at the face) turns the box by where it pushes
 ;; (push-offset), and holds while the box turns faster than max-turn-rate.
 ;; A spare coming turns the box the most: once the spare has a way to its
-;; place, the lone pusher holds at its own, leaving the spare's free.
+;; place, the lone pusher holds at its own, leaving the spare's free.  And
+;; from its partner's last word until a spare first speaks (or, with none,
+;; until it is alone), it holds too: pushing alone from its own half, the
+;; inside pusher at a bend turned the box away from the path.
 (define (steer! view side offset)
   (let ((box (car view)))
     (push-at! box (place-axis box) offset
               (cond ((paired?) (pair-share box side))
                     ((spare-on-its-way?) 0)
+                    ((and (not (alone?)) (>= (coming-age) 2)) 0)
                     ((> (abs turn-rate) max-turn-rate) 0)
                     (else 0.5)))))
 
