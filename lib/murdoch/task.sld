@@ -1,5 +1,5 @@
 ;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
-;;> pose-task and a task's life cycle.
+;;> pose-task, a task's life cycle, and the status of the lab.
 ;;> Its members are each a library of their own in task/.
 
 (define-library (murdoch task)
@@ -25,7 +25,10 @@
           make-maxrandom progress explain-no-takers explain-components explanation?
           explanation-line explanation-free explanation-capable with-coordinator
           team-barrier team-send! team-receive step-team make-coordinator
-          negotiated-winners negotiated-types negotiated-name winner-uid winner-promise)
+          negotiated-winners negotiated-types negotiated-name winner-uid winner-promise
+          aspace-report lab-status show-status write-lab-status report-uid report-since
+          report-pose report-battery report-held report-tasks report-goal report-ended
+          held-subject held-holder)
   (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
           (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
-          (murdoch task takers) (murdoch task team)))
+          (murdoch task takers) (murdoch task team) (murdoch task status)))
