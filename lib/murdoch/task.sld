@@ -1,6 +1,8 @@
 ;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
 ;;> pose-task and a task's life cycle.
-;;> Its members are each a library of their own in task/.
+;;> Its members are each a library of their own in task/.  It is a
+;;> selection: the life cycle's members (record, rank, offers, holding,
+;;> waiting) share their insides among themselves, which it leaves out.
 
 (define-library (murdoch task)
   (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
@@ -26,6 +28,8 @@
           explanation-line explanation-free explanation-capable with-coordinator
           team-barrier team-send! team-receive step-team make-coordinator
           negotiated-winners negotiated-types negotiated-name winner-uid winner-promise)
-  (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
-          (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
-          (murdoch task takers) (murdoch task team)))
+  (import (murdoch task assign) (murdoch task running) (murdoch task metric)
+          (murdoch task pose-task) (murdoch task progress) (murdoch task takers)
+          (murdoch task team) (murdoch task record) (murdoch task rank)
+          (murdoch task offers) (murdoch task holding) (murdoch task life-cycle)
+          (murdoch task steps)))
