@@ -1,6 +1,8 @@
 ;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
 ;;> pose-task, a task's life cycle, and the status of the lab.
-;;> Its members are each a library of their own in task/.
+;;> Its members are each a library of their own in task/.  It is a
+;;> selection: the life cycle's members (record, rank, offers, holding,
+;;> waiting) share their insides among themselves, which it leaves out.
 
 (define-library (murdoch task)
   (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
@@ -29,6 +31,8 @@
           aspace-report lab-status show-status write-lab-status report-uid report-since
           report-pose report-battery report-held report-tasks report-goal report-ended
           held-subject held-holder)
-  (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
-          (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
-          (murdoch task takers) (murdoch task team) (murdoch task status)))
+  (import (murdoch task assign) (murdoch task running) (murdoch task metric)
+          (murdoch task pose-task) (murdoch task progress) (murdoch task takers)
+          (murdoch task team) (murdoch task record) (murdoch task rank)
+          (murdoch task offers) (murdoch task holding) (murdoch task life-cycle)
+          (murdoch task steps) (murdoch task status)))
