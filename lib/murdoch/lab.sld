@@ -2,7 +2,7 @@
 ;;> setting in one table.
 
 (define-library (murdoch lab)
-  (export read-lab lab? lab-name lab-aspaces lab-setting lab-port-base
+  (export read-lab lab? lab-name lab-aspaces lab-setting lab-port-base planned-port lab-planned-port
           lab-guest-port lab-trip-port lab-trip-host lab-path lab-aspace-by-uid
           lab-robots lab-key lab-clause lab-robot-radius read-source
           unread-lab-port-base lab-aspace-uid lab-aspace-host lab-aspace-port
