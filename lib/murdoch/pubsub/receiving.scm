@@ -186,8 +186,8 @@
       (*on-free*)))
 
 ;; What runs when a reservation of exclusive subjects here ends: tasks
-;; that wait for robots hear of it (task.scm).  Global: the task layer
-;; sets it as it loads, before the lab is joined.
+;; that wait for robots hear of it (task/life-cycle.scm).  Global: the
+;; task layer sets it as it loads, before the lab is joined.
 (define *on-free* (lambda () #f))
 
 ;;> Sets the thunk that runs, outside any lock, each time exclusive
@@ -251,7 +251,7 @@
               promise))))
 
 ;; A promise applied to keep holds its subjects for another lease: a task
-;; that holds what it has while it waits for the rest (task.scm).
+;; that holds what it has while it waits for the rest (task/life-cycle.scm).
 ;; Answers whether it still holds them.
 (define (renew! r)
   (with-subscriptions
