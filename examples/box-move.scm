@@ -385,6 +385,13 @@
         (and (< -150 (car off) 250) (< (abs (cadr off)) (car slack)) (< turn 35))
         (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
+;; How far aside of its place a pusher at the face may stand and still push
+;; from there: 200 mm beside its partner, 75 mm alone; 100 mm while its
+;; partner is coming, for one further aside stands in the way into the
+;; partner's place, 340 mm off, and holds there waiting for it.
+(define (aside-slack)
+  (cond ((alone?) 75) ((paired?) 200) (else 100)))
+
 ;; What the pusher hears, on its own clock: when its partner last said it
 ;; was at the face ('here), and when it last said how far it still had to
 ;; come ((coming MM)); when the newest view came.
@@ -457,7 +464,7 @@
             (loop (latest view) at-face? said))
            (else
             (let ((offset (push-offset seen side)))
-              (cond ((at-place? box offset (and at-face? (if (alone?) 75 200)))
+              (cond ((at-place? box offset (and at-face? (aside-slack)))
                      (team-send! (partner) 'here)
                      (steer! seen side offset)
                      (loop (latest view) #t said))
