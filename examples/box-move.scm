@@ -494,7 +494,7 @@
                         (turned-words box)))
         ((> (abs (turn-error box)) 45)
          (string-append "the box is turned away from its way" (turned-words box)))
-        ((spare-on-its-way?) "it waits for a spare that does not come")
+        ((spare-on-its-way?) "it holds for its partner (or a spare), which does not come up")
         ((alone?) "it pushes alone: its partner was lost and no spare took its place")
         (else "the box does not move as it is pushed")))
 
