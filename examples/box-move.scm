@@ -267,9 +267,10 @@
 ;; It fails when it has come no nearer its place for stall-seconds.
 (define (take-place previous)
   (sonar-start)
-  (start-round!)
-  (reset-progress!)
-  (let* ((first (see-box)) (side (agree-side (my-side) (or first (path-start-box)))))
+  (let* ((first (begin (start-round!) (see-box)))
+         (side (agree-side (my-side) (or first (path-start-box)))))
+    (start-round!)
+    (reset-progress!)
     (let loop ((box (or first (path-start-box))) (seen-at (if first now -100)))
       (start-round!)
       (let* ((sighting (see-box))
@@ -328,7 +329,7 @@
 ;; The pushers' sides: the one that stands further left of the box's axis
 ;; (as each sees the box) takes the left place, so that the two do not
 ;; cross each other's way to them, whichever the negotiation gave which.
-;; Each tells the other where it stands; one that hears nothing within 10 s
+;; Each tells the other where it stands; one that hears nothing within 60 s
 ;; keeps the side it was given.
 (define (agree-side side box)
   (let* ((team (step-team))
@@ -336,7 +337,7 @@
          (me (reckon)) (a (* degrees (place-axis box)))
          (mine (- (* (- (cadr me) (cadr box)) (cos a)) (* (- (car me) (car box)) (sin a)))))
     (team-send! other (list 'left-of-axis mine))
-    (let wait ((left 10))
+    (let wait ((left 60))
       (let ((heard (and (> left 0) (guard (e (#t #f)) (team-receive left)))))
         (cond ((not heard) side)
               ((and (eq? (car heard) other) (pair? (cdr heard))
