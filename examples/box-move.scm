@@ -203,6 +203,7 @@
 (define (watch previous)
   (team-barrier 'push 120)
   (start-round!)
+  (reset-progress!)
   (let loop ((last #f) (where '()) (done 0) (began now))
     (start-round!)
     (let ((box (see-box)) (bodies (lost-bodies where)))
@@ -216,6 +217,14 @@
              (where (fold-at heard where))
              (done (+ done (count (lambda (h) (eq? (cdr h) 'done)) heard))))
         (cond ((or (>= done 2) (and (>= done 1) box (arrived? box))) (or box 'lost-sight))
+              ;; A pusher that stalls says it is done and fails; one lost
+              ;; says nothing: the watcher, too, stops when the box has
+              ;; come no nearer its goal for longer than a pusher waits.
+              ((and (stalled? (and box (path-to-go box)))
+                    (> (- now progress-at) (+ stall-seconds 30)))
+               (error (string-append "watch: the box came no nearer its goal in "
+                                     (number->string (+ stall-seconds 30)) " s")
+                      'box (and box (rounded box)) 'pushers-done done))
               ((> (- now began) 900) (error "watch: the pushers did not finish" done))
               (else (loop box where done began)))))))
 
