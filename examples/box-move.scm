@@ -396,11 +396,11 @@
         (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
 ;; How far aside of its place a pusher at the face may stand and still push
-;; from there: 200 mm beside its partner, 75 mm alone; 100 mm while its
-;; partner is coming, for one further aside stands in the way into the
+;; from there: 200 mm, 75 mm alone; 100 mm while its partner says it is on
+;; its way to its place, for one further aside stands in the way into the
 ;; partner's place, 340 mm off, and holds there waiting for it.
 (define (aside-slack)
-  (cond ((alone?) 75) ((paired?) 200) (else 100)))
+  (cond ((alone?) 75) ((spare-on-its-way?) 100) (else 200)))
 
 ;; What the pusher hears, on its own clock: when its partner last said it
 ;; was at the face ('here), and when it last said how far it still had to
