@@ -747,7 +747,7 @@
 ;; found clear (staging): its own cell, as start's, may be marked.
 (define cell 100)
 (define (plan-way goal box bodies)
-  (let* ((me (reckon)) (margin 1500)
+  (let* ((me (reckon)) (margin 2500)
          (x0 (- (min (car me) (car goal)) margin))
          (y0 (- (min (cadr me) (cadr goal)) margin))
          (nx (cells-across (car me) (car goal) margin))
