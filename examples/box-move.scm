@@ -685,8 +685,10 @@
            (set! held "something stands in its way into its place")
            (stop-base))
           ((and (eq? docking 'behind) (in-corridor? off 2))
+           (set! held "it does not come into its place along the box's axis")
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
+           (set! held "it does not come into its place along the box's face")
            (if (> (distance (reckon) place) 40)
                (drive-to! place)
                (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
@@ -695,7 +697,9 @@
            (if (or (not waypoint) (>= (- now planned-at) 0.8))
                (begin (set! planned-at now)
                       (set! waypoint (and stage (plan-way (car stage) box (cadr view))))))
-           (if (not waypoint) (set! held "it finds no way to its place past the box and what its sonar hears"))
+           (set! held (cond ((not stage) "a lost pusher's body lies at its place")
+                            (waypoint "it drives the way it plans and comes no nearer")
+                            (else "it finds no way to its place past the box and what its sonar hears")))
            (if waypoint (drive-to! waypoint) (stop-base))))))
 
 ;; Whether the sonar hears something other than the box in the way into
