@@ -564,16 +564,12 @@
 ;; lately that it is at the face) turns the box by where it pushes
 ;; (push-offset), and holds while the box turns faster than max-turn-rate.
 ;; A spare coming turns the box the most: once the spare has a way to its
-;; place, the lone pusher holds at its own, leaving the spare's free.  And
-;; from its partner's last word until a spare first speaks (or, with none,
-;; until it is alone), it holds too: pushing alone from its own half, the
-;; inside pusher at a bend turned the box away from the path.
+;; place, the lone pusher holds at its own, leaving the spare's free.
 (define (steer! view side offset)
   (let ((box (car view)))
     (push-at! box (place-axis box) offset
               (cond ((paired?) (pair-share box side))
                     ((spare-on-its-way?) 0)
-                    ((and (not (alone?)) (>= (coming-age) 2)) 0)
                     ((> (abs turn-rate) max-turn-rate) 0)
                     (else 0.5)))))
 
@@ -729,13 +725,16 @@
 ;; Where to come up to the place offset mm left of the middle from, as
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
 ;; nearer, or out to its side, whichever first is clear of the bodies and
-;; of what the sonar hears (a wall behind the box); beside it, 450 mm out,
+;; of what else the sonar hears (a wall behind the box: the echoes of a
+;; body are the body's, whose margin is clear-of?'s); beside it, 450 mm out,
 ;; when a body lies right behind it.  #f when the place itself is not clear.
 (define (staging box axis offset bodies)
   (let ((out (if (< offset 0) -1 1)) (heard (echoes (reckon) box)))
     (define (clear p kind)
       (and (clear-of? bodies (list p))
-           (every (lambda (e) (> (distance e p) (+ body-radius 120))) heard)
+           (every (lambda (e) (or (> (distance e p) (+ body-radius 60))
+                                  (not (clear-of? bodies (list e) -150))))
+                  heard)
            (cons p kind)))
     (and (clear-of? bodies (list (behind-at box axis offset)) -40)
          (or (any (lambda (back)
