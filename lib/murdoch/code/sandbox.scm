@@ -251,8 +251,8 @@
 ;;> (a guard's) gives the thread back the parameters it had when the
 ;;> handler was entered, and which calls \scheme{flush-call-ports!}.
 ;; What parameterize does, for a list of parameters known only when the
-;; process runs, without its dynamic-wind and closures: 1.7 KB of garbage a
-;; call (docs/speed.md, What Chibi charges).  A binding is a pair in the
+;; process runs, without its dynamic-wind (docs/speed.md, What Chibi
+;; charges).  A binding is a pair in the
 ;; thread's list of them, which setting the parameter changes.
 (define (call-in-sandbox proc args)
   (sandboxed (thread-call-ports) (thread-parameters) proc args))

@@ -290,9 +290,8 @@
 ;; bound to a global name after it was first sent still goes as its
 ;; source, which means the same there).  The same procedures are sent
 ;; again and again: a request's, and its user's closure, made afresh for
-;; each request.  Kept by closure, those filled the table, and srfi 69
-;; keeps twelve buckets a key: a requester's heap grew to a gigabyte
-;; making room for the bucket vector (docs/speed.md).  At most max-known
+;; each request; so they are kept by name, not by closure (docs/speed.md).
+;; At most max-known
 ;; are kept, so that a program that sends ever new globals is let go.
 ;; Global: a cache for every thread.
 (define max-known 512)

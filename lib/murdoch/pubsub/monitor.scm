@@ -49,8 +49,7 @@
   (string-copy (load-text ((monitoring-load-source *monitoring*)))))
 
 ;; The text of load, kept while the load stays the same: every negotiation
-;; asks each idle address space for it, and Chibi's number->string makes a
-;; string port each time (docs/speed.md).  Copied out, as received code
+;; asks for it (docs/speed.md).  Copied out, as received code
 ;; may change the string it is given.
 (define (load-text load)
   (let ((last (monitoring-last-load *monitoring*)))

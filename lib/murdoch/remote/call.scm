@@ -76,8 +76,7 @@
 ;; What the answer of pending call p, of call c, says: the value, or a
 ;; remote-error; none came within c's seconds, and p is given up.
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
-;; Read by cond, not match or case, and no let: each makes closures, and
-;; every peer's answer comes here (docs/speed.md).
+;; By cond, not match or case, and no let (docs/speed.md).
 (define (answer-value p c)
   (answer-says p (pending-call-answer p) c))
 
@@ -319,8 +318,7 @@
 
 ;; Hands an (answer ID KIND VALUE) frame from address space uid to the
 ;; call that waits for it; one for a call no longer waited for, or from
-;; an address space it was not sent to, is dropped.  A request's every
-;; answer by multicast comes here: no match, no let, no closure
+;; an address space it was not sent to, is dropped.  No match, no let
 ;; (docs/speed.md).
 (define (take-datagram-answer! uid message)
   (answer-datagram-call! (pending-of uid (datagram-calls-waiting-for

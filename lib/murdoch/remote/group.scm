@@ -131,10 +131,8 @@
 
 ;;; Receiving
 ;;
-;; On the path of every call that comes by the group, procedures of their
-;; own take what a let or a match would bind, no lock is taken by
-;; with-lock, and no table is read by hash-table-ref/default: each made a
-;; closure for every datagram (docs/speed.md, What Chibi charges).
+;; On the path of every call that comes by the group: no let, match,
+;; with-lock or hash-table-ref/default (docs/speed.md, What Chibi charges).
 
 (define (receive-call)
   (let ((n (receive! (group-socket *group*) (group-buffer *group*))))

@@ -146,8 +146,7 @@
        message-kinds))
 
 ;; The text " FIELD ...)" of fields, written to one string port for every
-;; call, under its lock: a port made for each call cost it 9.7 KB of
-;; garbage (docs/speed.md).  Encoded values are plain data, whose writing
+;; call, under its lock (docs/speed.md).  Encoded values are plain data, whose writing
 ;; raises nothing, so the lock needs no dynamic-wind.
 (define fields-port (open-output-string))
 (define fields-lock (make-mutex 'fields-text))
