@@ -1,11 +1,4 @@
-;;;; The MOVER robot primitives, spoken over trip.
-;;;
-;;; The protocol is docs/trip-protocol.md; in short:
-;;;
-;;;   frame    STX payload ETX, with STX, ETX and DLE sent as DLE, byte^#x40
-;;;   request  "TAG WORD ARG ..."    TAG a number 1..999999999 we choose
-;;;   reply    "TAG ok VALUE ..."  or  "TAG err CODE TEXT"
-;;;   tag 0    the server's own messages (framing errors, streamed readings)
+;;;; The MOVER robot primitives, spoken over trip (docs/trip-protocol.md).
 ;;;
 ;;; One connection per robot, which the threads of the address space
 ;;; share.  A thread sends its request under the connection's lock and
