@@ -34,7 +34,7 @@
           reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
-          ;; the task life cycle (lib/murdoch/task/life-cycle.scm)
+          ;; the task life cycle (lib/murdoch/task/life-cycle.scm and its neighbours)
           start-task task? task-id task-name task-status task-wait cancel-task
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries

@@ -18,7 +18,8 @@
   '(sys lab wire code robot
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
-    (task (assign progress metric takers) team (pose-task running) life-cycle status)
+    (task (assign progress metric takers) team (pose-task running) record rank
+          (offers holding) waiting life-cycle steps status)
     murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))

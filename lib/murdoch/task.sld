@@ -22,6 +22,8 @@
           team-receive step-team aspace-report lab-status show-status
           write-lab-status report-since report-pose report-battery report-held
           report-tasks report-goal report-ended held-subject held-holder)
-  (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
-          (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
-          (murdoch task takers) (murdoch task team) (murdoch task status)))
+  (import (murdoch task assign) (murdoch task running) (murdoch task metric)
+          (murdoch task pose-task) (murdoch task progress) (murdoch task takers)
+          (murdoch task team) (murdoch task record) (murdoch task rank)
+          (murdoch task offers) (murdoch task holding) (murdoch task life-cycle)
+          (murdoch task steps) (murdoch task status)))

@@ -7,6 +7,7 @@
   (import (scheme base) (scheme write) (srfi 1) (only (murdoch sys) utc-seconds)
           (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot)
           (only (murdoch task running) components-ended)
-          (only (murdoch task life-cycle) tasks listed-posed? listed-id listed-state
+          (only (murdoch task life-cycle) tasks)
+          (only (murdoch task record) listed-posed? listed-id listed-state
                 listed-place listed-why listed-index listed-poser))
   (include "status.scm"))
