@@ -1,20 +1,20 @@
 ;;;; Monitors (thesis appendix A.6 monitor.scm) and each address space's
 ;;;; first subscriptions (A.2 initial.scm): capabilities that come and go
-;;;; with the machine's state, subscribed through pubsub.scm.
+;;;; with the machine's state, subscribed through pubsub/messaging.scm.
 
 ;;; Monitors (A.6): capabilities that come and go with the machine's state
 
 ;;> The voltage, in tenths, above which a robot is taken to be on its
 ;;> charging tether; below it, the battery monitor subscribes to untethered.
-(define *battery-charging* 130)
+(define *battery-charging* (lab-default 'battery-charging))
 ;;> The voltage, in tenths, below which a robot's battery is low.
-(define *battery-low* 100)
+(define *battery-low* (lab-default 'battery-low))
 
 ;; A string, as in the thesis, where it crossed differently byte-ordered
 ;; machines.
 ;;> The load, a string such as ".75", below which the load monitor
 ;;> subscribes to idle.
-(define *load-threshold* ".75")
+(define *load-threshold* (lab-default 'load-threshold))
 
 ;; The thesis's names (A.5, A.6), global as there.  Received code reads
 ;; these and cannot assign them (sandbox.scm): a setting meant to change

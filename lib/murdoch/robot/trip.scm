@@ -20,11 +20,11 @@
 ;;; use; (im) opens them all at once, as MOVER's did.
 
 ;;> Seconds to wait for any reply.
-(define trip-timeout (make-parameter 5))
+(define trip-timeout (make-parameter (lab-default 'trip-timeout)))
 
 ;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is
 ;;> stopped and an error raised.
-(define trip-motion-timeout (make-parameter 120))
+(define trip-motion-timeout (make-parameter (lab-default 'trip-motion-timeout)))
 
 ;;> The connection the primitives use: #f on a workstation.  Set it for
 ;;> the whole address space with \scheme{set-current-robot!} (threads do
