@@ -20,7 +20,7 @@
         (entry (lab-aspace-by-uid lab uid)))
     (if entry (take-body! lab entry))
     (apply start-aspace! lab uid env port)
-    (initialize-subscriptions! lab entry)
+    (initialize-subscriptions! lab entry robot-freed!)
     env))
 
 ;; The settings that are the values of parameters, or of the thesis's

@@ -144,8 +144,10 @@
 ;;> Sets up this address space's subscriptions and monitors from its lab
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
 ;;> capabilities; idle through load-monitor; untethered through
-;;> battery-monitor on robots.
-(define (initialize-subscriptions! lab entry)
+;;> battery-monitor on robots.  \var{on-free} runs, outside any lock, each
+;;> time exclusive subjects here are freed: the task layer's hook.
+(define (initialize-subscriptions! lab entry on-free)
+  (on-free! on-free)
   (set! *monitoring*
         (make-monitoring (lab-setting lab 'monitor-period)
                          (load-source (and entry (lab-aspace-clause entry 'load)))
