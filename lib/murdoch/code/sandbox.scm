@@ -116,6 +116,7 @@
   (out sandbox-out sandbox-out-set!)
   (err sandbox-err sandbox-err-set!))
 
+;; Global: the lab's max-alloc, for every call the process serves.
 (define *sandbox* #f)
 
 ;; Refuses count items of unit bytes each, past the lab's max-alloc.

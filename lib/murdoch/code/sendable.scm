@@ -188,6 +188,7 @@
   (depth limits-depth)                  ; the lab's max-depth
   (pairs limits-pairs))                 ; a frame of max-frame bytes holds fewer
 
+;; Global: the lab's limits, for every value the process sends.
 (define *limits* #f)
 
 ;;> Takes the limits of values from \var{lab}: the deepest nesting a value

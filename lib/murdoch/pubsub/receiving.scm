@@ -89,6 +89,7 @@
   (seconds lease-seconds)
   (keeper lease-keeper-thread))
 
+;; Global, as the subscriptions are: one lease keeper a process.
 (define *leases* #f)
 
 (define (lease) (lease-seconds *leases*))

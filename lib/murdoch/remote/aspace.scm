@@ -33,6 +33,7 @@
   (peers-lock membership-peers-lock)    ; over peers, unreachable and live
   (live membership-live membership-live-set!)) ; the live set, #f once changed
 
+;; Global: a process joins one lab, as one address space.
 (define *membership* #f)
 
 (define (joined)

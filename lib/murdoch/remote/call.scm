@@ -269,6 +269,7 @@
   (uids others-uids)                    ; the live uids but ours
   (places others-places))               ; uid -> its place in uids
 
+;; Global: the peers of the process's one address space.
 (define *others* (make-others #f '() (make-hash-table eq?)))
 
 ;;> The others that a datagram call to the live set waits for answers from

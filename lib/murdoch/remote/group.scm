@@ -45,6 +45,7 @@
   (last-heard group-last-heard)         ; uid -> monotonic-seconds
   (last-heard-lock group-last-heard-lock))
 
+;; Global: an address space is in at most one group, its lab's.
 (define *group* #f)
 
 (define max-datagram 60000)

@@ -47,6 +47,7 @@
   (janitor-resting? server-janitor-resting? server-janitor-resting?-set!)
   (last-refusal server-last-refusal server-last-refusal-set!)) ; monotonic
 
+;; Global: a process is one address space, which serves on one port.
 (define *server* #f)
 
 (define janitor-seconds 0.1)

@@ -110,6 +110,7 @@
   (max-frame wire-max-frame)
   (max-depth wire-max-depth))
 
+;; Global: the lab's key and limits, for every frame of the process.
 (define *wire* #f)
 
 ;;> Makes the frames and datagrams of this process those of \var{lab}:
