@@ -219,8 +219,8 @@
         (append-reverse! next rev))))
 
 ;; True of data that stands for itself on the wire, pairs of it included:
-;; encode and decode give it back as it is instead of copying it, which
-;; on a receiver's path was most of their cost.  The look (plain-within?,
+;; encode and decode give it back as it is instead of copying it
+;; (docs/speed.md).  The look (plain-within?,
 ;; in plain.c, beside plain-atom?, the atoms that do) stops after a
 ;; budget of pairs, or at the depth limit, so that a long, deep or
 ;; circular value goes the general way, which says what is wrong with it.

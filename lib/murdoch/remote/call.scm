@@ -259,9 +259,7 @@
 
 ;; Whom a datagram call waits for: the live set but this address space,
 ;; and each one's place among them, by which an answer finds its pending
-;; call (a search of the list took a step a peer per answer, and a table
-;; made per call remade its buckets as it grew).  Kept while the live set
-;; is the same list (live-aspaces keeps it until it changes).
+;; call (docs/speed.md).  Kept while the live set is the same list.
 (define-record-type others
   (make-others live uids places)
   others?

@@ -209,12 +209,11 @@
               (server-servings *server*)))))
 
 ;; The janitor rests while no frame is half read and no apply runs in a
-;; reader: looking ten times a second cost an idle lab of 64 a twelfth of
-;; a core.  A reader that begins either wakes it (janitor-wanted!).  The
-;; janitor raises its flag before it looks and holds its mutex from the
-;; flag to the wait; a reader sets what it begins before it reads the flag.
-;; So either the look sees what the reader began, or the reader sees the
-;; flag and its wake-up finds the janitor waiting.
+;; reader (docs/speed.md).  A reader that begins either wakes it
+;; (janitor-wanted!).  The janitor raises its flag before it looks and holds
+;; its mutex from the flag to the wait; a reader sets what it begins before
+;; it reads the flag.  So either the look sees what the reader began, or the
+;; reader sees the flag and its wake-up finds the janitor waiting.
 (define (rest-while-idle)
   (let ((m (server-janitor-mutex *server*)))
     (lock! m)
