@@ -14,7 +14,7 @@
                 ended-ended ended-end)
           (only (murdoch robot) fiducial-id fiducial-range fiducial-bearing
                 fiducial-orientation)
-          (only (murdoch task status) report-since report-pose report-battery report-held
+          (only (murdoch task) report-since report-pose report-battery report-held
                 report-tasks report-goal report-ended held-subject held-holder)
           (scheme base) (scheme write)
           (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)
