@@ -114,16 +114,16 @@ class Robot:
                                       qos_profile_sensor_data)
         self.sonar = None               # 16 ranges in mm, or None before any
         self.sonar_topics = []
-        if args.scan:
-            self.sonar_topics = [topic(ns, args.scan)]
-            self.node.create_subscription(LaserScan, self.sonar_topics[0], self._on_scan,
-                                          qos_profile_sensor_data)
-        elif args.range:
+        if args.range:
             self.sonar_topics = [topic(ns, r) for r in args.range]
             self.ranges = [None] * len(args.range)
             for i, t in enumerate(self.sonar_topics):
                 self.node.create_subscription(
                     Range, t, lambda m, i=i: self._on_range(i, m), qos_profile_sensor_data)
+        elif args.scan:
+            self.sonar_topics = [topic(ns, args.scan)]
+            self.node.create_subscription(LaserScan, self.sonar_topics[0], self._on_scan,
+                                          qos_profile_sensor_data)
         self.battery = None             # volts
         self.battery_topic = topic(ns, args.battery) if args.battery else None
         if self.battery_topic:
@@ -353,11 +353,6 @@ class Server:
         self.base = Base(robot, args)
         self.sessions = {}
         self.sonar_on = False
-        self.have = {"base"}
-        if robot.sonar_topics:
-            self.have.add("sonar")
-        if robot.battery_topic:
-            self.have.add("battery")
         os.makedirs(args.lock_dir, exist_ok=True)
         self.sel = selectors.DefaultSelector()
         self.listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -533,21 +528,23 @@ class Server:
         raise TripError("unknown", "no command or device %.40s" % verb)
 
     def lacks(self, d):
-        if d not in self.have:
-            raise TripError("unknown", "this robot has no %s (a ROS 2 robot: %s)"
-                            % (d, self.missing_why(d)))
-
-    def missing_why(self, d):
-        if d in ("sonar",):
-            return "no scan or range topic in its lab clause"
-        if d == "battery":
-            return "no battery topic in its lab clause"
-        return "trip-ros2 maps only base, sonar and battery"
+        """Raises unknown for a device this robot has not: one trip_ros2 does
+        not map, or one whose topics nothing publishes."""
+        topics = {"base": [self.robot.odom_topic], "sonar": self.robot.sonar_topics,
+                  "battery": [self.robot.battery_topic] if self.robot.battery_topic else []}
+        if d not in topics:
+            raise TripError("unknown", "this robot has no %s (a ROS 2 robot: trip_ros2 maps"
+                            " base, sonar and battery)" % d)
+        node = self.robot.node
+        if not topics[d] or not all(node.get_publishers_info_by_topic(t) for t in topics[d]):
+            raise TripError("unknown", "this robot has no %s: nothing publishes %s"
+                            % (d, " ".join(topics[d]) or "a topic for it"))
 
     def device(self, s, tag, d, rest):
         if not rest:
             raise TripError("args", "%s needs a command" % d)
-        self.lacks(d)
+        if d not in s.locks:
+            self.lacks(d)
         cmd, args = rest[0], rest[1:]
         table = {
             "base": {"vel": 2, "translate": 1, "rotate": 1, "goto": 2, "stop": 0,
@@ -678,9 +675,9 @@ def main():
     p.add_argument("--cmd-vel", choices=sorted(CMD_VEL_TYPES), default="stamped")
     p.add_argument("--cmd-vel-topic", default="cmd_vel")
     p.add_argument("--odom", default="odom")
-    p.add_argument("--scan", default=None)
+    p.add_argument("--scan", default="scan")
     p.add_argument("--range", action="append", default=[])
-    p.add_argument("--battery", default=None)
+    p.add_argument("--battery", default="battery_state")
     p.add_argument("--lock-dir", default=None)
     p.add_argument("--appear-timeout", type=float, default=20.0)
     p.add_argument("--stall", type=float, default=2.0)

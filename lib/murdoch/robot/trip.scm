@@ -297,9 +297,14 @@
     (apply request c device words)))
 
 ;;> MOVER's initialisation: opens every device of the current robot, so
-;;> that a device held elsewhere shows up now rather than mid-task.
+;;> that a device held elsewhere shows up now rather than mid-task.  A
+;;> device the robot has not (\scheme{unknown}: a ROS 2 robot without
+;;> bumpers, say) stays closed, and its commands say so when used.
 (define (im)
-  (for-each (lambda (d) (open-device! (robot) d)) devices)
+  (for-each (lambda (d)
+              (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) #f))
+                (open-device! (robot) d)))
+            devices)
   #t)
 
 ;;; Motion
