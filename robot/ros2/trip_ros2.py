@@ -113,6 +113,7 @@ class Robot:
         self.node.create_subscription(Odometry, self.odom_topic, self._on_odom,
                                       qos_profile_sensor_data)
         self.sonar = None               # 16 ranges in mm, or None before any
+        self.sonar_seq = 0
         self.sonar_topics = []
         if args.range:
             self.sonar_topics = [topic(ns, r) for r in args.range]
@@ -161,6 +162,7 @@ class Robot:
             a += m.angle_increment
         with self.lock:
             self.sonar = [min(far, max(self.args.sonar_min, s)) for s in sectors]
+            self.sonar_seq += 1
 
     def _on_range(self, i, m):
         r = m.range * 1000.0 if math.isfinite(m.range) else self.args.sonar_max
@@ -168,6 +170,7 @@ class Robot:
             self.ranges[i] = min(self.args.sonar_max, max(self.args.sonar_min, r))
             if all(x is not None for x in self.ranges):
                 self.sonar = (self.ranges + [self.args.sonar_max] * SONARS)[:SONARS]
+                self.sonar_seq += 1
 
     def _on_battery(self, m):
         with self.lock:
@@ -342,6 +345,7 @@ class Session:
         self.out = bytearray()
         self.locks = {}                 # device -> fd of its flock
         self.awaits = []
+        self.stream = False
         self.errors = 0
         self.pending_since = None
         self.closed = False
@@ -353,6 +357,7 @@ class Server:
         self.base = Base(robot, args)
         self.sessions = {}
         self.sonar_on = False
+        self.streamed = 0
         os.makedirs(args.lock_dir, exist_ok=True)
         self.sel = selectors.DefaultSelector()
         self.listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -385,6 +390,7 @@ class Server:
         self.base.step()
         if was and not self.base.moving():
             self.answer_awaits()
+        self.stream_sonar()
         for s in list(self.sessions.values()):
             if s.pending_since and now - s.pending_since > self.args.stall_timeout:
                 self.send(s, "0 err stalled incomplete frame for too long")
@@ -652,7 +658,20 @@ class Server:
     def sonar_stream(self, s, tag, word):
         if word not in ("on", "off"):
             raise TripError("args", "sonar stream takes on or off")
-        raise TripError("unknown", "sonar stream: not served for a ROS 2 robot; read instead")
+        s.stream = word == "on"
+        return ""
+
+    def stream_sonar(self):
+        """Each new reading to the sessions that stream it, tag 0."""
+        with self.robot.lock:
+            seq, r = self.robot.sonar_seq, self.robot.sonar
+        if seq == self.streamed or r is None:
+            return
+        self.streamed = seq
+        for s in list(self.sessions.values()):
+            if s.stream and "sonar" in s.locks:
+                self.send(s, "0 sonar " + " ".join("%.0f" % x for x in r))
+                self.flush(s)
 
     def battery_read(self, s, tag):
         with self.robot.lock:
@@ -704,7 +723,8 @@ def main():
     except OSError as e:
         say(args.name, "ERROR: cannot listen on %s:%d: %s" % (args.host, args.port, e.strerror))
         sys.exit(1)
-    print("trip-ros2: %s trip %s:%d" % (args.name, args.host, args.port), flush=True)
+    print("trip-ros2: %s trip %s:%d pid %d" % (args.name, args.host, args.port, os.getpid()),
+          flush=True)
     deadline = time.monotonic() + args.appear_timeout
     try:
         while True:
