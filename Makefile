@@ -2,7 +2,7 @@
 # machine (see README.md).
 
 .PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
-	demo demo-box clean
+	demo demo-box bench-ros2 clean
 
 all: deps
 	$(MAKE) native
@@ -39,6 +39,11 @@ bench-chaos: all
 
 bench-sched: all
 	tools/chibi bench/sched.scm
+
+# Robots through ROS 2: trip command latency and odometry age beside
+# rclpy's floor, the dual-sonar task through ROS 2 over straight (bench/ros2).
+bench-ros2: all
+	bench/ros2
 
 # ROS2=1: every robot reached through ROS 2 (docs/ros2.md).
 demo: all
