@@ -153,7 +153,7 @@
           "1 err held base is held by another client" (ask d "1 open base"))
     (test "a device not open" "2 err not-open open sonar first" (ask d "2 sonar read"))
     (test "a device the robot lacks: unknown, saying so"
-          "5 err unknown this robot has no ir (a ROS 2 robot: trip_ros2 maps base, sonar and battery)"
+          "5 err unknown this robot has no ir (a ROS 2 robot: trip_ros2 maps base, sonar, battery and fiducial)"
           (ask c "5 open ir"))
     (test-assert "no battery topic: battery is unknown, naming the topic"
       (starts? (ask c "6 open battery") "6 err unknown this robot has no battery: nothing publishes /tb2/battery_state"))

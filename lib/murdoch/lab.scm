@@ -193,6 +193,7 @@
     (range . ,(make-reader (lambda (xs) (and (<= 1 (length xs) 16) (every string? xs)))
                            "one to sixteen ROS 2 topic names, in quotes"))
     (battery . ,topic-name)
+    (fiducials . ,topic-name)
     (appear-timeout . ,(values-of 1 positive-real? "a positive number of seconds"))))
 
 (define robot-table

@@ -7,7 +7,9 @@ For each robot NAME, whose trip server sim/b14 runs at HOST:PORT, a node
 under the namespace /NAME that does what a ROS 2 robot's drivers do:
 publishes nav_msgs/Odometry on odom (the B14's odometry), a 16-beam
 sensor_msgs/LaserScan on scan (its sonar ring) and sensor_msgs/BatteryState
-on battery_state, and drives the base from cmd_vel.  It is a trip client of
+on battery_state, the boxes its fiducial finder sees as a
+geometry_msgs/PoseArray on fiducials (each box's pose in the robot's frame,
+its id in position.z), and drives the base from cmd_vel.  It is a trip client of
 the simulator, as any address space is, so `make demo ROS2=1` reaches each
 robot through address space -> trip -> trip_ros2 -> ROS 2 -> this -> trip
 -> sim/b14.  Says `b14-face: ready` once every robot is served.
@@ -24,7 +26,8 @@ import time
 import rclpy
 from rclpy.executors import MultiThreadedExecutor
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
-from geometry_msgs.msg import Twist, TwistStamped
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Pose, PoseArray, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, LaserScan
 
@@ -74,7 +77,7 @@ class Face:
     def __init__(self, node, name, host, port, stamped):
         self.node, self.name = node, name
         self.trip = Trip(host, port)
-        for d in ("base", "sonar", "battery"):
+        for d in ("base", "sonar", "battery", "fiducial"):
             self.trip.ask("open", d)
         self.trip.ask("sonar", "start")
         ns = "/" + name
@@ -82,6 +85,8 @@ class Face:
         self.scan = node.create_publisher(LaserScan, ns + "/scan", qos_profile_sensor_data)
         self.battery = node.create_publisher(BatteryState, ns + "/battery_state",
                                              qos_profile_sensor_data)
+        self.fiducials = node.create_publisher(PoseArray, ns + "/fiducials",
+                                               qos_profile_sensor_data)
         node.create_subscription(TwistStamped if stamped else Twist, ns + "/cmd_vel",
                                  self.on_cmd_vel, QoSProfile(depth=10))
         self.count = 0
@@ -92,7 +97,10 @@ class Face:
                       "%.2f" % math.degrees(t.angular.z))
 
     def publish(self):
-        now = self.node.get_clock().now().to_msg()
+        # Stamped with the simulator's clock, which runs at its own speed:
+        # the robot's clock, as trip_ros2's `time` answers it.
+        ms = int(self.trip.ask("time")[0])
+        now = Time(sec=ms // 1000, nanosec=(ms % 1000) * 1000000)
         x, y, th = self.trip.ask("base", "reckon")
         o = Odometry()
         o.header.stamp = now
@@ -112,6 +120,7 @@ class Face:
             s.range_min, s.range_max = 0.15, 6.5
             s.ranges = [v / 1000.0 for v in r]
             self.scan.publish(s)
+            self.publish_fiducials(now)
         if self.count % BATTERY_EVERY == 1:
             volts, _ = self.trip.ask("battery", "read")
             b = BatteryState()
@@ -119,6 +128,24 @@ class Face:
             b.voltage = volts
             b.present = True
             self.battery.publish(b)
+
+
+    def publish_fiducials(self, now):
+        """The boxes the fiducial finder sees, in the robot's frame: each a
+        pose, its id in position.z (docs/ros2.md)."""
+        w = self.trip.ask("fiducial", "read")
+        a = PoseArray()
+        a.header.stamp = now
+        a.header.frame_id = self.name + "/base_link"
+        for i in range(int(w[0])):
+            ident, rng, bearing, orientation = w[1 + 4 * i: 5 + 4 * i]
+            p = Pose()
+            p.position.x = rng / 1000.0 * math.cos(math.radians(bearing))
+            p.position.y = rng / 1000.0 * math.sin(math.radians(bearing))
+            p.position.z = float(ident)
+            p.orientation.z, p.orientation.w = quaternion(orientation)
+            a.poses.append(p)
+        self.fiducials.publish(a)
 
 
 def main():

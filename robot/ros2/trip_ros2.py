@@ -16,6 +16,9 @@ and drives the robot through ROS 2's standard messages:
     sonar     sensor_msgs/LaserScan folded into the B14's 16 sectors, or
               sensor_msgs/Range topics, one per sonar
     battery   sensor_msgs/BatteryState
+    fiducial  geometry_msgs/PoseArray on fiducials: each marker's pose in the
+              robot's frame, its id in position.z (as robot/ros2/b14_face.py
+              publishes the simulator's fiducial finder)
     who       NAME ros2
 
 A device the robot lacks answers `unknown`.  It says `trip-ros2: NAME trip
@@ -39,7 +42,7 @@ import time
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
-from geometry_msgs.msg import Twist, TwistStamped
+from geometry_msgs.msg import PoseArray, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import BatteryState, LaserScan, Range
 
@@ -110,6 +113,7 @@ class Robot:
         self.odom = None                # (x mm, y mm, heading deg) as the robot has it
         self.odom_at = None             # monotonic seconds of the newest
         self.odom_count = 0
+        self.odom_stamp_ms = 0
         self.node.create_subscription(Odometry, self.odom_topic, self._on_odom,
                                       qos_profile_sensor_data)
         self.sonar = None               # 16 ranges in mm, or None before any
@@ -130,6 +134,11 @@ class Robot:
         if self.battery_topic:
             self.node.create_subscription(BatteryState, self.battery_topic, self._on_battery,
                                           qos_profile_sensor_data)
+        self.fiducials = None           # [(id, range mm, bearing, orientation)]
+        self.fiducial_topic = topic(ns, args.fiducials) if args.fiducials else None
+        if self.fiducial_topic:
+            self.node.create_subscription(PoseArray, self.fiducial_topic, self._on_fiducials,
+                                          qos_profile_sensor_data)
         self.executor = SingleThreadedExecutor()
         self.executor.add_node(self.node)
         threading.Thread(target=self._spin, daemon=True).start()
@@ -146,6 +155,7 @@ class Robot:
                                           1 - 2 * (q.y * q.y + q.z * q.z)))
         with self.lock:
             self.odom = (p.x * 1000.0, p.y * 1000.0, heading)
+            self.odom_stamp_ms = m.header.stamp.sec * 1000 + m.header.stamp.nanosec // 1000000
             self.odom_at = time.monotonic()
             self.odom_count += 1
 
@@ -172,6 +182,18 @@ class Robot:
                 self.sonar = (self.ranges + [self.args.sonar_max] * SONARS)[:SONARS]
                 self.sonar_seq += 1
 
+    def _on_fiducials(self, m):
+        seen = []
+        for p in m.poses:
+            q = p.orientation
+            yaw = math.degrees(math.atan2(2 * (q.w * q.z + q.x * q.y),
+                                          1 - 2 * (q.y * q.y + q.z * q.z)))
+            seen.append((int(round(p.position.z)),
+                         math.hypot(p.position.x, p.position.y) * 1000.0,
+                         math.degrees(math.atan2(p.position.y, p.position.x)), yaw))
+        with self.lock:
+            self.fiducials = sorted(seen, key=lambda f: f[1])[:32]
+
     def _on_battery(self, m):
         with self.lock:
             self.battery = m.voltage
@@ -189,6 +211,10 @@ class Robot:
         self.publisher.publish(t)
 
     def now_ms(self):
+        """The robot's clock: its newest odometry's stamp, else this node's."""
+        with self.lock:
+            if self.odom is not None and self.odom_stamp_ms:
+                return self.odom_stamp_ms
         return self.node.get_clock().now().nanoseconds // 1000000
 
     def appeared(self):
@@ -536,11 +562,13 @@ class Server:
     def lacks(self, d):
         """Raises unknown for a device this robot has not: one trip_ros2 does
         not map, or one whose topics nothing publishes."""
-        topics = {"base": [self.robot.odom_topic], "sonar": self.robot.sonar_topics,
-                  "battery": [self.robot.battery_topic] if self.robot.battery_topic else []}
+        r = self.robot
+        topics = {"base": [r.odom_topic], "sonar": r.sonar_topics,
+                  "battery": [r.battery_topic] if r.battery_topic else [],
+                  "fiducial": [r.fiducial_topic] if r.fiducial_topic else []}
         if d not in topics:
             raise TripError("unknown", "this robot has no %s (a ROS 2 robot: trip_ros2 maps"
-                            " base, sonar and battery)" % d)
+                            " base, sonar, battery and fiducial)" % d)
         node = self.robot.node
         if not topics[d] or not all(node.get_publishers_info_by_topic(t) for t in topics[d]):
             raise TripError("unknown", "this robot has no %s: nothing publishes %s"
@@ -558,6 +586,7 @@ class Server:
                      "set-heading": 1},
             "sonar": {"start": 0, "stop": 0, "read": 0, "stream": -1},
             "battery": {"read": 0, "tether": 1},
+            "fiducial": {"read": 0},
         }[d]
         if cmd not in table:
             raise TripError("unknown", "%s has no command %.40s" % (d, cmd))
@@ -681,6 +710,13 @@ class Server:
                             % self.robot.battery_topic)
         return "%.2f 0" % v
 
+    def fiducial_read(self, s, tag):
+        with self.robot.lock:
+            seen = self.robot.fiducials or []
+        return " ".join([str(len(seen))] + ["%d %.0f %s %s" % (i, r, angle_text(b, 1),
+                                                                angle_text(o, 1))
+                                            for i, r, b, o in seen])
+
     def battery_tether(self, s, tag, on):
         raise TripError("unknown", "battery tether: a ROS 2 robot is plugged in by hand")
 
@@ -697,6 +733,7 @@ def main():
     p.add_argument("--scan", default="scan")
     p.add_argument("--range", action="append", default=[])
     p.add_argument("--battery", default="battery_state")
+    p.add_argument("--fiducials", default="fiducials")
     p.add_argument("--lock-dir", default=None)
     p.add_argument("--appear-timeout", type=float, default=20.0)
     p.add_argument("--stall", type=float, default=2.0)
