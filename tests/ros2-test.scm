@@ -11,7 +11,7 @@
         (only (chibi process) kill signal/kill)
         (only (chibi string) string-prefix?)
         (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
-        (murdoch wire connect))
+        (murdoch wire connect) (only (murdoch robot trip) trip-connect trip-request trip-close))
 
 (if (not (file-exists? (tool-path ".deps/ros2/bin/python")))
     (begin (display "skipped: no ROS 2 in .deps/ros2 (make deps installs it)\n")
@@ -323,6 +323,27 @@
     (let ((text (file-text out)))
       (remove-test-lab! l)
       text)))
+
+(test-group "a simulated robot and a ROS 2 robot in one lab"
+  (let* ((l (make-test-lab '((aspace b1 (robot (pose 0 0 0)))
+                             (aspace tb3 (robot (pose 0 1000 0) (ros2 (namespace "/tb3")))))))
+         (lbase (number->string (test-lab-port-base l)))
+         (dir (test-lab-directory l))
+         (robot (start-process! (list (tool-path "tools/ros2-env") lbase "python3"
+                                      (tool-path "tests/ros2/unicycle.py") "--namespace" "/tb3")
+                                (string-append dir "/unicycle.log")))
+         (pid (start-murdoch-lab! (list (test-lab-file l)) (string-append dir "/lab.out")))
+         (who (lambda (i)
+                (let* ((c (trip-connect "127.0.0.1" (+ (test-lab-port-base l) 100 i)))
+                       (w (trip-request c 'who)))
+                  (trip-close c)
+                  w))))
+    (test "the simulator serves the B14 at its trip port" '("b1" "b14-sim") (who 0))
+    (test "and the ROS 2 robot's own server its own, the simulator none for it"
+          '("tb3" "ros2") (who 1))
+    (stop-process! pid)
+    (stop-process! robot)
+    (remove-test-lab! l)))
 
 (test-group "a cmd_vel of the wrong type: one clear error naming both"
   (let ((text (lab-output `((aspace tb2 (robot (ros2 (namespace "/tb2") (cmd-vel twist)
