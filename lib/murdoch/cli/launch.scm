@@ -33,7 +33,8 @@
 ;; robot/ros2/trip_ros2.py, which the lab starts beside its address space
 ;; unless (trip-host ...) says it runs on another host.  With
 ;; MURDOCH_ROS2=1 (make demo ROS2=1) every simulated robot is reached so
-;; too: the simulator's trip servers move to port-base + 150 + i, where
+;; too: the simulator's trip servers move to the port plan's face-trip
+;; (port-base + 150 + i), where
 ;; robot/ros2/b14_face.py gives them a ROS 2 face under their names, and
 ;; each gets a trip server of its own at its usual port.
 
@@ -83,7 +84,7 @@
 
 ;; Where the simulator serves robot a's trip under MURDOCH_ROS2=1.
 (define (face-port lab a)
-  (+ (lab-port-base lab) 150 (lab-aspace-index a)))
+  (lab-planned-port lab 'face-trip (lab-aspace-index a)))
 
 (define (trip-ros2-arguments lab a ros2)
   (cons* "--name" (symbol->string (lab-aspace-uid a))
@@ -139,7 +140,10 @@
 (define (sim-word lab)
   (cond ((not (any simulated? (lab-aspaces lab))) "")
         ((ros2-everywhere?)
-         (string-append "sim --port-base " (number->string (+ (lab-port-base lab) 50))))
+         ;; The simulator puts robot i at its port base + the plan's trip + i.
+         (string-append "sim --port-base "
+                        (number->string (- (lab-planned-port lab 'face-trip)
+                                           (planned-port 0 'trip)))))
         (else "sim")))
 
 ;; Closes a fileno through a port, which marks it closed: the collector

@@ -18,6 +18,6 @@
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
-          (only (murdoch status) write-lab-status)
+          (only (murdoch task) write-lab-status)
           (only (murdoch task) status-state step-status? step-status-entries))
   (include "launch.scm"))
