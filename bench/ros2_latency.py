@@ -18,7 +18,6 @@ Prints each round's figures, then the medians over the rounds.
 
 import math
 import os
-import socket
 import statistics
 import subprocess
 import sys
@@ -32,7 +31,7 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "robot", "ros2"))
-import trip_frame  # noqa: E402
+from b14_face import Trip  # noqa: E402  a blocking trip client
 
 SAMPLES = 60
 top = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
@@ -90,26 +89,6 @@ class Bench:
             return self.arrived.pop(key, None)
 
 
-class Trip:
-    def __init__(self, port):
-        self.sock = socket.create_connection(("127.0.0.1", port))
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.parser = trip_frame.Parser(65536)
-        self.tag = 0
-        self.frames = []
-
-    def ask(self, text):
-        self.tag += 1
-        self.sock.sendall(trip_frame.encode("%d %s" % (self.tag, text)))
-        while True:
-            while self.frames:
-                w = self.frames.pop(0).decode().split(" ")
-                if w[0] == str(self.tag):
-                    return w[1:]
-            self.frames += [v for k, v in self.parser.feed(self.sock.recv(65536))
-                            if k == "frame"]
-
-
 def main():
     base, rounds = int(sys.argv[1]), int(sys.argv[2])
     port = base + 190
@@ -126,8 +105,8 @@ def main():
                 break
         else:
             sys.exit("bench: the trip server did not start")
-        trip = Trip(port)
-        trip.ask("open base")
+        trip = Trip("127.0.0.1", port)
+        trip.ask("open", "base")
         figures = {"p50": [], "p95": [], "floor-p50": [], "floor-p95": [], "age-p95": []}
         value = 0.0
         for r in range(rounds):
@@ -135,7 +114,7 @@ def main():
             for i in range(SAMPLES):
                 value += 1.0                    # mm/s, new each time
                 sent = time.monotonic()
-                trip.ask("base vel %.1f 0" % value)
+                trip.ask("base", "vel", "%.1f" % value, 0)
                 got = b.wait_for(value)
                 if got:
                     cmd.append(got - sent)
@@ -147,10 +126,10 @@ def main():
                 got = b.wait_for(value)
                 if got:
                     floor.append(got - sent)
-                x = float(trip.ask("base reckon")[1]) / 1000.0
+                x = trip.ask("base", "reckon")[0] / 1000.0
                 ages.append(max(0.0, b.newest - x))
                 time.sleep(0.005 * (i % 4))   # not in step with the odometry
-            trip.ask("base stop")
+            trip.ask("base", "stop")
             f = {"p50": percentile(cmd, 50), "p95": percentile(cmd, 95),
                  "floor-p50": percentile(floor, 50), "floor-p95": percentile(floor, 95),
                  "age-p95": percentile(ages, 95)}
