@@ -10,7 +10,8 @@
         (srfi 1) (srfi 18) (chibi test)
         (only (chibi process) kill signal/kill)
         (only (chibi string) string-prefix?)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness)
         (murdoch wire connect) (only (murdoch robot trip) trip-connect trip-request trip-close))
 
 (if (not (file-exists? (tool-path ".deps/ros2/bin/python")))
