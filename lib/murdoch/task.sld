@@ -11,7 +11,7 @@
           step-status? step-status-index step-status-entries tasks listed-posed?
           listed-id listed-state listed-place listed-why listed-index
           listed-poser task-step start-steps pose-steps waiting-ranks
-          waiting-for receive-offer receive-give-way note-waiters!
+          waiting-for receive-offer receive-give-way note-waiters! robot-freed!
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between pose-task negotiate pose-task-progress
