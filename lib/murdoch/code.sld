@@ -11,7 +11,7 @@
           sized-make-bytevector sized-make-list sized-list-tabulate sized-iota
           sized-read-bytevector sized-expt call-in-sandbox flush-call-ports!
           sandbox-parameter! set-sandbox-ports! sendable-lambda sendable-define
-          sendable-procedure? encode
+          sendable-procedure? encode made-by!
           make-decoder send-error? abridged set-value-limits! make-proxy-ref proxy-ref?
           proxy-ref-uid proxy-ref-id make-proxy-procedure proxy-procedure-ref)
   (import (murdoch code abandon) (murdoch code sandbox) (murdoch code sendable)))

@@ -1,5 +1,5 @@
 ;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
-;;> pose-task and a task's life cycle.
+;;> pose-task, a task's life cycle, and tasks handed to the lab.
 ;;> Its members are each a library of their own in task/.
 
 (define-library (murdoch task)
@@ -25,7 +25,15 @@
           make-maxrandom progress explain-no-takers explain-components explanation?
           explanation-line explanation-free explanation-capable with-coordinator
           team-barrier team-send! team-receive step-team make-coordinator
-          negotiated-winners negotiated-types negotiated-name winner-uid winner-promise)
-  (import (murdoch task assign) (murdoch task running) (murdoch task life-cycle)
+          negotiated-winners negotiated-types negotiated-name winner-uid winner-promise
+          await-component components-running lab-tasks lab-task-id lab-task-role
+          lab-task-epoch lab-task-state lab-task-coordinator lab-task-standby
+          lab-task-poser lab-task-took-over coordinate-task! coordinator-ping
+          become-standby! receive-copy handed-role-of handed-entries handed-status
+          handed-wait handed-cancel)
+  (import (murdoch task assign) (murdoch task running)
+          (except (murdoch task life-cycle) start-task start-steps task-status task-wait
+                  cancel-task)
+          (murdoch task detached)
           (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
           (murdoch task takers) (murdoch task team)))

@@ -77,31 +77,41 @@
 ;;> (default: the lab's when-robots-busy); \scheme{priority}, the task's
 ;;> priority (default (pose-task-priority)); \scheme{deadline}, seconds
 ;;> after which a task not yet started fails with \scheme{deadline}.
-(define (start-task task-name num-robots capability-list metrics procs . options)
-  (let* ((lists (take-while list? options))
-         (priorities (if (pair? lists) (car lists) (iota num-robots num-robots -1)))
-         (restartable (if (and (pair? lists) (pair? (cdr lists)))
-                          (cadr lists)
-                          (make-list num-robots #f))))
-    (check-task task-name num-robots capability-list metrics procs priorities)
-    (if (not (and (list? restartable) (= (length restartable) num-robots)
-                  (every boolean? restartable)))
-        (error "start-task: restartable is a list of a boolean for each component"
-               restartable))
-    (let* ((turn (read-turn "start-task" (drop options (length lists))))
-           (t (new-task task-name capability-list metrics procs restartable turn)))
-      (thread-start!
-       (make-logged-thread (inheriting
-                            (lambda () (run-task t priorities)))
-                           (task-id t)))
-      t)))
+(define (start-task . args)
+  (let-values (((t priorities) (task-of-args #f #f args)))
+    (thread-start!
+     (make-logged-thread (inheriting (lambda () (run-task t priorities))) (task-id t)))
+    t))
 
-(define (new-task task-name capability-list metrics procs restartable turn)
+;; A new task record from start-task's arguments, and its priorities:
+;; its id is id, or a new one when id is #f; its turn that of turn-copy
+;; (see task-turn-copy), or of the keywords when turn-copy is #f.
+(define (task-of-args id turn-copy args)
+  (apply
+   (lambda (task-name num-robots capability-list metrics procs . options)
+     (let* ((lists (take-while list? options))
+            (priorities (if (pair? lists) (car lists) (iota num-robots num-robots -1)))
+            (restartable (if (and (pair? lists) (pair? (cdr lists)))
+                             (cadr lists)
+                             (make-list num-robots #f))))
+       (check-task task-name num-robots capability-list metrics procs priorities)
+       (if (not (and (list? restartable) (= (length restartable) num-robots)
+                     (every boolean? restartable)))
+           (error "start-task: restartable is a list of a boolean for each component"
+                  restartable))
+       (let ((turn (read-turn "start-task" (drop options (length lists)))))
+         (values (new-task (or id (task-key task-name)) task-name capability-list metrics
+                           procs restartable
+                           (if turn-copy (turn-of-copy turn-copy) turn))
+                 priorities))))
+   args))
+
+(define (new-task id task-name capability-list metrics procs restartable turn)
   (with-lock *tasks-lock*
     (lambda ()
       (check-waiting-room turn)
       (let ((t (make-task
-                (task-key task-name)
+                id
                 task-name
                 (map (lambda (k caps metric proc r)
                        (let ((c (make-component k caps metric proc r)))
@@ -123,11 +133,19 @@
 ;; a thread does not inherit its maker's parameters.
 (define (inheriting thunk)
   (let ((port (pose-task-progress)) (priority (pose-task-priority))
-        (assignment (pose-task-assignment)) (seconds (task-timeout)))
+        (assignment (pose-task-assignment)) (seconds (task-timeout))
+        (patience (heartbeat-patience)))
     (lambda ()
       (parameterize ((pose-task-progress port) (pose-task-priority priority)
-                     (pose-task-assignment assignment) (task-timeout seconds))
+                     (pose-task-assignment assignment) (task-timeout seconds)
+                     (heartbeat-patience patience))
         (thunk)))))
+
+;;> How many times longer than a poser's the components of a task started
+;;> under it wait for heartbeats before they stop, and its coordinator
+;;> before it declares their robot lost: a detached task's, that a
+;;> standby may take over before its components stop (detached.scm).
+(define heartbeat-patience (make-parameter 1))
 
 ;; Negotiates t, runs its components, each watched over by a thread of
 ;; its own, and puts their results in t's mailbox.
@@ -143,6 +161,7 @@
                                  (map component-metric cs) (map component-proc cs)
                                  priorities))))))
     (cond
+     ((let-go? t) (if (pair? team) (free-team! team)))
      ((and (symbol? team) (not (eq? team 'cancelled)))
       (if (memq (task-state t) '(negotiating waiting)) (task-state-set! t 'failed))
       (for-each (lambda (c)
@@ -154,24 +173,34 @@
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      ((eq? (task-state t) 'cancelled)
-      (for-each free-winner! (negotiated-winners team) (negotiated-types team))
+      (free-team! team)
       (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
       (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
       (task-team-set! t (map winner-uid (negotiated-winners team)))
-      (for-each thread-join!
-                (map (lambda (c winner type)
-                       (thread-start!
-                        (make-logged-thread (inheriting
-                                             (lambda ()
-                                               (supervise t c (winner-uid winner)
-                                                          (work-for winner type c)))))))
-                     cs (negotiated-winners team) (negotiated-types team)))
-      (finish! t (map component-result cs))))))
+      (supervise-all t (map (lambda (c winner type)
+                              (lambda ()
+                                (supervise t c (winner-uid winner)
+                                           (work-for winner type c))))
+                            cs (negotiated-winners team) (negotiated-types team)))))))
+
+(define (free-team! team)
+  (for-each free-winner! (negotiated-winners team) (negotiated-types team)))
+
+;; Runs each thunk, a component's supervision, in a thread of its own,
+;; and finishes t once all are over.
+(define (supervise-all t thunks)
+  (for-each thread-join!
+            (map (lambda (thunk) (thread-start! (make-logged-thread (inheriting thunk))))
+                 thunks))
+  (finish! t (map component-result (task-components t))))
 
 (define (finish! t results)
   (if (memq (task-state t) '(negotiating waiting running)) (task-state-set! t 'done))
+  (if (not (let-go? t)) (finish-told! t results)))
+
+(define (finish-told! t results)
   (progress (task-id t) ": " (task-state t))
   (mailbox-put! (task-done t) results))
 
@@ -189,20 +218,27 @@
 ;; Runs component c on uid, and again elsewhere while its robot is lost
 ;; and it may be restarted.
 (define (supervise t c uid work)
-  (component-state-set! c (list 'running uid (utc-seconds)))
+  (if (not (eq? work 'adopted))
+      (component-state-set! c (list 'running uid (utc-seconds))))
   (progress "  component " (component-index c) " starts on " uid)
-  (let ((outcome (attempt t c uid work)))
-    (component-attempts-set! c (append (component-attempts c)
-                                       (list (cons uid outcome))))
-    (progress "  component " (component-index c) " on " uid ": " outcome)
-    (cond
+  (after-attempt t c uid (if (let-go? t) '(let-go) (attempt t c uid work))))
+
+;; Moves c on from its run on uid, which ended with outcome: done,
+;; failed, or negotiated again and run elsewhere when it may.
+(define (after-attempt t c uid outcome)
+  (if (not (or (let-go? t) (not uid)))
+      (component-attempts-set! c (append (component-attempts c)
+                                         (list (cons uid outcome)))))
+  (progress "  component " (component-index c) " on " uid ": " outcome)
+  (cond
+     ((let-go? t) #f)
      ((eq? (task-state t) 'cancelled)
       (component-state-set! c '(failed "cancelled")))
      ((and (eq? (car outcome) 'lost) (restart? c))
       (let ((next (renegotiate t c)))
         (cond
          (next
-          (component-state-set! c (list 'reassigned uid (car next)))
+          (component-state-set! c (list 'reassigned (or uid 'none) (car next)))
           (replace-member! t (component-index c) (car next))
           (progress "  component " (component-index c) " reassigned from "
                     uid " to " (car next))
@@ -212,7 +248,7 @@
            c (list 'failed (string-append (cadr outcome)
                                           "; no other capable robot is free")))))))
      ((eq? (car outcome) 'done) (component-state-set! c outcome))
-     (else (component-state-set! c (list 'failed (cadr outcome)))))))
+     (else (component-state-set! c (list 'failed (cadr outcome))))))
 
 ;; Puts uid in t's team as the robot of component k.  By index, not by
 ;; the robot it replaces: a robot whose component is done may take
@@ -254,22 +290,25 @@
 (define (attempt t c uid work)
   (let* ((a (uid->aspace uid))
          (period (lab-setting (current-lab) 'heartbeat))
+         (patience (heartbeat-patience))
          (answer (make-mailbox))
          (runner (make-logged-thread
                   (call-there a answer (task-id t) (component-index c)
-                                     (local-aspace-uid) period work))))
+                                     (local-aspace-uid) (* patience period) work))))
     (thread-start! runner)
     (let watch ((heard (monotonic-seconds)))
       (let ((got (mailbox-take answer (+ (monotonic-seconds) period)
                                (lambda () #f))))
         (cond
          (got (outcome-of got))
+         ((let-go? t) (thread-interrupt! runner) '(let-go))
          ((heartbeat a (task-id t) (component-index c) period)
           (watch (monotonic-seconds)))
-         ((>= (- (monotonic-seconds) heard) (* lost-periods period))
+         ((>= (- (monotonic-seconds) heard) (* lost-periods patience period))
           (thread-interrupt! runner)    ; its call is given up
           (list 'lost (string-append (symbol->string uid) " silent for "
-                                     (number->string lost-periods) " heartbeats")))
+                                     (number->string (* lost-periods patience))
+                                     " heartbeats")))
          (else (watch heard)))))))
 
 ;; A thunk that runs work on a inside run-component, and puts (value V)
@@ -282,8 +321,10 @@
        (guard (e (#t (list 'raised e)))
          (list 'value
                (parameterize ((remote-timeout seconds))
-                 (remote-apply a (sendable-lambda ()
-                                   (run-component id k poser period work))))))))))
+                 (if (eq? work 'adopted)
+                     (remote-apply a (sendable-lambda () (await-component id k poser)))
+                     (remote-apply a (sendable-lambda ()
+                                       (run-component id k poser period work)))))))))))
 
 ;; Whether the robot a answered a heartbeat within a period.
 (define (heartbeat a id k period)
@@ -432,6 +473,98 @@
 ;;> The poser of the component in \var{e}, a running entry of (tasks).
 (define (listed-poser e) (cadr (cddr e)))
 
+;;; Tasks handed to the lab (detached.scm): what their coordinators need
+
+(define (let-go? t) (eq? (task-state t) 'let-go))
+
+;;> Stops acting for \var{t}, a detached task whose standby may be taking
+;;> it over: no heartbeat, start or negotiation more, and nothing is
+;;> cancelled; what it holds while it waits is given back.
+(define (let-task-go! t)
+  (task-state-set! t 'let-go)
+  (if (task-waiter t) (tell-waiter! (task-waiter t) '(cancel)))
+  (if (task-steps t) (for-each let-task-go! (task-steps t)))
+  (mailbox-put! (task-done t) 'let-go))
+
+;;> What \var{t}'s rank and deadline are made of, as data that travels:
+;;> (WAIT HOLD PRIORITY DEADLINE POSED), DEADLINE a utc-seconds or #f.
+(define (task-turn-copy t)
+  (let ((turn (task-turn t)))
+    (and turn
+         (list (turn-wait? turn) (turn-hold? turn) (turn-priority turn)
+               (and (turn-deadline turn)
+                    (+ (utc-seconds) (- (turn-deadline turn) (monotonic-seconds))))
+               (turn-posed turn)))))
+
+(define (turn-of-copy copy)
+  (apply (lambda (wait hold priority deadline posed)
+           (make-turn wait hold priority
+                      (and deadline (+ (monotonic-seconds) (- deadline (utc-seconds))))
+                      posed))
+         copy))
+
+;;> A detached task taken over by a new coordinator, as a task record:
+;;> \var{id} and \var{turn-copy} (task-turn-copy) are the task's, args
+;;> start-task's, and \var{plan} has (STATE ATTEMPTS UID) for each
+;;> component, UID the robot where it runs or ended lately, or #f.  A
+;;> task none of whose components started is negotiated again, at its
+;;> rank; otherwise each component is adopted where it runs, kept as it
+;;> ended, or, found nowhere, moved on as a lost robot's.
+(define (adopt-task id turn-copy plan args)
+  (let-values (((t priorities) (task-of-args id turn-copy args)))
+    (for-each (lambda (c p)
+                (component-state-set! c (plan-state p))
+                (component-attempts-set! c (plan-attempts p)))
+              (task-components t) plan)
+    (thread-start!
+     (make-logged-thread
+      (inheriting
+       (lambda ()
+         (cond
+          ((every (lambda (p) (and (not (plan-uid p))
+                                   (memq (car (plan-state p)) '(negotiating waiting))))
+                  plan)
+           (for-each (lambda (c) (component-state-set! c '(negotiating)))
+                     (task-components t))
+           (run-task t priorities))
+          (else
+           (task-state-set! t 'running)
+           (task-team-set! t (map (lambda (p) (or (plan-uid p) (state-uid (plan-state p))))
+                                  plan))
+           (supervise-all t (map (lambda (c p) (lambda () (go-on t c p)))
+                                 (task-components t) plan))))))
+      id))
+    t))
+
+;; The parts of an entry of adopt-task's plan.
+(define (plan-state p) (car p))
+(define (plan-attempts p) (cadr p))
+(define (plan-uid p) (car (cddr p)))
+
+;; The robot a component's state names, or #f.
+(define (state-uid state)
+  (case (car state)
+    ((running) (cadr state))
+    ((reassigned) (car (cddr state)))
+    (else #f)))
+
+;; Component c of an adopted task goes on from its entry p of the plan.
+(define (go-on t c p)
+  (let ((state (plan-state p)) (uid (plan-uid p)))
+    (cond (uid
+           (if (not (equal? (state-uid state) uid))
+               (component-state-set! c (list 'running uid (utc-seconds))))
+           (supervise t c uid 'adopted))
+          ((memq (car state) '(done failed)) #f)
+          (else
+           (after-attempt t c (state-uid state)
+                          '(lost "it was found nowhere when its standby took over"))))))
+
+;;> The parts of a step made by task-step, as that travels: its
+;;> capabilities, metrics, procedures and options, task-step's arguments.
+(define (step-parts s)
+  (cons* (step-capabilities s) (step-metrics s) (step-procs s) (step-options s)))
+
 ;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
 ;;; synchronization)
 ;;
@@ -476,7 +609,7 @@
         (error "start-steps: a task name, then one or more steps made by task-step"))
     (read-turn "start-steps" options)
     (for-each check-same steps (iota (length steps) 1))
-    (let ((t (new-task task-name '() '() '() '() #f)))
+    (let ((t (new-task (task-key task-name) task-name '() '() '() '() #f)))
       (task-steps-set! t '())
       (thread-start!
        (make-logged-thread (inheriting (lambda () (run-steps t steps options)))
@@ -737,6 +870,7 @@
     (give-way! w news)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
+     ((let-go? t) (answer-offers! offers #f) 'let-go)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
       (let ((team (if (or (pair? offers)

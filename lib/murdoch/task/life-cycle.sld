@@ -9,7 +9,9 @@
           step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
           listed-index listed-poser task-step start-steps pose-steps
-          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!)
+          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!
+          step? step-parts heartbeat-patience let-task-go! task-turn-copy adopt-task
+          (rename task-state task-state-of))
   (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
           (srfi 132) (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
           (murdoch wire) (murdoch lab) (murdoch remote) (murdoch task progress)
