@@ -34,7 +34,7 @@
           reckon-distance-between resolve-conflicts
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
-          ;; the task life cycle (lib/murdoch/task/life-cycle.scm)
+          ;; the task life cycle (lib/murdoch/task/life-cycle.scm and its neighbours)
           start-task task? task-id task-name task-status task-wait cancel-task
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries
@@ -51,7 +51,7 @@
           await-component components-running coordinate-task! coordinator-ping
           become-standby! receive-copy handed-role-of handed-entries handed-status
           handed-wait handed-cancel
-          ;; what the lab is doing (lib/murdoch/status.scm)
+                    ;; what the lab is doing (lib/murdoch/task/status.scm)
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/robot/trip.scm)
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
@@ -61,5 +61,4 @@
           fiducial-id fiducial-range fiducial-bearing fiducial-orientation
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch code) (murdoch remote) (murdoch pubsub) (murdoch task)
-          (murdoch robot)
-          (murdoch status)))
+          (murdoch robot)))

@@ -16,8 +16,9 @@
   '(sys lab wire code robot
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
-    (task (assign progress metric takers) team (pose-task running) life-cycle)
-    status murdoch cli view testing))
+    (task (assign progress metric takers) team (pose-task running) record rank
+          (offers holding) waiting life-cycle steps detached status)
+    murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))
 
@@ -145,10 +146,11 @@
 ;; The families whose users import them as one, by their umbrellas.
 (define families '(sys wire code robot remote pubsub task cli))
 
-;; remote's umbrella is a selection, what the layers above import (see
-;; lib/murdoch/remote.scm): its members share more among themselves, the
-;; calls' and connections' insides, which it leaves out.
-(define selections '(remote))
+;; remote's and task's umbrellas are selections, what the layers above
+;; import (see lib/murdoch/remote.scm and lib/murdoch/task.sld): their
+;; members share more among themselves, the calls' and connections'
+;; insides, a task's records and its waiters', which they leave out.
+(define selections '(remote task))
 
 ;; What remote's umbrella passes on from the families below it: the
 ;; remote errors and the locks that the thesis's remote layer offers.

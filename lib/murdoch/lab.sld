@@ -20,4 +20,5 @@
           (only (chibi ast) port-line)
           (chibi io) (chibi edit-distance)
           (only (murdoch sys) condition-message))
-  (include "lab.scm" "room.scm"))
+  (include "lab/file.scm" "lab/settings.scm" "lab/clauses.scm" "lab/source.scm"
+           "lab/room.scm" "lab/key.scm"))

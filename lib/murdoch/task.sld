@@ -1,6 +1,9 @@
 ;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
-;;> pose-task, a task's life cycle, and tasks handed to the lab.
-;;> Its members are each a library of their own in task/.
+;;> pose-task, a task's life cycle, tasks handed to the lab, and the
+;;> status of the lab.
+;;> Its members are each a library of their own in task/.  It is a
+;;> selection: the life cycle's members (record, rank, offers, holding,
+;;> waiting) share their insides among themselves, which it leaves out.
 
 (define-library (murdoch task)
   (export task-key task-key-parts assign-optimal assign-greedy assignment-cost
@@ -26,14 +29,18 @@
           explanation-line explanation-free explanation-capable with-coordinator
           team-barrier team-send! team-receive step-team make-coordinator
           negotiated-winners negotiated-types negotiated-name winner-uid winner-promise
-          await-component components-running lab-tasks lab-task-id lab-task-role
+          aspace-report lab-status show-status write-lab-status report-uid report-since
+          report-pose report-battery report-held report-tasks report-goal report-ended
+          held-subject held-holder report-handed lab-task-line
+          await-component lab-tasks lab-task-id lab-task-role
           lab-task-epoch lab-task-state lab-task-coordinator lab-task-standby
           lab-task-poser lab-task-took-over coordinate-task! coordinator-ping
           become-standby! receive-copy handed-role-of handed-entries handed-status
           handed-wait handed-cancel)
-  (import (murdoch task assign) (murdoch task running)
-          (except (murdoch task life-cycle) start-task start-steps task-status task-wait
-                  cancel-task)
-          (murdoch task detached)
-          (murdoch task metric) (murdoch task pose-task) (murdoch task progress)
-          (murdoch task takers) (murdoch task team)))
+  (import (murdoch task assign) (murdoch task running) (murdoch task metric)
+          (murdoch task pose-task) (murdoch task progress) (murdoch task takers)
+          (murdoch task team) (murdoch task record) (murdoch task rank)
+          (murdoch task offers) (murdoch task holding)
+          (except (murdoch task life-cycle) start-task task-status task-wait cancel-task)
+          (except (murdoch task steps) start-steps)
+          (murdoch task detached) (murdoch task status)))

@@ -19,8 +19,7 @@
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
-          (only (murdoch status) write-lab-status lab-task-line)
           (only (murdoch wire) error-message)
-          (only (murdoch task) status-state step-status? step-status-entries lab-tasks
-                task-wait task-status cancel-task))
+          (only (murdoch task) write-lab-status lab-task-line status-state step-status?
+                step-status-entries lab-tasks task-wait task-status cancel-task))
   (include "launch.scm"))

@@ -204,7 +204,7 @@
           (lambda ()
             (let ((results (task-wait t)))
               (when (and (eq? (handed-role h) 'coordinator) (= epoch (handed-epoch h)))
-                (handed-copy-set! h (list (task-state-of t) (task-status t) results
+                (handed-copy-set! h (list (task-state t) (task-status t) results
                                           (task-turn-copy t) (utc-seconds)))
                 (progress (handed-id h) ": ended; results kept for "
                           (lab-setting (current-lab) 'keep-results) " s"))))
@@ -234,7 +234,7 @@
   (let ((t (handed-task h)) (old (handed-copy h)))
     (if (or (not t) (copy-results old))
         old
-        (list (task-state-of t) (task-status t) #f (task-turn-copy t) #f))))
+        (list (task-state t) (task-status t) #f (task-turn-copy t) #f))))
 
 ;; Whether a finished task's copy has been kept for keep-results.
 (define (kept-enough? copy)
@@ -436,6 +436,91 @@
                               (filter-map (lambda (e) (and (eq? (ended-id e) id)
                                                            (list (ended-index e) 'ended)))
                                           (components-ended)))))))))
+
+;;; Letting a task go, and adopting it
+
+;; Stops acting for t, a detached task whose standby may be taking it
+;; over: no heartbeat, start or negotiation more (life-cycle.scm's let-go?
+;; checks), and nothing cancelled; what it holds while it waits is given
+;; back.
+(define (let-task-go! t)
+  (task-state-set! t 'let-go)
+  (if (task-waiter t) (tell-waiter! (task-waiter t) '(cancel)))
+  (mailbox-put! (task-done t) 'let-go))
+
+;; What t's rank and deadline are made of, as data that travels: (WAIT
+;; HOLD PRIORITY DEADLINE POSED), DEADLINE a utc-seconds or #f.
+(define (task-turn-copy t)
+  (let ((turn (task-turn t)))
+    (and turn
+         (list (turn-wait? turn) (turn-hold? turn) (turn-priority turn)
+               (and (turn-deadline turn)
+                    (+ (utc-seconds) (- (turn-deadline turn) (monotonic-seconds))))
+               (turn-posed turn)))))
+
+(define (turn-of-copy copy)
+  (and copy
+       (apply (lambda (wait hold priority deadline posed)
+                (make-turn wait hold priority
+                           (and deadline (+ (monotonic-seconds) (- deadline (utc-seconds))))
+                           posed))
+              copy)))
+
+;; The task record of a detached task taken over here: id and turn-copy
+;; are the task's, args start-task's, and plan has (STATE ATTEMPTS UID)
+;; for each component, UID the robot where it runs or ended lately, or
+;; #f.  A task none of whose components started is negotiated again, at
+;; its rank; otherwise each component is adopted where it runs, kept as
+;; it ended, or, found nowhere, moved on as a lost robot's.
+(define (adopt-task id turn-copy plan args)
+  (let-values (((t priorities) (task-of-args id (turn-of-copy turn-copy) args)))
+    (for-each (lambda (c p)
+                (component-state-set! c (plan-state p))
+                (component-attempts-set! c (plan-attempts p)))
+              (task-components t) plan)
+    (thread-start!
+     (make-logged-thread
+      (inheriting
+       (lambda ()
+         (cond
+          ((every (lambda (p) (and (not (plan-uid p))
+                                   (memq (car (plan-state p)) '(negotiating waiting))))
+                  plan)
+           (for-each (lambda (c) (component-state-set! c '(negotiating)))
+                     (task-components t))
+           (run-task t priorities))
+          (else
+           (task-state-set! t 'running)
+           (task-team-set! t (map (lambda (p) (or (plan-uid p) (state-uid (plan-state p))))
+                                  plan))
+           (supervise-all t (map (lambda (c p) (lambda () (go-on t c p)))
+                                 (task-components t) plan))))))
+      id))
+    t))
+
+;; The parts of an entry of adopt-task's plan.
+(define (plan-state p) (car p))
+(define (plan-attempts p) (cadr p))
+(define (plan-uid p) (car (cddr p)))
+
+;; The robot a component's state names, or #f.
+(define (state-uid state)
+  (case (car state)
+    ((running) (cadr state))
+    ((reassigned) (car (cddr state)))
+    (else #f)))
+
+;; Component c of an adopted task goes on from its entry p of the plan.
+(define (go-on t c p)
+  (let ((state (plan-state p)) (uid (plan-uid p)))
+    (cond (uid
+           (if (not (equal? (state-uid state) uid))
+               (component-state-set! c (list 'running uid (utc-seconds))))
+           (supervise t c uid 'adopted))
+          ((memq (car state) '(done failed)) #f)
+          (else
+           (after-attempt t c (state-uid state)
+                          '(lost "it was found nowhere when its standby took over"))))))
 
 ;;; Finding a detached task from anywhere
 

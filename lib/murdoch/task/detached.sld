@@ -13,11 +13,15 @@
           (only (chibi string) string-contains)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (murdoch task progress)
-          (only (murdoch task running) await-component components-running
-                components-ended ended-id ended-index)
+          (only (murdoch task running) components-running components-ended ended-id
+                ended-index)
+          (murdoch task record)
+          (only (murdoch task rank) make-turn turn-wait? turn-hold? turn-priority
+                turn-deadline turn-posed tell-waiter!)
           (rename (murdoch task life-cycle)
-                  (start-task start-here) (start-steps start-steps-here)
-                  (task-status status-here) (task-wait wait-here)
-                  (cancel-task cancel-here))
+                  (start-task start-here) (task-status status-here)
+                  (task-wait wait-here) (cancel-task cancel-here))
+          (rename (only (murdoch task steps) start-steps step? step-parts task-step)
+                  (start-steps start-steps-here))
           (only (murdoch pubsub) subscribe unsubscribe request get-system-load))
   (include "detached.scm"))

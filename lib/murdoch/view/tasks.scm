@@ -4,9 +4,9 @@
 ;;; The tasks: what the address spaces say they hold and run
 ;;
 ;; A robot tells the subjects it holds and for whom -- a reservation
-;; name, NAME@POSER/N (pose-task.scm) -- the components it runs, (running
+;; name, NAME@POSER/N (task/pose-task.scm) -- the components it runs, (running
 ;; ID INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed
-;; task's reservation name (running.scm), and the components that ended
+;; task's reservation name (task/running.scm), and the components that ended
 ;; there lately, each with how it ended, which its poser was told.  The
 ;; table remembers each component from when it is first seen on a robot
 ;; to when it ended there, and how; one that ended between two looks is

@@ -1,0 +1,116 @@
+;;;; Holding and giving way: what a task holds while it waits (the
+;;;; thesis's chapter 6 wish)
+;;
+;; A task started with hold #t keeps, while it waits, the robots it won
+;; for some of its components, and waits for the others.  No deadlock:
+;; a waiting task gives up what it holds when a better-ranked waiting
+;; task could start with it (give-way!), and ranks are totally ordered,
+;; so the best-ranked waiting task never waits on one that holds; a
+;; running component is never taken away.  docs/allocation.md gives the
+;; argument.
+
+;; Frees a winner of a negotiation: a runner-up, a task cancelled, or
+;; a robot held and given up.
+(define (free-winner! winner type)
+  (if (eq? type 'exclusive)
+      (guard (e (#t #f)) ((winner-promise winner) #f))))
+
+;; Runs component c on uid, and again elsewhere while its robot is lost
+
+;; A try that keeps what it wins: each component of w not yet held is
+;; negotiated alone, in priority order, without the robots held or given
+;; way on.  Answers (winners type-list) once every component has a robot.
+(define (hold-try w priorities)
+  (let ((t (waiter-task w)) (cs (waiter-components w)))
+    (for-each
+     (lambda (c)
+       (if (not (assv (component-index c) (waiter-held w)))
+           (let ((team (parameterize ((pose-task-excluded
+                                       (append (held-uids w) (waiter-yielded w)
+                                               (pose-task-excluded))))
+                         (negotiate (task-name t) 1 (list (component-capabilities c))
+                                    (list (component-metric c))
+                                    (list (component-proc c))))))
+             (if (pair? team)
+                 (waiter-held-set! w (cons (list (component-index c)
+                                                 (car (negotiated-winners team))
+                                                 (car (negotiated-types team)))
+                                           (waiter-held w)))))))
+     (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
+    (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
+      (cond ((every pair? held)
+             (waiter-held-set! w '())
+             (list (map held-winner held) (map held-type held)))
+            (else 'not-enough-takers)))))
+
+;; Frees what w holds on robot uid, or on every robot.
+(define (let-go-held! w . uid)
+  (let ((out (filter (lambda (h) (or (null? uid) (eq? (held-uid h) (car uid))))
+                     (waiter-held w))))
+    (for-each (lambda (h) (free-winner! (held-winner h) (held-type h))) out)
+    (waiter-held-set! w (remove (lambda (h) (memq h out)) (waiter-held w)))))
+
+;; Holds what w holds for another lease.
+(define (keep-held! w)
+  (waiter-kept-set! w (monotonic-seconds))
+  (for-each (lambda (h)
+              (if (eq? (held-type h) 'exclusive)
+                  (if (not (guard (e (#t #f)) ((winner-promise (held-winner h)) 'keep)))
+                      (let-go-held! w (held-uid h)))))
+            (waiter-held w)))
+
+;; Acts on the news: gives way on each robot a better-ranked task asked
+;; for, and takes robots offered to it again.
+(define (give-way! w news)
+  (for-each
+   (lambda (n)
+     (case (news-kind n)
+       ((give-way)
+        (let ((uid (give-way-uid n)))
+          (when (memq uid (held-uids w))
+            (progress (task-id (waiter-task w)) ": gives way on " uid)
+            (let-go-held! w uid)
+            (waiter-yielded-set! w (cons uid (waiter-yielded w))))))
+       ((offer)
+        (waiter-yielded-set! w (remove (lambda (u) (eq? u (offer-uid n)))
+                                       (waiter-yielded w))))))
+   news))
+
+;;> What a waiting task of rank \var{rank} calls where the task that holds
+;;> robot \var{uid} waits: that task gives way on it if \var{rank} goes
+;;> before its own.  Answers #t.
+(define (receive-give-way uid rank)
+  (for-each (lambda (w)
+              (if (and (memq uid (held-uids w)) (rank<? rank (waiter-rank w)))
+                  (tell-waiter! w (list 'give-way uid))))
+            (with-lock *tasks-lock* waiters))
+  #t)
+
+;; Asks the waiting tasks that rank after w, and hold robots w could
+;; start with, to give way, when with those robots and the free ones each
+;; of w's components not held would have one.
+(define (ask-way! w lines others)
+  (let* ((worse (filter (lambda (o) (rank<? (waiter-rank w) (waiting-there-rank o)))
+                        others))
+         (yieldable (append-map waiting-there-held worse))
+         (held (map held-index (waiter-held w)))
+         (open (filter-map (lambda (c line)
+                             (and (not (memv (component-index c) held))
+                                  (filter (lambda (uid)
+                                            (or (memq uid (explanation-free line))
+                                                (memq uid yieldable)))
+                                          (remove (lambda (u) (memq u (held-uids w)))
+                                                  (explanation-capable line)))))
+                           (waiter-components w) lines))
+         (wanted (filter (lambda (uid) (memq uid yieldable)) (apply append open))))
+    (when (and (pair? wanted) (every pair? open)
+               (>= (length (delete-duplicates (apply append open))) (length open)))
+      (for-each (lambda (o)
+                  (for-each (lambda (uid)
+                              (if (memq uid wanted)
+                                  (guard (e (#t #f))
+                                    (remote-apply (uid->aspace (waiting-there-poser o))
+                                                  receive-give-way uid (waiter-rank w)))))
+                            (waiting-there-held o)))
+                worse))))
+

@@ -1,0 +1,151 @@
+;;;; Offers: a robot freed offers itself to the tasks that wait for it,
+;;;; best rank first (the robot's side), and a waiting task answers the
+;;;; offers that come for it by a try (the poser's side).  waiting.scm
+;;;; has the whole protocol.
+
+;;; The poser's side
+
+;;> What a freed robot \var{uid} calls where task \var{id} waits: the
+;;> task tries again at once; answers whether it started, #f when it is
+;;> no longer waiting here, is already offered a robot for each component
+;;> it does not hold, or did not answer within two seconds.
+(define (receive-offer id uid)
+  (let* ((reply (make-mailbox))
+         (offer (cons uid id))
+         (w (with-lock *tasks-lock*
+              (lambda ()
+                (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
+                               (waiters))))
+                  (and w (not (offered-enough? w))
+                       (begin (set! *offers* (cons offer *offers*)) w)))))))
+    (and w
+         (dynamic-wind
+          (lambda () #f)
+          (lambda ()
+            (tell-waiter! w (list 'offer reply uid))
+            (mailbox-take reply (+ (monotonic-seconds) 2) (lambda () #f)))
+          (lambda ()
+            (with-lock *tasks-lock*
+              (lambda ()
+                (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+
+;; Whether w is offered a robot for each component it does not hold: two
+;; robots freed together offer themselves to one task, and the second
+;; goes on to the next task at once rather than after the first's try.
+;; A robot that w won, holding, in the try its offer began is no longer
+;; one of them, though its offer is answered only when that try ends.
+;; Under *tasks-lock*.
+(define (offered-enough? w)
+  (let ((id (task-id (waiter-task w))) (held (held-uids w)))
+    (>= (count (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held)))) *offers*)
+        (- (length (waiter-components w)) (length held)))))
+
+;; The offers being answered here, (UID . ID): the robot UID keeps itself
+;; for this poser while task ID tries, and the poser's other waiting
+;; tasks leave it alone meanwhile.
+(define *offers* '())
+
+(define (offered-to-others w)
+  (let ((id (task-id (waiter-task w))))
+    (filter-map (lambda (o) (and (not (eq? (cdr o) id)) (car o)))
+                (with-lock *tasks-lock* (lambda () *offers*)))))
+
+;;; The robot's side: offers when its subjects are freed
+
+(define *offering* #f)                  ; an offer round runs here
+(define *offer-again* #f)               ; and another was asked for meanwhile
+(define *offer-lock* (make-mutex 'offers))
+
+;; Whether a task may wait for this robot: set when a task starts to
+;; wait anywhere, cleared by an offer round that finds none, so that a lab
+;; where no task waits sends nothing more when a robot is freed.
+(define *waiters-here?* #f)
+
+;;> What a poser publishes to the lab when one of its tasks starts to
+;;> wait: the robots offer themselves when freed, and a free robot at
+;;> once, since a task posed behind others waits for the offers.
+(define (note-waiters!)
+  (set! *waiters-here?* #t)
+  (set! *new-waiters* #t)
+  (if (and (robot-here?) (free-here?)) (robot-freed!)))
+
+;; Whether a task started to wait, or was reminded of, since this robot's
+;; offer round asked who waits: the round's list may lack a better-ranked
+;; task, and it asks again before its next offer (forty tasks posed at
+;; once: a round that had asked before the best of them waited went on
+;; down its list to a worse one).
+(define *new-waiters* #f)
+
+(define (robot-here?)
+  (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
+    (and a (lab-aspace-clause a 'capabilities) #t)))
+
+;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
+;; starts an offer round, or asks the one running for another.  A round
+;; that runs keeps the robot as it is: offered to a poser, a runner-up of
+;; that poser's negotiation is freed while the robot waits for its answer,
+;; and the task that tries must still find the robot its poser's.
+(define (robot-freed!)
+  (when (and *waiters-here?*
+             (with-lock *offer-lock*
+               (lambda ()
+                 (if *offering*
+                     (begin (set! *offer-again* #t) #f)
+                     (begin (set! *offering* #t) #t)))))
+    ;; At once, not in the round's thread, which may start late.
+    (if *waiters-seen* (offer-subjects! 'nobody 3))
+    (thread-start! (make-logged-thread offer-rounds 'offers))))
+
+;; The robot is kept for the poser it was last offered to until the
+;; rounds end, so that no task takes it between two rounds.
+(define (offer-rounds)
+  (guard (e (#t (log-warn "offering this robot: " (error-message e))))
+    (offer-round))
+  (if (with-lock *offer-lock*
+        (lambda ()
+          (let ((again *offer-again*))
+            (set! *offer-again* #f)
+            (when (not again)
+              (offer-subjects! #f)
+              (set! *offering* #f))
+            again)))
+      (offer-rounds)))
+
+;; Offers this robot, while it is free, to the tasks that wait for it,
+;; best rank first.  While one tries, only its poser may reserve here;
+;; while it asks who waits, if tasks waited at its last round, nobody may,
+;; so that no task takes it before the best-ranked has been offered it.
+;; In a lab where no task waits it refuses nobody, as in the thesis.
+(define *waiters-seen* #f)
+
+(define (offer-round)
+  (let ((me (local-aspace-uid)))
+    (set! *waiters-here?* #f)       ; before asking: a note after it stands
+    (set! *new-waiters* #f)
+    (offer-subjects! (and *waiters-seen* 'nobody) 3)
+    (let ((waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
+                              (guard (e (#t '()))
+                                (append-map cadr (request 'waiting-tasks
+                                                          waiting-for me))))))
+      (set! *waiters-seen* (pair? waiting))
+      (if (pair? waiting) (set! *waiters-here?* #t))
+      (offer-to me waiting))))
+
+(define (offer-to me waiting)
+  (when (and (pair? waiting) (free-here?))
+    (let ((poser (wanting-poser (car waiting))))
+      (offer-subjects! poser 3)
+      (guard (e (#t #f))
+        (parameterize ((remote-timeout 3))
+          (remote-apply (uid->aspace poser) receive-offer
+                        (wanting-id (car waiting)) me)))
+      (if (and *new-waiters* (free-here?))
+          (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
+          (offer-to me (cdr waiting))))))
+
+;; Whether no subject here is held exclusively.
+(define (free-here?)
+  (every (lambda (s) (memq (cadr s) '(() shared))) (subscription-statuses '>)))
+
+(on-free! robot-freed!)
+

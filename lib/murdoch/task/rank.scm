@@ -1,0 +1,188 @@
+;;;; Waiting and rank: how a task waits its turn (its turn record, read
+;;;; from start-task's keywords), the order of the lab's waiting tasks
+;;;; (their ranks) and each one's place in it, and the record of a task
+;;;; waiting here (its waiter), with the news that comes for it.  The
+;;;; waiting itself is waiting.scm's; docs/tasks.md tells it.
+
+(define-record-type turn
+  (make-turn wait? hold? priority deadline posed)
+  turn?
+  (wait? turn-wait?)
+  (hold? turn-hold?)
+  (priority turn-priority)
+  (deadline turn-deadline)              ; monotonic-seconds, or #f
+  (posed turn-posed))                   ; utc-seconds
+
+;; A turn from start-task's keywords and their values.
+(define (read-turn who options)
+  (let loop ((kv options)
+             (wait (eq? (lab-setting (current-lab) 'when-robots-busy) 'wait))
+             (hold #f)
+             (priority (pose-task-priority))
+             (deadline #f))
+    (define (bad what)
+      (error (string-append who ": " what) kv))
+    (define (value ok? what)
+      (if (not (ok? (cadr kv))) (bad what))
+      (cadr kv))
+    (define (at-least-0? x) (and (real? x) (>= x 0)))
+    (cond
+     ((null? kv)
+      (make-turn (or wait hold) hold priority
+                 (and deadline (+ (monotonic-seconds) deadline)) (utc-seconds)))
+     ((not (and (symbol? (car kv)) (pair? (cdr kv))))
+      (bad (string-append "after the lists come keywords, each with its value: "
+                          "wait, hold, priority, deadline")))
+     ((eq? (car kv) 'wait)
+      (loop (cddr kv) (value boolean? "wait is #t or #f") hold priority deadline))
+     ((eq? (car kv) 'hold)
+      (loop (cddr kv) wait (value boolean? "hold is #t or #f") priority deadline))
+     ((eq? (car kv) 'priority)
+      (loop (cddr kv) wait hold (value at-least-0? "priority is a number, 0 or more")
+            deadline))
+     ((eq? (car kv) 'deadline)
+      (loop (cddr kv) wait hold priority
+            (value at-least-0? "deadline is a number of seconds, 0 or more")))
+     (else (bad "no such option; the options are wait, hold, priority and deadline")))))
+
+;; Refuses a task that would wait when this address space has
+;; max-waiting tasks waiting or about to.  Under *tasks-lock*.
+(define (check-waiting-room turn)
+  (if (and turn (turn-wait? turn)
+           (>= (count (lambda (t) (and (task-turn t) (turn-wait? (task-turn t))
+                                       (memq (task-state t) '(negotiating waiting))))
+                      (posed-tasks))
+               (lab-setting (current-lab) 'max-waiting)))
+      (error "start-task: this address space has max-waiting tasks waiting already"
+             (lab-setting (current-lab) 'max-waiting))))
+
+(define (turn-rank turn id)
+  (list (- (turn-priority turn) (* (lab-setting (current-lab) 'aging) (turn-posed turn)))
+        (turn-posed turn) (symbol->string id)))
+
+;; The parts of a rank, (SCORE POSED ID) as turn-rank makes it: it travels
+;; to the other posers.
+(define (rank-score r) (car r))
+(define (rank-posed r) (cadr r))
+(define (rank-id r) (car (cddr r)))
+
+;; Whether rank a goes before rank b.
+(define (rank<? a b)
+  (or (> (rank-score a) (rank-score b))
+      (and (= (rank-score a) (rank-score b))
+           (or (< (rank-posed a) (rank-posed b))
+               (and (= (rank-posed a) (rank-posed b))
+                    (string<? (rank-id a) (rank-id b)))))))
+
+;; A task waiting here: news is what came for it, offers and cancels, and
+;; bell rings when news comes.
+(define-record-type waiter
+  (make-waiter task components rank)
+  waiter?
+  (task waiter-task)
+  (components waiter-components)
+  (rank waiter-rank)
+  (held waiter-held waiter-held-set!)            ; ((INDEX WINNER TYPE) ...)
+  (looked waiter-looked waiter-looked-set!)      ; monotonic-seconds
+  (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
+  (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
+  (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
+  (position waiter-position waiter-position-set!)
+  (why waiter-why waiter-why-set!)               ; a line a component
+  (news waiter-news waiter-news-set!)
+  (bell waiter-bell waiter-bell-set!))
+
+;; The tasks waiting here, under *tasks-lock*.
+(define *waiters* '())
+
+(define (waiters) *waiters*)
+(define (add-waiter! w) (set! *waiters* (cons w *waiters*)))
+(define (drop-waiter! w) (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*)))
+
+;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
+;; UID): its kind, then what it says, read by name.
+(define (news-kind n) (car n))
+(define (offer? n) (eq? (news-kind n) 'offer))
+(define (offer-reply n) (cadr n))
+(define (offer-uid n) (car (cddr n)))
+(define (give-way-uid n) (cadr n))
+
+(define (tell-waiter! w news)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (cond ((memq w *waiters*)
+             (waiter-news-set! w (cons news (waiter-news w)))
+             (mailbox-put! (waiter-bell w) #t))
+            ((offer? news) (answer-offers! (list news) #f))))))
+
+;; The news that came for w, oldest first, once some has come or the
+;; monotonic second until has passed.
+(define (take-news! w until)
+  (mailbox-take (waiter-bell w) until (lambda () #f))
+  (with-lock *tasks-lock*
+    (lambda ()
+      (let ((news (reverse (waiter-news w))))
+        (waiter-news-set! w '())
+        (waiter-bell-set! w (make-mailbox))
+        news))))
+
+;; What w holds of a component, (INDEX WINNER TYPE), read by name.
+(define (held-index h) (car h))
+(define (held-winner h) (cadr h))
+(define (held-type h) (car (cddr h)))
+(define (held-uid h) (winner-uid (held-winner h)))
+
+(define (held-uids w) (map held-uid (waiter-held w)))
+
+;; w's place among the tasks of the lab that wait for a robot it may use:
+;; 1 + how many of them rank before it.
+(define (place-in-line w others)
+  (+ 1 (count (lambda (other)
+                (and (rank<? (waiting-there-rank other) (waiter-rank w))
+                     (may-use? other (waiter-capable w))))
+              others)))
+
+;; Whether other, a waiting-there, may use one of uids.
+(define (may-use? other uids)
+  (or (eq? (waiting-there-capable other) #t) (eq? uids #t)
+      (any (lambda (uid) (memq uid (waiting-there-capable other))) uids)))
+
+;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
+;;> of the robots it may use (#t before it has looked), and of those it
+;;> holds.
+(define (waiting-ranks)
+  (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
+       (with-lock *tasks-lock* waiters)))
+
+;; A task that waits at poser, as its entry of waiting-ranks says.
+(define-record-type waiting-there
+  (make-waiting-there poser rank capable held)
+  waiting-there?
+  (poser waiting-there-poser)
+  (rank waiting-there-rank)
+  (capable waiting-there-capable)
+  (held waiting-there-held))
+
+;; Every task of the lab that waits, each a waiting-there; request
+;; answers (POSER ENTRIES) for each poser.
+(define (waiting-elsewhere)
+  (append-map (lambda (answer)
+                (map (lambda (e) (apply make-waiting-there (car answer) e))
+                     (cadr answer)))
+              (request 'waiting-tasks waiting-ranks)))
+
+;;> The (RANK POSER ID) of each task waiting here that may use robot
+;;> \var{uid}.
+(define (waiting-for uid)
+  (filter-map (lambda (w)
+                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w)))
+                     (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
+              (with-lock *tasks-lock* waiters)))
+
+;; The parts of an entry of waiting-for, from any poser of the lab.
+(define (wanting-rank e) (car e))
+(define (wanting-poser e) (cadr e))
+(define (wanting-id e) (car (cddr e)))
+(define (answer-offers! offers took?)
+  (for-each (lambda (offer) (mailbox-put! (offer-reply offer) took?)) offers))
+

@@ -1,0 +1,23 @@
+;;> Waiting and rank: a task's turn (start-task's wait, hold, priority
+;;> and deadline), the lab-wide order of the waiting tasks, each one's
+;;> place in it, and the waiter record of a task waiting here.
+
+(define-library (murdoch task rank)
+  (export make-turn turn? turn-wait? turn-hold? turn-priority turn-deadline
+          turn-posed read-turn check-waiting-room turn-rank rank<?
+          make-waiter waiter? waiter-task waiter-components waiter-rank
+          waiter-held waiter-held-set! waiter-looked waiter-looked-set!
+          waiter-kept waiter-kept-set! waiter-yielded waiter-yielded-set!
+          waiter-capable waiter-capable-set! waiter-position waiter-position-set!
+          waiter-why waiter-why-set! waiter-news waiter-news-set!
+          waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter!
+          news-kind offer? offer-reply offer-uid give-way-uid tell-waiter!
+          take-news! answer-offers! held-index held-winner held-type held-uid
+          held-uids place-in-line may-use? waiting-ranks waiting-there?
+          waiting-there-poser waiting-there-rank waiting-there-capable
+          waiting-there-held waiting-elsewhere waiting-for wanting-rank
+          wanting-poser wanting-id)
+  (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (murdoch sys)
+          (murdoch lab) (murdoch remote) (murdoch task pose-task)
+          (only (murdoch pubsub) request) (murdoch task record))
+  (include "rank.scm"))

@@ -1,0 +1,118 @@
+;;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
+;;;; synchronization)
+;;
+;; A task of steps runs its steps in order, each a task as start-task runs
+;; one: a step starts when every component of the step before is done (a
+;; barrier), and its procedures are applied to that step's results.  Its
+;; components may ask for a robot that had a component of an earlier step,
+;; so that a team keeps its members, and run as a team: team-barrier,
+;; team-send! and team-receive (team.scm) reach the other members.  A step
+;; with a failed component stops the task; everything is freed as each
+;; step's components end.
+
+(define-record-type step
+  (make-step capabilities metrics procs options)
+  step?
+  (capabilities step-capabilities)
+  (metrics step-metrics)
+  (procs step-procs)
+  (options step-options))
+
+;;> A step of a task of steps: start-task's lists, one entry per component,
+;;> then optionally its priorities and its restartable list.  A capability
+;;> entry (same J K) asks for the robot that had component K of step J.
+;;> Each procedure is applied to the list of the step before's results
+;;> ('() for the first step), on its robot, as a member of the step's team.
+(define (task-step capability-list metrics procs . options)
+  (if (not (and (list? capability-list) (list? metrics) (list? procs)
+                (= (length capability-list) (length metrics) (length procs))))
+      (error "task-step: capabilities, metrics and procedures are lists of one length"))
+  (make-step capability-list metrics procs options))
+
+;;> The parts of a step made by task-step, as they travel: its
+;;> capabilities, metrics, procedures and options, task-step's arguments.
+(define (step-parts s)
+  (cons* (step-capabilities s) (step-metrics s) (step-procs s) (step-options s)))
+
+;;> Starts a task of \var{steps} (made by task-step) and answers its task
+;;> record at once; start-task's keywords may follow the steps, and each
+;;> step is started with them.  task-status gives (step I STATUS) for each
+;;> step started (read by step-status? and the other step-status-
+;;> procedures), task-wait the list of each step's results, and
+;;> cancel-task stops the step running and those after it.
+(define (start-steps task-name . steps+options)
+  (let ((steps (take-while step? steps+options))
+        (options (drop-while step? steps+options)))
+    (if (not (and (symbol? task-name) (pair? steps)))
+        (error "start-steps: a task name, then one or more steps made by task-step"))
+    (read-turn "start-steps" options)
+    (for-each check-same steps (iota (length steps) 1))
+    (let ((t (new-task (task-key task-name) task-name '() '() '() '() #f)))
+      (task-steps-set! t '())
+      (thread-start!
+       (make-logged-thread (inheriting (lambda () (run-steps t steps options)))
+                           (task-id t)))
+      t)))
+
+;;> Runs a task of steps and answers, as task-wait, each step's results.
+(define (pose-steps task-name . steps)
+  (task-wait (apply start-steps task-name steps)))
+
+(define (same? capability)
+  (and (pair? capability) (eq? (car capability) 'same)))
+
+;; A (same J K) entry of step i names a component of an earlier step.
+(define (check-same s i)
+  (for-each (lambda (c)
+              (if (and (same? c)
+                       (not (and (= (length c) 3) (exact-integer? (cadr c))
+                                 (< 0 (cadr c) i) (exact-integer? (car (cddr c))))))
+                  (error (string-append "task-step: (same J K) names component K"
+                                        " of a step J before this one")
+                         c)))
+            (step-capabilities s)))
+
+(define (run-steps t steps options)
+  (let loop ((i 1) (steps steps) (previous '()) (results '()))
+    (cond
+     ((or (null? steps) (eq? (task-state t) 'cancelled))
+      (finish! t (reverse results)))
+     (else
+      (let* ((sub #f)
+             (coordinator (make-coordinator (lambda () (if sub (task-team sub) '()))))
+             (step-results
+              (begin
+                (set! sub (start-step t (car steps) i previous coordinator options))
+                (task-steps-set! t (append (task-steps t) (list sub)))
+                (task-wait sub))))
+        (release-proxy! coordinator)
+        (progress (task-id t) ": step " i " done: " step-results)
+        (if (step-failed? step-results)
+            (begin (if (not (eq? (task-state t) 'cancelled)) (task-state-set! t 'failed))
+                   (finish! t (reverse (cons step-results results))))
+            (loop (+ i 1) (cdr steps) step-results (cons step-results results))))))))
+
+(define (step-failed? results)
+  (or (symbol? results)
+      (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
+
+;; Starts step number i of t as a task of its own.
+(define (start-step t s i previous coordinator options)
+  (apply start-task (task-name t) (length (step-procs s))
+         (map (lambda (c) (if (same? c) (same-robot t c) c)) (step-capabilities s))
+         (map (lambda (c m) (if (same? c) #f m))
+              (step-capabilities s) (step-metrics s))
+         (map (lambda (p)
+                (sendable-lambda ()
+                  (with-coordinator coordinator (lambda () (p previous)))))
+              (step-procs s))
+         (append (step-options s) options)))
+
+;; The capabilities of the robot that (same J K) names: its uid, to
+;; itself.
+(define (same-robot t c)
+  (let ((team (task-team (list-ref (task-steps t) (- (cadr c) 1)))))
+    (if (> (car (cddr c)) (length team))
+        (error "task-step: no such component" c))
+    (list (list (list-ref team (- (car (cddr c)) 1))) '())))
+

@@ -1,0 +1,215 @@
+;;;; Tasks that wait their turn (thesis ch. 6; docs/tasks.md)
+;;
+;; A task started with wait #t that finds too few capable robots free
+;; waits for them, holding nothing and trying only when a robot offers
+;; itself, while its poser subscribes to waiting-tasks and tells the lab
+;; that a task waits (note-waiters!).  When a robot's exclusive subjects
+;; are freed (pubsub's on-free!), the robot asks waiting-tasks who waits
+;; for it, and offers itself to each in rank order, its subjects kept for
+;; that one's poser while it tries, until one starts or none can.  A rank
+;; is (KEY POSED ID), KEY being the task's priority less aging times the
+;; second it was posed: the higher KEY goes first, then the earlier
+;; POSED, then the smaller ID.  That is a total order, the same in every
+;; address space, and aging does not reorder the tasks that wait: it
+;; raises all their priorities alike, and only a task posed later starts
+;; from lower down.  A task no live robot of the lab is capable of fails
+;; at once; one whose capable robots all die while it waits fails when
+;; it next looks at the lab, every ten heartbeats or a third of the
+;; lease, whichever is sooner.
+
+(define (enlist! w)
+  (waiter-held-set! w '())
+  (waiter-looked-set! w #f)
+  (waiter-kept-set! w (monotonic-seconds))
+  (waiter-yielded-set! w '())
+  (waiter-capable-set! w #t)            ; any robot, until it has looked
+  (waiter-position-set! w #f)
+  (waiter-why-set! w '())
+  (waiter-news-set! w '())
+  (waiter-bell-set! w (make-mailbox))
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-waiter-set! (waiter-task w) w)
+      (add-waiter! w)
+      (subscribe 'waiting-tasks)))
+  (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
+    (publish 'all note-waiters!)))
+
+;; The offers w had not answered are declined: a robot waits for no task
+;; that no longer waits.
+(define (delist! w)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (task-waiter-set! (waiter-task w) #f)
+      (drop-waiter! w)
+      (answer-offers! (filter offer? (waiter-news w)) #f)
+      (waiter-news-set! w '())
+      (if (null? (waiters)) (unsubscribe 'waiting-tasks)))))
+
+
+;; What try, a procedure of the task's waiter that negotiates cs of t,
+;; answers; for a task that waits, tried again whenever a robot it may
+;; use is offered, until it wins its robots or cannot: (winners
+;; type-list), or a symbol, not-enough-takers, deadline or cancelled.
+(define (negotiate-turn t cs try)
+  (let ((w (make-waiter t cs (turn-rank (task-turn t) (task-id t)))))
+    (if (not (turn-wait? (task-turn t)))
+        (try w)
+        (dynamic-wind
+         (lambda () (enlist! w))
+         (lambda () (wait-turn w try '((posed))))
+         (lambda () (let-go-held! w) (delist! w))))))
+
+;; Tries, answers the offers that woke it, and waits for the next.  It
+;; tries only when a robot offered itself, or when it was posed with no
+;; better-ranked task waiting for a robot it may use: a robot's offers
+;; come in rank order, and a try out of turn could take a robot freed for
+;; a better-ranked task.  It looks at the lab again when what it holds
+;; changed, or a second after its last look: an offer is answered by one
+;; try.
+(define (wait-turn w try news)
+  (let ((t (waiter-task w))
+        (offers (filter offer? news))
+        (held (held-uids w)))
+    (give-way! w news)
+    (cond
+     ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
+     ((eq? (task-state t) 'let-go) (answer-offers! offers #f) 'let-go)
+     ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
+     (else
+      (let ((team (if (or (pair? offers)
+                          (and (equal? news '((posed))) (not (behind-others? w))))
+                      (try-in-turn w try (map offer-uid offers))
+                      'not-enough-takers)))
+        (answer-offers! offers (pair? team))
+        (cond
+         ((pair? team) team)
+         ((and (or (not (equal? held (held-uids w))) (look-due? w)) (look! w))
+          => (lambda (never)
+               (for-each (lambda (c) (component-state-set! c (list 'failed never)))
+                         (waiter-components w))
+               'not-enough-takers))
+         (else
+          (if (> (- (monotonic-seconds) (waiter-kept w))
+                 (/ (lab-setting (current-lab) 'lease) 4))
+              (keep-held! w))
+          (wait-turn w try
+                     (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
+
+;; One try of w's, after the tries of this address space's other waiting
+;; tasks: two at once, each offered a robot, each reserved the other's
+;; robot as a candidate of its negotiation, and the one that lost its
+;; robot so, for a moment, found none and declined it.  The robots offered
+;; to the others are left alone, and so are all but those offered to w,
+;; the uids offered, when w can take robots one at a time (it holds, or
+;; needs one): a robot may be kept for this poser on its way to offer
+;; itself to another of its tasks.
+(define *try-lock* (make-mutex 'tries))
+
+(define (try-in-turn w try offered)
+  (with-lock *try-lock*
+    (lambda ()
+      (quiet-try (lambda ()
+                   (parameterize ((pose-task-excluded (append (offered-to-others w)
+                                                              (not-offered w offered)
+                                                              (pose-task-excluded))))
+                     (try w)))))))
+
+(define (not-offered w offered)
+  (let ((t (waiter-task w)))
+    (if (and (pair? offered) (list? (waiter-capable w))
+             (or (turn-hold? (task-turn t)) (= 1 (length (waiter-components w)))))
+        (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
+        '())))
+
+(define (look-due? w)
+  (or (not (waiter-looked w)) (> (- (monotonic-seconds) (waiter-looked w)) 1)))
+
+(define (past? deadline) (and deadline (>= (monotonic-seconds) deadline)))
+
+(define (next-look deadline)
+  (let ((look (+ (monotonic-seconds)
+                 (min (* 10 (lab-setting (current-lab) 'heartbeat))
+                      (/ (lab-setting (current-lab) 'lease) 3)))))
+    (if deadline (min deadline look) look)))
+
+;; A try that answers at once and writes no explanation: the waiter
+;; gives its own.
+(define (quiet-try try)
+  (parameterize ((pose-task-retries 0) (current-error-port (open-output-string)))
+    (try)))
+
+;; Looks at the lab for w after a try that failed: why it waits, and its
+;; place in line, in its components' states; answers why it never can be
+;; served, or #f.
+(define (look! w)
+  (waiter-looked-set! w (monotonic-seconds))
+  (let* ((cs (waiter-components w))
+         (lines (explain-components
+                 (map (lambda (c) (capability-layout (component-capabilities c))) cs)))
+         (capable (map (lambda (line)
+                         (remove (lambda (uid) (memq uid (pose-task-excluded)))
+                                 (explanation-capable line)))
+                       lines))
+         (others (guard (e (#t '())) (waiting-elsewhere)))
+         (exclusive (filter-map (lambda (c caps)
+                                  (and (pair? (car (capability-layout
+                                                    (component-capabilities c))))
+                                       caps))
+                                cs capable)))
+    (cond
+     ((any null? capable)
+      (string-append "no live robot of the lab is capable of it:"
+                     (apply string-append (map explanation-line lines))))
+     ((< (length (delete-duplicates (apply append exclusive))) (length exclusive))
+      "fewer live robots of the lab are capable of it than it has components")
+     (else
+      (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (remind-free! (delete-duplicates (append-map explanation-free lines)))
+      (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
+      (waiter-position-set! w (place-in-line w others))
+      (ask-way! w lines others)
+      (with-lock *tasks-lock*
+        (lambda ()
+          (if (eq? (task-state (waiter-task w)) 'negotiating)
+              (task-state-set! (waiter-task w) 'waiting))))
+      (for-each (lambda (c why)
+                  (component-state-set! c (list 'waiting (waiter-position w) why)))
+                cs (waiter-why w))
+      (progress (task-id (waiter-task w)) ": waiting, " (waiter-position w)
+                " in line")
+      #f))))
+
+;; Robots that a look finds free may have made their offers before this
+;; task waited, or be making them: each is asked to offer itself (again),
+;; best rank first, rather than taken by a try out of turn.
+(define (remind-free! uids)
+  (for-each (lambda (uid)
+              (guard (e (#t (log-warn "reminding " uid ": " (error-message e))))
+                (parameterize ((remote-timeout 1))
+                  (remote-apply (uid->aspace uid) note-waiters!))))
+            uids))
+
+(define (trimmed line)
+  (let loop ((s line))
+    (cond ((and (> (string-length s) 0) (char-whitespace? (string-ref s 0)))
+           (loop (substring s 1 (string-length s))))
+          ((and (> (string-length s) 0)
+                (char-whitespace? (string-ref s (- (string-length s) 1))))
+           (loop (substring s 0 (- (string-length s) 1))))
+          (else s))))
+
+;; Brings w's place in line, in its components' states, up to date.
+(define (move-up! w)
+  (let ((place (guard (e (#t (waiter-position w)))
+                 (place-in-line w (waiting-elsewhere)))))
+    (waiter-position-set! w place)
+    (for-each (lambda (c)
+                (let ((state (component-state c)))
+                  (if (eq? (car state) 'waiting)
+                      (component-state-set! c (list 'waiting place (car (cddr state)))))))
+              (waiter-components w))))
+
+;; Whether a better-ranked task of the lab waits for a robot w may use.
+(define (behind-others? w)
+  (> (place-in-line w (guard (e (#t '())) (waiting-elsewhere))) 1))

@@ -1,0 +1,15 @@
+;;> Tasks that wait their turn: negotiate-turn negotiates a task, and one
+;;> started with wait #t waits, trying again when a robot offers itself,
+;;> until it wins its robots, its deadline passes or it is cancelled.
+
+(define-library (murdoch task waiting)
+  (export negotiate-turn move-up!)
+  (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
+          (murdoch sys) (murdoch wire) (murdoch lab) (murdoch remote)
+          (murdoch task progress) (murdoch task pose-task)
+          (only (murdoch pubsub) subscribe unsubscribe publish capability-layout)
+          (only (murdoch task takers) explain-components explanation-line
+                explanation-free explanation-capable)
+          (murdoch task record) (murdoch task rank) (murdoch task offers)
+          (murdoch task holding))
+  (include "waiting.scm"))
