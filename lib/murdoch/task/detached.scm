@@ -579,7 +579,7 @@
 ;; Applies proc to id's record where it is held, trying for a few periods
 ;; while a takeover is under way; raises a clear error when nobody holds it.
 (define (at-holder who id proc . args)
-  (let try ((left 8))
+  (let try ((left 2))
     (let ((uid (holder-of id)))
       (cond
        ((and (not uid) (> left 0)) (thread-sleep! (period)) (try (- left 1)))
