@@ -273,7 +273,7 @@
               (begin
                 (handed-heard-set! h (monotonic-seconds))
                 (handed-partner-set! h uid)
-                (progress (handed-id h) ": " uid " stands by"))
+                (log-note "task " (handed-id h) ": " uid " stands by"))
               (try (cdr candidates))))))))
 
 ;;> What the standby of task \var{id} calls at its coordinator every
