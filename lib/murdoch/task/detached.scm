@@ -32,7 +32,7 @@
 ;; poser's: detached-patience times the periods, so that a takeover comes
 ;; before they stop as orphans.
 
-(define detached-patience 3)
+(define detached-patience 4)
 
 ;; The coordinator lets a task go when its standby's pings have not come
 ;; for let-go-periods; the standby takes over when its pings have not
@@ -244,7 +244,7 @@
 (define (send-copy! h copy)
   (let ((uid (handed-partner h)))
     (guard (e ((and (remote-error? e) (not (remote-raised-error? e)))
-               (if (process-gone? uid) (lost-standby! h uid))))
+               (if (gone-by? e uid) (lost-standby! h uid))))
       (if (not (parameterize ((remote-timeout (period)))
                  (remote-apply (uid->aspace uid) receive-copy (handed-id h)
                                (handed-epoch h) copy)))
@@ -287,16 +287,17 @@
 ;; about to take over.  It takes the task back only once it finds the
 ;; standby's process gone; it drops it when the standby took over.
 (define (let-go! h)
-  (let ((uid (handed-partner h)))
-    (log-warn "task " (handed-id h) ": its standby " uid " is silent; letting it go")
+  (let ((uid (handed-partner h)) (t (handed-task h)))
     (handed-role-set! h 'let-go)
-    (if (handed-task h) (let-task-go! (handed-task h)))
+    (if t (let-task-go! t))
+    (log-warn "task " (handed-id h) ": its standby " uid " is silent; letting it go;"
+              " its last heartbeat went at " (and t (task-acted t)))
     (thread-start!
      (make-logged-thread
       (lambda ()
         (let probe ()
           (thread-sleep! (period))
-          (let ((there (guard (e (#t (if (process-gone? uid) 'gone 'silent)))
+          (let ((there (guard (e (#t (if (gone-by? e uid) 'gone 'silent)))
                          (parameterize ((remote-timeout (period)))
                            (remote-apply (uid->aspace uid) handed-role-of
                                          (handed-id h))))))
@@ -315,8 +316,13 @@
   (let ((h (handed-by-id id)))
     (and h (handed-role h))))
 
-;; Whether uid's process is gone: its port refuses a connection.  A
-;; partition answers nothing, or says that there is no route.
+;; Whether e, what a call to uid raised, says that uid's process is gone:
+;; the call found no connection, and its port refuses one.  A partition
+;; answers nothing, or says that there is no route.
+(define (gone-by? e uid)
+  (and (remote-unreachable-error? e) (process-gone? uid)))
+
+;; Whether uid's process is gone: its port refuses a connection.
 (define (process-gone? uid)
   (let* ((a (uid->aspace uid))
          (io (open-connection (aspace-host a) (aspace-port a) (period))))
@@ -354,11 +360,12 @@
 ;; answered for take-over-periods, or a period after the coordinator's process
 ;; is found gone.
 (define (stand-by h)
-  (let loop ()
-    (thread-sleep! (period))
+  (let loop ((last (monotonic-seconds)))
+    (thread-sleep! (max 0 (- (+ last (period)) (monotonic-seconds))))
     (when (eq? (handed-role h) 'standby)
       (let* ((uid (handed-partner h))
-             (answer (guard (e (#t (if (process-gone? uid) 'gone 'silent)))
+             (started (monotonic-seconds))
+             (answer (guard (e (#t (if (gone-by? e uid) 'gone 'silent)))
                        (parameterize ((remote-timeout (period)))
                          (remote-apply (uid->aspace uid) coordinator-ping (handed-id h)
                                        (handed-epoch h))))))
@@ -373,7 +380,7 @@
           (log-warn "task " (handed-id h) ": its coordinator " uid " is silent for "
                     take-over-periods " periods")
           (take-over! h (list uid)))
-         (else (loop)))))))
+         (else (loop started)))))))
 
 ;; This address space becomes h's coordinator, at a new epoch: it adopts
 ;; the task's components where they run, and chooses a new standby, not
@@ -384,7 +391,7 @@
   (handed-partner-set! h #f)
   (handed-took-over-set! h (utc-seconds))
   (log-note "task " (handed-id h) ": taking over as its coordinator, epoch "
-            (handed-epoch h))
+            (handed-epoch h) ", at " (handed-took-over h))
   (let ((copy (handed-copy h)))
     (cond
      ((copy-results copy) #f)

@@ -93,6 +93,7 @@
         (task-steps-set! t #f)
         (task-turn-set! t turn)
         (task-waiter-set! t #f)
+        (task-acted-set! t #f)
         (add-posed! t)
         t))))
 
@@ -268,7 +269,8 @@
         (cond
          (got (outcome-of got))
          ((let-go? t) (thread-interrupt! runner) '(let-go))
-         ((heartbeat a (task-id t) (component-index c) period)
+         ((begin (task-acted-set! t (utc-seconds))
+                 (heartbeat a (task-id t) (component-index c) period))
           (watch (monotonic-seconds)))
          ((>= (- (monotonic-seconds) heard) (* lost-periods patience period))
           (thread-interrupt! runner)    ; its call is given up
