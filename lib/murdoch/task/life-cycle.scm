@@ -268,7 +268,9 @@
                                (lambda () #f))))
         (cond
          (got (outcome-of got))
-         ((let-go? t) (thread-interrupt! runner) '(let-go))
+         ;; Its call is not given up: that would stop the component,
+         ;; which the new coordinator adopts.
+         ((let-go? t) '(let-go))
          ((begin (task-acted-set! t (utc-seconds))
                  (heartbeat a (task-id t) (component-index c) period))
           (watch (monotonic-seconds)))

@@ -128,7 +128,8 @@
   (let ((r (find-running id k)))
     (when r
       (running-poser-set! r poser)
-      (running-heard-set! r (monotonic-seconds))))
+      (running-heard-set! r (monotonic-seconds))
+      (release-call! (running-thread r))))
   (let wait ()
     (cond ((find-running id k) (thread-sleep! 0.05) (wait))
           ((find-ending id k)

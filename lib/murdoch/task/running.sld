@@ -12,5 +12,5 @@
           components-running components-ended ended-id ended-index ended-started
           ended-ended ended-end lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
-          (murdoch robot) (only (murdoch remote) hand-over-connection!))
+          (murdoch robot) (only (murdoch remote) hand-over-connection! release-call!))
   (include "running.scm"))
