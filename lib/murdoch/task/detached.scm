@@ -180,7 +180,8 @@
 ;;> chose: starts the task of \var{kind} that \var{args} describe here
 ;;> (see start-kind); answers its id.
 (define (coordinate-task! kind args poser)
-  (let* ((t (parameterize ((heartbeat-patience detached-patience))
+  (let* ((t (parameterize ((heartbeat-patience detached-patience)
+                            (task-id-maker fresh-id))
               (start-kind kind args)))
          (h (make-handed (task-id t) kind args poser)))
     (handed-role-set! h 'coordinator)
@@ -193,6 +194,13 @@
     (hold-handed! h)
     (coordinate! h)
     (task-id t)))
+
+;; A task id no peer of the lab knows: a coordinator started again counts
+;; its ids from 1 again, and the lab keeps results, and robots remember
+;; the components that ended, by id.
+(define (fresh-id name)
+  (let ((id (task-key name)))
+    (if (or (holder-of id) (pair? (components-of id))) (fresh-id name) id)))
 
 ;; Starts the threads of h's coordinator: one keeps its standby's copy,
 ;; one waits for the task's end.

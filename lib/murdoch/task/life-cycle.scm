@@ -68,7 +68,7 @@
                      (every boolean? restartable)))
            (error "start-task: restartable is a list of a boolean for each component"
                   restartable))
-       (values (new-task (or id (task-key task-name)) task-name capability-list metrics
+       (values (new-task (or id ((task-id-maker) task-name)) task-name capability-list metrics
                          procs restartable (or turn keywords))
                priorities)))
    args))
@@ -114,6 +114,11 @@
 ;;> declares their robot lost: a detached task's, so that its standby may
 ;;> take over before they stop (detached.scm).
 (define heartbeat-patience (make-parameter 1))
+
+;;> What makes a new task's id of its name: task-key, NAME@UID/N; a
+;;> detached task's coordinator makes ids no peer of the lab knows
+;;> (detached.scm).
+(define task-id-maker (make-parameter task-key))
 
 ;; Whether t's coordinator let it go (detached.scm): it acts no more.
 (define (let-go? t) (eq? (task-state t) 'let-go))

@@ -47,7 +47,7 @@
         (error "start-steps: a task name, then one or more steps made by task-step"))
     (read-turn "start-steps" options)
     (for-each check-same steps (iota (length steps) 1))
-    (let ((t (new-task (task-key task-name) task-name '() '() '() '() #f)))
+    (let ((t (new-task ((task-id-maker) task-name) task-name '() '() '() '() #f)))
       (task-steps-set! t '())
       (thread-start!
        (make-logged-thread (inheriting (lambda () (run-steps t steps options)))

@@ -5,6 +5,5 @@
   (export task-step start-steps pose-steps step? step-parts)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (murdoch sys) (murdoch code)
           (murdoch remote) (murdoch task progress) (murdoch task team) (murdoch task record)
-          (murdoch task rank) (murdoch task life-cycle)
-          (only (murdoch task pose-task) task-key))
+          (murdoch task rank) (murdoch task life-cycle))
   (include "steps.scm"))
