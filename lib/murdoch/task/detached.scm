@@ -551,14 +551,27 @@
                  (handed-poser h) (handed-took-over h))))
        (with-lock *handed-lock* (lambda () *handed*))))
 
-;;> The parts of an entry of handed-entries or lab-tasks, by name.
+;;> The task's id in \var{e}, an entry of lab-tasks or handed-entries.
 (define (lab-task-id e) (car e))
+;;> The role of the address space that gave \var{e}, an entry of
+;;> lab-tasks: coordinator, standby or let-go.
 (define (lab-task-role e) (cadr e))
+;;> How many coordinators the task of \var{e}, an entry of lab-tasks,
+;;> has had: 1, and 1 more a takeover.
 (define (lab-task-epoch e) (list-ref e 2))
+;;> The state of the task of \var{e}, an entry of lab-tasks:
+;;> negotiating, waiting, running, done, failed or cancelled.
 (define (lab-task-state e) (list-ref e 3))
+;;> The coordinator's uid in \var{e}, an entry of lab-tasks.
 (define (lab-task-coordinator e) (list-ref e 4))
+;;> The standby's uid in \var{e}, an entry of lab-tasks, or #f while
+;;> there is none.
 (define (lab-task-standby e) (list-ref e 5))
+;;> The uid of the address space that posed the task of \var{e}, an
+;;> entry of lab-tasks.
 (define (lab-task-poser e) (list-ref e 6))
+;;> The utc-seconds at which the coordinator of \var{e}, an entry of
+;;> lab-tasks, took the task over from another, or #f.
 (define (lab-task-took-over e) (list-ref e 7))
 
 ;;> The lab's detached tasks, one entry each, as its coordinator (or, in

@@ -43,9 +43,13 @@
 ;;> #t or #f, whether the task waits when too few capable robots are free
 ;;> (default: the lab's when-robots-busy); \scheme{priority}, the task's
 ;;> priority (default (pose-task-priority)); \scheme{deadline}, seconds
-;;> after which a task not yet started fails with \scheme{deadline}.
-(define (start-task . args)
-  (let-values (((t priorities) (task-of-args #f #f args)))
+;;> after which a task not yet started fails with \scheme{deadline};
+;;> \scheme{detach} #t hands the task to the lab, and answers its id
+;;> (lib/murdoch/task/detached.scm).
+(define (start-task task-name num-robots capability-list metrics procs . options)
+  (let-values (((t priorities)
+                (task-of-args #f #f (cons* task-name num-robots capability-list metrics
+                                           procs options))))
     (thread-start!
      (make-logged-thread (inheriting (lambda () (run-task t priorities))) (task-id t)))
     t))
@@ -325,6 +329,7 @@
 ;;> WHY) or (reassigned FROM TO), SINCE a (utc-seconds); ATTEMPTS has
 ;;> (UID . OUTCOME) for each robot that had the component and is done
 ;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
+;;> \var{task} may also be a detached task's id, from any peer.
 (define (task-status task)
   (check-task-record "task-status" task)
   (if (task-waiter task) (move-up! (task-waiter task)))
@@ -339,7 +344,8 @@
 ;;> Waits for \var{task} to end, at most \var{seconds} (default: for
 ;;> ever), and answers what pose-task would have: each component's result,
 ;;> (error UID WHY) for a failed one, or not-enough-takers.  Raises an
-;;> error naming the task when the time runs out.
+;;> error naming the task when the time runs out.  \var{task} may also be a
+;;> detached task's id, from any peer.
 (define (task-wait task . seconds)
   (check-task-record "task-wait" task)
   (if (pair? seconds)
@@ -357,7 +363,8 @@
 
 ;;> Cancels \var{task}: every running component stops on its robot at its
 ;;> next robot command or remote call, its robot stops, and every
-;;> reservation is freed.  Answers #t.
+;;> reservation is freed.  Answers #t.  \var{task} may also be a
+;;> detached task's id, from any peer.
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
   (task-state-set! task 'cancelled)

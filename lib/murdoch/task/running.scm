@@ -155,7 +155,7 @@
     (if r (stop-running! r))
     (and r #t)))
 
-;; (ID INDEX POSER) for each component running here.
+;;> (ID INDEX POSER) for each component running here.
 (define (components-running)
   (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
        (with-lock *running-lock* (lambda () *running*))))
