@@ -230,12 +230,15 @@
         (handed-copy-set! h copy)
         (cond
          ((kept-enough? copy) (drop-handed! h))
+         ;; Ended, and the standby has the copy: nothing more to say.
+         ((and (copy-results copy) (equal? copy sent)) (loop sent-at sent))
          ((and (handed-partner h)
                (> (- (monotonic-seconds) (handed-heard h)) (* let-go-periods (period))))
           (let-go! h))
          ((or (not (equal? copy sent)) (> (- (monotonic-seconds) sent-at) (period)))
-          (if (handed-partner h) (send-copy! h copy) (choose-standby! h))
-          (loop (monotonic-seconds) copy))
+          (loop (monotonic-seconds)
+                (and (if (handed-partner h) (send-copy! h copy) (choose-standby! h))
+                     copy)))
          (else (loop sent-at sent)))))))
 
 (define (current-copy h)
@@ -249,14 +252,16 @@
   (and (copy-ended copy)
        (> (- (utc-seconds) (copy-ended copy)) (lab-setting (current-lab) 'keep-results))))
 
+;; Sends copy to h's standby; answers whether it has it.
 (define (send-copy! h copy)
   (let ((uid (handed-partner h)))
     (guard (e ((and (remote-error? e) (not (remote-raised-error? e)))
-               (if (gone-by? e uid) (lost-standby! h uid))))
-      (if (not (parameterize ((remote-timeout (period)))
-                 (remote-apply (uid->aspace uid) receive-copy (handed-id h)
-                               (handed-epoch h) copy)))
-          (lost-standby! h uid)))))
+               (if (gone-by? e uid) (lost-standby! h uid))
+               #f))
+      (or (parameterize ((remote-timeout (period)))
+            (remote-apply (uid->aspace uid) receive-copy (handed-id h)
+                          (handed-epoch h) copy))
+          (begin (lost-standby! h uid) #f)))))
 
 (define (lost-standby! h uid)
   (log-warn "task " (handed-id h) ": its standby " uid " is gone; choosing another")
@@ -264,14 +269,14 @@
   (choose-standby! h))
 
 ;; Asks the least loaded other member to stand by, as the coordinator
-;; was chosen; the poser and the members that had the task are left out
-;; while another will do.
+;; was chosen, the poser left out while another will do; answers whether
+;; one does, and has the copy.
 (define (choose-standby! h)
   (let* ((me (local-aspace-uid))
          (all (coordinator-candidates (list me)))
          (others (remove (lambda (u) (eq? u (handed-poser h))) all)))
     (let try ((candidates (if (pair? others) others all)))
-      (when (pair? candidates)
+      (and (pair? candidates)
         (let ((uid (car candidates)))
           (if (guard (e (#t #f))
                 (parameterize ((remote-timeout (period)))
@@ -281,7 +286,8 @@
               (begin
                 (handed-heard-set! h (monotonic-seconds))
                 (handed-partner-set! h uid)
-                (log-note "task " (handed-id h) ": " uid " stands by"))
+                (log-note "task " (handed-id h) ": " uid " stands by")
+                #t)
               (try (cdr candidates))))))))
 
 ;;> What the standby of task \var{id} calls at its coordinator every
@@ -373,13 +379,16 @@
     (when (eq? (handed-role h) 'standby)
       (let* ((uid (handed-partner h))
              (started (monotonic-seconds))
-             (answer (guard (e (#t (if (gone-by? e uid) 'gone 'silent)))
+             (answer (if (copy-results (handed-copy h))
+                         #t       ; ended: the copy holds the results
+                         (guard (e (#t (if (gone-by? e uid) 'gone 'silent)))
                        (parameterize ((remote-timeout (period)))
                          (remote-apply (uid->aspace uid) coordinator-ping (handed-id h)
-                                       (handed-epoch h))))))
+                                       (handed-epoch h)))))))
         (if (eq? answer #t) (handed-heard-set! h (monotonic-seconds)))
         (cond
          ((kept-enough? (handed-copy h)) (drop-handed! h))
+         ((copy-results (handed-copy h)) (loop started))
          ((memq answer '(gone #f))
           (log-warn "task " (handed-id h) ": its coordinator " uid " is gone")
           (thread-sleep! (period))  ; it stopped acting a period ago at least

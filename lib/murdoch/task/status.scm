@@ -15,7 +15,7 @@
   ;; in between is then in both lists, never in neither.
   (let* ((not-over (remove (lambda (t)
                              (and (listed-posed? t)
-                                  (memq (listed-state t) '(done failed cancelled))))
+                                  (memq (listed-state t) '(done failed cancelled let-go))))
                            (tasks)))
          (ended (components-ended)))
     (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
