@@ -58,6 +58,7 @@ void lab_add_box(lab *l, const lab_box *b)
 
 int lab_trip_port(const lab *l, const lab_robot *r)
 {
+    /* the port plan's trip offset (lib/murdoch/lab/file.scm) */
     return r->trip_port ? r->trip_port : l->port_base + 100 + r->aspace;
 }
 

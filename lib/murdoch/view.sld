@@ -14,10 +14,9 @@
                 ended-ended ended-end)
           (only (murdoch robot) fiducial-id fiducial-range fiducial-bearing
                 fiducial-orientation)
-          (only (murdoch task status) report-since report-pose report-battery report-held
+          (only (murdoch task) report-since report-pose report-battery report-held
                 report-tasks report-goal report-ended held-subject held-holder
-                report-handed)
-          (only (murdoch task) lab-task-id lab-task-role lab-task-state
+                report-handed lab-task-id lab-task-role lab-task-state
                 lab-task-coordinator lab-task-standby)
           (scheme base) (scheme write)
           (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)

@@ -48,6 +48,26 @@
 (define (lab-port-base lab)
   (settings-port-base (lab-settings lab)))
 
+;;> The port plan: what listens at port-base + offset, the offset plus
+;;> its index in the file for an address space or a robot.  sim/lab.c
+;;> gives a trip server the same port.
+(define port-plan
+  '((aspace . 0)                        ; address space i
+    (trip . 100)                        ; robot i's trip server
+    (view-peer . 147)                   ; the live view's address space
+    (view . 148)                        ; the live view's page
+    (multicast . 149)))                 ; the group, unless the lab names one
+
+;;> The port of \var{what} in the port plan (\scheme{aspace}, \scheme{trip},
+;;> \scheme{view-peer}, \scheme{view} or \scheme{multicast}) from port base
+;;> \var{base}, and \var{index} for an address space's or a robot's.
+(define (planned-port base what . index)
+  (+ base (cdr (assq what port-plan)) (if (pair? index) (car index) 0)))
+
+;;> The port of \var{what} in the port plan of \var{lab}.
+(define (lab-planned-port lab what . index)
+  (apply planned-port (lab-port-base lab) what index))
+
 ;;> The port base where no lab file is read (murdoch replay):
 ;;> MURDOCH_PORT_BASE, else port-base's default.
 (define (unread-lab-port-base)
@@ -172,7 +192,7 @@
   (let ((clauses (cddr form)))
     (make-lab-aspace (cadr form) index
                      (clause-value 'host clauses interface)
-                     (clause-value 'port clauses (+ base index))
+                     (clause-value 'port clauses (planned-port base 'aspace index))
                      clauses form)))
 
 (define (path-directory path)
@@ -195,7 +215,7 @@
 ;;> The port of the trip server of robot \var{a}: its (robot (trip-port N))
 ;;> or port-base + 100 + its index.
 (define (lab-trip-port lab a)
-  (robot-setting a 'trip-port (+ (lab-port-base lab) 100 (lab-aspace-index a))))
+  (robot-setting a 'trip-port (lab-planned-port lab 'trip (lab-aspace-index a))))
 
 ;;> The host of the trip server of robot \var{a}: its (robot (trip-host
 ;;> "ADDR")), for a robot whose address space runs on another host than

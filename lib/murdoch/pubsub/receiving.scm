@@ -89,6 +89,7 @@
   (seconds lease-seconds)
   (keeper lease-keeper-thread))
 
+;; Global, as the subscriptions are: one lease keeper a process.
 (define *leases* #f)
 
 (define (lease) (lease-seconds *leases*))
@@ -186,8 +187,9 @@
       (*on-free*)))
 
 ;; What runs when a reservation of exclusive subjects here ends: tasks
-;; that wait for robots hear of it (task.scm).  Global: the task layer
-;; sets it as it loads, before the lab is joined.
+;; that wait for robots hear of it (task/offers.scm).  Global, as the
+;; subscriptions are: the task layer's hook, which the address space's
+;; start passes to initialize-subscriptions!.
 (define *on-free* (lambda () #f))
 
 ;;> Sets the thunk that runs, outside any lock, each time exclusive
@@ -251,7 +253,7 @@
               promise))))
 
 ;; A promise applied to keep holds its subjects for another lease: a task
-;; that holds what it has while it waits for the rest (task.scm).
+;; that holds what it has while it waits for the rest (task/life-cycle.scm).
 ;; Answers whether it still holds them.
 (define (renew! r)
   (with-subscriptions

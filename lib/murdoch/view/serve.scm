@@ -104,7 +104,7 @@
 (define (run-view web lab-file port trace)
   (set-process-name! "murdoch-view")
   (let* ((lab (read-lab lab-file))
-         (port (or port (+ (lab-port-base lab) 148)))
+         (port (or port (lab-planned-port lab 'view)))
          (listener (listen-on port))
          (trace (or trace (default-trace lab)))
          (uid (string->symbol
@@ -112,7 +112,7 @@
          ;; Not a guest's port, which is one of fifty by process id: the
          ;; view stays as long as the lab, and a REPL or pose that drew
          ;; the same would not start.
-         (env (join-lab lab-file uid (+ (lab-port-base lab) 147)))
+         (env (join-lab lab-file uid (lab-planned-port lab 'view-peer)))
          (proc (eval report-source (make-repl-environment lab env)))
          (aspaces (map (lambda (a) (uid->aspace (lab-aspace-uid a))) (lab-aspaces lab)))
          (header (or (trace-header trace) (lab-header lab)))
@@ -198,7 +198,7 @@
     (if (not (and (list? header) (equal? (assq 'kind header) '(kind . "lab"))))
         (error (string-append "not a trace of the view: " trace " (a trace's first"
                               " line is the view's header of the room)"))))
-  (let* ((port (or port (+ (unread-lab-port-base) 148)))
+  (let* ((port (or port (planned-port (unread-lab-port-base) 'view)))
          (listener (listen-on port)))
     (say "view: http://127.0.0.1:" port "/ (replaying " trace ")")
     (serve! listener
