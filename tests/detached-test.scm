@@ -6,7 +6,8 @@
 ;;; its own address space's log, which the tests read.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (chibi test)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
 (define (tell . xs) (write xs) (newline) (flush-output-port))
