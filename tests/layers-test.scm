@@ -19,7 +19,7 @@
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
     (task (assign progress metric takers) team (pose-task running) record rank
-          (offers holding) waiting life-cycle steps status)
+          (offers holding) waiting life-cycle steps detached status)
     murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))

@@ -250,7 +250,9 @@
                                                        '(1) '(yes))))
                     "restartable"))
   (test-assert "task-status wants a task"
-    (text-contains? (error-text (lambda () (task-status 'x))) "not a task")))
+    (text-contains? (error-text (lambda () (task-status 42))) "not a task"))
+  (test-assert "or the id of a task handed to the lab"
+    (text-contains? (error-text (lambda () (task-status 'x))) "no such task")))
 
 (test-end)
 (stop-all-processes!)

@@ -133,6 +133,22 @@
 (define (look table t . robot-reports) (task-table-update! table t robot-reports))
 (define (robot uid held tasks . ended) (list uid (apply report uid held tasks ended)))
 
+(test-group "a detached task shows its coordinator and standby"
+  (let ((table (make-task-table)))
+    (task-table-update!
+     table 1
+     (list (list 'praline
+                 (append (report 'praline '() '((posed survey@praline/1 running)))
+                         (list '((survey@praline/1 coordinator 1 running praline troy
+                                  guest-7 #f)))))
+           (list 'troy
+                 (append (report 'troy '() '())
+                         (list '((survey@praline/1 standby 1 running praline troy
+                                  guest-7 #f)))))))
+    (test "as its coordinator says" '("praline" "troy" "running")
+      (let ((t (newest-task table)))
+        (list (assq-ref 'coordinator t) (assq-ref 'standby t) (assq-ref 'state t))))))
+
 (test-group "the task table"
   (let ((table (make-task-table)))
     ;; pose-task negotiating: the candidates hold their exclusive subjects.

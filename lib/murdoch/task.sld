@@ -1,5 +1,6 @@
 ;;> Tasks: assignment, metrics, progress, takers, dynamic teams,
-;;> pose-task, a task's life cycle, and the status of the lab.
+;;> pose-task, a task's life cycle, tasks handed to the lab, and the
+;;> status of the lab.
 ;;> Its members are each a library of their own in task/; this umbrella
 ;;> exports what the families above use of them.
 
@@ -21,9 +22,16 @@
           t sort-list make-maxrandom with-coordinator team-barrier team-send!
           team-receive step-team aspace-report lab-status show-status
           write-lab-status report-since report-pose report-battery report-held
-          report-tasks report-goal report-ended held-subject held-holder)
+          report-tasks report-goal report-ended held-subject held-holder
+          report-handed lab-task-line await-component components-running lab-tasks
+          lab-task-id lab-task-role lab-task-epoch lab-task-state
+          lab-task-coordinator lab-task-standby lab-task-poser lab-task-took-over
+          coordinate-task! coordinator-ping become-standby! receive-copy
+          handed-role-of handed-entries handed-status handed-wait handed-cancel)
   (import (murdoch task assign) (murdoch task running) (murdoch task metric)
           (murdoch task pose-task) (murdoch task progress) (murdoch task takers)
           (murdoch task team) (murdoch task record) (murdoch task rank)
-          (murdoch task offers) (murdoch task holding) (murdoch task life-cycle)
-          (murdoch task steps) (murdoch task status)))
+          (murdoch task offers) (murdoch task holding)
+          (except (murdoch task life-cycle) start-task task-status task-wait cancel-task)
+          (except (murdoch task steps) start-steps)
+          (murdoch task detached) (murdoch task status)))

@@ -15,7 +15,9 @@
           (only (murdoch robot) fiducial-id fiducial-range fiducial-bearing
                 fiducial-orientation)
           (only (murdoch task) report-since report-pose report-battery report-held
-                report-tasks report-goal report-ended held-subject held-holder)
+                report-tasks report-goal report-ended held-subject held-holder
+                report-handed lab-task-id lab-task-role lab-task-state
+                lab-task-coordinator lab-task-standby)
           (scheme base) (scheme write)
           (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)
           (chibi net) (chibi net http-server) (chibi net servlet)

@@ -272,29 +272,84 @@
 ;;> task its last form names (see task-of), and writes the result.
 ;;> pose-task's progress lines go to the standard output as it works.
 ;;> Exits 0 when the task completed, else 1: not-enough-takers, or a
-;;> component that failed.
-(define (run-pose lab-file task-file)
+;;> component that failed.  With \var{detach} true, the task is handed to
+;;> the lab (start-task's detach): its id is written, and it exits 0 at
+;;> once.
+(define (run-pose lab-file task-file detach)
   (let* ((lab (read-lab lab-file))
-         (uid (string->symbol (string-append
-                               "pose-" (number->string (current-process-id)))))
-         (env (make-repl-environment lab (join-lab lab-file uid
-                                                   (lab-guest-port lab)))))
+         (env (make-repl-environment lab (join-guest lab-file "pose"))))
     (tell-who-is-away lab)
     (eval `(pose-task-progress (current-output-port)) env)
     ;; A task file answers pose-task's arguments, or a task already
-    ;; started (start-task, start-steps), which is waited for.
+    ;; started (start-task, start-steps), which is waited for, or the id
+    ;; of one handed to the lab.
     (let* ((task (task-of task-file env))
-           (record? ((eval 'task? env) task))
-           (result (if record?
-                       ((eval 'task-wait env) task)
-                       (apply (eval 'pose-task env) task))))
-      (write result)
-      (newline)
-      (cond ((task-failed? result (and record? ((eval 'task-status env) task)))
-             (write-string "murdoch pose: the task did not complete\n"
-                           (current-error-port))
-             (exit 1))
-            (else (exit 0))))))
+           (record? (or ((eval 'task? env) task) (symbol? task))))
+      (cond
+       (detach
+        (if (not (list? task))
+            (begin (write-string (string-append "murdoch pose: --detach poses the"
+                                                " arguments of pose-task that "
+                                                task-file " answers; it answers a task"
+                                                " already started\n")
+                                 (current-error-port))
+                   (exit 1)))
+        (write (apply (eval 'start-task env) (append task '(detach #t))))
+        (newline)
+        (exit 0))
+       (else
+        (write-result-and-exit
+         "murdoch pose"
+         (if record? ((eval 'task-wait env) task) (apply (eval 'pose-task env) task))
+         (and record? ((eval 'task-status env) task))))))))
+
+;; Joins the lab at lab-file as a guest named after what and this
+;; process; answers the environment received code runs in.
+(define (join-guest lab-file what)
+  (join-lab lab-file
+            (string->symbol (string-append what "-" (number->string (current-process-id))))
+            (lab-guest-port (read-lab lab-file))))
+
+;; Writes a task's result, and exits 0 when it completed, else 1.
+(define (write-result-and-exit who result status)
+  (write result)
+  (newline)
+  (cond ((task-failed? result status)
+         (write-string (string-append who ": the task did not complete\n")
+                       (current-error-port))
+         (exit 1))
+        (else (exit 0))))
+
+;;> `murdoch tasks LAB`: a line for each task handed to the lab: its id,
+;;> state, coordinator, standby and poser.
+(define (run-tasks lab-file)
+  (join-guest lab-file "tasks")
+  (let ((tasks (lab-tasks)))
+    (if (null? tasks) (write-string "no task is handed to the lab\n"))
+    (for-each (lambda (e) (write-string (string-append (lab-task-line e) "\n"))) tasks)
+    (exit 0)))
+
+;;> `murdoch wait LAB ID`: waits for the task \var{id} handed to the lab,
+;;> from any peer, and writes its results as `murdoch pose` does; exits 0
+;;> when it completed, else 1, and 1 with the reason when the lab does
+;;> not hold it.
+(define (run-wait lab-file id)
+  (join-guest lab-file "wait")
+  (guard (e (#t (write-string (string-append "murdoch wait: " (error-message e) "\n")
+                              (current-error-port))
+                (exit 1)))
+    (let ((result (task-wait id)))
+      (write-result-and-exit "murdoch wait" result (task-status id)))))
+
+;;> `murdoch cancel LAB ID`: cancels the task \var{id} handed to the lab.
+(define (run-cancel lab-file id)
+  (join-guest lab-file "cancel")
+  (guard (e (#t (write-string (string-append "murdoch cancel: " (error-message e) "\n")
+                              (current-error-port))
+                (exit 1)))
+    (cancel-task id)
+    (write-string (string-append "cancelled " (symbol->string id) "\n"))
+    (exit 0)))
 
 ;; Whether what a pose answered says that its task did not complete:
 ;; not-enough-takers, or a component that failed, by the task's status
@@ -317,17 +372,14 @@
 ;;> its address spaces says of itself (see show-status); one that does not
 ;;> answer within two seconds is shown away.  Exits 1 when none answers.
 (define (run-status lab-file)
-  (let ((lab (read-lab lab-file)))
-    (join-lab lab-file (string->symbol (string-append
-                                        "status-" (number->string (current-process-id))))
-              (lab-guest-port lab))
-    (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
+  (join-guest lab-file "status")
+  (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
            (write-string (string-append "murdoch status: no address space of the lab"
                                         " answers (is the lab running, with the same"
                                         " MURDOCH_PORT_BASE?)\n")
                          (current-error-port))
            (exit 1))
-          (else (exit 0)))))
+          (else (exit 0))))
 
 ;;> The task \var{file} evaluates to in \var{env}: the value of its last
 ;;> form, or, when that form defines a procedure of no arguments, what the

@@ -2,7 +2,8 @@
 ;;> poses a task to it from a file, \scheme{demo} does both for the thesis's
 ;;> dual-sonar task.
 (define-library (murdoch cli launch)
-  (export lab-lines run-lab run-pose run-demo run-status run-check)
+  (export lab-lines run-lab run-pose run-demo run-status run-check run-tasks run-wait
+          run-cancel)
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context) (srfi 1)
           (only (chibi process) execute current-process-id parent-process-id fork waitpid
@@ -18,6 +19,7 @@
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
-          (only (murdoch task) write-lab-status)
-          (only (murdoch task) status-state step-status? step-status-entries))
+          (only (murdoch wire) error-message)
+          (only (murdoch task) write-lab-status lab-task-line status-state step-status?
+                step-status-entries lab-tasks task-wait task-status cancel-task))
   (include "launch.scm"))

@@ -76,6 +76,9 @@
     ;; every heartbeat seconds (task/life-cycle.scm).
     (heartbeat 0.5 ,seconds)
     (max-attempts 3 ,positive-count)
+    ;; A detached task's results stay readable from any peer this many
+    ;; seconds after it ends (task/detached.scm).
+    (keep-results 3600 ,seconds)
     ;; A started task that finds too few capable robots free waits for
     ;; them or fails with not-enough-takers; its priority rises by aging
     ;; a second while it waits; a poser keeps at most max-waiting such

@@ -143,7 +143,8 @@
 
 ;;> Sets up this address space's subscriptions and monitors from its lab
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
-;;> capabilities; idle through load-monitor; untethered through
+;;> capabilities, and coordinator for a workstation (one with a
+;;> position); idle through load-monitor; untethered through
 ;;> battery-monitor on robots.  \var{on-free} runs, outside any lock, each
 ;;> time exclusive subjects here are freed: the task layer's hook.
 (define (initialize-subscriptions! lab entry on-free)
@@ -156,6 +157,8 @@
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
                   (else '())))
+  ;; A workstation may coordinate the tasks handed to the lab (detached.scm).
+  (if (and entry (lab-aspace-clause entry 'position)) (subscribe 'coordinator))
   (load-monitor)
   (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))
   (start-leases! lab)

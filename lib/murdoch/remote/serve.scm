@@ -288,6 +288,17 @@
         ((eq? (cdar applying) thread) (without-thread (cdr applying) thread))
         (else (cons (car applying) (without-thread (cdr applying) thread)))))
 
+;;> Lets the call that \var{thread} runs here go from its caller: the
+;;> caller giving it up no longer stops it.  A detached task's component
+;;> that a new coordinator adopts (task/running.scm) is not stopped by the
+;;> old one's call, given up when it let the task go.
+(define (release-call! thread)
+  (with-lock (server-lock *server*)
+    (lambda ()
+      (for-each (lambda (s)
+                  (serving-applying-set! s (without-thread (serving-applying s) thread)))
+                (server-servings *server*)))))
+
 ;; The caller of apply id gave up on it: its thread is marked, to stop
 ;; where it next calls out (abandon.scm).  An apply already done is let be.
 (define (abandon-call! s id)

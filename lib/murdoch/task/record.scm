@@ -16,7 +16,8 @@
   (team task-team task-team-set!)       ; its robots, in component order
   (steps task-steps task-steps-set!)    ; of a task of steps, those started
   (turn task-turn task-turn-set!)       ; how it waits its turn: a turn record
-  (waiter task-waiter task-waiter-set!)) ; while it waits, its waiter record
+  (waiter task-waiter task-waiter-set!)  ; while it waits, its waiter record
+  (acted task-acted task-acted-set!))   ; utc-seconds of its last heartbeat sent
 
 (define-record-type component
   (make-component index capabilities metric proc restartable?)

@@ -6,6 +6,7 @@
   (export task? task-id task-name make-task task-components task-done
           task-state task-state-set! task-team task-team-set! task-steps
           task-steps-set! task-turn task-turn-set! task-waiter task-waiter-set!
+          task-acted task-acted-set!
           make-component component? component-index component-capabilities
           component-metric component-proc component-restartable? component-state
           component-state-set! component-attempts component-attempts-set!

@@ -12,7 +12,7 @@
   running?
   (id running-id)
   (index running-index)
-  (poser running-poser)
+  (poser running-poser running-poser-set!)   ; a detached task's: its coordinator
   (thread running-thread)
   (started running-started)                   ; monotonic-seconds
   (heard running-heard running-heard-set!)    ; monotonic-seconds
@@ -118,13 +118,44 @@
     (if r (running-heard-set! r (monotonic-seconds)))
     (and r #t)))
 
+;;> What a coordinator that took over a detached task calls where its
+;;> component \var{k} of task \var{id} ran or runs: the component's
+;;> heartbeats now come from \var{poser}, and the call answers, once it
+;;> ends, what run-component would have answered its first coordinator,
+;;> or raises what it raised.  One that ended lately answers at once; one
+;;> not found here raises an error.
+(define (await-component id k poser)
+  (let ((r (find-running id k)))
+    (when r
+      (running-poser-set! r poser)
+      (running-heard-set! r (monotonic-seconds))
+      (release-call! (running-thread r))))
+  (let wait ()
+    (cond ((find-running id k) (thread-sleep! 0.05) (wait))
+          ((find-ending id k)
+           => (lambda (e)
+                (let ((outcome (ending-outcome e)))
+                  (cond ((eq? outcome unfinished)
+                         (error "the component stopped with no answer" id k))
+                        ((raised? outcome) (raise (raised-condition outcome)))
+                        (else outcome)))))
+          (else (error "no such component here" id k)))))
+
+(define (find-ending id k)
+  (with-lock *running-lock*
+    (lambda ()
+      (find (lambda (e)
+              (let ((r (ending-running e)))
+                (and (eq? (running-id r) id) (= (running-index r) k))))
+            *ended*))))
+
 ;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
 (define (stop-component! id k)
   (let ((r (find-running id k)))
     (if r (stop-running! r))
     (and r #t)))
 
-;; (ID INDEX POSER) for each component running here.
+;;> (ID INDEX POSER) for each component running here.
 (define (components-running)
   (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
        (with-lock *running-lock* (lambda () *running*))))
@@ -141,15 +172,16 @@
 
 ;; Running r over, at a time on the monotonic clock, as end-of says.
 (define-record-type ending
-  (make-ending running at end)
+  (make-ending running at end outcome)
   ending?
   (running ending-running)
   (at ending-at)
-  (end ending-end))
+  (end ending-end)
+  (outcome ending-outcome))             ; what run-listed caught, for await-component
 
 ;; r is over, with outcome, as run-listed catches it.
 (define (note-ended! r outcome)
-  (let ((entry (make-ending r (monotonic-seconds) (end-of outcome))))
+  (let ((entry (make-ending r (monotonic-seconds) (end-of outcome) outcome)))
     (with-lock *running-lock*
       (lambda ()
         (set! *running* (remove (lambda (x) (eq? x r)) *running*))

@@ -8,20 +8,21 @@
 ;;> TASKS what (tasks) answers: the tasks it started that are not over,
 ;;> and the components it runs; GOAL where goto-xy is driving its robot,
 ;;> or #f; ENDED what (components-ended) answers, the components that
-;;> ended here lately.
+;;> ended here lately; HANDED what (handed-entries) answers, the detached
+;;> tasks it coordinates or stands by for.
 (define (aspace-report)
   ;; The components running are read before those ended: one that ends
   ;; in between is then in both lists, never in neither.
   (let* ((not-over (remove (lambda (t)
                              (and (listed-posed? t)
-                                  (memq (listed-state t) '(done failed cancelled))))
+                                  (memq (listed-state t) '(done failed cancelled let-go))))
                            (tasks)))
          (ended (components-ended)))
     (list (local-aspace-uid) (aspace-started-at) (safe-reckon)
           (safe-battery-voltage)
           (filter (lambda (h) (not (null? (held-holder h))))
                   (subscription-statuses '>))
-          not-over (goto-goal) ended)))
+          not-over (goto-goal) ended (handed-entries))))
 
 ;;> The parts of an aspace-report \var{r}, by name.
 (define (report-uid r) (car r))
@@ -33,6 +34,7 @@
 ;; A report from a peer older than GOAL, or ENDED, has none.
 (define (report-goal r) (and (> (length r) 6) (list-ref r 6)))
 (define (report-ended r) (if (> (length r) 7) (list-ref r 7) '()))
+(define (report-handed r) (if (> (length r) 8) (list-ref r 8) '()))
 
 ;;> The subject and its holder in \var{h}, one of a report's HELD.
 (define (held-subject h) (car h))
@@ -87,7 +89,31 @@
                               " held by " (held-text (held-holder held))))
                 (report-held r))
       (for-each (lambda (t) (write-line out "    " (task-text t)))
-                (report-tasks r))))))
+                (report-tasks r))
+      (for-each (lambda (e) (write-line out "    " (handed-text e)))
+                (report-handed r))))))
+
+;; An entry of handed-entries, as a line.
+(define (handed-text e)
+  (string-append
+   (case (lab-task-role e)
+     ((coordinator) "coordinates detached task ")
+     ((standby) "stands by for detached task ")
+     (else "let go of detached task "))
+   (held-text (lab-task-id e)) " " (held-text (lab-task-state e))
+   (if (eq? (lab-task-role e) 'standby)
+       (string-append ", coordinated by " (held-text (lab-task-coordinator e)))
+       (string-append ", standby " (held-text (or (lab-task-standby e) "none"))))))
+
+;;> An entry of lab-tasks as `murdoch tasks` writes it: the task's id,
+;;> state, coordinator, standby and poser, and when a standby took it
+;;> over.
+(define (lab-task-line e)
+  (string-append (held-text (lab-task-id e)) "  " (held-text (lab-task-state e))
+                 "  coordinator " (held-text (lab-task-coordinator e))
+                 "  standby " (held-text (or (lab-task-standby e) "none"))
+                 "  posed by " (held-text (lab-task-poser e))
+                 (if (lab-task-took-over e) "  (taken over)" "")))
 
 ;; An entry of (tasks), as a line.
 (define (task-text t)

@@ -3,11 +3,14 @@
 (define-library (murdoch task status)
   (export aspace-report lab-status show-status write-lab-status
           report-uid report-since report-pose report-battery report-held report-tasks
-          report-goal report-ended held-subject held-holder)
+          report-goal report-ended report-handed held-subject held-holder lab-task-line)
   (import (scheme base) (scheme write) (srfi 1) (only (murdoch sys) utc-seconds)
           (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot)
           (only (murdoch task running) components-ended)
           (only (murdoch task life-cycle) tasks)
+          (only (murdoch task detached) handed-entries lab-task-id lab-task-role
+                lab-task-state lab-task-coordinator lab-task-standby lab-task-poser
+                lab-task-took-over)
           (only (murdoch task record) listed-posed? listed-id listed-state
                 listed-place listed-why listed-index listed-poser))
   (include "status.scm"))

@@ -74,6 +74,7 @@
     (give-way! w news)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
+     ((eq? (task-state t) 'let-go) (answer-offers! offers #f) 'let-go)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
       (let ((team (if (or (pair? offers)

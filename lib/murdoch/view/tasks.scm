@@ -29,7 +29,9 @@
   (name task-entry-name)
   (poser task-entry-poser)
   (state task-entry-state task-entry-state-set!)
-  (components task-entry-components task-entry-components-set!))
+  (components task-entry-components task-entry-components-set!)
+  ;; A detached task's (COORDINATOR STANDBY), as its coordinator says.
+  (keepers task-entry-keepers task-entry-keepers-set!))
 
 (define-record-type component-entry
   (make-component-entry index robot subjects since until end from)
@@ -157,6 +159,7 @@
   (or (task-known table key)
       (let* ((nt (reservation-task key))
              (t (make-task-entry key (car nt) (cadr nt) #f '())))
+        (task-entry-keepers-set! t #f)
         (table-tasks-set! table (append (table-tasks table) (list t)))
         t)))
 
@@ -213,7 +216,17 @@
                              seen)))
           (report-components report))
          (for-each (lambda (e) (note-ended! table t robot e))
-                   (ended-entries report))))
+                   (ended-entries report))
+         (for-each (lambda (e)
+                     (when (eq? (lab-task-role e) 'coordinator)
+                       (let ((task (task-named table (text (lab-task-id e)))))
+                         (task-entry-keepers-set!
+                          task (list (text (lab-task-coordinator e))
+                                     (if (lab-task-standby e)
+                                         (text (lab-task-standby e))
+                                         'null)))
+                         (task-entry-state-set! task (text (lab-task-state e))))))
+                   (report-handed report))))
      reports)
     (let* ((answered (map (lambda (r) (text (sighting-uid r))) reports))
            (gone (note-robots! table t reports)))
@@ -360,7 +373,7 @@
     (and i (or (not j) (< i j)))))
 
 ;;> The table as JSON: the newest \var{most} tasks, each with its name,
-;;> poser, state and components (index, robot, subjects, since, until,
+;;> poser, state, coordinator and standby when it is detached, and components (index, robot, subjects, since, until,
 ;;> how it ended, and the robot it was reassigned from), by their number,
 ;;> the reservations last.
 (define (task-table->json table most)
@@ -370,6 +383,8 @@
             `((id . ,(task-entry-key task))
               (name . ,(task-entry-name task))
               (poser . ,(or (task-entry-poser task) 'null))
+              (coordinator . ,(let ((k (task-entry-keepers task))) (if k (car k) 'null)))
+              (standby . ,(let ((k (task-entry-keepers task))) (if k (cadr k) 'null)))
               (state . ,(or (task-entry-state task) (components-state cs)))
               (components
                . ,(list->vector
