@@ -10,18 +10,20 @@
           component-heartbeat! stop-component! components-running components-ended
           ended-id ended-index ended-started ended-ended ended-end
           lost-periods
-          start-task task? task-id task-name task-status task-wait cancel-task
+          start-task task? task-id task-name task-state task-why task-state-text
+          task-status task-wait cancel-task
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
-          listed-index listed-poser
+          listed-priority listed-held listed-wants listed-index listed-poser
+          waiting-entries rank<?
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer
           receive-give-way note-waiters! location-metric-maker load-metric-maker
           load-metric reverse-metric metric-by metric-by-asking metric-within
           compose-metrics reckon-distance-between sort-response metric-keys measure-key?
           measured-response asking-procs sort-measured shuffle pose-task negotiate
           check-task pose-task-progress task-timeout pose-task-assignment
-          pose-task-priority pose-task-retries pose-task-backoff pose-task-excluded
+          pose-task-priority pose-task-retries pose-task-backoff pose-task-excluded pose-task-reservation
           receive-rival pose-negotiations reservation-aspace-uid resolve-conflicts
           with-team-proc-maker with-team on-list current-team exec-on t sort-list
           make-maxrandom progress explain-no-takers explain-components explanation?
