@@ -16,7 +16,7 @@
           step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
           listed-priority listed-held listed-wants listed-index listed-poser
-          waiting-entries rank<?
+          waiting-entries rank<? offer-on-joining!
           task-step start-steps pose-steps waiting-ranks waiting-for receive-offer
           receive-give-way note-waiters! location-metric-maker load-metric-maker
           load-metric reverse-metric metric-by metric-by-asking metric-within

@@ -20,6 +20,7 @@
     (if entry (take-body! lab entry))
     (apply start-aspace! lab uid env port)
     (initialize-subscriptions! lab entry)
+    (offer-on-joining!)
     env))
 
 ;; A robot's address space drives its robot through trip, at the port the

@@ -10,5 +10,6 @@
           (only (chibi filesystem) is-a-tty? open open/read open/non-block
                 open-input-file-descriptor)
           (only (srfi 151) bitwise-ior) (murdoch sys) (murdoch code) (murdoch cli hints)
-          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot))
+          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot)
+          (only (murdoch task) offer-on-joining!))
   (include "command.scm"))

@@ -6,7 +6,8 @@
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context) (srfi 1)
           (only (chibi process) execute current-process-id parent-process-id fork waitpid
-                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill)
+                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill
+                signal/term)
           (only (chibi filesystem) open-pipe open open/read open/write open/append
                 open/create duplicate-file-descriptor-to set-file-descriptor-flags!
                 open-input-file-descriptor open-output-file-descriptor)
@@ -19,5 +20,6 @@
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
           (only (murdoch status) write-lab-status)
-          (only (murdoch task) status-state step-status? step-status-entries))
+          (only (murdoch task) task? start-task task-wait cancel-task task-id task-state
+                task-state-text))
   (include "launch.scm"))

@@ -125,8 +125,8 @@
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let ((waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                               (guard (e (#t '()))
-                                (append-map cadr (request 'waiting-tasks
-                                                          waiting-for me))))))
+                                (append-map cadr (request 'waiting-tasks waiting-for me
+                                                          (subjects-here)))))))
       (set! *waiters-seen* (pair? waiting))
       (if (pair? waiting) (set! *waiters-here?* #t))
       (offer-to me waiting))))
@@ -142,6 +142,17 @@
       (if (and *new-waiters* (free-here?))
           (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
           (offer-to me (cdr waiting))))))
+
+;; The subjects this address space subscribes to: a poser matches them
+;; against its waiting tasks' capabilities, for a robot it has not seen.
+(define (subjects-here) (map car (subscription-statuses '>)))
+
+;;> What an address space does once it has joined the lab: a robot
+;;> offers itself at once to the tasks that wait for it, which may have
+;;> waited for it while it was away, or before it came.
+(define (offer-on-joining!)
+  (set! *waiters-here?* #t)
+  (if (and (robot-here?) (free-here?)) (robot-freed!)))
 
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
