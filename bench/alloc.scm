@@ -18,7 +18,8 @@
 
 (import (except (scheme base) lambda define) (scheme write) (scheme time)
         (scheme inexact) (scheme eval) (srfi 1) (srfi 18) (srfi 27)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch task assign)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch task assign)
         (murdoch testing harness))
 
 (define (random-point) (list (* 10000 (random-real)) (* 10000 (random-real))))

@@ -18,7 +18,8 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme process-context) (scheme inexact)
         (srfi 1) (srfi 18) (srfi 27) (srfi 132)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness)
         (only (murdoch sys scheduler) monotonic-seconds))
 
 (define seconds

@@ -33,7 +33,8 @@
         (only (chibi process) current-process-id system?)
         (only (murdoch robot trip) split-words) (scheme read)
         (only (chibi string) string-prefix?)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness)
         (bench clock))
 
 (define (aspace-clause i)

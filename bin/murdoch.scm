@@ -8,8 +8,8 @@
         (chibi app) (chibi config) (chibi edit-distance)
         (only (chibi pathname) path-directory)
         (only (chibi ast) setenv unsetenv)
-        (only (murdoch wire) error-message error-message-naming) (murdoch lab) (murdoch cli command)
-        (murdoch cli launch))
+        (only (murdoch wire) error-message error-message-naming) (murdoch lab)
+        (murdoch cli))
 
 (define version "0.3")
 

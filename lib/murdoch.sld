@@ -46,7 +46,7 @@
           waiting-ranks waiting-entries waiting-for receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
           team-send! team-receive step-team
-          ;; what the lab is doing (lib/murdoch/status.scm)
+          ;; what the lab is doing (lib/murdoch/task/status.scm)
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/robot/trip.scm)
           im goto-xy rotate translate angle-to-heading set-velocity stop-base
@@ -56,5 +56,4 @@
           fiducial-id fiducial-range fiducial-bearing fiducial-orientation
           safe-im safe-battery-voltage safe-reckon)
   (import (murdoch code) (murdoch remote) (murdoch pubsub) (murdoch task)
-          (murdoch robot)
-          (murdoch status)))
+          (murdoch robot)))

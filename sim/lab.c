@@ -58,6 +58,7 @@ void lab_add_box(lab *l, const lab_box *b)
 
 int lab_trip_port(const lab *l, const lab_robot *r)
 {
+    /* the port plan's trip offset (lib/murdoch/lab/file.scm) */
     return r->trip_port ? r->trip_port : l->port_base + 100 + r->aspace;
 }
 
@@ -128,7 +129,7 @@ static int read_world(lab *l, const sx *world, char *err, int errlen)
         int n = numbers(c, v, 6);
         if (c->kind != SX_LIST)
             return bad(err, errlen, "world", NULL);
-        /* sizes and masses above 0, as lib/murdoch/lab.scm checks them */
+        /* sizes and masses above 0, as lib/murdoch/lab/clauses.scm checks them */
         if (sx_is(c->head, "wall") && (n == 4 || (n == 5 && v[4] > 0))) {
             lab_add_wall(l, v[0], v[1], v[2], v[3], n == 5 ? v[4] : 50);
         } else if (sx_is(c->head, "box") && (n == 5 || (n == 6 && v[5] > 0))

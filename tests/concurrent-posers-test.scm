@@ -4,7 +4,8 @@
 ;;; components at once.  Workstations with a grip stand in for robots.
 (import (except (scheme base) lambda define) (scheme eval)
         (srfi 1) (srfi 18) (srfi 132) (chibi test)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
 
 (define grippers '(g1 g2 g3 g4 g5 g6))
 (define posers '(p1 p2 p3))

@@ -1,4 +1,4 @@
-;;; Hostile peers: what the README's Security section promises, attacked
+;;; Hostile peers: what docs/security.md promises, attacked
 ;;; from outside by real processes and raw sockets, as a peer with the key,
 ;;; or without it, would.  After each attack the attacked address space is
 ;;; alive (or, for a heap past heap-max, ended by the documented rule),
@@ -8,7 +8,8 @@
         (srfi 1) (srfi 18) (srfi 132) (chibi test) (chibi net)
         (only (chibi process) kill current-process-id)
         (only (chibi filesystem) directory-files)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch lab)
         (murdoch wire multicast) (only (murdoch wire) datagram-head datagram-from?)
         (murdoch testing harness) (murdoch testing raw))
 
@@ -336,7 +337,7 @@
 
 (test-group "memory"
   ;; Many small allocations, each under max-alloc: not answered with an
-  ;; error (README, Security, says why), but ended by the heap guard.
+  ;; error (docs/security.md says why), but ended by the heap guard.
   (test "a loop that keeps what it conses ends the address space at heap-max" #t
     (begin (guard (e (#t #f))
              (parameterize ((remote-timeout 10))

@@ -1,5 +1,5 @@
 ;;; The lab file's settings: one table of names, defaults and checks
-;;; (lib/murdoch/lab.scm), read once, every mistake named with its clause.
+;;; (lib/murdoch/lab/settings.scm), read once, every mistake named with its clause.
 (import (scheme base) (scheme write) (scheme file) (chibi test)
         (only (chibi filesystem) delete-file-hierarchy)
         (murdoch lab) (murdoch testing harness))

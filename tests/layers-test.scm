@@ -1,7 +1,9 @@
 ;;; The libraries as layers: each imports only from its own layer and
-;;; those below, and no import goes round in a cycle.  The order of the
-;;; layers is written here, once, by folder; README's "The shape" follows
-;;; it, and names every library.
+;;; those below, no import goes round in a cycle, a library of another
+;;; family imports a family's umbrella, never its members, and each
+;;; umbrella exports only what is used above it.  The order of the layers
+;;; is written here, once, by folder; docs/architecture.md's "The shape"
+;;; follows it, and names every library.
 (import (scheme base) (scheme read) (scheme file) (scheme write) (scheme cxr)
         (srfi 1) (chibi test)
         (only (chibi filesystem) directory-files file-directory?)
@@ -17,8 +19,8 @@
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
     (task (assign progress metric takers) team (pose-task running) record rank
-          (offers holding) waiting life-cycle steps)
-    status murdoch cli view testing))
+          (offers holding) waiting life-cycle steps status)
+    murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))
 
@@ -54,12 +56,12 @@
       (import-set-library (cadr set))
       set))
 
-(define (imports form)
+(define (import-sets form)
   (append-map (lambda (decl)
-                (if (and (pair? decl) (eq? (car decl) 'import))
-                    (map import-set-library (cdr decl))
-                    '()))
+                (if (and (pair? decl) (eq? (car decl) 'import)) (cdr decl) '()))
               (cddr form)))
+
+(define (imports form) (map import-set-library (import-sets form)))
 
 (define (ours? name) (and (pair? name) (eq? (car name) 'murdoch)))
 
@@ -94,7 +96,7 @@
                   (any (lambda (next) (walk next (cons here path)))
                        (cond ((assoc here graph) => cdr) (else '()))))))))
 
-;; How README's shape table names a library: its path under lib/murdoch/,
+;; How docs/architecture.md's shape table names a library: its path under lib/murdoch/,
 ;; `wire/frame`, or `(murdoch)`.
 (define (table-name name)
   (if (null? (cdr name))
@@ -104,9 +106,9 @@
             path
             (loop (cdr parts) (string-append path "/" (symbol->string (car parts))))))))
 
-;; The second cells of the rows of README's "The shape" table.
+;; The second cells of the rows of docs/architecture.md's "The shape" table.
 (define shape-library-cells
-  (let loop ((lines (read-lines (tool-path "README.md"))) (in? #f) (cells '()))
+  (let loop ((lines (read-lines (tool-path "docs/architecture.md"))) (in? #f) (cells '()))
     (cond ((null? lines) cells)
           ((string=? (car lines) "## The shape") (loop (cdr lines) #t cells))
           ((and in? (text-contains? (car lines) "## ")) cells)
@@ -124,33 +126,65 @@
                     '()))
               (cddr form)))
 
-;; The names the top-level forms of the files a library form includes
-;; define, beside file: an umbrella's own procedures.
-(define (own-definitions file form)
+(define (file-forms file)
+  (call-with-input-file file
+    (lambda (in)
+      (let loop ((acc '()))
+        (let ((x (read in)))
+          (if (eof-object? x) (reverse acc) (loop (cons x acc))))))))
+
+;; The files of a library: its .sld and those it includes, beside it.
+(define (library-source-files file form)
   (let ((dir (substring file 0 (- (string-length file)
                                   (string-length (last (string-split file #\/)))))))
-    (append-map
-     (lambda (decl)
-       (if (and (pair? decl) (eq? (car decl) 'include))
-           (filter-map (lambda (x)
-                         (and (pair? x) (memq (car x) '(define define-syntax))
-                              (if (pair? (cadr x)) (car (cadr x)) (cadr x))))
-                       (call-with-input-file (string-append dir (cadr decl))
-                         (lambda (in)
-                           (let loop ((acc '()))
-                             (let ((x (read in)))
-                               (if (eof-object? x) (reverse acc) (loop (cons x acc))))))))
-           '()))
-     (cddr form))))
+    (cons file
+          (append-map (lambda (decl)
+                        (if (and (pair? decl) (eq? (car decl) 'include))
+                            (map (lambda (f) (string-append dir f)) (cdr decl))
+                            '()))
+                      (cddr form)))))
 
-;; The families whose users import them as one, by their umbrellas.
-(define families '(sys wire code robot remote pubsub task cli))
+;; The names the top-level forms of the files a library includes define:
+;; an umbrella's own procedures.
+(define (own-definitions file form)
+  (append-map
+   (lambda (f)
+     (filter-map (lambda (x)
+                   (and (pair? x) (memq (car x) '(define define-syntax))
+                        (if (pair? (cadr x)) (car (cadr x)) (cadr x))))
+                 (file-forms f)))
+   (cdr (library-source-files file form))))
 
-;; remote's and task's umbrellas are selections, what the layers above
-;; import (see lib/murdoch/remote.scm and lib/murdoch/task.sld): their
-;; members share more among themselves, the calls' and connections'
-;; insides, a task's records and its waiters', which they leave out.
-(define selections '(remote task))
+;; Every symbol the forms of files hold, quoted ones too; read once.
+(define symbols-read '())
+(define (symbols-in files)
+  (cond
+   ((assoc files symbols-read) => cdr)
+   (else
+    (let ((symbols (let walk ((x (append-map file-forms files)) (acc '()))
+                     (cond ((symbol? x) (cons x acc))
+                           ((pair? x) (walk (cdr x) (walk (car x) acc)))
+                           ((vector? x) (walk (vector->list x) acc))
+                           (else acc)))))
+      (set! symbols-read (cons (cons files symbols) symbols-read))
+      symbols))))
+
+(define (library-file name)
+  (find (lambda (file) (equal? (cadr (library-form file)) name)) library-files))
+
+;; The family of a library: its folder, or its own name for (murdoch),
+;; (murdoch lab) and the like.
+(define (family name)
+  (if (null? (cdr name)) 'murdoch (cadr name)))
+
+;; The families with libraries of their own in a folder, and an umbrella.
+(define families
+  (filter (lambda (f)
+            (and (library-file (list 'murdoch f))
+                 (any (lambda (name) (and (pair? (cdr name)) (pair? (cddr name))
+                                          (eq? (cadr name) f)))
+                      (map car graph))))
+          (delete-duplicates (map (lambda (entry) (family (car entry))) graph))))
 
 ;; What remote's umbrella passes on from the families below it: the
 ;; remote errors and the locks that the thesis's remote layer offers.
@@ -159,28 +193,86 @@
                             remote-raised-error? remote-protocol-error?
                             undo-on-raise with-lock)))
 
-;; How family's umbrella drifts from its members, the libraries in its
-;; folder: (FAMILY missing NAME ...) for their exports it leaves out (but
-;; for a selection), (FAMILY extra NAME ...) for exports no member, nor
-;; it, defines.
+;; The command, above every family: bin/murdoch.scm's imports and symbols.
+(define command-file (tool-path "bin/murdoch.scm"))
+(define command-imports
+  (append-map (lambda (x) (if (and (pair? x) (eq? (car x) 'import)) (cdr x) '()))
+              (file-forms command-file)))
+
+;; Whether name, exported by umbrella, is used above its family: named in
+;; an (only ...) import of it, or in the source of a library (or the
+;; command) that imports all of it.
+(define (used-above? umbrella name)
+  (define (uses? import-sets files)
+    (any (lambda (set)
+           (and (equal? (import-set-library set) umbrella)
+                (if (eq? (car set) 'only)
+                    (memq name (cddr set))
+                    (memq name (symbols-in files)))))
+         import-sets))
+  (or (any (lambda (file)
+             (let ((form (library-form file)))
+               (and (not (eq? (family (cadr form)) (family umbrella)))
+                    (uses? (import-sets form) (library-source-files file form)))))
+           library-files)
+      (uses? command-imports (list command-file))))
+
+;; How family's umbrella strays from a choice of its members' names:
+;; (FAMILY unused NAME ...) for exports nothing above it uses, (FAMILY
+;; extra NAME ...) for exports that no member, nor it, defines.
 (define (umbrella-drift family)
-  (let* ((folder (tool-path (string-append "lib/murdoch/" (symbol->string family))))
-         (file (string-append folder ".sld"))
+  (let* ((name (list 'murdoch family))
+         (file (library-file name))
          (form (library-form file))
-         (members (append-map (lambda (f) (exports (library-form f)))
-                              (sld-files folder)))
+         (members (append-map (lambda (entry)
+                                (if (and (pair? (cdr (car entry))) (pair? (cddr (car entry)))
+                                         (eq? (cadr (car entry)) family))
+                                    (exports (library-form (library-file (car entry))))
+                                    '()))
+                              graph))
          (own (append (own-definitions file form)
                       (cond ((assq family passed-on) => cdr) (else '()))))
-         (missing (if (memq family selections)
-                      '()
-                      (lset-difference eq? members (exports form))))
+         (unused (remove (lambda (x) (or (memq x own) (used-above? name x)))
+                         (exports form)))
          (extra (lset-difference eq? (exports form) (append members own))))
-    (append (if (pair? missing) (list (cons* family 'missing missing)) '())
+    (append (if (pair? unused) (list (cons* family 'unused unused)) '())
             (if (pair? extra) (list (cons* family 'extra extra)) '()))))
+
+;; The names docs/reference.md gives a row, as tests/reference-test.scm
+;; reads them: the first cell, `NAME` or `(NAME ARG ...)`.
+(define reference-names
+  (filter-map (lambda (line)
+                (and (> (string-length line) 3) (string=? "| `" (substring line 0 3))
+                     (let* ((cell (substring line 3 (string-length line)))
+                            (cell (if (char=? (string-ref cell 0) #\()
+                                      (substring cell 1 (string-length cell))
+                                      cell))
+                            (end (let loop ((i 0))
+                                   (if (memv (string-ref cell i) '(#\space #\) #\`))
+                                       i
+                                       (loop (+ i 1))))))
+                       (string->symbol (substring cell 0 end)))))
+              (read-lines (tool-path "docs/reference.md"))))
+
+;; The libraries of ours that received code's environment imports, as
+;; lib/murdoch/code/sandbox.scm's sandbox-libraries names them, but for
+;; the sandbox's own guarded versions of standard names.
+(define sandbox-murdoch-libraries
+  (let* ((forms (file-forms (tool-path "lib/murdoch/code/sandbox.scm")))
+         (def (find (lambda (x) (and (pair? x) (eq? (car x) 'define)
+                                     (eq? (cadr x) 'sandbox-libraries)))
+                    forms)))
+    (filter-map (lambda (set)
+                  (and (ours? (import-set-library set))
+                       (not (and (eq? (car set) 'rename)
+                                 (equal? (import-set-library set)
+                                         '(murdoch code sandbox))))
+                       (import-set-library set)))
+                (cadr (caddr def)))))
 
 (test-begin "layers")
 
-(test "README's shape table names every library" '()
+(test "docs/architecture.md's shape table names every library" '()
   (remove (lambda (name)
             (let ((quoted (string-append "`" (table-name name) "`")))
               (any (lambda (cell) (text-contains? cell quoted)) shape-library-cells)))
@@ -201,8 +293,25 @@
 (test "no imports go round in a cycle" '()
   (filter-map cycle-from (map car graph)))
 
-(test "each family's umbrella exports what its members export" '()
+(test "no library imports another family's member; only its umbrella" '()
+  (append-map (lambda (entry)
+                (filter-map (lambda (import)
+                              (and (ours? import) (pair? (cdr import)) (pair? (cddr import))
+                                   (not (eq? (cadr import) (family (car entry))))
+                                   (list (car entry) 'imports import)))
+                            (cdr entry)))
+              graph))
+
+(test "each family's umbrella exports what the families above use of it" '()
   (append-map umbrella-drift families))
+
+(test "docs/reference.md lists what (murdoch) exports, and nothing else" '(() ())
+  (let ((exported (exports (library-form (tool-path "lib/murdoch.sld")))))
+    (list (lset-difference eq? exported reference-names)
+          (lset-difference eq? reference-names exported))))
+
+(test "received code reaches (murdoch) and no other library of ours" '((murdoch))
+  sandbox-murdoch-libraries)
 
 (test-end)
 (test-exit)

@@ -18,7 +18,8 @@
         (only (chibi process) current-process-id system? kill signal/stop
               signal/continue)
         (only (chibi io) set-file-position! seek/set)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
 
 (define (can-run?)
   (cond ((not (equal? (command-output '("id" "-u")) "0")) "needs root")

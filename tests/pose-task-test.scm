@@ -5,7 +5,8 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (srfi 132) (chibi test)
         (only (chibi ast) thread-interrupt!)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness)
         (only (murdoch pubsub messaging) request-components))
 
 (define lab-code "

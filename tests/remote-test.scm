@@ -4,7 +4,8 @@
         (srfi 18) (chibi test) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor
               open-output-file-descriptor)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch lab)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment make-aspace)
+        (murdoch cli command) (murdoch lab)
         (murdoch wire netstring) (murdoch wire hmac) (murdoch wire connect)
         (only (murdoch wire) error-message)
         (murdoch testing harness)

@@ -4,7 +4,8 @@
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (chibi test)
         (only (chibi process) kill signal/stop signal/continue)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
 (define record '())

@@ -4,7 +4,8 @@
 ;;; it as lost; they are not the component's own errors.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (srfi 1) (srfi 18) (chibi test)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
 ;; Setup and cleanup count, here, how often they run.

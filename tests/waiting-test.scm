@@ -8,7 +8,8 @@
 ;;; gate there.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval) (scheme time)
         (srfi 1) (srfi 18) (chibi test)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch testing harness))
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
 ;; Each component counts, on its robot, how many run there at once, and

@@ -1,4 +1,4 @@
-// The page of the live view (lib/murdoch/view.scm).  It reads the run's
+// The page of the live view (lib/murdoch/view/).  It reads the run's
 // trace -- a line describing the room, then one snapshot per line -- from
 // /trace, then, when the run is live, each new snapshot from /events.
 // It draws one snapshot at a time: the one the time slider points at,

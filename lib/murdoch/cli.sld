@@ -1,9 +1,9 @@
 ;;> The command line: hints, the address-space and REPL commands, and
 ;;> the lab's launcher.
-;;> Its members are each a library of their own in cli/.
+;;> Its members are each a library of their own in cli/; this umbrella
+;;> exports what the families above use of them.
 
 (define-library (murdoch cli)
-  (export join-lab run-aspace run-repl tell-who-is-away make-lab-environment
-          make-repl-environment eval-with-hints lab-lines run-lab run-pose run-demo
-          run-status run-check)
+  (export join-lab run-aspace run-repl tell-who-is-away make-repl-environment
+          run-lab run-pose run-demo run-status run-check)
   (import (murdoch cli command) (murdoch cli hints) (murdoch cli launch)))

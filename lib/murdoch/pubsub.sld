@@ -1,16 +1,17 @@
 ;;> Publish/subscribe messaging (appendix A.8): subjects, requests and
 ;;> their promises, and the monitors (A.6, A.2).
-;;> Its members are each a library of their own in pubsub/.
+;;> Its members are each a library of their own in pubsub/; this umbrella
+;;> exports what the families above use of them.
 
 (define-library (murdoch pubsub)
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote publish request request-exclusive
           request-non-exclusive request-components asked-ok? asked-value
-          capability-layout check-subjects
-          request-status subscription-statuses receive-publication receive-request
-          receive-request-exclusive receive-request-non-exclusive receive-components
-          start-leases! on-free! offer-subjects! get-system-load load-monitor
-          battery-monitor *battery-charging* *battery-low* *load-threshold*
+          capability-layout check-subjects request-status subscription-statuses
+          receive-publication receive-request receive-request-exclusive
+          receive-request-non-exclusive receive-components on-free!
+          offer-subjects! get-system-load load-monitor battery-monitor
+          *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)
   (import (murdoch pubsub messaging) (murdoch pubsub monitor)))

@@ -4,19 +4,17 @@
 ;;> see lib/murdoch/remote.scm for their order.
 
 (define-library (murdoch remote)
-  (export aspace? aspace-uid aspace-host aspace-port make-aspace
-          local-aspace local-aspace-uid aspace-started-at uid->aspace known-uids
-          learn-aspace! live-uids live-aspaces live-aspace current-lab lab-environment
-          remote-run! remote-apply remote-timeout set-remote-timeout!
-          remote-apply-all remote-run-all! outcome-uid outcome-ok? outcome-value
-          call-all broadcast-apply broadcast-run!
-          make-result result? result-uid result-ok? result-value
-          delivery-mode
+  (export aspace? aspace-uid aspace-host aspace-port local-aspace
+          local-aspace-uid aspace-started-at uid->aspace known-uids live-uids
+          live-aspace current-lab remote-run! remote-apply remote-timeout
+          set-remote-timeout! remote-apply-all remote-run-all! outcome-uid
+          outcome-ok? outcome-value call-all broadcast-apply broadcast-run!
+          make-result result-uid result-ok? result-value delivery-mode
           remote-error? remote-error-uid remote-error-message
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
-          remote-protocol-error?
-          encap release-proxy! start-aspace! hand-over-connection!
-          var-ref var-set! display-remote undo-on-raise with-lock)
+          remote-protocol-error? encap release-proxy! start-aspace!
+          hand-over-connection! var-ref var-set! display-remote undo-on-raise
+          with-lock)
   (import (scheme base) (scheme write) (murdoch sys) (murdoch wire) (murdoch lab)
           (murdoch code) (murdoch remote aspace) (murdoch remote worker)
           (murdoch remote call) (murdoch remote serve) (murdoch remote group)

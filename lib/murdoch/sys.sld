@@ -1,16 +1,18 @@
 ;;> The process: green threads over ppoll, the heap guard, the process's
 ;;> name and the signal it ends by when its parent does, one-line logs,
 ;;> and one clock and one way to wait.
-;;> Its members are each a library of their own in sys/.
+;;> Its members are each a library of their own in sys/; this umbrella
+;;> exports what the families above use of them.
 
 (define-library (murdoch sys)
-  (export start-heap-guard! heap-on-huge-pages! utc-seconds set-log-name! stamp-log-lines! log-note log-warn
-          condition-message
-          set-process-name! set-parent-death-signal! poll-scheduler-installed? monotonic-seconds
-          wall-microseconds stack-guard-tripped? port-wait! poller-port poller-watch!
-          poller-unwatch! poller-release! poller-buffered poller-ready poller-frames!
-          lock! unlock! unlocked cell-value wind with-lock with-lock-by
-          seconds-until undo-on-raise map-guarded make-mailbox mailbox-put! mailbox-take mailbox-empty!
-          take-mailbox! take-all-mailboxes! make-gathering gathering-put! gathering-wait)
+  (export start-heap-guard! heap-on-huge-pages! utc-seconds set-log-name!
+          stamp-log-lines! log-note log-warn condition-message set-process-name!
+          set-parent-death-signal! monotonic-seconds wall-microseconds
+          stack-guard-tripped? port-wait! poller-port poller-watch!
+          poller-unwatch! poller-release! poller-buffered poller-ready
+          poller-frames! lock! unlock! unlocked cell-value wind with-lock
+          with-lock-by seconds-until undo-on-raise map-guarded make-mailbox
+          mailbox-put! mailbox-take mailbox-empty! take-mailbox!
+          take-all-mailboxes! make-gathering gathering-put! gathering-wait)
   (import (murdoch sys guard) (murdoch sys log) (murdoch sys process)
           (murdoch sys scheduler) (murdoch sys wait)))

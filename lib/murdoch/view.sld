@@ -14,7 +14,7 @@
                 ended-ended ended-end)
           (only (murdoch robot) fiducial-id fiducial-range fiducial-bearing
                 fiducial-orientation)
-          (only (murdoch status) report-since report-pose report-battery report-held
+          (only (murdoch task) report-since report-pose report-battery report-held
                 report-tasks report-goal report-ended held-subject held-holder
                 lab-line waiting-text)
           (scheme base) (scheme write)
@@ -25,4 +25,4 @@
                 open/create open/exclusive open-output-file-descriptor)
           (only (srfi 151) bitwise-ior) (only (srfi 132) list-stable-sort) (chibi json)
           (murdoch sys) (murdoch lab) (murdoch cli) (murdoch remote))
-  (include "view.scm" "view-tasks.scm"))
+  (include "view/snapshot.scm" "view/tasks.scm" "view/serve.scm"))

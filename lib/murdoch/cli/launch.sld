@@ -19,7 +19,6 @@
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
-          (only (murdoch status) write-lab-status)
-          (only (murdoch task) task? start-task task-wait cancel-task task-id task-state
-                task-state-text))
+          (only (murdoch task) write-lab-status task? start-task task-wait cancel-task
+                task-id task-state task-state-text))
   (include "launch.scm"))

@@ -5,7 +5,7 @@
 ;; Chibi stops a thread from outside only at whatever instruction it has
 ;; reached, which can leave a lock taken for good; so a marked thread stops
 ;; itself, where it waits on something of Murdoch's: each robot command
-;; (trip-client.scm) and each remote call (remote.scm) raises in it.  A
+;; (robot/trip.scm) and each remote call (remote.scm) raises in it.  A
 ;; procedure that calls neither runs to its end.  A thread in a long wait
 ;; (a robot's motion) is woken when it is marked, by the procedure it gave
 ;; with-wake-on-abandon, rather than look at its mark again and again.

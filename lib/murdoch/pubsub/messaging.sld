@@ -14,4 +14,4 @@
   (import (only (murdoch code) make-logged-thread) (scheme base) (srfi 1) (srfi 18)
           (chibi match) (murdoch sys) (murdoch lab) (murdoch remote)
           (only (murdoch wire) error-message))
-  (include "messaging.scm"))
+  (include "messaging.scm" "receiving.scm"))

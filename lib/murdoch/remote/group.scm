@@ -69,7 +69,7 @@
       (let ((group (cadr delivery))
             (port (if (pair? (cddr delivery))
                       (car (cddr delivery))
-                      (+ (lab-port-base lab) 149))))
+                      (lab-planned-port lab 'multicast))))
         (set! *group*
               (make-group (open-multicast-socket group port
                                                  (aspace-host (local-aspace)))

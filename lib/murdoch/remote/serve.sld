@@ -14,4 +14,4 @@
           (murdoch lab) (murdoch remote aspace) (murdoch remote worker)
           (murdoch remote call)
           (only (murdoch remote connection) watch-served! unwatch-served!))
-  (include "serve.scm"))
+  (include "serve.scm" "served-call.scm"))

@@ -1,4 +1,4 @@
-;;;; trip-client.scm -- the MOVER robot primitives, spoken over trip.
+;;;; The MOVER robot primitives, spoken over trip.
 ;;;
 ;;; The protocol is docs/trip-protocol.md; in short:
 ;;;

@@ -23,4 +23,4 @@
           (murdoch remote) (murdoch pubsub) (murdoch task assign)
           (murdoch task progress) (murdoch task metric) (murdoch task takers)
           (murdoch task team) (only (murdoch task running) run-posed-component))
-  (include "pose-task.scm"))
+  (include "pose-task.scm" "winners.scm" "rivals.scm"))

@@ -14,7 +14,7 @@
           (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
           (only (chibi ast) unsetenv errno integer->error-string)
-          (murdoch lab) (murdoch wire connect)
+          (murdoch lab) (only (murdoch wire) open-connection)
           (only (murdoch remote) remote-error? remote-error-message)
           (only (chibi test) test-failure-count)
           (only (chibi filesystem) delete-file-hierarchy current-directory directory-files

@@ -5,5 +5,6 @@
           hello-text hello-frame welcomed-raw-connect counted raw-answer
           text-of)
   (import (scheme base) (scheme read) (scheme write)
-          (chibi net) (murdoch wire netstring) (murdoch wire hmac))
+          (chibi net)
+          (only (murdoch wire) read-netstring write-netstring hmac-sha256))
   (include "raw.scm"))

@@ -3,25 +3,24 @@
 
 ;;; The tasks: what the address spaces say they hold and run
 ;;
-;; A robot tells the subjects it holds and for whom -- a reservation
-;; name, NAME@POSER/N (pose-task.scm) -- the components it runs, (running
-;; ID INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed
-;; task's reservation name (running.scm), and the components that ended
-;; there lately, each with how it ended, which its poser was told.  The
-;; table remembers each component from when it is first seen on a robot
-;; to when it ended there, and how; one that ended between two looks is
-;; added whole.  A component of a started task seen on another robot than
-;; before was reassigned.  Subjects held for a task that its robot runs no
+;; A robot tells the subjects it holds and for whom -- a reservation name,
+;; NAME@POSER/N (task/pose-task.scm) -- the components it runs, (running ID
+;; INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed task's
+;; reservation name (task/running.scm), and the components that ended there
+;; lately, each with how it ended, which its poser was told.  The table
+;; remembers each component from when it is first seen on a robot to when
+;; it ended there, and how; one that ended between two looks is added
+;; whole.  A component of a started task seen on another robot than before
+;; was reassigned.  Subjects held for a task that its robot runs no
 ;; component of are a reservation of its negotiation, shown without a
 ;; number until a component of that task starts on that robot, or it is
-;; released.  A task's own state is what its poser says, when the poser
-;; is an address space of the lab; else what its components say: running
-;; while one runs, negotiating while only reservations are held, failed
-;; when one failed or was lost, not started when none started, else done.
-;; A component is lost when its robot started again (its up-since moved)
-;; or has not answered for away-polls looks in a row: a robot that died
-;; does not say that it stopped, and its poser was told "connection
-;; lost".
+;; released.  A task's own state is what its poser says, when the poser is
+;; an address space of the lab; else what its components say: running while
+;; one runs, negotiating while only reservations are held, failed when one
+;; failed or was lost, not started when none started, else done.  A
+;; component is lost when its robot started again (its up-since moved) or
+;; has not answered for away-polls looks in a row: a robot that died does
+;; not say that it stopped, and its poser was told "connection lost".
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)

@@ -1,0 +1,277 @@
+;;;; Receiving, part of (murdoch pubsub messaging): what the senders of
+;;;; messaging.scm run in each address space, and the reservations that
+;;;; request-exclusive makes.
+
+;;; Receiving
+;;
+;; What a receiver answers travels back as a list: (#t UID VALUE) when it
+;; evaluated the message, else (#f UID); for request-components, (ANSWER
+;; ASKED) for each component.
+
+(define (evaluated? answer) (car answer))
+(define (evaluation answer) (cdr answer)) ; (UID VALUE)
+(define (component-answer entry) (car entry))
+(define (component-asked entry) (cadr entry))
+
+;;> Evaluates a publication if it is addressed here.
+(define (receive-publication topic uid proc args)
+  (if (addressed-here? topic)
+      (apply proc args))
+  #t)
+
+;;> Evaluates a request if it is addressed here: (#t uid result) or
+;;> (#f uid).
+(define (receive-request topic uid proc args)
+  (if (addressed-here? topic)
+      (list #t (local-aspace-uid) (apply proc args))
+      (list #f (local-aspace-uid))))
+
+;;> Reserves and promises, if addressed here and free: (#t uid promise)
+;;> or (#f uid).
+(define (receive-request-exclusive topiclist task-name uid proc args)
+  (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
+               proc args))
+
+;;> The shared counterpart of receive-request-exclusive.
+(define (receive-request-non-exclusive topics task-name uid proc args)
+  (promise-for (reserve-shared! topics task-name) proc args))
+
+;;> What request-components runs in each address space: for each (type
+;;> layout proc askings) of \var{components}, in order, (answer asked).
+;;> answer is what receive-request-exclusive answers for an exclusive
+;;> component and receive-request, addressed to the layout's non-exclusive
+;;> subjects, for another; asked, when answer makes this address space a
+;;> candidate, its answer to each asking, (#t value) or (#f message).
+(define (receive-components components task-name uid)
+  (map (lambda (c)
+         (match c
+           ((type layout proc askings)
+            (let ((answer (if (eq? type 'exclusive)
+                              (receive-request-exclusive layout task-name uid proc '())
+                              (receive-request (cadr layout) uid proc '()))))
+              (list answer (if (evaluated? answer) (map ask-here askings) '()))))))
+       components))
+
+;; An asking is the user's code, so that one raising costs only its own
+;; answer (a guard only where user code runs: docs/speed.md).
+(define (ask-here proc)
+  (guard (e (#t (list #f (error-message e))))
+    (list #t (proc))))
+
+;;> Whether \var{a}, a candidate's answer to an asking of
+;;> request-components, (#t value) or (#f message), was a value.
+(define (asked-ok? a) (car a))
+
+;;> The value of \var{a}, a candidate's answer to an asking, or why none.
+(define (asked-value a) (cadr a))
+
+;;; Reservations
+
+(define-record-type reservation
+  (make-reservation task exclusive shared deadline state)
+  reservation?
+  (task reservation-task)
+  (exclusive reservation-exclusive)     ; subjects held exclusively
+  (shared reservation-shared)           ; subjects held for sharing
+  (deadline reservation-deadline reservation-deadline-set!)
+  (state reservation-state reservation-state-set!)) ; reserved running done
+
+;; Those not yet promised away.  Global, beside the subscriptions, and
+;; under their lock: a reservation holds subscriptions.
+(define *reservations* '())
+
+;; The leases, made by start-leases!: the lab's lease, read there, and
+;; the thread that frees what outlives it.  Global: one per process, read
+;; by every reservation.
+(define-record-type leases
+  (make-leases seconds keeper)
+  leases?
+  (seconds lease-seconds)
+  (keeper lease-keeper-thread))
+
+(define *leases* #f)
+
+(define (lease) (lease-seconds *leases*))
+
+;;> Starts freeing the subjects of promises unapplied for \var{lab}'s
+;;> lease.
+(define (start-leases! lab)
+  (set! *leases* (make-leases (lab-setting lab 'lease)
+                              (make-logged-thread lease-keeper 'lease-keeper)))
+  (thread-start! (lease-keeper-thread *leases*)))
+
+;; A subject is free for task when it is free or already held by task: two
+;; components of one task may both get a promise from one robot, and
+;; conflict resolution gives that robot at most one of them.
+(define (free-for? s task)
+  (let ((status (subscription-status s)))
+    (or (null? status) (eq? status task))))
+
+(define (not-held-by-another? s task)
+  (let ((status (subscription-status s)))
+    (or (null? status) (eq? status task) (eq? status 'shared))))
+
+(define (hold! s status)
+  (subscription-status-set! s status)
+  (subscription-holds-set! s (+ 1 (subscription-holds s))))
+
+;; Caller holds the lock.  Answers the subscriptions, or #f if one is
+;; missing or not acceptable.
+(define (subscriptions-if topics ok?)
+  (let ((subs (map find-subscription topics)))
+    (and (every (lambda (s) (and s (ok? s))) subs) subs)))
+
+;; Whether every one of subjects is subscribed here, by its own name: an
+;; address space that lacks one reserves nothing, and is told so without
+;; the lock and the reservation's checks (most of a lab, for a robot's
+;; component).  Read without the lock, as addressed-here? reads: the
+;; list is replaced, not changed.
+(define (subscribed-to-all? subjects)
+  (or (null? subjects)
+      (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
+
+(define (reserve! exclusive non-exclusive task uid)
+  (and
+   (subscribed-to-all? exclusive) (subscribed-to-all? non-exclusive)
+   (with-subscriptions
+     (lambda ()
+       (let ((ex (and (not (and (pair? exclusive) (offered-elsewhere? uid)))
+                      (subscriptions-if exclusive (lambda (s) (free-for? s task)))))
+             (non (subscriptions-if non-exclusive
+                                    (lambda (s) (not-held-by-another? s task)))))
+         (and ex non
+              (begin
+                (for-each (lambda (s)
+                            (hold! s task)
+                            (add-subscription!
+                             (in-use-subject (subscription-topic s))))
+                          ex)
+                (new-reservation! task exclusive '()))))))))
+
+(define (reserve-shared! topics task)
+  (and
+   (subscribed-to-all? topics)
+   (with-subscriptions
+     (lambda ()
+       (let ((subs (subscriptions-if
+                    topics
+                    (lambda (s) (memq (subscription-status s) '(() shared))))))
+         (and subs
+              (begin (for-each (lambda (s) (hold! s 'shared)) subs)
+                     (new-reservation! task '() topics))))))))
+
+(define (new-reservation! task exclusive shared)
+  (let ((r (make-reservation task exclusive shared
+                             (+ (monotonic-seconds) (lease)) 'reserved)))
+    (set! *reservations* (cons r *reservations*))
+    r))
+
+(define (in-use-subject topic)
+  (string->symbol (string-append (symbol->string topic) ".in_use")))
+
+;; Frees a reservation's subjects, once.  A subject is free again when no
+;; reservation holds it any more.
+(define (release! r)
+  (if (with-subscriptions
+        (lambda ()
+          (and (not (eq? (reservation-state r) 'done))
+               (begin
+                 (reservation-state-set! r 'done)
+                 (set! *reservations* (remove (lambda (x) (eq? x r)) *reservations*))
+                 (for-each (lambda (topic) (let-go! topic #t))
+                           (reservation-exclusive r))
+                 (for-each (lambda (topic) (let-go! topic #f))
+                           (reservation-shared r))
+                 (pair? (reservation-exclusive r))))))
+      (*on-free*)))
+
+;; What runs when a reservation of exclusive subjects here ends: tasks
+;; that wait for robots hear of it (task/life-cycle.scm).  Global: the
+;; task layer sets it as it loads, before the lab is joined.
+(define *on-free* (lambda () #f))
+
+;;> Sets the thunk that runs, outside any lock, each time exclusive
+;;> subjects here are freed.
+(define (on-free! thunk) (set! *on-free* thunk))
+
+;; While a freed robot is offered to a waiting task's poser, exclusive
+;; subjects here are reserved for that poser's requests only: (uid
+;; . until), until a monotonic-seconds, or #f.  Global, beside the
+;; subscriptions and under their lock.
+(define *offered* #f)
+
+;;> For \var{seconds}, reserves exclusive subjects here only at the
+;;> request of address space \var{uid}; #f for \var{uid} ends that.
+(define (offer-subjects! uid . seconds)
+  (with-subscriptions
+    (lambda ()
+      (set! *offered* (and uid (cons uid (+ (monotonic-seconds) (car seconds))))))))
+
+;; Caller holds the lock.
+(define (offered-elsewhere? uid)
+  (and *offered* (not (eq? (car *offered*) uid))
+       (< (monotonic-seconds) (cdr *offered*))))
+
+(define (let-go! topic exclusive?)
+  (let ((s (find-subscription topic)))
+    (when s
+      (subscription-holds-set! s (max 0 (- (subscription-holds s) 1)))
+      (when (zero? (subscription-holds s))
+        (subscription-status-set! s '())
+        (if exclusive? (remove-subscription! (in-use-subject topic)))))))
+
+;; Marks r as being promised away; #f if its lease already ran out.
+(define (claim! r)
+  (with-subscriptions
+    (lambda ()
+      (and (eq? (reservation-state r) 'reserved)
+           (begin (reservation-state-set! r 'running)
+                  (set! *reservations*
+                        (remove (lambda (x) (eq? x r)) *reservations*))
+                  #t)))))
+
+(define (promise-for r proc args)
+  (if (not r)
+      (list #f (local-aspace-uid))
+      (list #t (local-aspace-uid)
+            (letrec ((promise
+                      (encap
+                       (lambda (commit?)
+                         (cond
+                          ((eq? commit? 'keep) (renew! r))
+                          ((not (claim! r))
+                           (error "this promise's reservation has ended"
+                                  (reservation-task r)))
+                          (else
+                           (release-proxy! promise)
+                           (dynamic-wind
+                            (lambda () #f)
+                            (lambda () (and commit? (apply proc args)))
+                            (lambda () (release! r)))))))))
+              promise))))
+
+;; A promise applied to keep holds its subjects for another lease: a task
+;; that holds what it has while it waits for the rest (task/life-cycle.scm).
+;; Answers whether it still holds them.
+(define (renew! r)
+  (with-subscriptions
+    (lambda ()
+      (and (eq? (reservation-state r) 'reserved)
+           (begin (reservation-deadline-set! r (+ (monotonic-seconds) (lease)))
+                  #t)))))
+
+;; Frees the reservations whose promise was never applied: the sender
+;; died, or the network broke.  No subject is held for ever.
+(define (lease-keeper)
+  (thread-sleep! (min 1 (/ (lease) 4)))
+  (for-each (lambda (r)
+              (log-warn "lease ran out: freeing " (reservation-exclusive r)
+                        (reservation-shared r) " held for "
+                        (reservation-task r))
+              (release! r))
+            (with-subscriptions
+              (lambda ()
+                (filter (lambda (r)
+                          (< (reservation-deadline r) (monotonic-seconds)))
+                        *reservations*))))
+  (lease-keeper))

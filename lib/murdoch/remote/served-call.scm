@@ -1,0 +1,221 @@
+;;;; Served calls, part of (murdoch remote serve): reading a connection's
+;;;; calls, running them and writing their answers.
+
+;; A call that a reader has read, from a connection or the group: who
+;; sent it, its id, what it applies, and how it is answered, a procedure
+;; of the connection's or the group's (see reply!).
+(define-record-type served-call
+  (make-served-call caller id kind proc-code args-code answer)
+  served-call?
+  (caller served-call-caller)           ; its uid, or for the group its aspace
+  (id served-call-id)
+  (kind served-call-kind)               ; run or apply
+  (proc-code served-call-proc-code)
+  (args-code served-call-args-code)
+  (answer served-call-answer))          ; (answer C KIND VALUE)
+
+;;> Answers served call \var{c}: \var{kind} ack, value or error, and
+;;> \var{value}, the encoded value or the error's message.
+(define (reply! c kind value) ((served-call-answer c) c kind value))
+
+;; A thread reading s's calls: the call it runs, until its answer is made,
+;; for read-calls to answer an error to.
+(define-record-type reading
+  (make-reading serving call)
+  reading?
+  (serving reading-serving)
+  (call reading-call reading-call-set!))
+
+;; Runs (read-on r) while this thread is s's reader, r its reading, under
+;; one handler for the thread's life (docs/speed.md, What Chibi charges).
+;; An error in the call r runs is answered by (answer-error call e), once
+;; what the call wrote is flushed (see call-in-sandbox); any other by
+;; (other-failure e), which may raise to end the reader.
+(define (read-calls s read-on answer-error other-failure)
+  (let ((r (make-reading s #f)))
+    (let again ()
+      (guard (e ((reading-call r)
+                 => (lambda (c)
+                      (flush-call-ports!)
+                      (reading-call-set! r #f)
+                      (let ((still (inline-apply-ends! s)))
+                        (answer-error c e)
+                        (if still (again)))))
+                (#t (other-failure e)
+                    (if (reader? s) (again))))
+        (read-on r)))))
+
+;; Runs call c, which reading r has read.  A run is acknowledged once its
+;; procedure is decoded, so that one that cannot be is reported to its
+;; caller, and runs in a worker; an apply runs here, until the janitor
+;; gives r's connection a new reader, and its value goes back.
+(define (serve-call r c)
+  (reading-call-set! r c)
+  (if (eq? (served-call-kind c) 'run)
+      (serve-run r c (decode-call c))
+      (serve-apply r (reading-serving r) c)))
+
+(define (serve-run r c thunk)
+  (reading-call-set! r #f)
+  (reply! c 'ack #t)
+  (run-in-worker thunk))
+
+(define (serve-apply r s c)
+  (inline-apply-begins! s (served-call-id c))
+  ;; Answered while the call is r's: a value that cannot go back (too
+  ;; large, say) is answered with the error instead.
+  (reply! c 'value (encoded-result c))
+  (reading-call-set! r #f)
+  (inline-apply-ends! s))
+
+;; What a connection knows once its caller has said hello: who called,
+;; the nonces each side MACs with, and the count of frames each way.
+(define-record-type greeting
+  (make-greeting uid caller-nonce nonce text write-lock answer count sent flushed)
+  greeting?
+  (uid greeting-uid)
+  (caller-nonce greeting-caller-nonce)  ; our answers are MACed with it
+  (nonce greeting-nonce)                ; the caller's frames are
+  (text greeting-text)                  ; see frame-text
+  (write-lock greeting-write-lock)
+  (answer greeting-answer)              ; a served call's (reply!)
+  (count greeting-count greeting-count-set!)    ; frames read
+  (sent greeting-sent greeting-sent-set!)       ; frames written
+  (flushed greeting-flushed greeting-flushed-set!)) ; sent when last flushed
+
+;; Welcomes the caller of hello, which the poller read on s.
+(define (greet! s hello)
+  (match (check-message hello '(hello) "a hello")
+    (('hello uid host port caller-nonce)
+     ;; Where the caller listens, learned from its hello.
+     (learn-aspace! (make-aspace uid host port))
+     (let ((g (make-greeting uid caller-nonce (random-hex 16) (open-output-string)
+                             (make-mutex)
+                             (lambda (c kind value) (answer-call s c kind value))
+                             0 0 0)))
+       (serving-greeting-set! s g)
+       (serving-deadline-set! s #f)
+       (serving-read-on-set! s (lambda () (serve-greeted s)))
+       (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
+                    (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))))
+
+;; Serves s's frames while this thread is its reader; see read-calls.
+(define (serve-greeted s)
+  (read-calls s (lambda (r) (read-on s r))
+              (lambda (c e)
+                (let-go-of-writes! s)
+                (reply! c 'error (error-message-naming e))
+                (flush-if-idle! s (serving-greeting s)))
+              raise))
+
+(define (read-on s r)
+  (serve-read! s r (read-served s)))
+
+(define (serve-read! s r message)
+  (unless (eof-object? message)
+    (serve-frame r (greeting-uid (serving-greeting s))
+                 (greeting-answer (serving-greeting s)) message)
+    (flush-if-idle! s (serving-greeting s))
+    (if (reader? s) (read-on s r))))
+
+;; Answers served call c on s.
+(define (answer-call s c kind value)
+  (if (eq? kind 'ack)
+      (answer! s (serving-greeting s) (make-message 'ack (served-call-id c)) #f)
+      (answer! s (serving-greeting s) (make-message kind (served-call-id c) value)
+               #t)))
+
+;; The reader's own answers wait in the port's buffer until it has read
+;; every call that has arrived: a burst of calls is answered in one write.
+;; A value or an error, last? true, goes under the same lock when no call
+;; waits behind it, where flush-if-idle! would take the lock again; a
+;; run's ack waits for flush-if-idle!, after its worker has its procedure
+;; (flushed at once, it cost remote-runs a third of their throughput:
+;; docs/speed.md, Levers tried).  Answers from former readers go at once.
+;; The write lock is taken by lock!, without with-lock's wind and
+;; closures (docs/speed.md, What Chibi charges): a raise under it, from a
+;; message too large or a caller that left, is let go of by the reader's
+;; handlers (let-go-of-writes!).
+(define (answer! s g message last?)
+  (lock! (greeting-write-lock g))
+  (write-answer! s g (frame-text (greeting-text g) message))
+  (if (or (not (reader? s)) (and last? (null? (serving-frames s))))
+      (flush! s g))
+  (unlock! (greeting-write-lock g)))
+
+;; A caller that left makes this raise, and the connection end.
+(define (write-answer! s g frame)
+  (greeting-sent-set! g (+ 1 (greeting-sent g)))
+  (write-frame! (serving-out s) frame (greeting-caller-nonce g) (greeting-sent g)))
+
+;; The caller holds the write lock.
+(define (flush! s g)
+  (flush-output-port (serving-out s))
+  (greeting-flushed-set! g (greeting-sent g)))
+
+;; Nothing to flush after a frame that had no answer (the answers to our
+;; own datagram calls, which a requester gets from every peer): no lock
+;; taken for it.  Sent and flushed change under the write lock, and a
+;; writer flushes or comes here after its write.
+(define (flush-if-idle! s g)
+  (when (and (not (= (greeting-flushed g) (greeting-sent g)))
+             (null? (serving-frames s)))
+    (lock! (greeting-write-lock g))
+    (flush! s g)
+    (unlock! (greeting-write-lock g))))
+
+;; The write lock of s, should this thread hold it: a raise under it
+;; (see answer!) leaves it held.
+(define (let-go-of-writes! s)
+  (let ((g (serving-greeting s)))
+    (if (and g (eq? (mutex-state (greeting-write-lock g)) (current-thread)))
+        (unlock! (greeting-write-lock g)))))
+
+;; Serves one frame from the caller uid, read by r: a call, which answer
+;; answers, or one that needs no answer (serve-notice).
+(define (serve-frame r uid answer message)
+  (if (memq (car message) '(run apply))
+      (serve-call r (served-call-of message uid answer))
+      (serve-notice (reading-serving r) uid message)))
+
+;; The served call that message, a run or an apply checked whole by
+;; open-served, asks for: its procedure and arguments taken by their
+;; places in the wire's table of messages (wire/frame.scm), where match
+;; made 600 B of garbage a call (docs/speed.md, What Chibi charges).
+(define (served-call-of message uid answer)
+  (make-served-call uid (message-id message) (car message) (list-ref message 2)
+                    (list-ref message 3) answer))
+
+;; Serves a frame of s from uid that needs no answer: the answer to one
+;; of our datagram calls, or an abandon, checked whole by open-served.
+;; By cond, not match: a multicast requester's every answer comes here
+;; (docs/speed.md, What Chibi charges).
+(define (serve-notice s uid message)
+  (if (eq? (car message) 'answer)
+      (take-datagram-answer! uid message)
+      (abandon-call! s (message-id message))))
+
+;; The application run c asks for, as a thunk that runs it in the sandbox.
+(define (decode-call c)
+  (sandboxed-thunk (served-procedure c) (served-arguments c)))
+
+(define (sandboxed-thunk proc args)
+  (lambda () (call-in-sandbox proc args)))
+
+;; What the application call c asks for answers, encoded to go back.  No
+;; thunk made for it, as decode-call makes (docs/speed.md, What Chibi
+;; charges).
+(define (encoded-result c)
+  (encode (call-in-sandbox (served-procedure c) (served-arguments c))
+          (lab-environment) "the result"))
+
+;; The procedure and the arguments of served call c, decoded.
+(define (served-procedure c)
+  (checked-procedure (decode-value (served-call-proc-code c))))
+
+(define (served-arguments c) (decode-value (served-call-args-code c)))
+
+(define (checked-procedure proc)
+  (if (not (procedure? proc))
+      (error "not a procedure" proc))
+  proc)
