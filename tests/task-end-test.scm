@@ -7,7 +7,8 @@
         (scheme process-context) (srfi 1)
         (srfi 18) (chibi test)
         (only (chibi process) system)
-        (murdoch) (murdoch remote) (murdoch cli command) (murdoch view)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch view)
         (murdoch testing harness))
 
 (define lab-code "
