@@ -117,7 +117,7 @@
 ;; by the address space that answered them.
 (define (posed-states tasks)
   (filter-map (lambda (t)
-                (and (pair? t) (listed-posed? t) (= (length t) 8)
+                (and (pair? t) (listed-posed? t) (>= (length t) 3)
                      (cons (text (listed-id t)) (posed-state-text t (listed-place t)))))
               tasks))
 
@@ -126,7 +126,8 @@
 ;; for, and its place in the lab's line.
 (define (posed-state-text t place)
   (let ((word (text (listed-state t))))
-    (cond ((memq (listed-state t) '(waiting holding))
+    (cond ((< (length t) 8) word)       ; a peer older than the word's details
+          ((memq (listed-state t) '(waiting holding))
            (string-append word ": " (waiting-text (list 'posed (listed-id t) (listed-state t)
                                                         #f place (list-ref t 5)
                                                         (list-ref t 6) (list-ref t 7))
