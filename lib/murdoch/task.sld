@@ -7,12 +7,13 @@
   (export task-key-parts run-component run-posed-component component-heartbeat!
           stop-component! components-ended ended-id ended-index ended-started
           ended-ended ended-end start-task task? task-id task-name task-status
-          task-state task-why task-state-text task-wait cancel-task status-index status-state status-attempts
+          task-state task-why task-state-text task-wait cancel-task status-index
+          status-state status-attempts
           step-status? step-status-index step-status-entries tasks listed-posed?
           listed-id listed-state listed-place listed-why listed-priority
           listed-held listed-wants listed-index listed-poser waiting-entries
           offer-on-joining! task-step start-steps pose-steps waiting-ranks
-          waiting-for receive-offer receive-give-way note-waiters!
+          waiting-for receive-offer receive-give-way note-waiters! robot-freed!
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between pose-task negotiate pose-task-progress

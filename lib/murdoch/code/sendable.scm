@@ -188,6 +188,7 @@
   (depth limits-depth)                  ; the lab's max-depth
   (pairs limits-pairs))                 ; a frame of max-frame bytes holds fewer
 
+;; Global: the lab's limits, for every value the process sends.
 (define *limits* #f)
 
 ;;> Takes the limits of values from \var{lab}: the deepest nesting a value
@@ -218,8 +219,8 @@
         (append-reverse! next rev))))
 
 ;; True of data that stands for itself on the wire, pairs of it included:
-;; encode and decode give it back as it is instead of copying it, which
-;; on a receiver's path was most of their cost.  The look (plain-within?,
+;; encode and decode give it back as it is instead of copying it
+;; (docs/speed.md).  The look (plain-within?,
 ;; in plain.c, beside plain-atom?, the atoms that do) stops after a
 ;; budget of pairs, or at the depth limit, so that a long, deep or
 ;; circular value goes the general way, which says what is wrong with it.
@@ -290,9 +291,8 @@
 ;; bound to a global name after it was first sent still goes as its
 ;; source, which means the same there).  The same procedures are sent
 ;; again and again: a request's, and its user's closure, made afresh for
-;; each request.  Kept by closure, those filled the table, and srfi 69
-;; keeps twelve buckets a key: a requester's heap grew to a gigabyte
-;; making room for the bucket vector (docs/speed.md).  At most max-known
+;; each request; so they are kept by name, not by closure (docs/speed.md).
+;; At most max-known
 ;; are kept, so that a program that sends ever new globals is let go.
 ;; Global: a cache for every thread.
 (define max-known 512)

@@ -1,11 +1,4 @@
-;;;; The MOVER robot primitives, spoken over trip.
-;;;
-;;; The protocol is docs/trip-protocol.md; in short:
-;;;
-;;;   frame    STX payload ETX, with STX, ETX and DLE sent as DLE, byte^#x40
-;;;   request  "TAG WORD ARG ..."    TAG a number 1..999999999 we choose
-;;;   reply    "TAG ok VALUE ..."  or  "TAG err CODE TEXT"
-;;;   tag 0    the server's own messages (framing errors, streamed readings)
+;;;; The MOVER robot primitives, spoken over trip (docs/trip-protocol.md).
 ;;;
 ;;; One connection per robot, which the threads of the address space
 ;;; share.  A thread sends its request under the connection's lock and
@@ -27,11 +20,11 @@
 ;;; use; (im) opens them all at once, as MOVER's did.
 
 ;;> Seconds to wait for any reply.
-(define trip-timeout (make-parameter 5))
+(define trip-timeout (make-parameter (lab-default 'trip-timeout)))
 
 ;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is
 ;;> stopped and an error raised.
-(define trip-motion-timeout (make-parameter 120))
+(define trip-motion-timeout (make-parameter (lab-default 'trip-motion-timeout)))
 
 ;;> The connection the primitives use: #f on a workstation.  Set it for
 ;;> the whole address space with \scheme{set-current-robot!} (threads do

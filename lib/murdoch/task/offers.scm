@@ -165,5 +165,3 @@
 (define (free-here?)
   (every (lambda (s) (memq (cadr s) '(() shared))) (subscription-statuses '>)))
 
-(on-free! robot-freed!)
-

@@ -29,11 +29,11 @@
 
 ;;> How many times a task whose robots another task holds tries again
 ;;> before it answers \scheme{not-enough-takers}.
-(define pose-task-retries (make-parameter 5))
+(define pose-task-retries (make-parameter (lab-default 'pose-task-retries)))
 
 ;;> Seconds of the first wait before trying again; each wait is drawn at
 ;;> random below this, doubled for each try before it.
-(define pose-task-backoff (make-parameter 0.1))
+(define pose-task-backoff (make-parameter (lab-default 'pose-task-backoff)))
 
 ;;> Robots that pose-task gives no component to: a task that lost a
 ;;> robot renegotiates without it (life-cycle.scm).

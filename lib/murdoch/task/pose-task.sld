@@ -20,6 +20,7 @@
           (only (chibi ast) procedure-code procedure-vars opcode? thread-interrupt!)
           (only (chibi) call-with-output-string)
           (only (chibi process) current-process-id) (murdoch sys) (murdoch code)
+          (only (murdoch lab) lab-default)
           (murdoch remote) (murdoch pubsub) (murdoch task assign)
           (murdoch task progress) (murdoch task metric) (murdoch task takers)
           (murdoch task team) (only (murdoch task running) run-posed-component))
