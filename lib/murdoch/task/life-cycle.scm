@@ -373,7 +373,7 @@
 (define (tasks)
   (let* ((posed (with-lock *tasks-lock* posed-tasks))
          (others (and (any task-waiter posed)
-                      (guard (e (#t '())) (waiting-elsewhere)))))
+                      (guard (e (#t '())) (lab-waiting)))))
     (append (map (lambda (t) (posed-entry t others)) posed)
             (map (lambda (r) (cons 'running r)) (components-running)))))
 

@@ -177,6 +177,31 @@
                      (cadr answer)))
               (request 'waiting-tasks waiting-ranks)))
 
+;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
+;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*.
+(define *lab-waiting* #f)
+
+;; Every task of the lab that waits, as waiting-elsewhere answers, asked
+;; of the lab at most once a heartbeat for all the tasks waiting here,
+;; this poser's own as they are now.  Each waiting task's look numbers
+;; its place in the line: with W tasks waiting, a look that asked every
+;; poser each time cost W squared a period lab-wide.  A place may so be a
+;; heartbeat old; who is offered a robot is decided by the robot's own
+;; round, never by this list.
+(define (lab-waiting)
+  (let* ((now (monotonic-seconds))
+         (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
+         (all (if (and cached
+                       (< (- now (car cached)) (lab-setting (current-lab) 'heartbeat)))
+                  (cdr cached)
+                  (let ((fresh (waiting-elsewhere)))
+                    (with-lock *tasks-lock*
+                      (lambda () (set! *lab-waiting* (cons now fresh))))
+                    fresh)))
+         (me (local-aspace-uid)))
+    (append (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)
+            (map (lambda (e) (apply make-waiting-there me e)) (waiting-ranks)))))
+
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
 ;;> when it last looked, or that has a component those subjects serve (a

@@ -150,7 +150,7 @@
                          (remove (lambda (uid) (memq uid (pose-task-excluded)))
                                  (explanation-capable line)))
                        lines))
-         (others (guard (e (#t '())) (waiting-elsewhere)))
+         (others (guard (e (#t '())) (lab-waiting)))
          (exclusive (filter-map (lambda (c caps)
                                   (and (pair? (car (capability-layout
                                                     (component-capabilities c))))
@@ -202,7 +202,7 @@
 ;; others are the lab's waiting tasks, asked for when not given.
 (define (move-up! w . others)
   (let ((place (guard (e (#t (waiter-position w)))
-                 (place-in-line w (if (pair? others) (car others) (waiting-elsewhere)))))
+                 (place-in-line w (if (pair? others) (car others) (lab-waiting)))))
         (t (waiter-task w)))
     (with-lock *tasks-lock*
       (lambda ()
