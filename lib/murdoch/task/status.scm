@@ -133,7 +133,8 @@
   (if (listed-posed? t)
       (string-append "task " (held-text (listed-id t)) " " (held-text (listed-state t))
                      (cond ((memq (listed-state t) '(waiting holding))
-                            (string-append ": " (waiting-text t place)))
+                            (string-append ": " (join-text (cons (waiting-text t place)
+                                                                 (or (listed-why t) '())))))
                            ((listed-why t) => (lambda (why) (string-append ": " why)))
                            (else "")))
       (string-append "runs component " (held-text (listed-index t)) " of "
@@ -141,7 +142,7 @@
 
 ;;> What a waiting task's entry \var{t} of (tasks) says, at \var{place} in
 ;;> the lab's line: "holds lifter2; waits for 1 more (mobile lift); 2nd
-;;> in line; priority 0; " then why it waits.
+;;> in line; priority 0".  The status adds why it waits.
 (define (waiting-text t place)
   (let ((held (listed-held t)) (wants (listed-wants t)))
     (join-text
@@ -153,8 +154,7 @@
                            (if (pair? held) " more" "")
                            " (" (join-with ", " (map capability-text wants)) ")")
             (if place (string-append (ordinal place) " in line") "not in line yet")
-            (string-append "priority " (held-text (listed-priority t))))
-      (or (listed-why t) '())))))
+            (string-append "priority " (held-text (listed-priority t))))))))
 
 ;; A component's capabilities, (EXCLUSIVE SHARED) or a list of subjects,
 ;; as their subjects' names: "mobile lift".

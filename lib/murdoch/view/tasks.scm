@@ -128,10 +128,7 @@
   (let ((word (text (listed-state t))))
     (cond ((< (length t) 8) word)       ; a peer older than the word's details
           ((memq (listed-state t) '(waiting holding))
-           (string-append word ": " (waiting-text (list 'posed (listed-id t) (listed-state t)
-                                                        #f place (list-ref t 5)
-                                                        (list-ref t 6) (list-ref t 7))
-                                                  place)))
+           (string-append word ": " (waiting-text t place)))
           ((string? (listed-why t)) (string-append word ": " (listed-why t)))
           (else word))))
 
