@@ -350,10 +350,10 @@ it move to another robot when its robot is lost), then keywords
 
 | keyword | value | default |
 | --- | --- | --- |
-| `wait` | `#t`: wait while too few capable robots are free; `#f`: fail at once with `not-enough-takers` | the lab's `when-robots-busy` |
-| `hold` | `#t`: wait, keeping the robots won for some components | `#f` |
-| `priority` | a number, 0 or more; the higher goes first | `(pose-task-priority)` |
-| `deadline` | seconds: a task not started by then ends as `deadline` | none |
+| wait | `#t`: wait while too few capable robots are free; `#f`: fail at once with `not-enough-takers` | the lab's `when-robots-busy` |
+| hold | `#t`: wait, keeping the robots won for some components | `#f` |
+| priority | a number, 0 or more; the higher goes first | `(pose-task-priority)` |
+| deadline | seconds: a task not started by then ends as `deadline` | none |
 
 `task-state` is one word: `negotiating`, `waiting`, `holding`, `running`,
 then `done` (every component completed), `failed` (`task-why` says why:

@@ -118,7 +118,8 @@
 (define (posed-states tasks)
   (filter-map (lambda (t)
                 (and (pair? t) (listed-posed? t) (>= (length t) 3)
-                     (cons (text (listed-id t)) (posed-state-text t (listed-place t)))))
+                     (cons (text (listed-id t))
+                           (posed-state-text t (and (= (length t) 8) (listed-place t))))))
               tasks))
 
 ;; A posed task's state as the view shows it: its word, as task-state's,
