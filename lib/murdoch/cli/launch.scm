@@ -27,6 +27,78 @@
                                    ")"))
       (list "workstation")))
 
+;;; Robots reached through ROS 2 (docs/ros2.md)
+;;
+;; A robot whose clause has (ros2 ...) has a trip server of its own,
+;; robot/ros2/trip_ros2.py, which the lab starts beside its address space
+;; unless (trip-host ...) says it runs on another host.  With
+;; MURDOCH_ROS2=1 (make demo ROS2=1) every simulated robot is reached so
+;; too: the simulator's trip servers move to the port plan's face-trip
+;; (port-base + 150 + i), where
+;; robot/ros2/b14_face.py gives them a ROS 2 face under their names, and
+;; each gets a trip server of its own at its usual port.
+
+(define (ros2-everywhere?)
+  (equal? (get-environment-variable "MURDOCH_ROS2") "1"))
+
+;; The robot's (ros2 ...) clause, or the one the simulator's face gives a
+;; simulated robot under MURDOCH_ROS2=1, or #f.
+(define (robot-ros2 a)
+  (let ((robot (lab-aspace-clause a 'robot)))
+    (cond ((not robot) #f)
+          ((assq 'ros2 (filter pair? (cdr robot))) => cdr)
+          ((ros2-everywhere?)
+           `((namespace ,(string-append "/" (symbol->string (lab-aspace-uid a))))))
+          (else #f))))
+
+(define (simulated? a)
+  (and (lab-aspace-clause a 'robot)
+       (not (assq 'ros2 (filter pair? (cdr (lab-aspace-clause a 'robot)))))))
+
+;; One line per trip server the lab starts for a ROS 2 robot, "ros2 NAME
+;; PORT-BASE ARG ...", the arguments trip_ros2.py takes; and "face
+;; PORT-BASE NAME=HOST:PORT ..." for the simulator's face.
+(define (ros2-lines lab)
+  (let ((base (number->string (lab-port-base lab))))
+    (append
+     (if (and (ros2-everywhere?) (any simulated? (lab-aspaces lab)))
+         (list (string-join
+                (cons* "face" base
+                       (map (lambda (a)
+                              (string-append (symbol->string (lab-aspace-uid a)) "="
+                                             (address (lab-trip-host lab a)
+                                                      (face-port lab a))))
+                            (filter simulated? (lab-aspaces lab))))))
+         '())
+     (filter-map
+      (lambda (a)
+        (let ((ros2 (robot-ros2 a)))
+          (and ros2 (not (robot-trip-host a))
+               (string-join
+                (cons* "ros2" (symbol->string (lab-aspace-uid a)) base
+                       (trip-ros2-arguments lab a ros2))))))
+      (lab-aspaces lab)))))
+
+(define (robot-trip-host a)
+  (assq 'trip-host (filter pair? (cdr (lab-aspace-clause a 'robot)))))
+
+;; Where the simulator serves robot a's trip under MURDOCH_ROS2=1.
+(define (face-port lab a)
+  (lab-planned-port lab 'face-trip (lab-aspace-index a)))
+
+(define (trip-ros2-arguments lab a ros2)
+  (cons* "--name" (symbol->string (lab-aspace-uid a))
+         "--host" (lab-aspace-host a)
+         "--port" (number->string (lab-trip-port lab a))
+         (append-map (lambda (c)
+                       (append-map (lambda (v)
+                                     (list (string-append "--" (symbol->string (car c)))
+                                           (cond ((string? v) v)
+                                                 ((symbol? v) (symbol->string v))
+                                                 (else (number->string v)))))
+                                   (cdr c)))
+                     ros2)))
+
 (define (capabilities a)
   (cond ((lab-aspace-clause a 'capabilities) => cdr) (else '())))
 
@@ -59,9 +131,20 @@
       (execute "/bin/sh"
                (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
                       (or logs "") (or trace "") (or speed "")
-                      (if (pair? (lab-robots lab)) "sim" "")
+                      (sim-word lab)
                       (number->string loader)
-                      (lab-lines lab except)))))))
+                      (append (ros2-lines lab) (lab-lines lab except))))))))
+
+;; "sim" when the lab has simulated robots, with the simulator's port base
+;; when their trip servers move for their ROS 2 face; else "".
+(define (sim-word lab)
+  (cond ((not (any simulated? (lab-aspaces lab))) "")
+        ((ros2-everywhere?)
+         ;; The simulator puts robot i at its port base + the plan's trip + i.
+         (string-append "sim --port-base "
+                        (number->string (- (lab-planned-port lab 'face-trip)
+                                           (planned-port 0 'trip)))))
+        (else "sim")))
 
 ;; Closes a fileno through a port, which marks it closed: the collector
 ;; closes the descriptor of a fileno left open, whatever it is by then.
