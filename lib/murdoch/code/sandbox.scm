@@ -253,11 +253,8 @@
                               (cons (cons current-error-port (call-ports-err p))
                                     outer)))))
 
-(define (fresh-bindings parameters bindings)
-  (if (null? parameters)
-      bindings
-      (fresh-bindings (cdr parameters)
-                      (cons (cons (car parameters) ((car parameters))) bindings))))
+;; fresh-bindings, in C (call-bindings.c): each parameter's pair, in
+;; front of bindings.
 
 (define (flush-ports p)
   (flush-if-open (call-ports-out p))
