@@ -35,14 +35,15 @@
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
           ;; the task life cycle (lib/murdoch/task/life-cycle.scm and its neighbours)
-          start-task task? task-id task-name task-status task-wait cancel-task
+          start-task task? task-id task-name task-state task-why task-state-text
+          task-status task-wait cancel-task
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
-          listed-index listed-poser run-component run-posed-component components-ended
+          listed-priority listed-held listed-wants listed-index listed-poser run-component run-posed-component components-ended
           ended-id ended-index ended-started ended-ended ended-end
           component-heartbeat! stop-component!
-          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!
+          waiting-ranks waiting-entries waiting-for receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
           team-send! team-receive step-team
           ;; tasks handed to the lab (lib/murdoch/task/detached.scm)

@@ -8,10 +8,12 @@
   (export task-key-parts run-component run-posed-component component-heartbeat!
           stop-component! components-ended ended-id ended-index ended-started
           ended-ended ended-end start-task task? task-id task-name task-status
-          task-wait cancel-task status-index status-state status-attempts
+          task-state task-why task-state-text task-wait cancel-task status-index
+          status-state status-attempts
           step-status? step-status-index step-status-entries tasks listed-posed?
-          listed-id listed-state listed-place listed-why listed-index
-          listed-poser task-step start-steps pose-steps waiting-ranks
+          listed-id listed-state listed-place listed-why listed-priority
+          listed-held listed-wants listed-index listed-poser waiting-entries
+          offer-on-joining! task-step start-steps pose-steps waiting-ranks
           waiting-for receive-offer receive-give-way note-waiters! robot-freed!
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
@@ -21,8 +23,8 @@
           resolve-conflicts with-team-proc-maker with-team on-list current-team
           t sort-list make-maxrandom with-coordinator team-barrier team-send!
           team-receive step-team aspace-report lab-status show-status
-          write-lab-status report-since report-pose report-battery report-held
-          report-tasks report-goal report-ended held-subject held-holder
+          write-lab-status lab-line waiting-text report-since report-pose report-battery
+          report-held report-tasks report-goal report-ended held-subject held-holder
           report-handed lab-task-line await-component components-running lab-tasks
           lab-task-id lab-task-role lab-task-epoch lab-task-state
           lab-task-coordinator lab-task-standby lab-task-poser lab-task-took-over

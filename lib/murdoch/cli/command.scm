@@ -21,6 +21,7 @@
     (if entry (take-body! lab entry))
     (apply start-aspace! lab uid env port)
     (initialize-subscriptions! lab entry robot-freed!)
+    (offer-on-joining!)
     env))
 
 ;; The settings that are the values of parameters, or of the thesis's

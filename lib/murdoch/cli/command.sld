@@ -12,5 +12,5 @@
           (only (srfi 151) bitwise-ior) (murdoch sys) (murdoch code) (murdoch cli hints)
           (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot)
           (only (murdoch task) task-timeout pose-task-retries pose-task-backoff
-                robot-freed!))
+                robot-freed! offer-on-joining!))
   (include "command.scm"))

@@ -280,11 +280,12 @@
          (env (make-repl-environment lab (join-guest lab-file "pose"))))
     (tell-who-is-away lab)
     (eval `(pose-task-progress (current-output-port)) env)
-    ;; A task file answers pose-task's arguments, or a task already
-    ;; started (start-task, start-steps), which is waited for, or the id
-    ;; of one handed to the lab.
-    (let* ((task (task-of task-file env))
-           (record? (or ((eval 'task? env) task) (symbol? task))))
+    ;; A task file answers pose-task's arguments, which are started as
+    ;; start-task starts them, or a task already started (start-task,
+    ;; start-steps), or the id of one handed to the lab: each is waited
+    ;; for, but with detach, where pose-task's arguments are handed to
+    ;; the lab and their id written.
+    (let ((task (task-of task-file env)))
       (cond
        (detach
         (if (not (list? task))
@@ -294,14 +295,33 @@
                                                 " already started\n")
                                  (current-error-port))
                    (exit 1)))
-        (write (apply (eval 'start-task env) (append task '(detach #t))))
+        (write (apply start-task (append task '(detach #t))))
         (newline)
         (exit 0))
-       (else
-        (write-result-and-exit
-         "murdoch pose"
-         (if record? ((eval 'task-wait env) task) (apply (eval 'pose-task env) task))
-         (and record? ((eval 'task-status env) task))))))))
+       ((symbol? task)
+        (write-result-and-exit "murdoch pose" (task-wait task) (task-status task)))
+       (else (wait-and-exit (if (task? task) task (apply start-task task))))))))
+
+;; Waits for task record t as murdoch pose does: Ctrl-C or SIGTERM cancel
+;; it; writes its results and a last line with its word, and exits 0
+;; when it is done.
+(define (wait-and-exit t)
+  (let* ((signalled (cancel-on-signals! t))
+         (result (wait-for-task t signalled)))
+    (write result)
+    (newline)
+    (write-string (string-append "murdoch pose: " (symbol->string (task-id t)) " "
+                                 (task-state-text t)
+                                 (if (signalled)
+                                     (string-append
+                                      " by " (signal-name (signalled))
+                                      ": its robots stop where they are and their"
+                                      " subjects are freed")
+                                     "")
+                                 "\n"))
+    (exit (cond ((signalled) => (lambda (n) (+ 128 n)))
+                ((eq? (task-state t) 'done) 0)
+                (else 1)))))
 
 ;; Joins the lab at lab-file as a guest named after what and this
 ;; process; answers the environment received code runs in.
@@ -351,22 +371,45 @@
     (write-string (string-append "cancelled " (symbol->string id) "\n"))
     (exit 0)))
 
-;; Whether what a pose answered says that its task did not complete:
-;; not-enough-takers, or a component that failed, by the task's status
-;; (see task-status) when it is a task record, else by its (error UID WHY).
+;; Whether a task that a peer waited for by its id did not complete: by
+;; its status (see task-status), where every component, of every step,
+;; must be done.
 (define (task-failed? result status)
-  (or (symbol? result)
-      (if status
-          (any failed-status? status)
-          (any (lambda (r) (and (list? r) (= (length r) 3) (eq? (car r) 'error)
-                                (symbol? (cadr r))))
-               result))))
+  (or (symbol? result) (any failed-status? status)))
 
-;; s an entry of task-status: a component's, or a step's.
 (define (failed-status? s)
   (if (step-status? s)
       (any failed-status? (step-status-entries s))
-      (eq? (car (status-state s)) 'failed)))
+      (not (eq? (car (status-state s)) 'done))))
+
+;; On Ctrl-C (SIGINT) or SIGTERM, t is cancelled, as Ctrl-C at a REPL
+;; gives its components up: each robot stops where it is and frees its
+;; subjects.  A second signal ends the pose at once.  Answers a thunk
+;; that answers the signal's number once one came, else #f.
+(define (cancel-on-signals! t)
+  (let ((caught #f))
+    (for-each (lambda (signal)
+                (set-signal-action! signal
+                                    (lambda (n)
+                                      (if caught (exit (+ 128 n)))
+                                      (set! caught n)
+                                      (cancel-task t))))
+              (list signal/interrupt signal/term))
+    (lambda () caught)))
+
+;; What task-wait answers for t; once a signal cancelled it, at most
+;; ten seconds more: a component that neither moves its robot nor calls
+;; a peer stops only at its end.
+(define (wait-for-task t signalled)
+  (let loop ((cancelled-at #f))
+    (cond ((guard (e (#t #f)) (list (task-wait t 0.5))) => car)
+          ((and cancelled-at (> (- (current-second) cancelled-at) 10)) 'cancelled)
+          (else (loop (or cancelled-at (and (signalled) (current-second))))))))
+
+(define (signal-name n)
+  (cond ((= n signal/interrupt) "Ctrl-C")
+        ((= n signal/term) "SIGTERM")
+        (else (string-append "signal " (number->string n)))))
 
 ;;> `murdoch status LAB`: joins the lab as a guest and shows what each of
 ;;> its address spaces says of itself (see show-status); one that does not

@@ -7,7 +7,8 @@
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context) (srfi 1)
           (only (chibi process) execute current-process-id parent-process-id fork waitpid
-                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill)
+                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill
+                signal/term)
           (only (chibi filesystem) open-pipe open open/read open/write open/append
                 open/create duplicate-file-descriptor-to set-file-descriptor-flags!
                 open-input-file-descriptor open-output-file-descriptor)
@@ -21,5 +22,6 @@
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
           (only (murdoch wire) error-message)
           (only (murdoch task) write-lab-status lab-task-line status-state step-status?
-                step-status-entries lab-tasks task-wait task-status cancel-task))
+                step-status-entries lab-tasks task? start-task task-wait task-status
+                cancel-task task-id task-state task-state-text))
   (include "launch.scm"))

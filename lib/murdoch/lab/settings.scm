@@ -88,6 +88,9 @@
                                     "fail or wait"))
     (aging 0.1 ,rate)
     (max-waiting 100 ,positive-count)
+    ;; A poser's (tasks) keeps the newest tasks-kept of its tasks that are
+    ;; over, and forgets the others (task/record.scm).
+    (tasks-kept 20 ,(whole-from 0 1000000 "a whole number, 0 or more"))
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" ,(make-reader size-bytes

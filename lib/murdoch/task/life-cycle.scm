@@ -93,6 +93,7 @@
                      restartable)
                 (make-mailbox))))
         (task-state-set! t 'negotiating)
+        (task-why-set! t #f)
         (task-team-set! t '())
         (task-steps-set! t #f)
         (task-turn-set! t turn)
@@ -131,31 +132,32 @@
 ;; its own, and puts their results in t's mailbox.
 (define (run-task t priorities)
   (let* ((cs (task-components t))
-         (team (negotiate-turn
-                t cs
-                (if (and (turn-hold? (task-turn t)) (> (length cs) 1))
-                    (lambda (w) (hold-try w priorities))
-                    (lambda (w)
-                      (negotiate (task-name t) (length cs)
-                                 (map component-capabilities cs)
-                                 (map component-metric cs) (map component-proc cs)
-                                 priorities))))))
+         (team (parameterize ((pose-task-reservation (task-id t)))
+                 (negotiate-turn
+                  t cs
+                  (if (and (turn-hold? (task-turn t)) (> (length cs) 1))
+                      (lambda (w) (hold-try w priorities))
+                      (lambda (w)
+                        (negotiate (task-name t) (length cs)
+                                   (map component-capabilities cs)
+                                   (map component-metric cs) (map component-proc cs)
+                                   priorities)))))))
     (cond
      ((let-go? t) (if (pair? team) (free-team! team)))
-     ((and (symbol? team) (not (eq? team 'cancelled)))
-      (if (memq (task-state t) '(negotiating waiting)) (task-state-set! t 'failed))
+     ((eq? team 'deadline)
+      (task-state-set! t 'deadline)
+      (end-all! t 'deadline)
+      (finish! t team))
+     ((or (eq? team 'cancelled) (eq? (task-state t) 'cancelled))
+      (if (pair? team) (free-team! team))
+      (end-all! t 'cancelled)
+      (finish! t (map component-result cs)))
+     ((symbol? team)
       (for-each (lambda (c)
                   (if (not (eq? (car (component-state c)) 'failed))
-                      (component-state-set! c (list 'failed team))))
+                      (fail-component! t c (symbol->string team))))
                 cs)
       (finish! t team))
-     ((symbol? team)
-      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
-      (finish! t (map component-result cs)))
-     ((eq? (task-state t) 'cancelled)
-      (free-team! team)
-      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
-      (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
       (task-team-set! t (map winner-uid (negotiated-winners team)))
@@ -176,12 +178,47 @@
                  thunks))
   (finish! t (map component-result (task-components t))))
 
-;; A task let go finishes here no more: its new coordinator finishes it.
+;; Puts each component of t that is not over in state (how): cancelled
+;; or deadline.
+(define (end-all! t how)
+  (for-each (lambda (c)
+              (if (not (memq (car (component-state c)) '(done failed)))
+                  (component-state-set! c (list how))))
+            (task-components t)))
+
+;; Ends t: done only when every component completed, else failed with
+;; its first failure's why, or as it was cancelled or ran out of time.
+;; A task of steps is done when its last step is.  A task let go
+;; finishes here no more: its new coordinator finishes it.
 (define (finish! t results)
   (when (not (let-go? t))
-    (if (memq (task-state t) '(negotiating waiting running)) (task-state-set! t 'done))
-    (progress (task-id t) ": " (task-state t))
+    (with-lock *tasks-lock*
+      (lambda ()
+        (if (not (memq (task-state t) '(cancelled deadline failed)))
+            (task-state-set!
+             t (if (every (lambda (c) (eq? (car (component-state c)) 'done))
+                          (task-components t))
+                   'done
+                   'failed)))
+        (if (and (eq? (task-state t) 'failed) (not (task-why t)))
+            (task-why-set! t (first-failure t)))
+        (forget-over! (lab-setting (current-lab) 'tasks-kept))))
+    (progress (task-id t) ": " (task-state-text t))
     (mailbox-put! (task-done t) results)))
+
+;; The why of t's first component that failed, for a task that failed
+;; without fail-component!: a component stopped without word.
+(define (first-failure t)
+  (let ((failed (find (lambda (c) (eq? (car (component-state c)) 'failed))
+                      (task-components t))))
+    (if failed (cadr (component-state failed)) "a component did not complete")))
+
+;;> \var{task}'s state as a person reads it: its word (see task-state),
+;;> and for a failed task why, as "failed: connection lost".
+(define (task-state-text task)
+  (if (and (eq? (task-state task) 'failed) (task-why task))
+      (string-append "failed: " (task-why task))
+      (symbol->string (task-state task))))
 
 ;; What a winner runs: (proc arg ...), a promise applied to #t for an
 ;; exclusive component.
@@ -189,6 +226,8 @@
   (if (eq? type 'exclusive)
       (list (winner-promise winner) #t)
       (list (component-proc c))))
+
+;; Runs component c on uid, and again elsewhere while its robot is lost
 ;; and it may be restarted.
 ;; work is (PROC ARG ...), or adopted for a component of a detached task
 ;; that runs on uid already, where a new coordinator found it.
@@ -205,12 +244,17 @@
   (if (and uid (not (let-go? t)))
       (component-attempts-set! c (append (component-attempts c)
                                          (list (cons uid outcome)))))
-  (progress "  component " (component-index c) " on " uid ": " outcome)
+  (progress "  component " (component-index c) " " (car outcome) " on " uid ": "
+            (case (car outcome)
+              ((done) (abridged (cadr outcome) 50))
+              ((let-go) "its coordinator let it go")
+              (else (cadr outcome))))
   (cond
      ((let-go? t) #f)
      ((eq? (task-state t) 'cancelled)
-      (component-state-set! c '(failed "cancelled")))
+      (component-state-set! c '(cancelled)))
      ((and (eq? (car outcome) 'lost) (restart? c))
+      (component-state-set! c '(negotiating))
       (let ((next (renegotiate t c)))
         (cond
          (next
@@ -220,11 +264,10 @@
                     uid " to " (car next))
           (supervise t c (car next) (cdr next)))
          (else
-          (component-state-set!
-           c (list 'failed (string-append (cadr outcome)
-                                          "; no other capable robot is free")))))))
+          (fail-component! t c (string-append (cadr outcome)
+                                              "; no other capable robot is free"))))))
      ((eq? (car outcome) 'done) (component-state-set! c outcome))
-     (else (component-state-set! c (list 'failed (cadr outcome))))))
+     (else (fail-component! t c (cadr outcome)))))
 
 ;; Puts uid in t's team as the robot of component k.  By index, not by
 ;; the robot it replaces: a robot whose component is done may take
@@ -244,7 +287,8 @@
 ;; The next robot for c, (uid proc arg ...), or #f: c is negotiated alone,
 ;; without the robots it had, nor those of the task's other components.
 (define (renegotiate t c)
-  (parameterize ((pose-task-excluded
+  (parameterize ((pose-task-reservation (task-id t))
+                 (pose-task-excluded
                   (append (map car (component-attempts c))
                           (filter-map (lambda (other)
                                         (and (eq? (car (component-state other)) 'running)
@@ -363,11 +407,14 @@
 
 ;;> Cancels \var{task}: every running component stops on its robot at its
 ;;> next robot command or remote call, its robot stops, and every
-;;> reservation is freed.  Answers #t.  \var{task} may also be a
-;;> detached task's id, from any peer.
+;;> reservation is freed.  A task already over stays as it ended.
+;;> Answers #t.  \var{task} may also be a detached task's id, from any
+;;> peer.
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
-  (task-state-set! task 'cancelled)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (if (not (over? task)) (task-state-set! task 'cancelled))))
   (if (task-waiter task) (tell-waiter! (task-waiter task) '(cancel)))
   (if (task-steps task) (for-each cancel-task (task-steps task)))
   (for-each (lambda (c)
@@ -382,16 +429,23 @@
     (parameterize ((remote-timeout 1))
       (remote-apply (uid->aspace uid) (sendable-lambda () (stop-component! id k))))))
 
-;;> The tasks of this address space: (posed ID STATE) for each it started,
-;;> newest first, (posed ID waiting PLACE WHY) for one waiting its turn,
-;;> and (running ID INDEX POSER) for each component it runs.  listed-id
-;;> and the other listed- procedures read them.
+;;> The tasks of this address space: (posed ID STATE WHY PLACE PRIORITY
+;;> HELD WANTS) for each it started that is not over, and the newest of
+;;> those over, at most the lab's tasks-kept, newest first; and (running
+;;> ID INDEX POSER) for each component it runs.  listed-id and the other
+;;> listed- procedures read them.
 (define (tasks)
-  (append (map (lambda (t)
-                 (let ((w (task-waiter t)))
-                   (if (and w (eq? (task-state t) 'waiting))
-                       (list 'posed (task-id t) 'waiting (waiter-position w)
-                             (waiter-why w))
-                       (list 'posed (task-id t) (task-state t)))))
-               (with-lock *tasks-lock* posed-tasks))
-          (map (lambda (r) (cons 'running r)) (components-running))))
+  (let* ((posed (with-lock *tasks-lock* posed-tasks))
+         (others (and (any task-waiter posed)
+                      (guard (e (#t '())) (lab-waiting)))))
+    (append (map (lambda (t) (posed-entry t others)) posed)
+            (map (lambda (r) (cons 'running r)) (components-running)))))
+
+;; t as (tasks) lists it; a waiting task as waiting-entry has it, with
+;; its place in the lab's line of others, the lab's waiting tasks.
+(define (posed-entry t others)
+  (let ((w (task-waiter t)))
+    (if w
+        (begin (move-up! w others) (waiting-entry w))
+        (list 'posed (task-id t) (task-state t) (task-why t) #f
+              (and (task-turn t) (turn-priority (task-turn t))) '() '()))))

@@ -16,7 +16,8 @@
   (thread running-thread)
   (started running-started)                   ; monotonic-seconds
   (heard running-heard running-heard-set!)    ; monotonic-seconds
-  (over? running-over? running-over?-set!))
+  (over? running-over? running-over?-set!)
+  (cancelled? running-cancelled? running-cancelled?-set!)) ; by its poser
 
 ;; Global: the poser's calls (component-heartbeat! ...) find them by name.
 (define *running* '())
@@ -49,6 +50,7 @@
          (r (make-running id k poser (current-thread) now now))
          (outcome unfinished))
     (running-over?-set! r #f)
+    (running-cancelled?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
     (watch! r)
     (dynamic-wind
@@ -152,7 +154,9 @@
 ;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
 (define (stop-component! id k)
   (let ((r (find-running id k)))
-    (if r (stop-running! r))
+    (when r
+      (running-cancelled?-set! r #t)
+      (stop-running! r))
     (and r #t)))
 
 ;;> (ID INDEX POSER) for each component running here.
@@ -181,7 +185,12 @@
 
 ;; r is over, with outcome, as run-listed catches it.
 (define (note-ended! r outcome)
-  (let ((entry (make-ending r (monotonic-seconds) (end-of outcome) outcome)))
+  (let ((entry (make-ending r (monotonic-seconds)
+                            (if (and (running-cancelled? r)
+                                     (not (eq? (car (end-of outcome)) 'done)))
+                                '(cancelled)
+                                (end-of outcome))
+                            outcome)))
     (with-lock *running-lock*
       (lambda ()
         (set! *running* (remove (lambda (x) (eq? x r)) *running*))
@@ -190,7 +199,7 @@
 
 ;; How a component ended, from what it answered or raised: (done), (lost
 ;; WHY) for a robot failure, or (failed WHY), WHY the message its poser
-;; is given.
+;; is given; note-ended! makes it (cancelled) when its poser cancelled it.
 (define (end-of outcome)
   (cond ((eq? outcome unfinished) '(failed "it stopped with no answer"))
         ((raised? outcome) (list 'failed (error-message (raised-condition outcome))))
@@ -200,7 +209,7 @@
 
 ;;> The components that ended here, the last sixteen, newest first, each
 ;;> as (ID INDEX POSER STARTED ENDED END): STARTED and ENDED are seconds
-;;> before now, END is (done), (failed WHY) or (lost WHY).  They travel
+;;> before now, END is (done), (failed WHY), (lost WHY) or (cancelled).  They travel
 ;;> as lists, to the status and the view; ended-id and the other ended-
 ;;> procedures read them.
 (define (components-ended)
@@ -226,5 +235,5 @@
 (define (ended-ended e) (list-ref e 4))
 
 ;;> How the component of \var{e}, an entry of components-ended, ended:
-;;> (done), (failed WHY) or (lost WHY).
+;;> (done), (failed WHY), (lost WHY) or (cancelled).
 (define (ended-end e) (list-ref e 5))

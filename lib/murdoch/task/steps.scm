@@ -88,7 +88,11 @@
         (release-proxy! coordinator)
         (progress (task-id t) ": step " i " done: " step-results)
         (if (step-failed? step-results)
-            (begin (if (not (eq? (task-state t) 'cancelled)) (task-state-set! t 'failed))
+            (begin (when (not (eq? (task-state t) 'cancelled))
+                     (task-state-set! t (if (memq (task-state sub) '(cancelled deadline))
+                                            (task-state sub)
+                                            'failed))
+                     (task-why-set! t (task-why sub)))
                    (finish! t (reverse (cons step-results results))))
             (loop (+ i 1) (cdr steps) step-results (cons step-results results))))))))
 

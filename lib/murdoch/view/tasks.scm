@@ -119,19 +119,52 @@
 ;; by the address space that answered them.
 (define (posed-states tasks)
   (filter-map (lambda (t)
-                (and (pair? t) (listed-posed? t) (memv (length t) '(3 5))
+                (and (pair? t) (listed-posed? t) (>= (length t) 3)
                      (cons (text (listed-id t))
-                           (if (listed-place t)
-                               (string-append "waiting, " (text (listed-place t))
-                                              " in line")
-                               (text (listed-state t))))))
+                           (posed-state-text t (and (= (length t) 8) (listed-place t))))))
               tasks))
+
+;; A posed task's state as the view shows it: its word, as task-state's,
+;; then for a failed one why, for a waiting one what it holds and waits
+;; for, and its place in the lab's line.
+(define (posed-state-text t place)
+  (let ((word (text (listed-state t))))
+    (cond ((< (length t) 8) word)       ; a peer older than the word's details
+          ((memq (listed-state t) '(waiting holding))
+           (string-append word ": " (waiting-text t place)))
+          ((string? (listed-why t)) (string-append word ": " (listed-why t)))
+          (else word))))
 
 ;; Whether the table takes a posed task's (KEY . STATE): it goes on, or
 ;; it is one the table has; a task over before the view saw it is left out.
 (define (posed-news? table posed)
   (or (task-known table (car posed))
-      (not (member (cdr posed) '("done" "failed" "cancelled")))))
+      (not (any (lambda (word) (string-prefix? word (cdr posed)))
+                '("done" "failed" "cancelled" "deadline")))))
+
+;;> Brings the tasks of \var{table} that wait their turn up to date with
+;;> \var{line}, the lab's waiting tasks as lab-line has them, whoever
+;;> posed them: their state, and their place in the one line.  A task a
+;;> guest posed that has left the line is over or running, as its
+;;> components say.
+(define (task-table-note-line! table line)
+  (let ((keys (map (lambda (x) (text (listed-id (car (cddr x))))) line)))
+    (for-each (lambda (x key)
+                (task-entry-state-set! (task-named table key)
+                                       (posed-state-text (car (cddr x)) (cadr x))))
+              line keys)
+    (for-each (lambda (task)
+                (let ((state (task-entry-state task)))
+                  (if (and (string? state)
+                           (or (string-prefix? "waiting" state)
+                               (string-prefix? "holding" state))
+                           (not (member (task-entry-key task) keys)))
+                      (task-entry-state-set! task #f))))
+              (table-tasks table))))
+
+(define (string-prefix? prefix s)
+  (and (>= (string-length s) (string-length prefix))
+       (string=? prefix (substring s 0 (string-length prefix)))))
 
 ;; The entries of components-ended that a report gives, those well made.
 (define (ended-entries report)
@@ -188,6 +221,7 @@
 (define (components-state cs)
   (cond ((any (lambda (c) (and (open? c) (component-entry-index c))) cs) "running")
         ((any open? cs) "negotiating")
+        ((any (lambda (c) (equal? (component-entry-end c) "cancelled")) cs) "cancelled")
         ((any (lambda (c) (failed-for-good? c cs)) cs) "failed")
         ((any component-entry-index cs) "done")
         (else "not started")))
