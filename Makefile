@@ -2,7 +2,7 @@
 # machine (see README.md).
 
 .PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched bench-box \
-	demo demo-box clean
+	demo demo-box bench-ros2 clean
 
 all: deps
 	$(MAKE) native
@@ -45,8 +45,14 @@ bench-sched: all
 bench-box: all
 	tools/chibi bench/box.scm
 
+# Robots through ROS 2: trip command latency and odometry age beside
+# rclpy's floor, the dual-sonar task through ROS 2 over straight (bench/ros2).
+bench-ros2: all
+	bench/ros2
+
+# ROS2=1: every robot reached through ROS 2 (docs/ros2.md).
 demo: all
-	bin/murdoch demo examples/tulane-lab.scm
+	MURDOCH_ROS2=$(ROS2) bin/murdoch demo examples/tulane-lab.scm
 
 # A team moves a box along a path (docs/box-move.md); FAULT=1 kills the
 # inside pusher midway, FAULT=2 the other, and a spare takes its place.
@@ -54,7 +60,7 @@ demo-box: all
 	MURDOCH_DEMO_TASK=examples/pose-box-move.scm \
 	MURDOCH_DEMO_JUDGE=examples/box-judge.scm \
 	MURDOCH_DEMO_FAULT=$(if $(filter 1,$(FAULT)),inside,$(if $(filter 2,$(FAULT)),outside)) \
-	bin/murdoch demo $(or $(BOX_LAB),examples/box-lab.scm)
+	MURDOCH_ROS2=$(ROS2) bin/murdoch demo $(or $(BOX_LAB),examples/box-lab.scm)
 
 clean: native-clean
 	$(MAKE) -C sim clean

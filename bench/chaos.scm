@@ -14,19 +14,32 @@
 ;;;                                    here with no kill
 ;;;   bench: chaos-tasks N, with how they ended
 ;;;   bench: chaos-double-bookings N, chaos-leaked N, chaos-hung N
+;;; Beside them, two more posers hand restartable tasks to the lab
+;;; ('detach #t), coordinated by three workstations k1..k3, and a second
+;;; killer kill -9s a running detached task's coordinator or standby every
+;;; few seconds, starting it again a second later.  It prints
+;;;   bench: takeover-p50 / -p95 S s   a coordinator's kill to its standby
+;;;                                    taking over, by the standby's clock
+;;;   bench: takeover-floor S s        what the rule leaves at least: a
+;;;                                    heartbeat period, and the lab asked
+;;;                                    where the task's components run
+;;;   bench: detached-lost N           tasks whose result no peer could read
+;;;   bench: detached-double-runs N    a component running twice at once
 ;;; MURDOCH_CHAOS_SECONDS sets how long the kills go on (default 90).
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
-        (scheme process-context) (scheme inexact)
+        (scheme process-context) (scheme inexact) (scheme time)
         (srfi 1) (srfi 18) (srfi 27) (srfi 132)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness)
-        (only (murdoch sys scheduler) monotonic-seconds))
+        (only (murdoch sys scheduler) monotonic-seconds) (only (murdoch lab) lab-setting)
+        (only (murdoch wire) error-message) (only (murdoch sys) utc-seconds))
 
 (define seconds
   (cond ((get-environment-variable "MURDOCH_CHAOS_SECONDS") => string->number)
         (else 90)))
 
 (define robots '(r1 r2 r3 r4 r5))
+(define workstations '(k1 k2 k3))
 
 (define lab-code "
 (define inside '())       ; on quiet: ((uid started-at) . n) now running
@@ -52,6 +65,32 @@
      (lambda ()
        (guard (e (#t #f))
          (remote-apply (uid->aspace 'quiet) (lambda () (leave! who))))))))
+;; The copies of each detached task's component running now: (TAG UID
+;; STARTED-AT), UID's address space as it was when the copy began.  A copy
+;; whose robot was killed never leaves: a copy that begins finds it stale
+;; when its robot is away or was started again since.
+(define copies '())
+(define double-runs 0)
+(define (copy-enter! tag who)
+  (let ((others (filter (lambda (c) (and (equal? (car c) tag) (live-copy? c))) copies)))
+    (if (pair? others) (set! double-runs (+ double-runs 1)))
+    (set! copies (cons (cons tag who) copies))))
+(define (live-copy? c)
+  (guard (e (#t #f))
+    (equal? (caddr c)
+            (parameterize ((remote-timeout 1))
+              (remote-apply (uid->aspace (cadr c)) aspace-started-at)))))
+(define (copy-leave! tag who)
+  (set! copies (remove (lambda (c) (equal? c (cons tag who))) copies)))
+(define (detached-component tag)
+  (let ((who (list (local-aspace-uid) (aspace-started-at))))
+    (remote-apply (uid->aspace 'quiet) (lambda () (copy-enter! tag who)))
+    (dynamic-wind
+     (lambda () #f)
+     chaos-component
+     (lambda ()
+       (guard (e (#t #f))
+         (remote-apply (uid->aspace 'quiet) (lambda () (copy-leave! tag who))))))))
 (define (held subjects)
   (apply + (map (lambda (r) (length (filter (lambda (s) (pair? (cadr s))) (cadr r))))
                 (request 'all (lambda ()
@@ -66,13 +105,14 @@
    `((code "code.scm") (lease 10)
      (aspace tester)
      (aspace quiet (load 0.1))
+     ,@(map (lambda (uid) `(aspace ,uid (position 0 5000 0) (load 0.1))) workstations)
      ,@(map (lambda (uid i) `(aspace ,uid (position ,(* 1000 i) 0 0)
                                      (capabilities mobile) (load 0.5)))
             robots (iota (length robots))))
    `(("code.scm" . ,lab-code))))
 
 (define pids (map (lambda (uid) (cons uid (start-lab-aspace! lab uid)))
-                  (cons 'quiet robots)))
+                  (cons 'quiet (append workstations robots))))
 (join-lab (test-lab-file lab) 'tester)
 (define (lab-proc name) (eval name (lab-environment)))
 (define (at-quiet expr)
@@ -89,10 +129,54 @@
     (thread-sleep! (+ 2 (* 2 (random-real))))
     (let ((uid (list-ref robots (random-integer (length robots)))))
       (locked (lambda () (set! kills (cons (cons uid (monotonic-seconds)) kills))))
-      (kill-process! (cdr (assq uid pids)))
-      (thread-sleep! 1)
-      (set! pids (cons (cons uid (start-lab-aspace! lab uid)) pids)))
+      (kill-and-restart! uid))
     (killer until)))
+
+(define (kill-and-restart! uid)
+  (kill-process! (locked (lambda () (cdr (assq uid pids)))))
+  (thread-sleep! 1)
+  (let ((pid (start-lab-aspace! lab uid)))
+    (locked (lambda () (set! pids (cons (cons uid pid) pids))))))
+
+;; Every few seconds, the coordinator or the standby of a running
+;; detached task, in turn, is killed and started again; a coordinator's
+;; kill is timed to its standby's takeover.
+(define takeovers '())
+(define coordinator-kills 0)
+(define standby-kills 0)
+
+(define (coordinator-killer until coordinator?)
+  (when (< (monotonic-seconds) until)
+    (thread-sleep! (+ 2 (* 2 (random-real))))
+    (let ((e (find (lambda (e) (and (eq? (lab-task-state e) 'running)
+                                    (lab-task-standby e)
+                                    (memq (lab-task-coordinator e) workstations)
+                                    (memq (lab-task-standby e) workstations)))
+                   (lab-tasks))))
+      (when e
+        (let ((uid (if coordinator? (lab-task-coordinator e) (lab-task-standby e)))
+              (killed-at (utc-seconds)))
+          (if coordinator?
+              (locked (lambda () (set! coordinator-kills (+ coordinator-kills 1))))
+              (locked (lambda () (set! standby-kills (+ standby-kills 1)))))
+          (kill-and-restart! uid)
+          (if coordinator?
+              (thread-start!
+               (make-thread (lambda () (time-takeover! (lab-task-id e)
+                                                       (lab-task-epoch e)
+                                                       killed-at))))))))
+    (coordinator-killer until (not coordinator?))))
+
+(define (time-takeover! id epoch killed-at)
+  (let ((e (wait-until 15 (lambda ()
+                            (find (lambda (e) (and (eq? (lab-task-id e) id)
+                                                   (> (lab-task-epoch e) epoch)
+                                                   (lab-task-took-over e)))
+                                  (lab-tasks))))))
+    (if e
+        (locked (lambda ()
+                  (set! takeovers (cons (- (lab-task-took-over e) killed-at)
+                                        takeovers)))))))
 
 ;; When uid was last killed, at or after moment, or #f.
 (define (killed-after uid moment)
@@ -153,6 +237,31 @@
     (one-task)
     (poser until)))
 
+;;; The detached posers: each hands a task to the lab, then waits for it
+;;; by its id, as any peer could.
+
+(define detached-outcomes '())          ; done, failed or lost, one a task
+(define tags 0)
+
+(define (one-detached-task)
+  (let* ((tag (locked (lambda () (set! tags (+ tags 1)) tags)))
+         (id (start-task 'handed 1 (list '((mobile) ())) (list #f)
+                         (list (eval `(lambda () (detached-component ,tag))
+                                     (lab-environment)))
+                         '(1) '(#t) 'detach #t))
+         (outcome (guard (e (#t (display (error-message e)) (newline) 'lost))
+                    (let ((r (task-wait id 60)))
+                      (cond ((and (pair? r) (memq (car r) robots)) 'done)
+                            ((symbol? r) r)
+                            (else 'failed))))))
+    (locked (lambda () (set! detached-outcomes (cons outcome detached-outcomes))))))
+
+(define (detached-poser until)
+  (when (< (monotonic-seconds) until)
+    (guard (e (#t (display (error-message e)) (newline) (thread-sleep! 1)))
+      (one-detached-task))
+    (detached-poser until)))
+
 ;;; The floor: a component moved by hand, with nothing killed -- what
 ;;; renegotiating one component and starting it again costs.
 
@@ -170,11 +279,22 @@
     (if (zero? n) +nan.0 (list-ref s (min (- n 1) (exact (floor (* p n))))))))
 (define (seconds-text x) (number->string (/ (round (* 1000 x)) 1000)))
 
+;; The least a takeover takes: the period the rule waits, and a request
+;; to the whole lab, as a takeover asks where the task's components run.
+(define (takeover-floor-once)
+  (let ((t0 (monotonic-seconds)))
+    (request 'all (lambda () (components-running)))
+    (+ (lab-setting (current-lab) 'heartbeat) (- (monotonic-seconds) t0))))
+
 (let* ((floors (map (lambda (i) (floor-once)) (iota 7)))
+       (takeover-floors (map (lambda (i) (takeover-floor-once)) (iota 7)))
        (until (+ (monotonic-seconds) seconds))
-       (threads (cons (make-thread (lambda () (killer until)))
-                      (map (lambda (i) (make-thread (lambda () (poser until))))
-                           (iota 3)))))
+       (threads (append
+                 (list (make-thread (lambda () (killer until)))
+                       (make-thread (lambda () (coordinator-killer until #t))))
+                 (map (lambda (i) (make-thread (lambda () (poser until)))) (iota 3))
+                 (map (lambda (i) (make-thread (lambda () (detached-poser until))))
+                      (iota 2)))))
   (for-each thread-start! threads)
   (for-each thread-join! threads)
   (wait-until 15 (lambda () (zero? ((lab-proc 'held) '(mobile)))))
@@ -201,7 +321,28 @@
                                         kinds))))
            (string-append "bench: chaos-double-bookings " (number->string doubles))
            (string-append "bench: chaos-leaked " (number->string leaked))
-           (string-append "bench: chaos-hung " (number->string hung))))))
+           (string-append "bench: chaos-hung " (number->string hung))
+           (string-append "bench: takeover-p50 " (seconds-text (median takeovers)) " s")
+           (string-append "bench: takeover-p95 "
+                          (seconds-text (percentile takeovers 0.95)) " s")
+           (string-append "bench: takeover-floor " (seconds-text (median takeover-floors))
+                          " s")
+           (string-append "chaos: detached tasks " (number->string (length detached-outcomes))
+                          ": done " (number->string (count (lambda (o) (eq? o 'done))
+                                                           detached-outcomes))
+                          ", not-enough-takers "
+                          (number->string (count (lambda (o) (eq? o 'not-enough-takers))
+                                                 detached-outcomes))
+                          ", failed " (number->string (count (lambda (o) (eq? o 'failed))
+                                                             detached-outcomes))
+                          "; coordinators killed " (number->string coordinator-kills)
+                          ", standbys killed " (number->string standby-kills)
+                          ", takeovers timed " (number->string (length takeovers)))
+           (string-append "bench: detached-lost "
+                          (number->string (count (lambda (o) (eq? o 'lost))
+                                                 detached-outcomes)))
+           (string-append "bench: detached-double-runs "
+                          (number->string (at-quiet 'double-runs)))))))
 
 (stop-all-processes!)
 (remove-test-lab! lab)

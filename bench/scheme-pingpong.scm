@@ -28,6 +28,10 @@
 ;;   bench: chibi-fanout-poll-NN VALUE us  they wait in ppoll through
 ;;                                         (murdoch sys scheduler), as an
 ;;                                         address space waits
+;; and with poll the receiver's floor, the servers' own CPU per frame
+;; over the same timed rounds (each wakes in ppoll, reads one netstring
+;; and writes it back), beside a lab's request-receiver-cpu-NN:
+;;   bench: chibi-echo-cpu-per-frame-NN VALUE us
 ;; The sender waits in ppoll in both.  bench/c-pingpong N is the same in C.
 ;;
 ;; Usage: tools/chibi bench/scheme-pingpong.scm phases N
@@ -169,11 +173,11 @@
     (or (guard (e ((> tries 0) #f)) (open-net-io "127.0.0.1" port))
         (begin (thread-sleep! 0.1) (try (- tries 1))))))
 
-;; (measure ios) with ios connected to n echo servers started as
-;; processes of their own (bench/echo-server.scm).  With a group address
-;; they also answer the datagrams sent to it, at port (group-port base
-;; n), and measure is applied to ios and (socket . address): a socket on
-;; the group, and where to send to it.
+;; (measure ios pids) with ios connected to n echo servers started as
+;; processes of their own (bench/echo-server.scm), pids theirs.  With a
+;; group address they also answer the datagrams sent to it, at port
+;; (group-port base n), and measure is applied to ios, pids and (socket
+;; . address): a socket on the group, and where to send to it.
 (define (with-echo-servers n wait measure . group)
   (environment '(murdoch sys scheduler))
   (let* ((base (free-port-base))
@@ -183,20 +187,22 @@
          (group-socket (and (pair? group)
                             (open-multicast-socket (car group) (group-port base n)
                                                    "127.0.0.1"))))
-    (for-each (lambda (i)
-                (start-process! (append (list (tool-path "tools/chibi")
-                                              (tool-path "bench/echo-server.scm")
-                                              (number->string (+ base i)) wait)
-                                        group-args)
-                                "/dev/null"))
-              (iota n))
+    (define pids
+      (map (lambda (i)
+             (start-process! (append (list (tool-path "tools/chibi")
+                                           (tool-path "bench/echo-server.scm")
+                                           (number->string (+ base i)) wait)
+                                     group-args)
+                             "/dev/null"))
+           (iota n)))
     (guard (e (#t (stop-all-processes!) (raise e)))
       (let* ((ios (map (lambda (i) (connect-to-server (+ base i))) (iota n)))
              (result (if group-socket
-                         (measure ios (cons group-socket
-                                            (get-address-info (car group)
-                                                              (group-port base n))))
-                         (measure ios))))
+                         (measure ios pids
+                                  (cons group-socket
+                                        (get-address-info (car group)
+                                                          (group-port base n))))
+                         (measure ios pids))))
         (stop-all-processes!)
         result))))
 
@@ -207,17 +213,23 @@
 ;; two runs at once apart.
 (define floor-group "239.255.77.11")
 
+;; The median round of the fan-out to n servers, and the servers' CPU per
+;; frame over the timed rounds: (round-us . server-us).
 (define (measure-fan-out n wait)
   (with-echo-servers n wait
-    (lambda (ios)
-      (median-time (lambda () (fan-out ios)) (quotient 20000 n) (quotient 1000 n)))))
+    (lambda (ios pids)
+      (let ((trips (quotient 20000 n)))
+        (do ((i 0 (+ i 1))) ((= i (quotient 1000 n))) (fan-out ios))
+        (let* ((before (processes-cpu-us pids))
+               (round (median-time (lambda () (fan-out ios)) trips 0)))
+          (cons round (/ (- (processes-cpu-us pids) before) trips n)))))))
 
 ;; The sender's CPU per peer over rounds after a warm-up, each fan-out
 ;; followed by a multicast round: (write-us read-us mcast-send-us
 ;; mcast-us), the last two the datagram's sending and the whole round.
 (define (measure-phases n)
   (with-echo-servers n "poll"
-    (lambda (ios group)
+    (lambda (ios pids group)
       (let ((rounds (quotient 32000 n)) (write-us 0.) (read-us 0.)
             (send-us 0.) (mcast-us 0.))
         (do ((i 0 (+ i 1))) ((= i (quotient 1000 n)))
@@ -278,9 +290,13 @@
               (round2 (/ (list-ref phases 3) (+ (car phases) (cadr phases)))) "x")))
    ((and (pair? args) (equal? (car args) "fanout"))
     (let* ((n (string->number (cadr args)))
-           (poll? (pair? (cddr args))))
+           (poll? (pair? (cddr args)))
+           (measured (measure-fan-out n (if poll? "poll" "block"))))
       (report (string-append (if poll? "chibi-fanout-poll-N" "chibi-fanout-N")
                              (number->string n))
-              (measure-fan-out n (if poll? "poll" "block")))))
+              (car measured))
+      (if poll?
+          (report (string-append "chibi-echo-cpu-per-frame-N" (number->string n))
+                  (round1 (cdr measured))))))
    (else
     (for-each run (if (null? args) '(nap poll) (map string->symbol args))))))

@@ -33,7 +33,6 @@
         (srfi 1) (srfi 18) (srfi 69) (srfi 132)
         (chibi net) (chibi process) (chibi filesystem)
         (only (chibi) read) (rename (only (chibi) equal?) (equal? chibi-equal?))
-        (only (murdoch robot trip) split-words)
         (murdoch) (murdoch cli command) (murdoch testing harness)
         (murdoch wire netstring) (murdoch wire hmac) (murdoch wire frame)
         (murdoch code sendable) (murdoch remote aspace) (murdoch code sandbox)
@@ -50,15 +49,6 @@
 (join-lab (test-lab-file lab) 'bencher)
 
 ;;; Clocks
-
-;; Microseconds of CPU that process pid has used (its scheduler's count).
-(define (process-cpu-us pid)
-  (/ (string->number
-      (car (split-words
-            (call-with-input-file
-                (string-append "/proc/" (number->string pid) "/schedstat")
-              read-line))))
-     1000.))
 
 (define rounds 7)
 (define loops 2000)

@@ -71,8 +71,17 @@
                          http://127.0.0.1:PORT/ (PORT may be left out: the lab's \
                          port-base + 148)"))
          ,(lambda (cfg lab) (run-lab* cfg lab)))
-    (pose (LAB FILE) "pose the task FILE evaluates to, as a guest of the running lab" ()
-          ,(lambda (cfg lab file) (run-pose lab file)))
+    (pose (LAB FILE) "pose the task FILE evaluates to, as a guest of the running lab"
+          ((detach boolean "hand the task to the lab, print its id and exit at once: \
+                            the lab keeps it, on a coordinator and a standby it chooses"))
+          ,(lambda (cfg lab file) (run-pose lab file (conf-get cfg '(command pose detach)))))
+    (tasks (LAB) "list the tasks handed to the lab (pose --detach): each one's state, \
+                  coordinator and standby" ()
+           ,(lambda (cfg lab) (run-tasks lab)))
+    (wait (LAB ID) "wait for the task ID handed to the lab, and print its results" ()
+          ,(lambda (cfg lab id) (run-wait lab (string->symbol id))))
+    (cancel (LAB ID) "cancel the task ID handed to the lab" ()
+            ,(lambda (cfg lab id) (run-cancel lab (string->symbol id))))
     (demo (LAB) "start the lab, pose the dual-sonar task, show where the trace is" ()
           ,(lambda (cfg lab) (run-demo bin lab)))
     (view (LAB (PORT)) "show the running lab in the browser: serve its live view at \
@@ -136,15 +145,16 @@
 (define (show-command-usage c out)
   (write-string (string-append "Usage: " (usage-line c) "\n  " (command-doc c) "\n") out)
   (for-each (lambda (o)
-              (write-string (string-append "  --" (symbol->string (option-key o)) " "
+              (write-string (string-append "  --" (symbol->string (option-key o))
                                            (string-upcase-name (option-type o))
                                            "\n      " (option-doc o) "\n")
                             out))
             (command-options c)))
 
 (define (string-upcase-name type)
-  (cond ((pair? type) "A,B,...") ((eq? type 'real) "X") ((eq? type 'integer) "PORT")
-        (else "TEXT")))
+  (cond ((pair? type) " A,B,...") ((eq? type 'real) " X") ((eq? type 'integer) " PORT")
+        ((eq? type 'boolean) "")
+        (else " TEXT")))
 
 (define (show-help name)
   (cond ((null? name) (show-usage (current-output-port)))
@@ -217,6 +227,9 @@
                                 (and (pair? (cdr rest)) (cadr rest))))
                      (next (if (inline-value arg) (cdr rest) (cddr* rest))))
                  (cond
+                  ((eq? (option-type o) 'boolean)
+                   (if (inline-value arg) (mistake c (value-mistake o (inline-value arg))))
+                   (loop (cdr rest)))
                   ((and (eq? (option-key o) 'view) (not (inline-value arg))
                         (not (and value (string->number value))))
                    (if (and value (not (option-word? value))
@@ -245,6 +258,7 @@
                    ((integer) (if (eq? (option-key o) 'view) "a port number, or nothing"
                                   "a port number"))
                    ((string) "a name")
+                   ((boolean) "no value")
                    (else "names, as a,b,..."))
                  (if value (string-append ", not " value) "")))
 
@@ -263,7 +277,7 @@
 
 ;; (chibi app) wants a command's options before its arguments; people
 ;; write `murdoch lab LAB --trace FILE` too.  Every option takes a value
-;; but --view, whose port may be left out: it is then 0.
+;; but --view, whose port may be left out (it is then 0), and a flag.
 (define (options-first args)
   (let loop ((rest args) (options '()) (positional '()))
     (cond
@@ -271,11 +285,22 @@
      ((and (equal? (car rest) "--view")
            (or (null? (cdr rest)) (not (string->number (cadr rest)))))
       (loop (cdr rest) (cons* "0" "--view" options) positional))
+     ((flag-word? (car rest))
+      (loop (cdr rest) (cons (car rest) options) positional))
      ((option-word? (car rest))
       (if (or (null? (cdr rest)) (inline-value (car rest)))
           (loop (cdr rest) (cons (car rest) options) positional)
           (loop (cddr rest) (cons* (cadr rest) (car rest) options) positional)))
      (else (loop (cdr rest) options (cons (car rest) positional))))))
+
+;; Whether arg is a flag, an option of no value: --detach.
+(define (flag-word? arg)
+  (any (lambda (c)
+         (any (lambda (o) (and (eq? (option-type o) 'boolean)
+                               (equal? arg (string-append "--" (symbol->string
+                                                                (option-key o))))))
+              (command-options c)))
+       commands))
 
 (define (positional args)
   (let loop ((rest args) (acc '()))
@@ -283,6 +308,7 @@
           ((and (equal? (car rest) "--view")
                 (or (null? (cdr rest)) (not (string->number (cadr rest)))))
            (loop (cdr rest) acc))
+          ((flag-word? (car rest)) (loop (cdr rest) acc))
           ((option-word? (car rest))
            (loop (if (and (pair? (cdr rest)) (not (inline-value (car rest))))
                      (cddr rest)

@@ -35,17 +35,24 @@
           with-team-proc-maker with-team on-list current-team t
           sort-list make-maxrandom
           ;; the task life cycle (lib/murdoch/task/life-cycle.scm and its neighbours)
-          start-task task? task-id task-name task-status task-wait cancel-task
+          start-task task? task-id task-name task-state task-why task-state-text
+          task-status task-wait cancel-task
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries
           tasks listed-posed? listed-id listed-state listed-place listed-why
-          listed-index listed-poser run-component run-posed-component components-ended
+          listed-priority listed-held listed-wants listed-index listed-poser run-component run-posed-component components-ended
           ended-id ended-index ended-started ended-ended ended-end
           component-heartbeat! stop-component!
-          waiting-ranks waiting-for receive-offer receive-give-way note-waiters!
+          waiting-ranks waiting-entries waiting-for receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
           team-send! team-receive step-team
-          ;; what the lab is doing (lib/murdoch/task/status.scm)
+          ;; tasks handed to the lab (lib/murdoch/task/detached.scm)
+          lab-tasks lab-task-id lab-task-role lab-task-epoch lab-task-state
+          lab-task-coordinator lab-task-standby lab-task-poser lab-task-took-over
+          await-component components-running coordinate-task! coordinator-ping
+          become-standby! receive-copy handed-role-of handed-entries handed-status
+          handed-wait handed-cancel
+                    ;; what the lab is doing (lib/murdoch/task/status.scm)
           aspace-report lab-status show-status aspace-started-at
           ;; the robot (lib/murdoch/robot/trip.scm)
           im goto-xy rotate translate angle-to-heading set-velocity stop-base

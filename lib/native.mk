@@ -38,6 +38,7 @@ lib/murdoch/sys/guard.so: lib/murdoch/sys/heap-watch.c
 lib/murdoch/wire/hmac.so: lib/murdoch/wire/hmac-sha256.c
 lib/murdoch/wire/netstring.so: lib/murdoch/wire/netstring-scan.c
 lib/murdoch/code/sendable.so: lib/murdoch/code/plain.c
+lib/murdoch/code/sandbox.so: lib/murdoch/code/call-bindings.c
 lib/murdoch/wire/connect.so: lib/murdoch/wire/nonblocking-connect.c
 lib/murdoch/wire/multicast.so: lib/murdoch/wire/multicast-socket.c
 

@@ -100,6 +100,9 @@ static int read_robot(lab *l, const sx *aspace, int index, const sx *robot,
     strcpy(r.name, name->text);
     r.aspace = index;
     r.battery = 13.6;
+    for (c = robot->head->next; c; c = c->next)
+        if (sx_is(c->head, "ros2"))
+            return 0;   /* a ROS 2 robot: its own trip server, not a B14 */
     for (c = robot->head->next; c; c = c->next) {
         const sx *arg = sx_nth(c, 1);
         if (sx_is(c->head, "pose") && numbers(c, v, 3) == 3) {

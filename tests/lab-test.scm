@@ -2,7 +2,8 @@
 ;;; down whole, an address space that dies is started again, one that
 ;;; cannot start stops the lab, and pose poses the task a file names.
 (import (scheme base) (scheme write) (scheme file) (scheme read) (srfi 1) (chibi test)
-        (only (chibi process) system system? kill signal/kill)
+        (only (chibi process) system system? kill signal/kill signal/interrupt
+              signal/term)
         (chibi io) (chibi net)
         (only (chibi filesystem) open-input-file-descriptor)
         (murdoch testing harness))
@@ -78,6 +79,13 @@
 ;; The lines `bin/murdoch pose` prints for the task file `task`.
 (define (pose-output task) (command-lines "pose" (in-dir task)))
 
+;; The result `bin/murdoch pose` prints for the task file `task`: the
+;; line before its last, which says how the task ended.
+(define (pose-result task) (before-last (pose-output task)))
+
+(define (before-last lines)
+  (if (> (length lines) 1) (list-ref lines (- (length lines) 2)) ""))
+
 (define (address port)
   (string-append "127.0.0.1:" (number->string port)))
 
@@ -130,11 +138,11 @@
                         out)))
       (test (string-append "the task a file's last form evaluates to is posed;"
                            " the result ends the output")
-          "(troy)" (last (pose-output "task.scm")))
+          "(troy)" (pose-result "task.scm"))
       (test "pose-task's progress comes first" #t
         (text-contains? (car (pose-output "task.scm")) "pose-task: where"))
       (test "a file that defines its task as a procedure: it is called"
-          "(called)" (last (pose-output "thunk.scm")))
+          "(called)" (pose-result "thunk.scm"))
       (call-with-output-file (in-dir "started.scm")
         (lambda (out)
           (write-string "(start-task 'where 1 (list (list '() (list 'camera)))
@@ -142,7 +150,7 @@
                                     (list (lambda () 'started)))\n"
                         out)))
       (test "a file whose task is already started: it is waited for"
-          "(started)" (last (pose-output "started.scm")))
+          "(started)" (pose-result "started.scm"))
       ;; Guests took port-base + 150 + (pid mod 50), and clashed; here
       ;; other processes hold every one of those ports.
       (let ((squatters (map (lambda (i)
@@ -161,7 +169,7 @@
             (map (lambda (i)
                    (let ((lines (read-lines (in-dir (string-append "guest.out."
                                                                    (number->string i))))))
-                     (if (pair? lines) (last lines) "")))
+                     (before-last lines)))
                  (iota 10 1))))
         (for-each (lambda (sock) (close-port (open-input-file-descriptor sock)))
                   squatters))
@@ -175,7 +183,7 @@
                                      (lambda () ((make-maxrandom 1000000000)))))\n"
                         out)))
       (test "forks of one loader draw random numbers of their own" #t
-        (let ((draws (read (open-input-string (last (pose-output "draw.scm"))))))
+        (let ((draws (read (open-input-string (pose-result "draw.scm")))))
           (and (= (length draws) 2) (not (= (car draws) (cadr draws))))))
       (call-with-output-file (in-dir "failing.scm")
         (lambda (out)
@@ -184,6 +192,52 @@
                         out)))
       (test "a task whose component failed: pose exits 1" 1
         (command-status "pose" (in-dir "failing.scm")))
+      (test "pose's last lines say how it ended, as its progress did" #t
+        (let ((lines (pose-output "failing.scm")))
+          (and (any (lambda (l) (and (text-contains? l "component 1 failed on troy: ")
+                                     (text-contains? l "car")))
+                    lines)
+               (text-contains? (last lines) "murdoch pose: fails@pose-")
+               (text-contains? (last lines) " failed: "))))
+      (test "and a task done says done" #t
+        (let ((line (last (pose-output "task.scm"))))
+          (and (text-contains? line "murdoch pose: where@pose-")
+               (text-contains? line " done"))))
+      (call-with-output-file (in-dir "spin.scm")
+        (lambda (out)
+          (write-string "(list 'spin 1 (list (list (list 'camera) '())) (list #f)
+                               (list (lambda ()
+                                       (let loop ()
+                                         (remote-apply (uid->aspace 'praline)
+                                                       (lambda () 1))
+                                         (thread-sleep! 0.05)
+                                         (loop)))))\n"
+                        out)))
+      (for-each
+       (lambda (signal name code)
+         (let* ((out (in-dir (string-append "spin-" name ".out")))
+                (pose (start-process! (list (tool-path "bin/murdoch") "pose"
+                                            (test-lab-file lab) (in-dir "spin.scm"))
+                                      out))
+                (spinning? (lambda ()
+                             (any (lambda (l) (text-contains? l "runs component 1 of spin@"))
+                                  (command-lines "status")))))
+           (test (string-append name " on pose: the component ran first") #t
+             (wait-until 30 spinning?))
+           (kill pose signal)
+           (test (string-append name " on pose: it exits " (number->string code)) code
+             (quotient (reap! pose) 256))
+           (test (string-append name " on pose: one line says the components are given up")
+               #t
+             (let ((line (last (read-lines out))))
+               (and (text-contains? line " cancelled by ")
+                    (text-contains? line "robots stop where they are"))))
+           (test (string-append name " on pose: troy stops it and frees its subjects") #t
+             (wait-until 10 (lambda ()
+                              (not (any (lambda (l) (or (text-contains? l "spin@")
+                                                        (text-contains? l "camera held")))
+                                        (command-lines "status"))))))))
+       (list signal/interrupt signal/term) '("Ctrl-C" "SIGTERM") '(130 143))
       (call-with-output-file (in-dir "typo.scm")
         (lambda (out)
           (write-string ";; load-metric, mistyped\n(list 'where 1 (list (list '() (list 'camera)))
@@ -212,7 +266,9 @@
       (test "pose with the lab gone says that nobody answers" #t
         (text-contains? (car output)
                         "no address space of the lab answers; away: (troy praline)"))
-      (test "and nobody takes the task" "not-enough-takers" (last output)))
+      (test "and nobody takes the task" "not-enough-takers" (before-last output))
+      (test "its last line says it failed" #t
+        (text-contains? (last output) " failed: not-enough-takers")))
     (test "a task nobody took: pose exits 1" 1
       (command-status "pose" (in-dir "task.scm")))
     (test "status, when no address space answers, exits 1" 1
@@ -334,7 +390,7 @@
       (wait-until 60 (lambda () (text-contains? (file-text (in-dir "repl.out"))
                                                 "praline> "))))
     (test "and takes a task posed from elsewhere" "(praline)"
-      (last (pose-output "asks-praline.scm")))
+      (pose-result "asks-praline.scm"))
     (call-with-output-file (in-dir "fifo")
       (lambda (out)
         (write-string (string-append "(remote-apply (uid->aspace 'troy)"

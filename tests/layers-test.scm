@@ -19,7 +19,7 @@
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
     (task (assign progress metric takers) team (pose-task running) record rank
-          (offers holding) waiting life-cycle steps status)
+          (offers holding) waiting life-cycle steps detached status)
     murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))
@@ -199,23 +199,30 @@
   (append-map (lambda (x) (if (and (pair? x) (eq? (car x) 'import)) (cdr x) '()))
               (file-forms command-file)))
 
+;; Each library, and the command: (NAME IMPORT-SETS SYMBOLS), SYMBOLS
+;; those of its source, read once.
+(define users
+  (cons (list '(command) command-imports (symbols-in (list command-file)))
+        (map (lambda (file)
+               (let ((form (library-form file)))
+                 (list (cadr form) (import-sets form)
+                       (symbols-in (library-source-files file form)))))
+             library-files)))
+
 ;; Whether name, exported by umbrella, is used above its family: named in
 ;; an (only ...) import of it, or in the source of a library (or the
 ;; command) that imports all of it.
 (define (used-above? umbrella name)
-  (define (uses? import-sets files)
-    (any (lambda (set)
-           (and (equal? (import-set-library set) umbrella)
-                (if (eq? (car set) 'only)
-                    (memq name (cddr set))
-                    (memq name (symbols-in files)))))
-         import-sets))
-  (or (any (lambda (file)
-             (let ((form (library-form file)))
-               (and (not (eq? (family (cadr form)) (family umbrella)))
-                    (uses? (import-sets form) (library-source-files file form)))))
-           library-files)
-      (uses? command-imports (list command-file))))
+  (any (lambda (user)
+         (and (or (equal? (car user) '(command))
+                  (not (eq? (family (car user)) (family umbrella))))
+              (any (lambda (set)
+                     (and (equal? (import-set-library set) umbrella)
+                          (if (eq? (car set) 'only)
+                              (memq name (cddr set))
+                              (memq name (caddr user)))))
+                   (cadr user))))
+       users))
 
 ;; How family's umbrella strays from a choice of its members' names:
 ;; (FAMILY unused NAME ...) for exports nothing above it uses, (FAMILY

@@ -5,7 +5,10 @@
 ;;; moves to a robot on the other side; when the link returns, the stale
 ;;; component has stopped.  Then the same on a loaded robot, starved of the
 ;;; CPU: its copy's last command comes a heartbeat period or more before
-;;; the poser declares it lost (docs/tasks.md, no ghosts).  Needs root and
+;;; the poser declares it lost (docs/tasks.md, no ghosts).  Last, a
+;;; detached task's coordinator, on a host of its own, is cut off: it lets
+;;; the task go a period or more before its standby takes it over
+;;; (docs/tasks.md, never two coordinators).  Needs root and
 ;;; iproute2; elsewhere it says "skipped: WHY" and tests/run counts it
 ;;; neither way.
 ;;;
@@ -40,6 +43,8 @@
 (define (address i) (string-append subnet (number->string i)))
 (define bridge (string-append "mdb" id))
 (define robots '(near far spare))
+;; A workstation on a host of its own, to coordinate a detached task.
+(define hosts (append robots '(coord)))
 (define (netns uid) (string-append "md" id "-" (symbol->string uid)))
 (define (veth uid) (string-append "md" id (substring (symbol->string uid) 0 1)))
 (define (peer uid) (string-append (veth uid) "p"))
@@ -68,7 +73,7 @@
      (ip "-n" (netns uid) "link" "set" "lo" "up")
      ;; Multicast leaves by the link, which a route for the group says.
      (ip "-n" (netns uid) "route" "add" "224.0.0.0/4" "dev" (peer uid)))
-   robots (iota (length robots) 2)))
+   hosts (iota (length hosts) 2)))
 
 (define (tear-down!)
   (stop-all-processes!)
@@ -131,6 +136,20 @@
       (cond ((thunk) (current-second))
             ((> (current-second) deadline) #f)
             (else (thread-sleep! 0.01) (loop))))))
+;; The number that follows text on the first line of uid's log that
+;; holds it, or #f.
+(define (log-number uid text)
+  (let ((line (find (lambda (l) (text-contains? l text))
+                    (read-lines (string-append (test-lab-directory lab) "/"
+                                               (symbol->string uid) ".log")))))
+    (and line
+         (let loop ((i 0))
+           (cond ((> (+ i (string-length text)) (string-length line)) #f)
+                 ((string=? text (substring line i (+ i (string-length text))))
+                  (read (open-input-string
+                         (substring line (+ i (string-length text)) (string-length line)))))
+                 (else (loop (+ i 1))))))))
+
 ;; How many commands uid's log shows that command-loop sent there.
 (define (commands uid)
   (let ((line (string-append "(command " (symbol->string uid) ")")))
@@ -226,7 +245,9 @@
             (aspace far (host ,(address 3)) (position 3000 0 0) (capabilities mobile)
                     (load 0.5))
             (aspace spare (host ,(address 4)) (position 6000 0 0) (capabilities mobile)
-                    (load 0.5)))
+                    (load 0.5))
+            (aspace coord (host ,(address 5)) (position 0 0 0) (load 0.1))
+            (aspace keeper (host ,(address 1)) (position 0 0 0) (load 0.2)))
           `(("code.scm" . ,lab-code))))
    (set! robot-pids (map (lambda (uid) (cons uid (start-robot! uid))) robots))
    (join-lab (test-lab-file lab) 'tester)
@@ -309,7 +330,53 @@
            (test "and a period or more before the new copy's first" #t
              (<= (+ old-last period) new-first))))
        (cancel-task t)
-       (test-assert "the task ends" (pair? (task-wait t 10))))))
+       (test-assert "the task ends" (pair? (task-wait t 10)))))
+
+   (test-group "a partition cuts a detached task's coordinator off"
+     (set! robot-pids (cons (cons 'coord (start-robot! 'coord)) robot-pids))
+     (start-process! (list (tool-path "bin/murdoch") "aspace" (test-lab-file lab) "keeper")
+                     (string-append (test-lab-directory lab) "/keeper.log"))
+     (wait-until 20 (lambda ()
+                      (every (lambda (uid)
+                               (guard (e (#t #f))
+                                 (remote-apply (uid->aspace uid) local-aspace-uid)))
+                             '(coord keeper))))
+     (let* ((period 0.3)
+            (id (start-task 'cut-off 1 (list '((mobile) ()))
+                            (list (location-metric-maker '(3000 0 0 0)))
+                            (list (eval 'spin-long (lab-environment))) '(1) '(#t)
+                            'detach #t))
+            (entry (lambda () (or (find (lambda (e) (eq? (lab-task-id e) id)) (lab-tasks))
+                                  (list id #f 0 #f #f #f #f #f)))))
+       (test "coordinated on its own host, with a standby here" '(coord keeper)
+         (wait-until 15 (lambda ()
+                          (let ((e (entry)))
+                            (and (eq? (lab-task-state e) 'running)
+                                 (lab-task-standby e)
+                                 (list (lab-task-coordinator e) (lab-task-standby e)))))))
+       (let ((spins (spins-at 'far)))
+         (ip "link" "set" (veth 'coord) "down")
+         (test "the standby takes over" 'keeper
+           (wait-until 15 (lambda () (let ((e (entry)))
+                                       (and (= 2 (lab-task-epoch e))
+                                            (lab-task-coordinator e))))))
+         (test "its component runs on, on far" #t
+           (wait-until 10 (lambda () (> (spins-at 'far) (+ spins 40))))))
+       (ip "link" "set" (veth 'coord) "up")
+       (test "the old coordinator drops it once it hears the new one" '()
+         (wait-until 20 (lambda ()
+                          (guard (e (#t #f))
+                            (let ((held (remote-apply (uid->aspace 'coord) handed-entries)))
+                              (and (null? held) held))))))
+       (let ((let-go (log-number 'coord "its last heartbeat went at "))
+             (took-over (log-number 'keeper "taking over as its coordinator, epoch 2, at ")))
+         (test "the old coordinator's last heartbeat comes a period or more before the
+               new one takes over"
+             #t (and let-go took-over (<= (+ let-go period) took-over))))
+       (test "the component was adopted, not started again" '()
+         (status-attempts (car (task-status id))))
+       (cancel-task id)
+       (test-assert "the task ends" (pair? (task-wait id 10))))))
  (lambda ()
    (tear-down!)
    (if lab (remove-test-lab! lab))))
@@ -317,7 +384,7 @@
 (test "everything made is gone" '()
   (filter (lambda (name)
             (system? "sh" "-c" (string-append "ip netns list | grep -q '^" name "'")))
-          (map netns robots)))
+          (map netns hosts)))
 (test "the bridge too" #f
   (system? "sh" "-c" (string-append "ip link show " bridge " >/dev/null 2>&1")))
 

@@ -153,17 +153,18 @@
     (test "the lab's status shows it, where it was posed and where it runs"
         (list (list 'posed (task-id t) 'running) (list 'running (task-id t) 1 'tester))
       (let ((status (lab-status (current-lab))))
-        (list (find (lambda (x) (eq? (cadr x) (task-id t)))
-                    (list-ref (assq 'tester status) 5))
+        (list (let ((e (find (lambda (x) (eq? (cadr x) (task-id t)))
+                             (list-ref (assq 'tester status) 5))))
+                (list (car e) (listed-id e) (listed-state e)))
               (find (lambda (x) (eq? (cadr x) (task-id t)))
                     (list-ref (assq 'near status) 5)))))
     (test "cancel-task answers #t" #t (cancel-task t))
     (test "the component stops on its robot within a second" #t
       (wait-until 1 (lambda () (stopped-at? 'near))))
     (test "its setup and cleanup ran once" '(1 1) (counts-after-stop 'near))
-    (test-assert "task-wait answers, the component failed as cancelled"
+    (test-assert "task-wait answers, the component cancelled"
       (let ((r (task-wait t 5)))
-        (and (eq? (car (car r)) 'error) (equal? (state-of t 1) '(failed "cancelled")))))
+        (and (eq? (car (car r)) 'error) (equal? (state-of t 1) '(cancelled)))))
     (test "every subject is free" #t (wait-until 5 all-free?))))
 
 (define (restart-robot! uid)
@@ -250,7 +251,9 @@
                                                        '(1) '(yes))))
                     "restartable"))
   (test-assert "task-status wants a task"
-    (text-contains? (error-text (lambda () (task-status 'x))) "not a task")))
+    (text-contains? (error-text (lambda () (task-status 42))) "not a task"))
+  (test-assert "or the id of a task handed to the lab"
+    (text-contains? (error-text (lambda () (task-status 'x))) "no such task")))
 
 (test-end)
 (stop-all-processes!)

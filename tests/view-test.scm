@@ -133,6 +133,22 @@
 (define (look table t . robot-reports) (task-table-update! table t robot-reports))
 (define (robot uid held tasks . ended) (list uid (apply report uid held tasks ended)))
 
+(test-group "a detached task shows its coordinator and standby"
+  (let ((table (make-task-table)))
+    (task-table-update!
+     table 1
+     (list (list 'praline
+                 (append (report 'praline '() '((posed survey@praline/1 running)))
+                         (list '((survey@praline/1 coordinator 1 running praline troy
+                                  guest-7 #f)))))
+           (list 'troy
+                 (append (report 'troy '() '())
+                         (list '((survey@praline/1 standby 1 running praline troy
+                                  guest-7 #f)))))))
+    (test "as its coordinator says" '("praline" "troy" "running")
+      (let ((t (newest-task table)))
+        (list (assq-ref 'coordinator t) (assq-ref 'standby t) (assq-ref 'state t))))))
+
 (test-group "the task table"
   (let ((table (make-task-table)))
     ;; pose-task negotiating: the candidates hold their exclusive subjects.
@@ -519,8 +535,9 @@
       (system? "sh" "-c" "timeout 60 \"$0\" pose \"$1\" \"$2\" >\"$3\" 2>&1"
                (tool-path "bin/murdoch") (test-lab-file lab) (in-dir "task.scm")
                (in-dir "pose.out"))
+      ;; The result is the line before pose's last, which says how it ended.
       (let ((winner (let ((lines (read-lines (in-dir "pose.out"))))
-                      (if (pair? lines) (last lines) "")))
+                      (if (> (length lines) 1) (list-ref lines (- (length lines) 2)) "")))
             (state (lambda () (string->json (http-get view-port "/state")))))
         (test "the task ran on a robot" #t
           (and (member winner '("(moseley)" "(ernst)")) #t))

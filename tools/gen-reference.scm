@@ -334,7 +334,46 @@
                       (else ""))
                 " |\n")))))
         entries))
-     libraries)))
+     libraries)
+    (display tasks-epilogue)))
+
+;; What the first sentences leave out of the tasks' procedures, and
+;; `murdoch pose`'s task file, written here once.
+(define tasks-epilogue "
+## Tasks: start-task's keywords, a task's word, murdoch pose's task file
+
+`(start-task NAME N CAPABILITIES METRICS PROCEDURES [PRIORITIES
+[RESTARTABLE]] KEYWORD VALUE ...)`: pose-task's arguments, then optionally
+the components' priorities and a list of a boolean for each component (may
+it move to another robot when its robot is lost), then keywords
+(docs/tasks.md):
+
+| keyword | value | default |
+| --- | --- | --- |
+| wait | `#t`: wait while too few capable robots are free; `#f`: fail at once with `not-enough-takers` | the lab's `when-robots-busy` |
+| hold | `#t`: wait, keeping the robots won for some components | `#f` |
+| priority | a number, 0 or more; the higher goes first | `(pose-task-priority)` |
+| deadline | seconds: a task not started by then ends as `deadline` | none |
+
+`task-state` is one word: `negotiating`, `waiting`, `holding`, `running`,
+then `done` (every component completed), `failed` (`task-why` says why:
+the first failure's), `cancelled` or `deadline`.  `(tasks)` lists the
+tasks this address space started that are not over, and the newest
+`tasks-kept` (a lab setting, 20) of those over, as `(posed ID STATE WHY
+PLACE PRIORITY HELD WANTS)`, and each component it runs as `(running ID
+INDEX POSER)`.
+
+`murdoch pose LAB FILE` reads FILE as the REPL would and takes the value
+of its last form: pose-task's arguments, which it starts as `start-task`
+does; a task already started (`start-task`, `start-steps`), which it
+waits for; or, when the last form defines a procedure of no arguments,
+what that procedure answers.  It prints pose-task's progress, the task's
+results, and a last line `murdoch pose: ID WORD` (`failed: WHY` for a
+failed task).  It exits 0 when the task is done, 1 when it is not, 130
+after Ctrl-C and 143 after SIGTERM: either cancels the task, so that its
+robots stop where they are and free their subjects, as Ctrl-C at a REPL
+gives its components up; a second one ends the pose at once.
+")
 
 (define (find-docs* name)
   (any (lambda (lib) (find-docs lib name '()))

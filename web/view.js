@@ -183,7 +183,13 @@ function drawTasks(state) {
     const div = el("div", { class: "task", "data-task": t.name }, box);
     const h = el("h3", {}, div);
     textEl("span", t.name, { class: "task-name" }, h);
-    textEl("span", ` posed by ${t.poser || "?"}: `, {}, h);
+    textEl("span", ` posed by ${t.poser || "?"}`, {}, h);
+    if (t.coordinator) {
+      textEl("span", `, coordinated by ${t.coordinator}` +
+             (t.standby ? ` (standby ${t.standby})` : " (no standby)"),
+             { class: "keepers" }, h);
+    }
+    textEl("span", ": ", {}, h);
     textEl("span", t.state, { class: `state-${t.state.replace(/ /g, "-")}` }, h);
     const table = el("table", {}, div);
     const head = el("tr", {}, table);

@@ -10,7 +10,7 @@
           visible-names nearest-name at-form-line make-guarded-thread
           make-logged-thread call-in-sandbox flush-call-ports!
           sandbox-parameter! set-sandbox-ports! sendable-lambda sendable-define
-          encode make-decoder send-error? abridged set-value-limits!
+          encode made-by! make-decoder send-error? abridged set-value-limits!
           make-proxy-ref proxy-ref-uid proxy-ref-id make-proxy-procedure
           proxy-procedure-ref)
   (import (murdoch code abandon) (murdoch code sandbox) (murdoch code sendable)))

@@ -2,12 +2,13 @@
 ;;> setting in one table.
 
 (define-library (murdoch lab)
-  (export read-lab lab? lab-name lab-aspaces lab-setting lab-port-base planned-port lab-planned-port
-          lab-guest-port lab-trip-port lab-trip-host lab-path lab-aspace-by-uid
-          lab-robots lab-key lab-clause lab-robot-radius read-source
-          unread-lab-port-base lab-aspace-uid lab-aspace-host lab-aspace-port
-          lab-aspace-clause random-hex lab-walls lab-boxes wall-from wall-to
-          wall-thickness box-centre box-width box-depth box-heading)
+  (export read-lab lab? lab-name lab-aspaces lab-setting lab-default
+          lab-port-base planned-port lab-planned-port lab-guest-port
+          lab-trip-port lab-trip-host lab-path lab-aspace-by-uid lab-robots
+          lab-key lab-clause lab-robot-radius read-source unread-lab-port-base
+          lab-aspace-uid lab-aspace-index lab-aspace-host lab-aspace-port
+          lab-aspace-clause random-hex lab-walls lab-boxes wall-from wall-to wall-thickness
+          box-centre box-width box-depth box-heading)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
           (scheme process-context)
           (scheme inexact)

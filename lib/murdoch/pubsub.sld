@@ -9,7 +9,7 @@
           request-non-exclusive request-components asked-ok? asked-value
           capability-layout check-subjects request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
-          receive-request-non-exclusive receive-components on-free!
+          receive-request-non-exclusive receive-components
           offer-subjects! get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!

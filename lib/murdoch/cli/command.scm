@@ -15,12 +15,27 @@
 ;; of its connection instead, to whoever reads it.
 (define (join-read-lab lab uid port)
   (set-signal-action! signal/pipe #f)
+  (take-tunables! lab)
   (let ((env (make-lab-environment lab))
         (entry (lab-aspace-by-uid lab uid)))
     (if entry (take-body! lab entry))
     (apply start-aspace! lab uid env port)
-    (initialize-subscriptions! lab entry)
+    (initialize-subscriptions! lab entry robot-freed!)
+    (offer-on-joining!)
     env))
+
+;; The settings that are the values of parameters, or of the thesis's
+;; globals, of the layers above the lab: each takes the lab's value here,
+;; before anything runs.  Their defaults are the lab's table's.
+(define tunables
+  `((task-timeout . ,task-timeout) (trip-timeout . ,trip-timeout)
+    (trip-motion-timeout . ,trip-motion-timeout)
+    (pose-task-retries . ,pose-task-retries) (pose-task-backoff . ,pose-task-backoff)
+    (battery-charging . ,set-battery-charging!) (battery-low . ,set-battery-low!)
+    (load-threshold . ,set-load-threshold!)))
+
+(define (take-tunables! lab)
+  (for-each (lambda (t) ((cdr t) (lab-setting lab (car t)))) tunables))
 
 ;; A robot's address space drives its robot through trip, at the port the
 ;; lab gives it; a workstation answers safe-reckon from its lab position.

@@ -10,5 +10,7 @@
           (only (chibi filesystem) is-a-tty? open open/read open/non-block
                 open-input-file-descriptor)
           (only (srfi 151) bitwise-ior) (murdoch sys) (murdoch code) (murdoch cli hints)
-          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot))
+          (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot)
+          (only (murdoch task) task-timeout pose-task-retries pose-task-backoff
+                robot-freed! offer-on-joining!))
   (include "command.scm"))

@@ -14,7 +14,8 @@
 ;;     one line, with the nearest name or uid, not as (chibi repl)'s search
 ;;     of every module for it;
 ;;   - a call that timed out: the procedure may still run there, and a
-;;     loop that never calls out cannot be stopped (docs/architecture.md, "Waiting and giving up").
+;;     loop that never calls out cannot be stopped (docs/architecture.md,
+;;     "Waiting and giving up").
 
 ;;> Evaluates \var{expr} in \var{env} as the REPL's eval: an error raised
 ;;> in Murdoch's or Chibi's own files is raised again without that place,

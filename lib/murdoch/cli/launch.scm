@@ -27,6 +27,78 @@
                                    ")"))
       (list "workstation")))
 
+;;; Robots reached through ROS 2 (docs/ros2.md)
+;;
+;; A robot whose clause has (ros2 ...) has a trip server of its own,
+;; robot/ros2/trip_ros2.py, which the lab starts beside its address space
+;; unless (trip-host ...) says it runs on another host.  With
+;; MURDOCH_ROS2=1 (make demo ROS2=1) every simulated robot is reached so
+;; too: the simulator's trip servers move to the port plan's face-trip
+;; (port-base + 150 + i), where
+;; robot/ros2/b14_face.py gives them a ROS 2 face under their names, and
+;; each gets a trip server of its own at its usual port.
+
+(define (ros2-everywhere?)
+  (equal? (get-environment-variable "MURDOCH_ROS2") "1"))
+
+;; The robot's (ros2 ...) clause, or the one the simulator's face gives a
+;; simulated robot under MURDOCH_ROS2=1, or #f.
+(define (robot-ros2 a)
+  (let ((robot (lab-aspace-clause a 'robot)))
+    (cond ((not robot) #f)
+          ((assq 'ros2 (filter pair? (cdr robot))) => cdr)
+          ((ros2-everywhere?)
+           `((namespace ,(string-append "/" (symbol->string (lab-aspace-uid a))))))
+          (else #f))))
+
+(define (simulated? a)
+  (and (lab-aspace-clause a 'robot)
+       (not (assq 'ros2 (filter pair? (cdr (lab-aspace-clause a 'robot)))))))
+
+;; One line per trip server the lab starts for a ROS 2 robot, "ros2 NAME
+;; PORT-BASE ARG ...", the arguments trip_ros2.py takes; and "face
+;; PORT-BASE NAME=HOST:PORT ..." for the simulator's face.
+(define (ros2-lines lab)
+  (let ((base (number->string (lab-port-base lab))))
+    (append
+     (if (and (ros2-everywhere?) (any simulated? (lab-aspaces lab)))
+         (list (string-join
+                (cons* "face" base
+                       (map (lambda (a)
+                              (string-append (symbol->string (lab-aspace-uid a)) "="
+                                             (address (lab-trip-host lab a)
+                                                      (face-port lab a))))
+                            (filter simulated? (lab-aspaces lab))))))
+         '())
+     (filter-map
+      (lambda (a)
+        (let ((ros2 (robot-ros2 a)))
+          (and ros2 (not (robot-trip-host a))
+               (string-join
+                (cons* "ros2" (symbol->string (lab-aspace-uid a)) base
+                       (trip-ros2-arguments lab a ros2))))))
+      (lab-aspaces lab)))))
+
+(define (robot-trip-host a)
+  (assq 'trip-host (filter pair? (cdr (lab-aspace-clause a 'robot)))))
+
+;; Where the simulator serves robot a's trip under MURDOCH_ROS2=1.
+(define (face-port lab a)
+  (lab-planned-port lab 'face-trip (lab-aspace-index a)))
+
+(define (trip-ros2-arguments lab a ros2)
+  (cons* "--name" (symbol->string (lab-aspace-uid a))
+         "--host" (lab-aspace-host a)
+         "--port" (number->string (lab-trip-port lab a))
+         (append-map (lambda (c)
+                       (append-map (lambda (v)
+                                     (list (string-append "--" (symbol->string (car c)))
+                                           (cond ((string? v) v)
+                                                 ((symbol? v) (symbol->string v))
+                                                 (else (number->string v)))))
+                                   (cdr c)))
+                     ros2)))
+
 (define (capabilities a)
   (cond ((lab-aspace-clause a 'capabilities) => cdr) (else '())))
 
@@ -59,9 +131,20 @@
       (execute "/bin/sh"
                (cons* "/bin/sh" (string-append bin "/murdoch-lab") lab-file
                       (or logs "") (or trace "") (or speed "")
-                      (if (pair? (lab-robots lab)) "sim" "")
+                      (sim-word lab)
                       (number->string loader)
-                      (lab-lines lab except)))))))
+                      (append (ros2-lines lab) (lab-lines lab except))))))))
+
+;; "sim" when the lab has simulated robots, with the simulator's port base
+;; when their trip servers move for their ROS 2 face; else "".
+(define (sim-word lab)
+  (cond ((not (any simulated? (lab-aspaces lab))) "")
+        ((ros2-everywhere?)
+         ;; The simulator puts robot i at its port base + the plan's trip + i.
+         (string-append "sim --port-base "
+                        (number->string (- (lab-planned-port lab 'face-trip)
+                                           (planned-port 0 'trip)))))
+        (else "sim")))
 
 ;; Closes a fileno through a port, which marks it closed: the collector
 ;; closes the descriptor of a fileno left open, whatever it is by then.
@@ -189,62 +272,157 @@
 ;;> task its last form names (see task-of), and writes the result.
 ;;> pose-task's progress lines go to the standard output as it works.
 ;;> Exits 0 when the task completed, else 1: not-enough-takers, or a
-;;> component that failed.
-(define (run-pose lab-file task-file)
+;;> component that failed.  With \var{detach} true, the task is handed to
+;;> the lab (start-task's detach): its id is written, and it exits 0 at
+;;> once.
+(define (run-pose lab-file task-file detach)
   (let* ((lab (read-lab lab-file))
-         (uid (string->symbol (string-append
-                               "pose-" (number->string (current-process-id)))))
-         (env (make-repl-environment lab (join-lab lab-file uid
-                                                   (lab-guest-port lab)))))
+         (env (make-repl-environment lab (join-guest lab-file "pose"))))
     (tell-who-is-away lab)
     (eval `(pose-task-progress (current-output-port)) env)
-    ;; A task file answers pose-task's arguments, or a task already
-    ;; started (start-task, start-steps), which is waited for.
-    (let* ((task (task-of task-file env))
-           (record? ((eval 'task? env) task))
-           (result (if record?
-                       ((eval 'task-wait env) task)
-                       (apply (eval 'pose-task env) task))))
-      (write result)
-      (newline)
-      (cond ((task-failed? result (and record? ((eval 'task-status env) task)))
-             (write-string "murdoch pose: the task did not complete\n"
-                           (current-error-port))
-             (exit 1))
-            (else (exit 0))))))
+    ;; A task file answers pose-task's arguments, which are started as
+    ;; start-task starts them, or a task already started (start-task,
+    ;; start-steps), or the id of one handed to the lab: each is waited
+    ;; for, but with detach, where pose-task's arguments are handed to
+    ;; the lab and their id written.
+    (let ((task (task-of task-file env)))
+      (cond
+       (detach
+        (if (not (list? task))
+            (begin (write-string (string-append "murdoch pose: --detach poses the"
+                                                " arguments of pose-task that "
+                                                task-file " answers; it answers a task"
+                                                " already started\n")
+                                 (current-error-port))
+                   (exit 1)))
+        (write (apply start-task (append task '(detach #t))))
+        (newline)
+        (exit 0))
+       ((symbol? task)
+        (write-result-and-exit "murdoch pose" (task-wait task) (task-status task)))
+       (else (wait-and-exit (if (task? task) task (apply start-task task))))))))
 
-;; Whether what a pose answered says that its task did not complete:
-;; not-enough-takers, or a component that failed, by the task's status
-;; (see task-status) when it is a task record, else by its (error UID WHY).
+;; Waits for task record t as murdoch pose does: Ctrl-C or SIGTERM cancel
+;; it; writes its results and a last line with its word, and exits 0
+;; when it is done.
+(define (wait-and-exit t)
+  (let* ((signalled (cancel-on-signals! t))
+         (result (wait-for-task t signalled)))
+    (write result)
+    (newline)
+    (write-string (string-append "murdoch pose: " (symbol->string (task-id t)) " "
+                                 (task-state-text t)
+                                 (if (signalled)
+                                     (string-append
+                                      " by " (signal-name (signalled))
+                                      ": its robots stop where they are and their"
+                                      " subjects are freed")
+                                     "")
+                                 "\n"))
+    (exit (cond ((signalled) => (lambda (n) (+ 128 n)))
+                ((eq? (task-state t) 'done) 0)
+                (else 1)))))
+
+;; Joins the lab at lab-file as a guest named after what and this
+;; process; answers the environment received code runs in.
+(define (join-guest lab-file what)
+  (join-lab lab-file
+            (string->symbol (string-append what "-" (number->string (current-process-id))))
+            (lab-guest-port (read-lab lab-file))))
+
+;; Writes a task's result, and exits 0 when it completed, else 1.
+(define (write-result-and-exit who result status)
+  (write result)
+  (newline)
+  (cond ((task-failed? result status)
+         (write-string (string-append who ": the task did not complete\n")
+                       (current-error-port))
+         (exit 1))
+        (else (exit 0))))
+
+;;> `murdoch tasks LAB`: a line for each task handed to the lab: its id,
+;;> state, coordinator, standby and poser.
+(define (run-tasks lab-file)
+  (join-guest lab-file "tasks")
+  (let ((tasks (lab-tasks)))
+    (if (null? tasks) (write-string "no task is handed to the lab\n"))
+    (for-each (lambda (e) (write-string (string-append (lab-task-line e) "\n"))) tasks)
+    (exit 0)))
+
+;;> `murdoch wait LAB ID`: waits for the task \var{id} handed to the lab,
+;;> from any peer, and writes its results as `murdoch pose` does; exits 0
+;;> when it completed, else 1, and 1 with the reason when the lab does
+;;> not hold it.
+(define (run-wait lab-file id)
+  (join-guest lab-file "wait")
+  (guard (e (#t (write-string (string-append "murdoch wait: " (error-message e) "\n")
+                              (current-error-port))
+                (exit 1)))
+    (let ((result (task-wait id)))
+      (write-result-and-exit "murdoch wait" result (task-status id)))))
+
+;;> `murdoch cancel LAB ID`: cancels the task \var{id} handed to the lab.
+(define (run-cancel lab-file id)
+  (join-guest lab-file "cancel")
+  (guard (e (#t (write-string (string-append "murdoch cancel: " (error-message e) "\n")
+                              (current-error-port))
+                (exit 1)))
+    (cancel-task id)
+    (write-string (string-append "cancelled " (symbol->string id) "\n"))
+    (exit 0)))
+
+;; Whether a task that a peer waited for by its id did not complete: by
+;; its status (see task-status), where every component, of every step,
+;; must be done.
 (define (task-failed? result status)
-  (or (symbol? result)
-      (if status
-          (any failed-status? status)
-          (any (lambda (r) (and (list? r) (= (length r) 3) (eq? (car r) 'error)
-                                (symbol? (cadr r))))
-               result))))
+  (or (symbol? result) (any failed-status? status)))
 
-;; s an entry of task-status: a component's, or a step's.
 (define (failed-status? s)
   (if (step-status? s)
       (any failed-status? (step-status-entries s))
-      (eq? (car (status-state s)) 'failed)))
+      (not (eq? (car (status-state s)) 'done))))
+
+;; On Ctrl-C (SIGINT) or SIGTERM, t is cancelled, as Ctrl-C at a REPL
+;; gives its components up: each robot stops where it is and frees its
+;; subjects.  A second signal ends the pose at once.  Answers a thunk
+;; that answers the signal's number once one came, else #f.
+(define (cancel-on-signals! t)
+  (let ((caught #f))
+    (for-each (lambda (signal)
+                (set-signal-action! signal
+                                    (lambda (n)
+                                      (if caught (exit (+ 128 n)))
+                                      (set! caught n)
+                                      (cancel-task t))))
+              (list signal/interrupt signal/term))
+    (lambda () caught)))
+
+;; What task-wait answers for t; once a signal cancelled it, at most
+;; ten seconds more: a component that neither moves its robot nor calls
+;; a peer stops only at its end.
+(define (wait-for-task t signalled)
+  (let loop ((cancelled-at #f))
+    (cond ((guard (e (#t #f)) (list (task-wait t 0.5))) => car)
+          ((and cancelled-at (> (- (current-second) cancelled-at) 10)) 'cancelled)
+          (else (loop (or cancelled-at (and (signalled) (current-second))))))))
+
+(define (signal-name n)
+  (cond ((= n signal/interrupt) "Ctrl-C")
+        ((= n signal/term) "SIGTERM")
+        (else (string-append "signal " (number->string n)))))
 
 ;;> `murdoch status LAB`: joins the lab as a guest and shows what each of
 ;;> its address spaces says of itself (see show-status); one that does not
 ;;> answer within two seconds is shown away.  Exits 1 when none answers.
 (define (run-status lab-file)
-  (let ((lab (read-lab lab-file)))
-    (join-lab lab-file (string->symbol (string-append
-                                        "status-" (number->string (current-process-id))))
-              (lab-guest-port lab))
-    (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
+  (join-guest lab-file "status")
+  (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
            (write-string (string-append "murdoch status: no address space of the lab"
                                         " answers (is the lab running, with the same"
                                         " MURDOCH_PORT_BASE?)\n")
                          (current-error-port))
            (exit 1))
-          (else (exit 0)))))
+          (else (exit 0))))
 
 ;;> The task \var{file} evaluates to in \var{env}: the value of its last
 ;;> form, or, when that form defines a procedure of no arguments, what the

@@ -2,11 +2,13 @@
 ;;> poses a task to it from a file, \scheme{demo} does both for the thesis's
 ;;> dual-sonar task.
 (define-library (murdoch cli launch)
-  (export lab-lines run-lab run-pose run-demo run-status run-check)
+  (export lab-lines run-lab run-pose run-demo run-status run-check run-tasks run-wait
+          run-cancel)
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context) (srfi 1)
           (only (chibi process) execute current-process-id parent-process-id fork waitpid
-                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill)
+                wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill
+                signal/term)
           (only (chibi filesystem) open-pipe open open/read open/write open/append
                 open/create duplicate-file-descriptor-to set-file-descriptor-flags!
                 open-input-file-descriptor open-output-file-descriptor)
@@ -18,6 +20,8 @@
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)
-          (only (murdoch task) write-lab-status)
-          (only (murdoch task) status-state step-status? step-status-entries))
+          (only (murdoch wire) error-message)
+          (only (murdoch task) write-lab-status lab-task-line status-state step-status?
+                step-status-entries lab-tasks task? start-task task-wait task-status
+                cancel-task task-id task-state task-state-text))
   (include "launch.scm"))

@@ -3,34 +3,12 @@
 ;; It is the safety boundary of an address space: a peer that holds the
 ;; lab's key can run anything this sandbox allows, and nothing more.
 ;;
-;; 1. The environment has R7RS's computing libraries and Murdoch's
-;;    interface, and none of (scheme file), (scheme process-context),
-;;    (scheme load), (scheme eval) or (scheme repl).  The lab's code files
-;;    are loaded into it, so that their procedures are there to be called
-;;    by name.
-;; 2. Its imported bindings cannot be assigned.  Chibi shares an imported
-;;    binding's cell with the library it comes from, so (set! car cdr)
-;;    there would change car for the whole process, the person's REPL
-;;    included; R7RS makes such an assignment an error, and here it is
-;;    one, found when the code is compiled.  What the lab's code files
-;;    define is the lab's own, and var-set! changes it as before.  A
-;;    define inside received code is local to that code.
-;; 3. A thread that serves calls cannot be ended by the code it serves
-;;    (see make-guarded-thread): its caller would never be answered.
-;; 4. Each received call runs with ports of its own, writing through to
-;;    the process's standard output and error: code that closes or rebinds
-;;    them harms no other call and not the process's log.  Its parameter
-;;    bindings are its own too, Murdoch's among them (see
-;;    sandbox-parameter!): (remote-timeout 0) in one call sets nothing for
-;;    the next.
-;; 5. A constructor told a size (make-vector, make-string, iota, expt ...)
-;;    refuses one whose result would take more than the lab's max-alloc
-;;    bytes, with an error answered to the call: Chibi would grow the heap
-;;    by twice that at once, past heap-max, and the heap guard would end
-;;    the address space with every call it runs.
-;; 6. A thread that received code makes, and one that serves calls, says
-;;    in one line of the log that it died, and of what (make-logged-thread),
-;;    where Chibi writes its own objects and a backtrace.
+;; docs/security.md says what it allows; here, each rule where it is
+;; kept: the environment (sandbox-libraries), imports that cannot be
+;; assigned (Assignment), a serving thread received code cannot end
+;; (make-guarded-thread), each call's own ports and parameters
+;; (sandbox-parameter!), sized constructors under max-alloc, and threads
+;; that say in one line of the log that they died (make-logged-thread).
 
 (define sandbox-libraries
   '((except (scheme base) lambda define set! make-vector make-string
@@ -138,6 +116,7 @@
   (out sandbox-out sandbox-out-set!)
   (err sandbox-err sandbox-err-set!))
 
+;; Global: the lab's max-alloc, for every call the process serves.
 (define *sandbox* #f)
 
 ;; Refuses count items of unit bytes each, past the lab's max-alloc.
@@ -251,8 +230,8 @@
 ;;> (a guard's) gives the thread back the parameters it had when the
 ;;> handler was entered, and which calls \scheme{flush-call-ports!}.
 ;; What parameterize does, for a list of parameters known only when the
-;; process runs, without its dynamic-wind and closures: 1.7 KB of garbage a
-;; call (docs/speed.md, What Chibi charges).  A binding is a pair in the
+;; process runs, without its dynamic-wind (docs/speed.md, What Chibi
+;; charges).  A binding is a pair in the
 ;; thread's list of them, which setting the parameter changes.
 (define (call-in-sandbox proc args)
   (sandboxed (thread-call-ports) (thread-parameters) proc args))
@@ -274,11 +253,8 @@
                               (cons (cons current-error-port (call-ports-err p))
                                     outer)))))
 
-(define (fresh-bindings parameters bindings)
-  (if (null? parameters)
-      bindings
-      (fresh-bindings (cdr parameters)
-                      (cons (cons (car parameters) ((car parameters))) bindings))))
+;; fresh-bindings, in C (call-bindings.c): each parameter's pair, in
+;; front of bindings.
 
 (define (flush-ports p)
   (flush-if-open (call-ports-out p))

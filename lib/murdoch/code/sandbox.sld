@@ -19,4 +19,5 @@
           (only (chibi io) make-custom-output-port make-null-input-port)
           (only (meta) mutable-environment) (murdoch sys)
           (only (murdoch wire) error-message) (murdoch lab))
+  (include-shared "sandbox")
   (include "sandbox.scm"))

@@ -15,6 +15,8 @@
 ;;                                      environment received code runs in
 ;;   #(murdoch:closure SOURCE ((NAME . VALUE) ...))
 ;;   #(murdoch:proxy UID ID)            a procedure made by encap
+;;   #(murdoch:made NAME ARG ...)       a procedure that (NAME ARG ...) made,
+;;                                      NAME bound where it lands (made-by!)
 ;;   #(murdoch:vector ELEMENT ...)      a vector (vectors are encoded too,
 ;;                                      so a user's vector is never a tag)
 ;;   #(murdoch:void) #(murdoch:eof)
@@ -150,7 +152,7 @@
 (define (tag? x)
   (and (vector? x) (> (vector-length x) 0)
        (memq (vector-ref x 0) '(murdoch:global murdoch:closure murdoch:proxy
-                               murdoch:vector murdoch:void murdoch:eof))))
+                               murdoch:made murdoch:vector murdoch:void murdoch:eof))))
 
 (define void-value (if #f #f))
 
@@ -188,6 +190,7 @@
   (depth limits-depth)                  ; the lab's max-depth
   (pairs limits-pairs))                 ; a frame of max-frame bytes holds fewer
 
+;; Global: the lab's limits, for every value the process sends.
 (define *limits* #f)
 
 ;;> Takes the limits of values from \var{lab}: the deepest nesting a value
@@ -218,8 +221,8 @@
         (append-reverse! next rev))))
 
 ;; True of data that stands for itself on the wire, pairs of it included:
-;; encode and decode give it back as it is instead of copying it, which
-;; on a receiver's path was most of their cost.  The look (plain-within?,
+;; encode and decode give it back as it is instead of copying it
+;; (docs/speed.md).  The look (plain-within?,
 ;; in plain.c, beside plain-atom?, the atoms that do) stops after a
 ;; budget of pairs, or at the depth limit, so that a long, deep or
 ;; circular value goes the general way, which says what is wrong with it.
@@ -275,6 +278,13 @@
     => (lambda (name)
          (know-encoding! p env (env-cell env name)
                          (vector 'murdoch:global name))))
+   ((hash-table-ref/default *made* p #f)
+    => (lambda (recipe)
+         (list->vector
+          (cons 'murdoch:made
+                (cons (car recipe)
+                      (map-elements (lambda (e) (enc e env what (+ depth 1) left))
+                                    (cdr recipe)))))))
    ((and (not (opcode? p)) (closure-info p))
     => (lambda (info)
          (let ((code (enc-closure info env depth left))
@@ -283,6 +293,19 @@
    (else (send-fail "cannot send " (what-string what) ": it is "
                     (describe p)))))
 
+;;> Answers \var{proc}, which \scheme{(name arg ...)} made: it travels
+;;> as that call, made again where it lands, where \var{name} is bound to
+;;> the same maker.  So a library's procedures that users pass on, such as
+;;> metrics, can travel though no Murdoch lambda made them.  At most
+;;> max-known are remembered, as the encodings below.
+(define (made-by! proc name . args)
+  (if (>= (hash-table-size *made*) max-known)
+      (set! *made* (make-hash-table eq?)))
+  (hash-table-set! *made* proc (cons name args))
+  proc)
+
+(define *made* (make-hash-table eq?))   ; procedure -> (NAME ARG ...)
+
 ;; The encodings of procedures that do not change: a global's, kept by
 ;; the procedure while its name is bound to it, and a closure's that
 ;; captures no variable, kept by its source (the quoted list the lambda
@@ -290,9 +313,8 @@
 ;; bound to a global name after it was first sent still goes as its
 ;; source, which means the same there).  The same procedures are sent
 ;; again and again: a request's, and its user's closure, made afresh for
-;; each request.  Kept by closure, those filled the table, and srfi 69
-;; keeps twelve buckets a key: a requester's heap grew to a gigabyte
-;; making room for the bucket vector (docs/speed.md).  At most max-known
+;; each request; so they are kept by name, not by closure (docs/speed.md).
+;; At most max-known
 ;; are kept, so that a program that sends ever new globals is let go.
 ;; Global: a cache for every thread.
 (define max-known 512)
@@ -421,6 +443,9 @@
                    (map (lambda (b) (dec (cdr b) (+ depth 1)))
                         (vector-ref v 2)))))
        ((eq? tag 'murdoch:global) (global-ref (vector-ref v 1)))
+       ((eq? tag 'murdoch:made)
+        (let ((recipe (dec (cdr (vector->list v)) depth)))
+          (apply made-by! (apply (global-ref (car recipe)) (cdr recipe)) recipe)))
        ((eq? tag 'murdoch:vector)
         (list->vector (dec (cdr (vector->list v)) depth)))
        ((eq? tag 'murdoch:proxy) (proxy (vector-ref v 1) (vector-ref v 2)))

@@ -3,7 +3,7 @@
 
 (define-library (murdoch code sendable)
   (export sendable-lambda sendable-define sendable-procedure?
-          encode make-decoder send-error? abridged set-value-limits!
+          encode make-decoder send-error? made-by! abridged set-value-limits!
           make-proxy-ref proxy-ref? proxy-ref-uid proxy-ref-id
           make-proxy-procedure proxy-procedure-ref)
   (import (scheme base) (scheme eval) (scheme write)

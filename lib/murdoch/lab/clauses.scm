@@ -32,8 +32,25 @@
            (every (lambda (p) (and (list? p) (= (length p) 2) (every non-negative? p)))
                   x))))
 
+(define topic-name (values-of 1 string? "a ROS 2 topic name, in quotes"))
+
+;; A robot reached through ROS 2 (docs/ros2.md): its trip server is
+;; robot/ros2/trip_ros2.py, and the simulator makes no B14 for it.
+(define ros2-table
+  `((namespace . ,(values-of 1 string? "a ROS 2 namespace, in quotes, as \"/tb1\""))
+    (cmd-vel . ,(values-of 1 (lambda (x) (memq x '(twist stamped))) "twist or stamped"))
+    (cmd-vel-topic . ,topic-name)
+    (odom . ,topic-name)
+    (scan . ,topic-name)
+    (range . ,(make-reader (lambda (xs) (and (<= 1 (length xs) 16) (every string? xs)))
+                           "one to sixteen ROS 2 topic names, in quotes"))
+    (battery . ,topic-name)
+    (fiducials . ,topic-name)
+    (appear-timeout . ,(values-of 1 positive-real? "a positive number of seconds"))))
+
 (define robot-table
-  `((pose . ,(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
+  `((ros2 . ,ros2-table)
+    (pose . ,(reals 3 3 "x y heading, three numbers (mm, mm, degrees)"))
     (tethered . ,(values-of 1 boolean? "#t or #f"))
     (battery . ,(values-of 1 positive-real? "volts, a positive number"))
     (trip-port . ,(values-of 1 port-number? "a port number"))

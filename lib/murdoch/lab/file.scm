@@ -56,10 +56,12 @@
     (trip . 100)                        ; robot i's trip server
     (view-peer . 147)                   ; the live view's address space
     (view . 148)                        ; the live view's page
-    (multicast . 149)))                 ; the group, unless the lab names one
+    (multicast . 149)                   ; the group, unless the lab names one
+    (face-trip . 150)))                 ; robot i's B14 behind its ROS 2 face,
+                                        ; when MURDOCH_ROS2=1 (docs/ros2.md)
 
 ;;> The port of \var{what} in the port plan (\scheme{aspace}, \scheme{trip},
-;;> \scheme{view-peer}, \scheme{view} or \scheme{multicast}) from port base
+;;> \scheme{face-trip}, \scheme{view-peer}, \scheme{view} or \scheme{multicast}) from port base
 ;;> \var{base}, and \var{index} for an address space's or a robot's.
 (define (planned-port base what . index)
   (+ base (cdr (assq what port-plan)) (if (pair? index) (car index) 0)))

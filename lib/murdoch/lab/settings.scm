@@ -76,6 +76,9 @@
     ;; every heartbeat seconds (task/life-cycle.scm).
     (heartbeat 0.5 ,seconds)
     (max-attempts 3 ,positive-count)
+    ;; A detached task's results stay readable from any peer this many
+    ;; seconds after it ends (task/detached.scm).
+    (keep-results 3600 ,seconds)
     ;; A started task that finds too few capable robots free waits for
     ;; them or fails with not-enough-takers; its priority rises by aging
     ;; a second while it waits; a poser keeps at most max-waiting such
@@ -85,6 +88,9 @@
                                     "fail or wait"))
     (aging 0.1 ,rate)
     (max-waiting 100 ,positive-count)
+    ;; A poser's (tasks) keeps the newest tasks-kept of its tasks that are
+    ;; over, and forgets the others (task/record.scm).
+    (tasks-kept 20 ,(whole-from 0 1000000 "a whole number, 0 or more"))
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" ,(make-reader size-bytes
@@ -92,6 +98,18 @@
     ;; Chibi grows its heap by twice one allocation (sandbox.scm).
     (max-alloc "32M" ,(make-reader size-bytes
                                    "bytes, or a size in quotes such as \"32M\""))
+    ;; The defaults of parameters and globals of the layers above, which
+    ;; take the lab's values as an address space joins (cli/command.scm).
+    (task-timeout 600 ,seconds)
+    (trip-timeout 5 ,seconds)
+    (trip-motion-timeout 120 ,seconds)
+    (pose-task-retries 5 ,(whole-from 0 1000 "a whole number from 0 to 1000"))
+    (pose-task-backoff 0.1 ,seconds)
+    (battery-charging 130 ,(number-over 0 "a voltage in tenths, above 0"))
+    (battery-low 100 ,(number-over 0 "a voltage in tenths, above 0"))
+    (load-threshold ".75"
+                    ,(make-reader (lambda (x) (and (string? x) (string->number x) x))
+                                  "a load in quotes, such as \".75\""))
     (code () ,(make-reader (lambda (x) (and (every string? x) x))
                            "file names, in quotes"))
     (delivery (broadcast)
@@ -112,6 +130,11 @@
 (define (lab-setting lab key)
   (cond ((assq key (lab-settings lab)) => cdr)
         (else (error "lab-setting: no such setting" key))))
+
+;;> The default of setting \var{key}, as the table gives it.
+(define (lab-default key)
+  (let ((s (or (setting-named key) (error "lab-default: no such setting" key))))
+    ((reader-read (setting-reader s)) (setting-default s))))
 
 ;; The settings of the clauses, every one of the table's, checked: an
 ;; error names the file, the clause and what is wrong.

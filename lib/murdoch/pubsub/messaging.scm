@@ -34,8 +34,7 @@
 
 (define (find-subscription topic) (subscription-in *subscriptions* topic))
 
-;; A loop of its own: find's test would be a closure made for every
-;; message addressed here (docs/speed.md, What Chibi charges).
+;; A loop of its own, not find (docs/speed.md, What Chibi charges).
 (define (subscription-in subscriptions topic)
   (cond ((null? subscriptions) #f)
         ((eq? (subscription-topic (car subscriptions)) topic) (car subscriptions))
@@ -118,8 +117,7 @@
             (else (loop start (+ i 1) acc))))))
 
 ;; A predicate true of the topics the address subject pattern reaches,
-;; made once per message: most subjects have no wildcard, and splitting
-;; one into its levels copies its name (docs/speed.md).
+;; made once per message (docs/speed.md).
 (define (subject-matcher pattern)
   (let ((levels (subject-levels pattern)))
     (if (or (member "*" levels) (member ">" levels))
@@ -137,9 +135,8 @@
 ;; True when every subject of the address is among the subscriptions
 ;; (the thesis says "proper subset"; it means subset).  It takes no lock:
 ;; it reads the list once, and then only the topics, which never change.
-;; A subject subscribed as it is matches itself, wildcards included, and
-;; is the common case (all, a uid): found so, it costs no matcher, and
-;; no closure is made (docs/speed.md, What Chibi charges).
+;; A subject subscribed as it is matches itself, wildcards included: the
+;; common case (all, a uid), which needs no matcher (docs/speed.md).
 (define (addressed-here? topic)
   (if (list? topic)
       (subjects-here? *subscriptions* topic)
@@ -268,10 +265,7 @@
 
 ;; rows, each receiver's result, with the value of one that is not n
 ;; entries (answer asked) made a failure: each row is checked once, and
-;; each component's column then read from it by procedures of their own:
-;; checked again for each component, with closures for each receiver, the
-;; rows cost the poser of a negotiation of 64 0.45 ms of CPU where they
-;; now cost 0.07, while the lab waits (docs/speed.md).
+;; each component's column read from it after (docs/speed.md).
 (define (checked-rows rows n)
   (cond ((null? rows) '())
         ((or (not (result-ok? (car rows))) (row-of? (result-value (car rows)) n))

@@ -1,20 +1,20 @@
 ;;;; Monitors (thesis appendix A.6 monitor.scm) and each address space's
 ;;;; first subscriptions (A.2 initial.scm): capabilities that come and go
-;;;; with the machine's state, subscribed through pubsub.scm.
+;;;; with the machine's state, subscribed through pubsub/messaging.scm.
 
 ;;; Monitors (A.6): capabilities that come and go with the machine's state
 
 ;;> The voltage, in tenths, above which a robot is taken to be on its
 ;;> charging tether; below it, the battery monitor subscribes to untethered.
-(define *battery-charging* 130)
+(define *battery-charging* (lab-default 'battery-charging))
 ;;> The voltage, in tenths, below which a robot's battery is low.
-(define *battery-low* 100)
+(define *battery-low* (lab-default 'battery-low))
 
 ;; A string, as in the thesis, where it crossed differently byte-ordered
 ;; machines.
 ;;> The load, a string such as ".75", below which the load monitor
 ;;> subscribes to idle.
-(define *load-threshold* ".75")
+(define *load-threshold* (lab-default 'load-threshold))
 
 ;; The thesis's names (A.5, A.6), global as there.  Received code reads
 ;; these and cannot assign them (sandbox.scm): a setting meant to change
@@ -49,8 +49,7 @@
   (string-copy (load-text ((monitoring-load-source *monitoring*)))))
 
 ;; The text of load, kept while the load stays the same: every negotiation
-;; asks each idle address space for it, and Chibi's number->string makes a
-;; string port each time (docs/speed.md).  Copied out, as received code
+;; asks for it (docs/speed.md).  Copied out, as received code
 ;; may change the string it is given.
 (define (load-text load)
   (let ((last (monitoring-last-load *monitoring*)))
@@ -144,9 +143,12 @@
 
 ;;> Sets up this address space's subscriptions and monitors from its lab
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
-;;> capabilities; idle through load-monitor; untethered through
-;;> battery-monitor on robots.
-(define (initialize-subscriptions! lab entry)
+;;> capabilities, and coordinator for a workstation (one with a
+;;> position); idle through load-monitor; untethered through
+;;> battery-monitor on robots.  \var{on-free} runs, outside any lock, each
+;;> time exclusive subjects here are freed: the task layer's hook.
+(define (initialize-subscriptions! lab entry on-free)
+  (on-free! on-free)
   (set! *monitoring*
         (make-monitoring (lab-setting lab 'monitor-period)
                          (load-source (and entry (lab-aspace-clause entry 'load)))
@@ -155,6 +157,8 @@
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
                   (else '())))
+  ;; A workstation may coordinate the tasks handed to the lab (detached.scm).
+  (if (and entry (lab-aspace-clause entry 'position)) (subscribe 'coordinator))
   (load-monitor)
   (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))
   (start-leases! lab)

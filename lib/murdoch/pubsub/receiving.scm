@@ -89,6 +89,7 @@
   (seconds lease-seconds)
   (keeper lease-keeper-thread))
 
+;; Global, as the subscriptions are: one lease keeper a process.
 (define *leases* #f)
 
 (define (lease) (lease-seconds *leases*))
@@ -186,8 +187,9 @@
       (*on-free*)))
 
 ;; What runs when a reservation of exclusive subjects here ends: tasks
-;; that wait for robots hear of it (task/life-cycle.scm).  Global: the
-;; task layer sets it as it loads, before the lab is joined.
+;; that wait for robots hear of it (task/offers.scm).  Global, as the
+;; subscriptions are: the task layer's hook, which the address space's
+;; start passes to initialize-subscriptions!.
 (define *on-free* (lambda () #f))
 
 ;;> Sets the thunk that runs, outside any lock, each time exclusive

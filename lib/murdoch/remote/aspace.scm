@@ -33,6 +33,7 @@
   (peers-lock membership-peers-lock)    ; over peers, unreachable and live
   (live membership-live membership-live-set!)) ; the live set, #f once changed
 
+;; Global: a process joins one lab, as one address space.
 (define *membership* #f)
 
 (define (joined)
@@ -67,8 +68,7 @@
   (or (known-aspace (joined) uid)
       (error "no address space of this uid is known" uid)))
 
-;; The lock without a dynamic-wind, since nothing under it raises: it and
-;; its closures cost a lookup 1.3 KB (docs/speed.md).
+;; The lock without a wind, since nothing under it raises (docs/speed.md).
 (define (known-aspace m uid)
   (lock! (membership-peers-lock m))
   (unlocked (membership-peers-lock m)
@@ -114,9 +114,8 @@
 (define (live-uids) (map aspace-uid (live-aspaces)))
 
 ;;> The address spaces that answer, this one among them: what a request
-;;> to all is sent to.  Kept until the peers or who answers change: made
-;;> from the tables each time, it cost a request to all 32 KB of garbage
-;;> in a lab of 4 and 120 KB in a lab of 16, twice (docs/speed.md).
+;;> to all is sent to.  Kept until the peers or who answers change
+;;> (docs/speed.md).
 (define (live-aspaces)
   (let ((m (joined)))
     (or (membership-live m)

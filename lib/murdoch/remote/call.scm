@@ -76,8 +76,7 @@
 ;; What the answer of pending call p, of call c, says: the value, or a
 ;; remote-error; none came within c's seconds, and p is given up.
 ;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
-;; Read by cond, not match or case, and no let: each makes closures, and
-;; every peer's answer comes here (docs/speed.md).
+;; By cond, not match or case, and no let (docs/speed.md).
 (define (answer-value p c)
   (answer-says p (pending-call-answer p) c))
 
@@ -260,9 +259,7 @@
 
 ;; Whom a datagram call waits for: the live set but this address space,
 ;; and each one's place among them, by which an answer finds its pending
-;; call (a search of the list took a step a peer per answer, and a table
-;; made per call remade its buckets as it grew).  Kept while the live set
-;; is the same list (live-aspaces keeps it until it changes).
+;; call (docs/speed.md).  Kept while the live set is the same list.
 (define-record-type others
   (make-others live uids places)
   others?
@@ -270,6 +267,7 @@
   (uids others-uids)                    ; the live uids but ours
   (places others-places))               ; uid -> its place in uids
 
+;; Global: the peers of the process's one address space.
 (define *others* (make-others #f '() (make-hash-table eq?)))
 
 ;;> The others that a datagram call to the live set waits for answers from
@@ -319,8 +317,7 @@
 
 ;; Hands an (answer ID KIND VALUE) frame from address space uid to the
 ;; call that waits for it; one for a call no longer waited for, or from
-;; an address space it was not sent to, is dropped.  A request's every
-;; answer by multicast comes here: no match, no let, no closure
+;; an address space it was not sent to, is dropped.  No match, no let
 ;; (docs/speed.md).
 (define (take-datagram-answer! uid message)
   (answer-datagram-call! (pending-of uid (datagram-calls-waiting-for

@@ -226,7 +226,7 @@
         ((connection-nonce c) (close-connection! c))
         (else (greeted! c x))))
 
-;; No let above: a closure made for every answer (docs/speed.md).
+;; No let above (docs/speed.md).
 (define (take-message! c message)
   (if (connection-nonce c)
       (deliver-answer! c message)
@@ -313,8 +313,7 @@
 ;; out leaves the connection closed to calls; a message that cannot be
 ;; sent (too large, say) leaves it as it was.  Either way p is taken out,
 ;; and its peer is noted unreachable.  One wind for the lock and the undo,
-;; its stage kept by the connection under the lock, and no let: each
-;; closure costs every peer of a request (docs/speed.md).
+;; its stage kept by the connection under the lock; no let (docs/speed.md).
 (define (send-counted! c message p)
   (wind (lambda () (lock! (connection-write-lock c)) (connection-stage-set! c 'before))
         (lambda () (write-counted! c message p))

@@ -17,13 +17,9 @@
 ;;   (beacon UID HOST PORT)         every beacon period: here I am
 ;;   (call ID KIND PROC ARGS)       KIND run or apply, as on a connection
 ;;
-;; Beacons are live membership without a registry: an address space not
-;; heard from for three beacon periods leaves the live set, and its next
-;; beacon brings it back.  The period is a second in a lab of up to 16
-;; address spaces and grows with the lab beyond (as RTCP's report interval
-;; grows with a session), so that the lab as a whole sends about 16
-;; beacons a second: with every one beaconing each second, each address
-;; space of a lab of N would receive N a second, and the lab N squared.
+;; Beacons are live membership without a registry (docs/architecture.md,
+;; "Delivery and membership"); the period grows with the lab beyond 16,
+;; as RTCP's report interval grows with a session.
 ;;
 ;; The group knows nothing of what a call means.  start-group! is handed
 ;; the procedure that serves the group's calls, as Chibi's run-net-server
@@ -49,6 +45,7 @@
   (last-heard group-last-heard)         ; uid -> monotonic-seconds
   (last-heard-lock group-last-heard-lock))
 
+;; Global: an address space is in at most one group, its lab's.
 (define *group* #f)
 
 (define max-datagram 60000)
@@ -131,10 +128,8 @@
 
 ;;; Receiving
 ;;
-;; On the path of every call that comes by the group, procedures of their
-;; own take what a let or a match would bind, no lock is taken by
-;; with-lock, and no table is read by hash-table-ref/default: each made a
-;; closure for every datagram (docs/speed.md, What Chibi charges).
+;; On the path of every call that comes by the group: no let, match,
+;; with-lock or hash-table-ref/default (docs/speed.md, What Chibi charges).
 
 (define (receive-call)
   (let ((n (receive! (group-socket *group*) (group-buffer *group*))))

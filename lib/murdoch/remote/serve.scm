@@ -47,6 +47,7 @@
   (janitor-resting? server-janitor-resting? server-janitor-resting?-set!)
   (last-refusal server-last-refusal server-last-refusal-set!)) ; monotonic
 
+;; Global: a process is one address space, which serves on one port.
 (define *server* #f)
 
 (define janitor-seconds 0.1)
@@ -122,8 +123,7 @@
         ((eof-object? (car items)) (end-serving! s))
         (else (protocol-fail "netstring" (car items)))))
 
-;; A procedure of its own, where a let made a closure for every frame: a
-;; multicast requester's every answer comes here (docs/speed.md).
+;; A procedure of its own, not a let (docs/speed.md).
 (define (take-opened! s message rest)
   (if (memq (car message) '(run apply))
       (hand-to-reader! s (cons message rest))
@@ -156,9 +156,8 @@
 
 ;; The next message of s for its reader thread, or an eof object; waits
 ;; as long as need be for a frame to begin, then gives it the lab's
-;; frame-timeout to come whole.  Here and down to answer-call, procedures
-;; of their own take what a let would bind, on the path of every call
-;; served (docs/speed.md, What Chibi charges).
+;; frame-timeout to come whole.  From here to answer-call, no let
+;; (docs/speed.md, What Chibi charges).
 (define (read-served s)
   (opened s (next-served-frame s)))
 
@@ -210,12 +209,11 @@
               (server-servings *server*)))))
 
 ;; The janitor rests while no frame is half read and no apply runs in a
-;; reader: looking ten times a second cost an idle lab of 64 a twelfth of
-;; a core.  A reader that begins either wakes it (janitor-wanted!).  The
-;; janitor raises its flag before it looks and holds its mutex from the
-;; flag to the wait; a reader sets what it begins before it reads the flag.
-;; So either the look sees what the reader began, or the reader sees the
-;; flag and its wake-up finds the janitor waiting.
+;; reader (docs/speed.md).  A reader that begins either wakes it
+;; (janitor-wanted!).  The janitor raises its flag before it looks and holds
+;; its mutex from the flag to the wait; a reader sets what it begins before
+;; it reads the flag.  So either the look sees what the reader began, or the
+;; reader sees the flag and its wake-up finds the janitor waiting.
 (define (rest-while-idle)
   (let ((m (server-janitor-mutex *server*)))
     (lock! m)
@@ -284,12 +282,22 @@
   (if (abandoned?) (forget-abandoned! (current-thread)))
   still)
 
-;; The entries of applying but thread's: remove's test would be a closure
-;; made for every apply (docs/speed.md, What Chibi charges).
+;; The entries of applying but thread's; not remove (docs/speed.md).
 (define (without-thread applying thread)
   (cond ((null? applying) '())
         ((eq? (cdar applying) thread) (without-thread (cdr applying) thread))
         (else (cons (car applying) (without-thread (cdr applying) thread)))))
+
+;;> Lets the call that \var{thread} runs here go from its caller: the
+;;> caller giving it up no longer stops it.  A detached task's component
+;;> that a new coordinator adopts (task/running.scm) is not stopped by the
+;;> old one's call, given up when it let the task go.
+(define (release-call! thread)
+  (with-lock (server-lock *server*)
+    (lambda ()
+      (for-each (lambda (s)
+                  (serving-applying-set! s (without-thread (serving-applying s) thread)))
+                (server-servings *server*)))))
 
 ;; The caller of apply id gave up on it: its thread is marked, to stop
 ;; where it next calls out (abandon.scm).  An apply already done is let be.

@@ -3,7 +3,7 @@
 ;;> relieves readers held by a long apply.
 
 (define-library (murdoch remote serve)
-  (export start-serving! hand-over-connection!
+  (export start-serving! hand-over-connection! release-call!
           new-serving! read-as-reader reader? read-calls serve-call
           make-served-call served-call-caller served-call-id reply!
           serving-read-on serving-read-on-set!)

@@ -127,13 +127,11 @@
 
 ;; The reader's own answers wait in the port's buffer until it has read
 ;; every call that has arrived: a burst of calls is answered in one write.
-;; A value or an error, last? true, goes under the same lock when no call
-;; waits behind it, where flush-if-idle! would take the lock again; a
-;; run's ack waits for flush-if-idle!, after its worker has its procedure
-;; (flushed at once, it cost remote-runs a third of their throughput:
-;; docs/speed.md, Levers tried).  Answers from former readers go at once.
-;; The write lock is taken by lock!, without with-lock's wind and
-;; closures (docs/speed.md, What Chibi charges): a raise under it, from a
+;; A value or an error, last? true, is flushed under the same lock when no
+;; call waits behind it; a run's ack waits for flush-if-idle!, after its
+;; worker has its procedure (docs/speed.md, Levers tried).  Answers from
+;; former readers go at once.  The write lock is taken by lock!, not
+;; with-lock (docs/speed.md, What Chibi charges): a raise under it, from a
 ;; message too large or a caller that left, is let go of by the reader's
 ;; handlers (let-go-of-writes!).
 (define (answer! s g message last?)
@@ -180,16 +178,15 @@
 
 ;; The served call that message, a run or an apply checked whole by
 ;; open-served, asks for: its procedure and arguments taken by their
-;; places in the wire's table of messages (wire/frame.scm), where match
-;; made 600 B of garbage a call (docs/speed.md, What Chibi charges).
+;; places in the wire's table of messages (wire/frame.scm), not by match
+;; (docs/speed.md, What Chibi charges).
 (define (served-call-of message uid answer)
   (make-served-call uid (message-id message) (car message) (list-ref message 2)
                     (list-ref message 3) answer))
 
 ;; Serves a frame of s from uid that needs no answer: the answer to one
 ;; of our datagram calls, or an abandon, checked whole by open-served.
-;; By cond, not match: a multicast requester's every answer comes here
-;; (docs/speed.md, What Chibi charges).
+;; By cond, not match (docs/speed.md, What Chibi charges).
 (define (serve-notice s uid message)
   (if (eq? (car message) 'answer)
       (take-datagram-answer! uid message)

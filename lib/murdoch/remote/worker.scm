@@ -28,9 +28,8 @@
       (spawn (lambda () (work thunk)) 'worker)))
 
 ;; The mailbox of a waiting worker, taken from the pool, or #f.  Here and
-;; in next-job the pool's lock is taken by lock!, without with-lock's wind
-;; and closures, on the path of every run served, where nothing under it
-;; raises (docs/speed.md, What Chibi charges).
+;; in next-job the pool's lock is taken by lock!, not with-lock: nothing
+;; under it raises (docs/speed.md, What Chibi charges).
 (define (idle-worker)
   (lock! *workers-lock*)
   (let ((mb (and (pair? *idle-workers*) (car *idle-workers*))))

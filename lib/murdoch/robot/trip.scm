@@ -1,11 +1,4 @@
-;;;; The MOVER robot primitives, spoken over trip.
-;;;
-;;; The protocol is docs/trip-protocol.md; in short:
-;;;
-;;;   frame    STX payload ETX, with STX, ETX and DLE sent as DLE, byte^#x40
-;;;   request  "TAG WORD ARG ..."    TAG a number 1..999999999 we choose
-;;;   reply    "TAG ok VALUE ..."  or  "TAG err CODE TEXT"
-;;;   tag 0    the server's own messages (framing errors, streamed readings)
+;;;; The MOVER robot primitives, spoken over trip (docs/trip-protocol.md).
 ;;;
 ;;; One connection per robot, which the threads of the address space
 ;;; share.  A thread sends its request under the connection's lock and
@@ -27,11 +20,11 @@
 ;;; use; (im) opens them all at once, as MOVER's did.
 
 ;;> Seconds to wait for any reply.
-(define trip-timeout (make-parameter 5))
+(define trip-timeout (make-parameter (lab-default 'trip-timeout)))
 
 ;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is
 ;;> stopped and an error raised.
-(define trip-motion-timeout (make-parameter 120))
+(define trip-motion-timeout (make-parameter (lab-default 'trip-motion-timeout)))
 
 ;;> The connection the primitives use: #f on a workstation.  Set it for
 ;;> the whole address space with \scheme{set-current-robot!} (threads do
@@ -118,15 +111,17 @@
   trip-connection?
   (host trip-connection-host)
   (port trip-connection-port)
-  (in trip-connection-in)
-  (out trip-connection-out)
+  (in trip-connection-in trip-connection-in-set!)
+  (out trip-connection-out trip-connection-out-set!)
   (lock trip-connection-lock)              ; held to send, and for waiting
   (waiting trip-connection-waiting)        ; tag -> the mailbox of its request
   (opened trip-connection-opened trip-connection-opened-set!)
   (name trip-connection-name trip-connection-name-set!)
   (tag trip-connection-tag trip-connection-tag-set!)       ; the last sent
   (open? trip-connection-open? trip-connection-open?-set!)
-  (goal trip-connection-goal trip-connection-goal-set!))   ; goto-xy's (x y)
+  (goal trip-connection-goal trip-connection-goal-set!)    ; goto-xy's (x y)
+  (lost? trip-connection-lost? trip-connection-lost?-set!) ; ended by the server
+  (relock trip-connection-relock trip-connection-relock-set!))  ; held to reconnect
 
 (define (robot-name c)
   (or (trip-connection-name c)
@@ -146,6 +141,8 @@
       (trip-connection-tag-set! c 0)
       (trip-connection-open?-set! c #t)
       (trip-connection-goal-set! c #f)
+      (trip-connection-lost?-set! c #f)
+      (trip-connection-relock-set! c (make-mutex 'trip-reconnect))
       (thread-start! (make-logged-thread (lambda () (read-replies c)) 'trip-replies))
       (guard (e (#t (trip-close c) (raise e)))
         (trip-connection-name-set! c (car (request c "who"))))
@@ -183,12 +180,37 @@
     (lambda () (take-mailbox! (trip-connection-waiting c) tag))))
 
 ;; Close c at its end, and take the mailboxes of the requests that still
-;; wait: no reply will come to them.
+;; wait: no reply will come to them.  The next request connects again.
 (define (close-for-good! c)
   (with-lock (trip-connection-lock c)
     (lambda ()
+      (if (trip-connection-open? c) (trip-connection-lost?-set! c #t))
       (shut! c)
       (take-all-mailboxes! (trip-connection-waiting c)))))
+
+;; A connection the server ended (a robot's trip server that died, and
+;; that its lab starts again) connects again, once, for the request about
+;; to be sent, and opens again the devices it had open; a server still
+;; away is the error closed, as a lost connection is.
+(define (reconnect! c command)
+  (with-lock (trip-connection-relock c)
+    (lambda ()
+      (when (and (trip-connection-lost? c) (not (trip-connection-open? c)))
+        (let ((io (open-connection (trip-connection-host c) (trip-connection-port c)
+                                   (trip-timeout)))
+              (devices (reverse (trip-connection-opened c))))
+          (if (string? io)
+              (trip-error (robot-name c) command "closed"
+                          (string-append "connection lost, and cannot connect again: " io)))
+          (with-lock (trip-connection-lock c)
+            (lambda ()
+              (trip-connection-in-set! c (car io))
+              (trip-connection-out-set! c (cadr io))
+              (trip-connection-lost?-set! c #f)
+              (trip-connection-open?-set! c #t)
+              (trip-connection-opened-set! c '())))
+          (thread-start! (make-logged-thread (lambda () (read-replies c)) 'trip-replies))
+          (for-each (lambda (d) (open-device! c d)) devices))))))
 
 ;;> The words of \var{s}, separated by spaces.
 (define (split-words s)
@@ -239,6 +261,7 @@
      (lambda () (mailbox-put! mb 'abandoned))
      (lambda ()
        (check-not-abandoned command)
+       (if (trip-connection-lost? c) (reconnect! c command))
        (let* ((tag (send! c command mb fail))
               (reply (mailbox-take mb deadline (lambda () 'late))))
          ;; A reply that comes after all finds no mailbox, and is dropped.
@@ -297,9 +320,14 @@
     (apply request c device words)))
 
 ;;> MOVER's initialisation: opens every device of the current robot, so
-;;> that a device held elsewhere shows up now rather than mid-task.
+;;> that a device held elsewhere shows up now rather than mid-task.  A
+;;> device the robot has not (\scheme{unknown}: a ROS 2 robot without
+;;> bumpers, say) stays closed, and its commands say so when used.
 (define (im)
-  (for-each (lambda (d) (open-device! (robot) d)) devices)
+  (for-each (lambda (d)
+              (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) #f))
+                (open-device! (robot) d)))
+            devices)
   #t)
 
 ;;; Motion
@@ -464,10 +492,14 @@
 (define (safe-im)
   (if (current-robot) (im) #t))
 
-;;> The battery on a robot; on a workstation 140, high enough to count as
-;;> charging.
+;;> The battery on a robot; on a workstation, or a robot that has no
+;;> battery reading (a ROS 2 robot without BatteryState), 140, high
+;;> enough to count as charging.
 (define (safe-battery-voltage)
-  (if (current-robot) (battery-voltage) 140))
+  (if (current-robot)
+      (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) 140))
+        (battery-voltage))
+      140))
 
 ;;> Where a workstation says it is, (x y heading) from its lab clause
 ;;> \scheme{(position X Y HEADING)}; #f when it has none.  Set it once, as

@@ -16,7 +16,7 @@
   (import (scheme base) (scheme write) (srfi 18) (srfi 69) (srfi 151)
           (only (chibi) make-exception exception? exception-kind exception-irritants
                 call-with-output-string)
-          (murdoch code) (murdoch wire)
+          (murdoch code) (murdoch wire) (only (murdoch lab) lab-default)
           (only (murdoch sys) with-lock make-mailbox mailbox-put! mailbox-take
                 take-mailbox! take-all-mailboxes! monotonic-seconds port-wait!))
   (include "trip.scm"))

@@ -5,14 +5,11 @@
 ;; a mutex taken by a deadline: no loop sleeps and looks again.  (A wait
 ;; for a socket is the scheduler's port-wait!.)
 
-;;> Chibi's dynamic-wind: \scheme{(in)}, then \scheme{(body)}'s value,
-;;> with \scheme{(out)} run however body leaves.  Chibi's own makes 640 B
-;;> of garbage a call (the closures of its lets, and its point made by
-;;> the variadic vector); this one 64 (docs/speed.md), and every lock
-;;> and every call of the remote layer goes through one.  Its point is
-;;> Chibi's (init-7.scm: a vector of depth, in, out and parent, kept by
-;;> each thread in %dk), so call/cc and raise wind through it as through
-;;> dynamic-wind's.
+;;> Chibi's dynamic-wind without its garbage (docs/speed.md, What Chibi
+;;> charges): \scheme{(in)}, then \scheme{(body)}'s value, with
+;;> \scheme{(out)} run however body leaves.  Its point is Chibi's (a vector
+;;> of depth, in, out and parent in %dk), so call/cc and raise wind
+;;> through it as through dynamic-wind's.
 (define (wind in body out)
   (in)
   (wound (%dk) in body out))
@@ -35,18 +32,15 @@
 
 ;;> \scheme{(mutex-lock! m)} and \scheme{(mutex-unlock! m)} of srfi 18,
 ;;> for a mutex taken with no timeout and freed with no condition
-;;> variable.  srfi 18's take those as optional arguments, in a rest list
-;;> and a let that makes a closure: 224 B of garbage a pair, and a request
-;;> takes five pairs a peer (docs/speed.md).  These call the primitives
-;;> that srfi 18's call, and go on as they do when the mutex is held.
+;;> variable, without the garbage of their optional arguments
+;;> (docs/speed.md): the primitives that srfi 18's call.
 (define (lock! m)
   (or (%mutex-lock! m #f #t)
       (begin (thread-yield!) (mutex-lock! m))))   ; as srfi 18's, once it failed
 
 (define (unlock! m) (%mutex-unlock! m #f #f))
 
-;;> \var{value}, once \var{m} is unlocked: a value taken under a lock with
-;;> no let, which would make a closure (docs/speed.md).
+;;> \var{value}, once \var{m} is unlocked: no let (docs/speed.md).
 (define (unlocked m value)
   (unlock! m)
   value)
@@ -72,9 +66,8 @@
 
 (define (nothing) #f)
 
-;; Seconds from now to deadline, none if it has passed: inexact, and
-;; compared only with inexact zero, for Chibi makes an inexact number
-;; that meets an exact one exact, a ratio of bignums (docs/speed.md).
+;; Seconds from now to deadline, none if it has passed; inexact, never
+;; mixed with exact numbers (docs/speed.md).
 (define (seconds-until deadline)
   (not-below-zero (- (inexact deadline) (monotonic-seconds))))
 
@@ -85,11 +78,9 @@
 (define (waited? m cv left)
   (and (> left 0.) (mutex-unlock! m cv left)))
 
-;;> Calls thunk; when it leaves by raising, calls undo on the way out.  A
-;; wind point whose out is undo, taken off with no call when thunk
-;; returns: not a guard (a copy of the stack), and no flag set by the
-;; body for the out to read (closures), on the path of every call
-;; (docs/speed.md).
+;;> Calls thunk; when it leaves by raising, calls undo on the way out: a
+;;> wind point whose out is undo, taken off unrun when thunk returns, not
+;;> a guard (docs/speed.md).
 (define (undo-on-raise undo thunk)
   (undone-on-raise (%dk) undo thunk))
 
@@ -102,9 +93,8 @@
   value)
 
 ;;> (map proc items), where an item whose (proc item) raises gives
-;;> (on-raise item e): the handler is entered once, and again after each
-;;> raise only, where a guard for each item copied the stack for each
-;;> (docs/speed.md, What Chibi charges).
+;;> (on-raise item e), under one handler, entered again only after a
+;;> raise (docs/speed.md, What Chibi charges).
 (define (map-guarded proc items on-raise)
   (let ((done '()) (rest items))
     (let run ()
@@ -150,8 +140,7 @@
 
 ;; The mailbox's value, or (timed-out) once the deadline, on the monotonic
 ;; clock, has passed.  Chibi's SRFI-18 time objects count whole seconds, so
-;; each wait is given as the seconds left.  No named let: a worker's every
-;; job waits here (docs/speed.md).
+;; each wait is given as the seconds left.  No named let (docs/speed.md).
 (define (mailbox-take mb deadline timed-out)
   (lock! (mailbox-mutex mb))
   (if (mailbox-full? mb)
@@ -172,16 +161,14 @@
 (define (take-mailbox! table id)
   (taken table id (hash-table-cell table id #f)))
 
-;; hash-table-cell, and no let: hash-table-ref/default makes a closure
-;; for its default, and a let here another (docs/speed.md).
+;; hash-table-cell, and no let (docs/speed.md).
 (define (taken table id cell)
   (and cell
        (begin (hash-table-delete! table id)
               (cdr cell))))
 
 ;;> The value in \var{cell}, from srfi 69's \scheme{hash-table-cell}, or
-;;> \var{default} when it is #f: a lookup without the closure that
-;;> \scheme{hash-table-ref/default} makes for its default (docs/speed.md).
+;;> \var{default} when it is #f, without hash-table-ref/default's closure.
 (define (cell-value cell default) (if cell (cdr cell) default))
 
 ;;> Every mailbox of \var{table}, taken out of it: the connection ended,
@@ -210,8 +197,7 @@
 
 ;;> Gives \var{item} the answer \var{value}, by \scheme{(put item value)},
 ;;> under the gathering's lock, and counts it, unless \scheme{(get item)}
-;;> shows it has one.  No dynamic-wind, since put only sets a field, and
-;;> no closure made: both would cost every answer (docs/speed.md).
+;;> shows it has one.  No wind, as put only sets a field (docs/speed.md).
 (define (gathering-put! g item value get put)
   (lock! (gathering-mutex g))
   (when (not (get item))
@@ -222,8 +208,7 @@
   (unlock! (gathering-mutex g)))
 
 ;;> Waits until \var{n} answers have come, answering #t, or until the
-;;> deadline, answering #f.  No let or named let: a caller's every wait
-;;> comes here (docs/speed.md).
+;;> deadline, answering #f.  No let (docs/speed.md).
 (define (gathering-wait g n deadline)
   (lock! (gathering-mutex g))
   (gathering-wanted-set! g n)

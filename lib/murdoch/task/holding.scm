@@ -15,8 +15,6 @@
   (if (eq? type 'exclusive)
       (guard (e (#t #f)) ((winner-promise winner) #f))))
 
-;; Runs component c on uid, and again elsewhere while its robot is lost
-
 ;; A try that keeps what it wins: each component of w not yet held is
 ;; negotiated alone, in priority order, without the robots held or given
 ;; way on.  Answers (winners type-list) once every component has a robot.

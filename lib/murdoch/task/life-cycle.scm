@@ -43,32 +43,46 @@
 ;;> #t or #f, whether the task waits when too few capable robots are free
 ;;> (default: the lab's when-robots-busy); \scheme{priority}, the task's
 ;;> priority (default (pose-task-priority)); \scheme{deadline}, seconds
-;;> after which a task not yet started fails with \scheme{deadline}.
+;;> after which a task not yet started fails with \scheme{deadline};
+;;> \scheme{detach} #t hands the task to the lab, and answers its id
+;;> (lib/murdoch/task/detached.scm).
 (define (start-task task-name num-robots capability-list metrics procs . options)
-  (let* ((lists (take-while list? options))
-         (priorities (if (pair? lists) (car lists) (iota num-robots num-robots -1)))
-         (restartable (if (and (pair? lists) (pair? (cdr lists)))
-                          (cadr lists)
-                          (make-list num-robots #f))))
-    (check-task task-name num-robots capability-list metrics procs priorities)
-    (if (not (and (list? restartable) (= (length restartable) num-robots)
-                  (every boolean? restartable)))
-        (error "start-task: restartable is a list of a boolean for each component"
-               restartable))
-    (let* ((turn (read-turn "start-task" (drop options (length lists))))
-           (t (new-task task-name capability-list metrics procs restartable turn)))
-      (thread-start!
-       (make-logged-thread (inheriting
-                            (lambda () (run-task t priorities)))
-                           (task-id t)))
-      t)))
+  (let-values (((t priorities)
+                (task-of-args #f #f (cons* task-name num-robots capability-list metrics
+                                           procs options))))
+    (thread-start!
+     (make-logged-thread (inheriting (lambda () (run-task t priorities))) (task-id t)))
+    t))
 
-(define (new-task task-name capability-list metrics procs restartable turn)
+;; A new task record from start-task's arguments, args, and its
+;; priorities: its id is id, or a new one when id is #f; its turn is
+;; turn, or the keywords' when turn is #f (a detached task taken over
+;; keeps its own, detached.scm).
+(define (task-of-args id turn args)
+  (apply
+   (lambda (task-name num-robots capability-list metrics procs . options)
+     (let* ((lists (take-while list? options))
+            (priorities (if (pair? lists) (car lists) (iota num-robots num-robots -1)))
+            (restartable (if (and (pair? lists) (pair? (cdr lists)))
+                             (cadr lists)
+                             (make-list num-robots #f)))
+            (keywords (read-turn "start-task" (drop options (length lists)))))
+       (check-task task-name num-robots capability-list metrics procs priorities)
+       (if (not (and (list? restartable) (= (length restartable) num-robots)
+                     (every boolean? restartable)))
+           (error "start-task: restartable is a list of a boolean for each component"
+                  restartable))
+       (values (new-task (or id ((task-id-maker) task-name)) task-name capability-list metrics
+                         procs restartable (or turn keywords))
+               priorities)))
+   args))
+
+(define (new-task id task-name capability-list metrics procs restartable turn)
   (with-lock *tasks-lock*
     (lambda ()
       (check-waiting-room turn)
       (let ((t (make-task
-                (task-key task-name)
+                id
                 task-name
                 (map (lambda (k caps metric proc r)
                        (let ((c (make-component k caps metric proc r)))
@@ -79,10 +93,12 @@
                      restartable)
                 (make-mailbox))))
         (task-state-set! t 'negotiating)
+        (task-why-set! t #f)
         (task-team-set! t '())
         (task-steps-set! t #f)
         (task-turn-set! t turn)
         (task-waiter-set! t #f)
+        (task-acted-set! t #f)
         (add-posed! t)
         t))))
 
@@ -90,57 +106,119 @@
 ;; a thread does not inherit its maker's parameters.
 (define (inheriting thunk)
   (let ((port (pose-task-progress)) (priority (pose-task-priority))
-        (assignment (pose-task-assignment)) (seconds (task-timeout)))
+        (assignment (pose-task-assignment)) (seconds (task-timeout))
+        (patience (heartbeat-patience)))
     (lambda ()
       (parameterize ((pose-task-progress port) (pose-task-priority priority)
-                     (pose-task-assignment assignment) (task-timeout seconds))
+                     (pose-task-assignment assignment) (task-timeout seconds)
+                     (heartbeat-patience patience))
         (thunk)))))
+
+;;> How many times longer than a poser's the components of a task started
+;;> under it wait for heartbeats before they stop, and it waits before it
+;;> declares their robot lost: a detached task's, so that its standby may
+;;> take over before they stop (detached.scm).
+(define heartbeat-patience (make-parameter 1))
+
+;;> What makes a new task's id of its name: task-key, NAME@UID/N; a
+;;> detached task's coordinator makes ids no peer of the lab knows
+;;> (detached.scm).
+(define task-id-maker (make-parameter task-key))
+
+;; Whether t's coordinator let it go (detached.scm): it acts no more.
+(define (let-go? t) (eq? (task-state t) 'let-go))
 
 ;; Negotiates t, runs its components, each watched over by a thread of
 ;; its own, and puts their results in t's mailbox.
 (define (run-task t priorities)
   (let* ((cs (task-components t))
-         (team (negotiate-turn
-                t cs
-                (if (and (turn-hold? (task-turn t)) (> (length cs) 1))
-                    (lambda (w) (hold-try w priorities))
-                    (lambda (w)
-                      (negotiate (task-name t) (length cs)
-                                 (map component-capabilities cs)
-                                 (map component-metric cs) (map component-proc cs)
-                                 priorities))))))
+         (team (parameterize ((pose-task-reservation (task-id t)))
+                 (negotiate-turn
+                  t cs
+                  (if (and (turn-hold? (task-turn t)) (> (length cs) 1))
+                      (lambda (w) (hold-try w priorities))
+                      (lambda (w)
+                        (negotiate (task-name t) (length cs)
+                                   (map component-capabilities cs)
+                                   (map component-metric cs) (map component-proc cs)
+                                   priorities)))))))
     (cond
-     ((and (symbol? team) (not (eq? team 'cancelled)))
-      (if (memq (task-state t) '(negotiating waiting)) (task-state-set! t 'failed))
+     ((let-go? t) (if (pair? team) (free-team! team)))
+     ((eq? team 'deadline)
+      (task-state-set! t 'deadline)
+      (end-all! t 'deadline)
+      (finish! t team))
+     ((or (eq? team 'cancelled) (eq? (task-state t) 'cancelled))
+      (if (pair? team) (free-team! team))
+      (end-all! t 'cancelled)
+      (finish! t (map component-result cs)))
+     ((symbol? team)
       (for-each (lambda (c)
                   (if (not (eq? (car (component-state c)) 'failed))
-                      (component-state-set! c (list 'failed team))))
+                      (fail-component! t c (symbol->string team))))
                 cs)
       (finish! t team))
-     ((symbol? team)
-      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
-      (finish! t (map component-result cs)))
-     ((eq? (task-state t) 'cancelled)
-      (for-each free-winner! (negotiated-winners team) (negotiated-types team))
-      (for-each (lambda (c) (component-state-set! c '(failed "cancelled"))) cs)
-      (finish! t (map component-result cs)))
      (else
       (task-state-set! t 'running)
       (task-team-set! t (map winner-uid (negotiated-winners team)))
-      (for-each thread-join!
-                (map (lambda (c winner type)
-                       (thread-start!
-                        (make-logged-thread (inheriting
-                                             (lambda ()
-                                               (supervise t c (winner-uid winner)
-                                                          (work-for winner type c)))))))
-                     cs (negotiated-winners team) (negotiated-types team)))
-      (finish! t (map component-result cs))))))
+      (supervise-all t (map (lambda (c winner type)
+                              (lambda ()
+                                (supervise t c (winner-uid winner)
+                                           (work-for winner type c))))
+                            cs (negotiated-winners team) (negotiated-types team)))))))
 
+(define (free-team! team)
+  (for-each free-winner! (negotiated-winners team) (negotiated-types team)))
+
+;; Runs each thunk, a component's supervision, in a thread of its own,
+;; and finishes t once all are over.
+(define (supervise-all t thunks)
+  (for-each thread-join!
+            (map (lambda (thunk) (thread-start! (make-logged-thread (inheriting thunk))))
+                 thunks))
+  (finish! t (map component-result (task-components t))))
+
+;; Puts each component of t that is not over in state (how): cancelled
+;; or deadline.
+(define (end-all! t how)
+  (for-each (lambda (c)
+              (if (not (memq (car (component-state c)) '(done failed)))
+                  (component-state-set! c (list how))))
+            (task-components t)))
+
+;; Ends t: done only when every component completed, else failed with
+;; its first failure's why, or as it was cancelled or ran out of time.
+;; A task of steps is done when its last step is.  A task let go
+;; finishes here no more: its new coordinator finishes it.
 (define (finish! t results)
-  (if (memq (task-state t) '(negotiating waiting running)) (task-state-set! t 'done))
-  (progress (task-id t) ": " (task-state t))
-  (mailbox-put! (task-done t) results))
+  (when (not (let-go? t))
+    (with-lock *tasks-lock*
+      (lambda ()
+        (if (not (memq (task-state t) '(cancelled deadline failed)))
+            (task-state-set!
+             t (if (every (lambda (c) (eq? (car (component-state c)) 'done))
+                          (task-components t))
+                   'done
+                   'failed)))
+        (if (and (eq? (task-state t) 'failed) (not (task-why t)))
+            (task-why-set! t (first-failure t)))
+        (forget-over! (lab-setting (current-lab) 'tasks-kept))))
+    (progress (task-id t) ": " (task-state-text t))
+    (mailbox-put! (task-done t) results)))
+
+;; The why of t's first component that failed, for a task that failed
+;; without fail-component!: a component stopped without word.
+(define (first-failure t)
+  (let ((failed (find (lambda (c) (eq? (car (component-state c)) 'failed))
+                      (task-components t))))
+    (if failed (cadr (component-state failed)) "a component did not complete")))
+
+;;> \var{task}'s state as a person reads it: its word (see task-state),
+;;> and for a failed task why, as "failed: connection lost".
+(define (task-state-text task)
+  (if (and (eq? (task-state task) 'failed) (task-why task))
+      (string-append "failed: " (task-why task))
+      (symbol->string (task-state task))))
 
 ;; What a winner runs: (proc arg ...), a promise applied to #t for an
 ;; exclusive component.
@@ -148,32 +226,48 @@
   (if (eq? type 'exclusive)
       (list (winner-promise winner) #t)
       (list (component-proc c))))
+
+;; Runs component c on uid, and again elsewhere while its robot is lost
 ;; and it may be restarted.
+;; work is (PROC ARG ...), or adopted for a component of a detached task
+;; that runs on uid already, where a new coordinator found it.
 (define (supervise t c uid work)
-  (component-state-set! c (list 'running uid (utc-seconds)))
+  (if (not (eq? work 'adopted))
+      (component-state-set! c (list 'running uid (utc-seconds))))
   (progress "  component " (component-index c) " starts on " uid)
-  (let ((outcome (attempt t c uid work)))
-    (component-attempts-set! c (append (component-attempts c)
-                                       (list (cons uid outcome))))
-    (progress "  component " (component-index c) " on " uid ": " outcome)
-    (cond
+  (after-attempt t c uid (if (let-go? t) '(let-go) (attempt t c uid work))))
+
+;; Moves c on from its run on uid (#f: none known), which ended with
+;; outcome: done, failed, or negotiated again and run elsewhere when it
+;; may.
+(define (after-attempt t c uid outcome)
+  (if (and uid (not (let-go? t)))
+      (component-attempts-set! c (append (component-attempts c)
+                                         (list (cons uid outcome)))))
+  (progress "  component " (component-index c) " " (car outcome) " on " uid ": "
+            (case (car outcome)
+              ((done) (abridged (cadr outcome) 50))
+              ((let-go) "its coordinator let it go")
+              (else (cadr outcome))))
+  (cond
+     ((let-go? t) #f)
      ((eq? (task-state t) 'cancelled)
-      (component-state-set! c '(failed "cancelled")))
+      (component-state-set! c '(cancelled)))
      ((and (eq? (car outcome) 'lost) (restart? c))
+      (component-state-set! c '(negotiating))
       (let ((next (renegotiate t c)))
         (cond
          (next
-          (component-state-set! c (list 'reassigned uid (car next)))
+          (component-state-set! c (list 'reassigned (or uid 'none) (car next)))
           (replace-member! t (component-index c) (car next))
           (progress "  component " (component-index c) " reassigned from "
                     uid " to " (car next))
           (supervise t c (car next) (cdr next)))
          (else
-          (component-state-set!
-           c (list 'failed (string-append (cadr outcome)
-                                          "; no other capable robot is free")))))))
+          (fail-component! t c (string-append (cadr outcome)
+                                              "; no other capable robot is free"))))))
      ((eq? (car outcome) 'done) (component-state-set! c outcome))
-     (else (component-state-set! c (list 'failed (cadr outcome)))))))
+     (else (fail-component! t c (cadr outcome)))))
 
 ;; Puts uid in t's team as the robot of component k.  By index, not by
 ;; the robot it replaces: a robot whose component is done may take
@@ -193,7 +287,8 @@
 ;; The next robot for c, (uid proc arg ...), or #f: c is negotiated alone,
 ;; without the robots it had, nor those of the task's other components.
 (define (renegotiate t c)
-  (parameterize ((pose-task-excluded
+  (parameterize ((pose-task-reservation (task-id t))
+                 (pose-task-excluded
                   (append (map car (component-attempts c))
                           (filter-map (lambda (other)
                                         (and (eq? (car (component-state other)) 'running)
@@ -215,22 +310,28 @@
 (define (attempt t c uid work)
   (let* ((a (uid->aspace uid))
          (period (lab-setting (current-lab) 'heartbeat))
+         (patience (heartbeat-patience))
          (answer (make-mailbox))
          (runner (make-logged-thread
                   (call-there a answer (task-id t) (component-index c)
-                                     (local-aspace-uid) period work))))
+                                     (local-aspace-uid) (* patience period) work))))
     (thread-start! runner)
     (let watch ((heard (monotonic-seconds)))
       (let ((got (mailbox-take answer (+ (monotonic-seconds) period)
                                (lambda () #f))))
         (cond
          (got (outcome-of got))
-         ((heartbeat a (task-id t) (component-index c) period)
+         ;; Its call is not given up: that would stop the component,
+         ;; which the new coordinator adopts.
+         ((let-go? t) '(let-go))
+         ((begin (task-acted-set! t (utc-seconds))
+                 (heartbeat a (task-id t) (component-index c) period))
           (watch (monotonic-seconds)))
-         ((>= (- (monotonic-seconds) heard) (* lost-periods period))
+         ((>= (- (monotonic-seconds) heard) (* lost-periods patience period))
           (thread-interrupt! runner)    ; its call is given up
           (list 'lost (string-append (symbol->string uid) " silent for "
-                                     (number->string lost-periods) " heartbeats")))
+                                     (number->string (* lost-periods patience))
+                                     " heartbeats")))
          (else (watch heard)))))))
 
 ;; A thunk that runs work on a inside run-component, and puts (value V)
@@ -243,8 +344,10 @@
        (guard (e (#t (list 'raised e)))
          (list 'value
                (parameterize ((remote-timeout seconds))
-                 (remote-apply a (sendable-lambda ()
-                                   (run-component id k poser period work))))))))))
+                 (if (eq? work 'adopted)
+                     (remote-apply a (sendable-lambda () (await-component id k poser)))
+                     (remote-apply a (sendable-lambda ()
+                                       (run-component id k poser period work)))))))))))
 
 ;; Whether the robot a answered a heartbeat within a period.
 (define (heartbeat a id k period)
@@ -270,6 +373,7 @@
 ;;> WHY) or (reassigned FROM TO), SINCE a (utc-seconds); ATTEMPTS has
 ;;> (UID . OUTCOME) for each robot that had the component and is done
 ;;> with it, OUTCOME being (done VALUE), (failed WHY) or (lost WHY).
+;;> \var{task} may also be a detached task's id, from any peer.
 (define (task-status task)
   (check-task-record "task-status" task)
   (if (task-waiter task) (move-up! (task-waiter task)))
@@ -284,7 +388,8 @@
 ;;> Waits for \var{task} to end, at most \var{seconds} (default: for
 ;;> ever), and answers what pose-task would have: each component's result,
 ;;> (error UID WHY) for a failed one, or not-enough-takers.  Raises an
-;;> error naming the task when the time runs out.
+;;> error naming the task when the time runs out.  \var{task} may also be a
+;;> detached task's id, from any peer.
 (define (task-wait task . seconds)
   (check-task-record "task-wait" task)
   (if (pair? seconds)
@@ -302,10 +407,14 @@
 
 ;;> Cancels \var{task}: every running component stops on its robot at its
 ;;> next robot command or remote call, its robot stops, and every
-;;> reservation is freed.  Answers #t.
+;;> reservation is freed.  A task already over stays as it ended.
+;;> Answers #t.  \var{task} may also be a detached task's id, from any
+;;> peer.
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
-  (task-state-set! task 'cancelled)
+  (with-lock *tasks-lock*
+    (lambda ()
+      (if (not (over? task)) (task-state-set! task 'cancelled))))
   (if (task-waiter task) (tell-waiter! (task-waiter task) '(cancel)))
   (if (task-steps task) (for-each cancel-task (task-steps task)))
   (for-each (lambda (c)
@@ -320,16 +429,23 @@
     (parameterize ((remote-timeout 1))
       (remote-apply (uid->aspace uid) (sendable-lambda () (stop-component! id k))))))
 
-;;> The tasks of this address space: (posed ID STATE) for each it started,
-;;> newest first, (posed ID waiting PLACE WHY) for one waiting its turn,
-;;> and (running ID INDEX POSER) for each component it runs.  listed-id
-;;> and the other listed- procedures read them.
+;;> The tasks of this address space: (posed ID STATE WHY PLACE PRIORITY
+;;> HELD WANTS) for each it started that is not over, and the newest of
+;;> those over, at most the lab's tasks-kept, newest first; and (running
+;;> ID INDEX POSER) for each component it runs.  listed-id and the other
+;;> listed- procedures read them.
 (define (tasks)
-  (append (map (lambda (t)
-                 (let ((w (task-waiter t)))
-                   (if (and w (eq? (task-state t) 'waiting))
-                       (list 'posed (task-id t) 'waiting (waiter-position w)
-                             (waiter-why w))
-                       (list 'posed (task-id t) (task-state t)))))
-               (with-lock *tasks-lock* posed-tasks))
-          (map (lambda (r) (cons 'running r)) (components-running))))
+  (let* ((posed (with-lock *tasks-lock* posed-tasks))
+         (others (and (any task-waiter posed)
+                      (guard (e (#t '())) (lab-waiting)))))
+    (append (map (lambda (t) (posed-entry t others)) posed)
+            (map (lambda (r) (cons 'running r)) (components-running)))))
+
+;; t as (tasks) lists it; a waiting task as waiting-entry has it, with
+;; its place in the lab's line of others, the lab's waiting tasks.
+(define (posed-entry t others)
+  (let ((w (task-waiter t)))
+    (if w
+        (begin (move-up! w others) (waiting-entry w))
+        (list 'posed (task-id t) (task-state t) (task-why t) #f
+              (and (task-turn t) (turn-priority (task-turn t))) '() '()))))

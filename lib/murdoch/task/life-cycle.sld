@@ -4,8 +4,9 @@
 ;;> component is given to another.  See lib/murdoch/task/life-cycle.scm's header.
 
 (define-library (murdoch task life-cycle)
-  (export start-task task-status task-wait cancel-task tasks new-task inheriting
-          finish!)
+  (export start-task task-status task-wait cancel-task tasks task-state-text
+          new-task inheriting finish! task-of-args run-task supervise-all supervise
+          after-attempt heartbeat-patience task-id-maker)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
           (murdoch wire) (murdoch lab) (murdoch remote) (murdoch task progress)

@@ -69,13 +69,13 @@
 ;;> A metric that prefers the candidate with the smaller
 ;;> \scheme{(measure uid)}: a number for a candidate's uid.
 (define (metric-by measure)
-  (keyed-metric (list (make-measure-key measure 0))))
+  (made-by! (keyed-metric (list (make-measure-key measure 0))) 'metric-by measure))
 
 ;;> A metric that prefers the candidate whose answer to \var{proc},
 ;;> applied there, has the smaller \scheme{(score answer)}.  pose-task
 ;;> asks all of a component's candidates with one message each.
 (define (metric-by-asking proc score)
-  (metric-by (make-asking proc score)))
+  (made-by! (metric-by (make-asking proc score)) 'metric-by-asking proc score))
 
 ;;> \var{metric}, a metric by one measure (metric-by, metric-by-asking,
 ;;> the makers below), counting two candidates whose measures differ by
@@ -85,7 +85,8 @@
     (if (not (and measure (real? tolerance) (>= tolerance 0)))
         (error "metric-within: a tolerance >= 0 and a metric by one measure"
                tolerance metric))
-    (keyed-metric (list (make-measure-key measure tolerance)))))
+    (made-by! (keyed-metric (list (make-measure-key measure tolerance)))
+              'metric-within tolerance metric)))
 
 ;;> A metric that compares by the first of \var{metrics}; where it ties
 ;;> two candidates, by the next; and so on.  pose-task measures each
@@ -96,7 +97,8 @@
               (if (not (procedure? m))
                   (error "compose-metrics: a metric is a procedure" m)))
             metrics)
-  (keyed-metric (append-map metric-keys metrics)))
+  (apply made-by! (keyed-metric (append-map metric-keys metrics))
+         'compose-metrics metrics))
 
 (define (measure-one measure uid)
   (if (asking? measure)
@@ -115,12 +117,14 @@
 ;;> Prefers the candidate closest to \var{target}, (x y theta 0) as reckon
 ;;> answers, by each candidate's safe-reckon.
 (define (location-metric-maker target)
-  (metric-by-asking safe-reckon
-                    (lambda (position) (reckon-distance-between target position))))
+  (made-by! (metric-by-asking safe-reckon
+                              (lambda (position)
+                                (reckon-distance-between target position)))
+            'location-metric-maker target))
 
 ;;> Prefers the candidate with the lowest system load.
 (define (load-metric-maker)
-  (metric-by-asking get-system-load string->number))
+  (made-by! (metric-by-asking get-system-load string->number) 'load-metric-maker))
 
 ;;> The load metric of Figure 4.6.
 (define load-metric (load-metric-maker))
@@ -128,7 +132,7 @@
 ;;> The opposite preference: the worst candidate by \var{metric} first,
 ;;> ties as they were.
 (define (reverse-metric metric)
-  (keyed-metric (map reverse-key (metric-keys metric))))
+  (made-by! (keyed-metric (map reverse-key (metric-keys metric))) 'reverse-metric metric))
 
 (define (reverse-key key)
   (if (measure-key? key)

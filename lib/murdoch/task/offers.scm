@@ -8,7 +8,7 @@
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
 ;;> task tries again at once; answers whether it started, #f when it is
 ;;> no longer waiting here, is already offered a robot for each component
-;;> it does not hold, or did not answer within two seconds.
+;;> it does not hold, or did not answer within offer-seconds.
 (define (receive-offer id uid)
   (let* ((reply (make-mailbox))
          (offer (cons uid id))
@@ -23,11 +23,17 @@
           (lambda () #f)
           (lambda ()
             (tell-waiter! w (list 'offer reply uid))
-            (mailbox-take reply (+ (monotonic-seconds) 2) (lambda () #f)))
+            (mailbox-take reply (+ (monotonic-seconds) (offer-seconds)) (lambda () #f)))
           (lambda ()
             (with-lock *tasks-lock*
               (lambda ()
                 (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+
+;; How long a robot waits for the answer to its offer: the lab's timeout.
+;; A waiter answers its offers after the try or look it is in, which on a
+;; busy lab may take seconds; a robot that moved on sooner went to a
+;; worse-ranked task meanwhile.
+(define (offer-seconds) (lab-setting (current-lab) 'timeout))
 
 ;; Whether w is offered a robot for each component it does not hold: two
 ;; robots freed together offer themselves to one task, and the second
@@ -67,7 +73,8 @@
 (define (note-waiters!)
   (set! *waiters-here?* #t)
   (set! *new-waiters* #t)
-  (if (and (robot-here?) (free-here?)) (robot-freed!)))
+  (if (and (robot-here?) (free-here?)) (robot-freed!))
+  #t)
 
 ;; Whether a task started to wait, or was reminded of, since this robot's
 ;; offer round asked who waits: the round's list may lack a better-ranked
@@ -125,8 +132,8 @@
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let ((waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                               (guard (e (#t '()))
-                                (append-map cadr (request 'waiting-tasks
-                                                          waiting-for me))))))
+                                (append-map cadr (request 'waiting-tasks waiting-for me
+                                                          (subjects-here)))))))
       (set! *waiters-seen* (pair? waiting))
       (if (pair? waiting) (set! *waiters-here?* #t))
       (offer-to me waiting))))
@@ -134,18 +141,27 @@
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
     (let ((poser (wanting-poser (car waiting))))
-      (offer-subjects! poser 3)
+      (offer-subjects! poser (+ (offer-seconds) 1))
       (guard (e (#t #f))
-        (parameterize ((remote-timeout 3))
+        (parameterize ((remote-timeout (+ (offer-seconds) 1)))
           (remote-apply (uid->aspace poser) receive-offer
                         (wanting-id (car waiting)) me)))
       (if (and *new-waiters* (free-here?))
           (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
           (offer-to me (cdr waiting))))))
 
+;; The subjects this address space subscribes to: a poser matches them
+;; against its waiting tasks' capabilities, for a robot it has not seen.
+(define (subjects-here) (map car (subscription-statuses '>)))
+
+;;> What an address space does once it has joined the lab: a robot
+;;> offers itself at once to the tasks that wait for it, which may have
+;;> waited for it while it was away, or before it came.
+(define (offer-on-joining!)
+  (set! *waiters-here?* #t)
+  (if (and (robot-here?) (free-here?)) (robot-freed!)))
+
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
   (every (lambda (s) (memq (cadr s) '(() shared))) (subscription-statuses '>)))
-
-(on-free! robot-freed!)
 

@@ -29,15 +29,24 @@
 
 ;;> How many times a task whose robots another task holds tries again
 ;;> before it answers \scheme{not-enough-takers}.
-(define pose-task-retries (make-parameter 5))
+(define pose-task-retries (make-parameter (lab-default 'pose-task-retries)))
 
 ;;> Seconds of the first wait before trying again; each wait is drawn at
 ;;> random below this, doubled for each try before it.
-(define pose-task-backoff (make-parameter 0.1))
+(define pose-task-backoff (make-parameter (lab-default 'pose-task-backoff)))
 
 ;;> Robots that pose-task gives no component to: a task that lost a
 ;;> robot renegotiates without it (life-cycle.scm).
 (define pose-task-excluded (make-parameter '()))
+
+;; The reservation name a negotiation holds its robots under, or #f for
+;; a new one: a started task's id, so that its reservations, holdings
+;; and components name the task as start-task answered it.
+(define pose-task-reservation (make-parameter #f))
+
+;; Whether a component's result is pose-task's (error UID WHY).
+(define (failed-result? r)
+  (and (list? r) (= (length r) 3) (eq? (car r) 'error) (string? (caddr r))))
 
 (for-each sandbox-parameter!
           (list pose-task-assignment pose-task-priority pose-task-retries
@@ -121,8 +130,11 @@
                             (release-proxy! (winner-promise winner))))
                       (negotiated-winners team) (negotiated-types team))
             (for-each (lambda (i uid result)
-                        (progress "  component " i " done on " uid ": "
-                                  (abridged result 50)))
+                        (if (failed-result? result)
+                            (progress "  component " i " failed on " uid ": "
+                                      (caddr result))
+                            (progress "  component " i " done on " uid ": "
+                                      (abridged result 50))))
                       (iota (length uids) 1) uids results)
             results)))))
 
@@ -147,7 +159,7 @@
     (check-task task-name num-robots capability-list metrics procs priorities)
     (let* ((layouts (map capability-layout capability-list))
            (type-list (map component-type layouts))
-           (name (task-key task-name))
+           (name (or (pose-task-reservation) (task-key task-name)))
            (task (make-pose name layouts type-list (map metric-keys metrics)
                             procs priorities)))
       (progress task-name ": " (length procs) " components")

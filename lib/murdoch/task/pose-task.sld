@@ -7,7 +7,7 @@
   (export pose-task negotiate negotiated-winners negotiated-types negotiated-name
           winner-uid winner-promise check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
-          pose-task-backoff pose-task-excluded receive-rival pose-negotiations
+          pose-task-backoff pose-task-excluded pose-task-reservation receive-rival pose-negotiations
           reservation-aspace-uid task-key task-key-parts
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
@@ -20,6 +20,7 @@
           (only (chibi ast) procedure-code procedure-vars opcode? thread-interrupt!)
           (only (chibi) call-with-output-string)
           (only (chibi process) current-process-id) (murdoch sys) (murdoch code)
+          (only (murdoch lab) lab-default)
           (murdoch remote) (murdoch pubsub) (murdoch task assign)
           (murdoch task progress) (murdoch task metric) (murdoch task takers)
           (murdoch task team) (only (murdoch task running) run-posed-component))

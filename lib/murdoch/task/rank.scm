@@ -50,7 +50,7 @@
 (define (check-waiting-room turn)
   (if (and turn (turn-wait? turn)
            (>= (count (lambda (t) (and (task-turn t) (turn-wait? (task-turn t))
-                                       (memq (task-state t) '(negotiating waiting))))
+                                       (memq (task-state t) '(negotiating waiting holding))))
                       (posed-tasks))
                (lab-setting (current-lab) 'max-waiting)))
       (error "start-task: this address space has max-waiting tasks waiting already"
@@ -134,13 +134,19 @@
 
 (define (held-uids w) (map held-uid (waiter-held w)))
 
-;; w's place among the tasks of the lab that wait for a robot it may use:
-;; 1 + how many of them rank before it.
+;; w's place in the lab's line, others being every task of the lab that
+;; waits: 1 + how many of them rank before it.  One order for the whole
+;; lab, 1 to n, whatever robots each may use.
 (define (place-in-line w others)
-  (+ 1 (count (lambda (other)
-                (and (rank<? (waiting-there-rank other) (waiter-rank w))
-                     (may-use? other (waiter-capable w))))
+  (+ 1 (count (lambda (other) (rank<? (waiting-there-rank other) (waiter-rank w)))
               others)))
+
+;; Whether one of others that ranks before w may use a robot w may use.
+(define (ahead-for-its-robots? w others)
+  (any (lambda (other)
+         (and (rank<? (waiting-there-rank other) (waiter-rank w))
+              (may-use? other (waiter-capable w))))
+       others))
 
 ;; Whether other, a waiting-there, may use one of uids.
 (define (may-use? other uids)
@@ -171,13 +177,65 @@
                      (cadr answer)))
               (request 'waiting-tasks waiting-ranks)))
 
+;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
+;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*.
+(define *lab-waiting* #f)
+
+;; Every task of the lab that waits, as waiting-elsewhere answers, asked
+;; of the lab at most once a heartbeat for all the tasks waiting here,
+;; this poser's own as they are now.  Each waiting task's look numbers
+;; its place in the line: with W tasks waiting, a look that asked every
+;; poser each time cost W squared a period lab-wide.  A place may so be a
+;; heartbeat old; who is offered a robot is decided by the robot's own
+;; round, never by this list.
+(define (lab-waiting)
+  (let* ((now (monotonic-seconds))
+         (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
+         (all (if (and cached
+                       (< (- now (car cached)) (lab-setting (current-lab) 'heartbeat)))
+                  (cdr cached)
+                  (let ((fresh (waiting-elsewhere)))
+                    (with-lock *tasks-lock*
+                      (lambda () (set! *lab-waiting* (cons now fresh))))
+                    fresh)))
+         (me (local-aspace-uid)))
+    (append (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)
+            (map (lambda (e) (apply make-waiting-there me e)) (waiting-ranks)))))
+
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
-;;> \var{uid}.
-(define (waiting-for uid)
+;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
+;;> when it last looked, or that has a component those subjects serve (a
+;;> robot that joined since).
+(define (waiting-for uid . subjects)
   (filter-map (lambda (w)
-                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w)))
+                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w))
+                         (and (pair? subjects) (serves? (car subjects) w)))
                      (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
               (with-lock *tasks-lock* waiters)))
+
+;; Whether a robot subscribed to subjects could take a component of w.
+(define (serves? subjects w)
+  (any (lambda (c)
+         (every (lambda (s) (memq s subjects))
+                (apply append (capability-layout (component-capabilities c)))))
+       (waiter-components w)))
+
+;;> Each task waiting here, as (RANK . ENTRY), ENTRY as (tasks) lists it:
+;;> the lab's status and its view number them all, from their ranks, in
+;;> one line.
+(define (waiting-entries)
+  (map (lambda (w) (cons (waiter-rank w) (waiting-entry w)))
+       (with-lock *tasks-lock* waiters)))
+
+;; w as (tasks) lists it: (posed ID STATE WHY PLACE PRIORITY HELD WANTS).
+(define (waiting-entry w)
+  (let ((t (waiter-task w)))
+    (list 'posed (task-id t) (task-state t) (waiter-why w) (waiter-position w)
+          (turn-priority (task-turn t)) (held-uids w)
+          (filter-map (lambda (c)
+                        (and (not (assv (component-index c) (waiter-held w)))
+                             (component-capabilities c)))
+                      (waiter-components w)))))
 
 ;; The parts of an entry of waiting-for, from any poser of the lab.
 (define (wanting-rank e) (car e))

@@ -13,11 +13,12 @@
           waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter!
           news-kind offer? offer-reply offer-uid give-way-uid tell-waiter!
           take-news! answer-offers! held-index held-winner held-type held-uid
-          held-uids place-in-line may-use? waiting-ranks waiting-there?
+          held-uids place-in-line ahead-for-its-robots? may-use? waiting-ranks waiting-there?
           waiting-there-poser waiting-there-rank waiting-there-capable
-          waiting-there-held waiting-elsewhere waiting-for wanting-rank
+          waiting-there-held waiting-elsewhere lab-waiting waiting-for waiting-entries waiting-entry
+          wanting-rank
           wanting-poser wanting-id)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (murdoch sys)
           (murdoch lab) (murdoch remote) (murdoch task pose-task)
-          (only (murdoch pubsub) request) (murdoch task record))
+          (only (murdoch pubsub) request capability-layout) (murdoch task record))
   (include "rank.scm"))

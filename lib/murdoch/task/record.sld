@@ -4,15 +4,17 @@
 
 (define-library (murdoch task record)
   (export task? task-id task-name make-task task-components task-done
-          task-state task-state-set! task-team task-team-set! task-steps
+          task-state task-state-set! task-why task-why-set! task-team task-team-set! task-steps
           task-steps-set! task-turn task-turn-set! task-waiter task-waiter-set!
+          task-acted task-acted-set!
           make-component component? component-index component-capabilities
           component-metric component-proc component-restartable? component-state
           component-state-set! component-attempts component-attempts-set!
-          *tasks-lock* posed-tasks add-posed! component-result check-task-record
+          *tasks-lock* posed-tasks add-posed! over? forget-over! fail-component!
+          component-result check-task-record
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries
           listed-posed? listed-id listed-state listed-place listed-why
-          listed-index listed-poser)
+          listed-priority listed-held listed-wants listed-index listed-poser)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18))
   (include "record.scm"))

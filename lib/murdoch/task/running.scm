@@ -12,11 +12,12 @@
   running?
   (id running-id)
   (index running-index)
-  (poser running-poser)
+  (poser running-poser running-poser-set!)   ; a detached task's: its coordinator
   (thread running-thread)
   (started running-started)                   ; monotonic-seconds
   (heard running-heard running-heard-set!)    ; monotonic-seconds
-  (over? running-over? running-over?-set!))
+  (over? running-over? running-over?-set!)
+  (cancelled? running-cancelled? running-cancelled?-set!)) ; by its poser
 
 ;; Global: the poser's calls (component-heartbeat! ...) find them by name.
 (define *running* '())
@@ -49,6 +50,7 @@
          (r (make-running id k poser (current-thread) now now))
          (outcome unfinished))
     (running-over?-set! r #f)
+    (running-cancelled?-set! r #f)
     (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
     (watch! r)
     (dynamic-wind
@@ -118,13 +120,46 @@
     (if r (running-heard-set! r (monotonic-seconds)))
     (and r #t)))
 
+;;> What a coordinator that took over a detached task calls where its
+;;> component \var{k} of task \var{id} ran or runs: the component's
+;;> heartbeats now come from \var{poser}, and the call answers, once it
+;;> ends, what run-component would have answered its first coordinator,
+;;> or raises what it raised.  One that ended lately answers at once; one
+;;> not found here raises an error.
+(define (await-component id k poser)
+  (let ((r (find-running id k)))
+    (when r
+      (running-poser-set! r poser)
+      (running-heard-set! r (monotonic-seconds))
+      (release-call! (running-thread r))))
+  (let wait ()
+    (cond ((find-running id k) (thread-sleep! 0.05) (wait))
+          ((find-ending id k)
+           => (lambda (e)
+                (let ((outcome (ending-outcome e)))
+                  (cond ((eq? outcome unfinished)
+                         (error "the component stopped with no answer" id k))
+                        ((raised? outcome) (raise (raised-condition outcome)))
+                        (else outcome)))))
+          (else (error "no such component here" id k)))))
+
+(define (find-ending id k)
+  (with-lock *running-lock*
+    (lambda ()
+      (find (lambda (e)
+              (let ((r (ending-running e)))
+                (and (eq? (running-id r) id) (= (running-index r) k))))
+            *ended*))))
+
 ;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
 (define (stop-component! id k)
   (let ((r (find-running id k)))
-    (if r (stop-running! r))
+    (when r
+      (running-cancelled?-set! r #t)
+      (stop-running! r))
     (and r #t)))
 
-;; (ID INDEX POSER) for each component running here.
+;;> (ID INDEX POSER) for each component running here.
 (define (components-running)
   (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
        (with-lock *running-lock* (lambda () *running*))))
@@ -141,15 +176,21 @@
 
 ;; Running r over, at a time on the monotonic clock, as end-of says.
 (define-record-type ending
-  (make-ending running at end)
+  (make-ending running at end outcome)
   ending?
   (running ending-running)
   (at ending-at)
-  (end ending-end))
+  (end ending-end)
+  (outcome ending-outcome))             ; what run-listed caught, for await-component
 
 ;; r is over, with outcome, as run-listed catches it.
 (define (note-ended! r outcome)
-  (let ((entry (make-ending r (monotonic-seconds) (end-of outcome))))
+  (let ((entry (make-ending r (monotonic-seconds)
+                            (if (and (running-cancelled? r)
+                                     (not (eq? (car (end-of outcome)) 'done)))
+                                '(cancelled)
+                                (end-of outcome))
+                            outcome)))
     (with-lock *running-lock*
       (lambda ()
         (set! *running* (remove (lambda (x) (eq? x r)) *running*))
@@ -158,7 +199,7 @@
 
 ;; How a component ended, from what it answered or raised: (done), (lost
 ;; WHY) for a robot failure, or (failed WHY), WHY the message its poser
-;; is given.
+;; is given; note-ended! makes it (cancelled) when its poser cancelled it.
 (define (end-of outcome)
   (cond ((eq? outcome unfinished) '(failed "it stopped with no answer"))
         ((raised? outcome) (list 'failed (error-message (raised-condition outcome))))
@@ -168,7 +209,7 @@
 
 ;;> The components that ended here, the last sixteen, newest first, each
 ;;> as (ID INDEX POSER STARTED ENDED END): STARTED and ENDED are seconds
-;;> before now, END is (done), (failed WHY) or (lost WHY).  They travel
+;;> before now, END is (done), (failed WHY), (lost WHY) or (cancelled).  They travel
 ;;> as lists, to the status and the view; ended-id and the other ended-
 ;;> procedures read them.
 (define (components-ended)
@@ -194,5 +235,5 @@
 (define (ended-ended e) (list-ref e 4))
 
 ;;> How the component of \var{e}, an entry of components-ended, ended:
-;;> (done), (failed WHY) or (lost WHY).
+;;> (done), (failed WHY), (lost WHY) or (cancelled).
 (define (ended-end e) (list-ref e 5))

@@ -8,8 +8,9 @@
 
 (define-library (murdoch task running)
   (export run-component run-posed-component component-heartbeat! stop-component!
+          await-component
           components-running components-ended ended-id ended-index ended-started
           ended-ended ended-end lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
-          (murdoch robot) (only (murdoch remote) hand-over-connection!))
+          (murdoch robot) (only (murdoch remote) hand-over-connection! release-call!))
   (include "running.scm"))

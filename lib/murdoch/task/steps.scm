@@ -29,6 +29,11 @@
       (error "task-step: capabilities, metrics and procedures are lists of one length"))
   (make-step capability-list metrics procs options))
 
+;;> The parts of a step made by task-step, as they travel: its
+;;> capabilities, metrics, procedures and options, task-step's arguments.
+(define (step-parts s)
+  (cons* (step-capabilities s) (step-metrics s) (step-procs s) (step-options s)))
+
 ;;> Starts a task of \var{steps} (made by task-step) and answers its task
 ;;> record at once; start-task's keywords may follow the steps, and each
 ;;> step is started with them.  task-status gives (step I STATUS) for each
@@ -42,7 +47,7 @@
         (error "start-steps: a task name, then one or more steps made by task-step"))
     (read-turn "start-steps" options)
     (for-each check-same steps (iota (length steps) 1))
-    (let ((t (new-task task-name '() '() '() '() #f)))
+    (let ((t (new-task ((task-id-maker) task-name) task-name '() '() '() '() #f)))
       (task-steps-set! t '())
       (thread-start!
        (make-logged-thread (inheriting (lambda () (run-steps t steps options)))
@@ -83,7 +88,11 @@
         (release-proxy! coordinator)
         (progress (task-id t) ": step " i " done: " step-results)
         (if (step-failed? step-results)
-            (begin (if (not (eq? (task-state t) 'cancelled)) (task-state-set! t 'failed))
+            (begin (when (not (eq? (task-state t) 'cancelled))
+                     (task-state-set! t (if (memq (task-state sub) '(cancelled deadline))
+                                            (task-state sub)
+                                            'failed))
+                     (task-why-set! t (task-why sub)))
                    (finish! t (reverse (cons step-results results))))
             (loop (+ i 1) (cdr steps) step-results (cons step-results results))))))))
 

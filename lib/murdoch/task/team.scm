@@ -54,7 +54,7 @@
 ;;> component is told as failed (see on-error), and stops on its robot at
 ;;> its next robot command or remote call (abandon.scm); until then an
 ;;> exclusive one holds its subjects.
-(define task-timeout (make-parameter 600))
+(define task-timeout (make-parameter (lab-default 'task-timeout)))
 (sandbox-parameter! task-timeout)
 
 (define (select-robots options)

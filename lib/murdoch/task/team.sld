@@ -8,6 +8,7 @@
           make-coordinator)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
-          (only (murdoch wire) error-message) (murdoch remote) (murdoch task progress)
+          (only (murdoch wire) error-message) (only (murdoch lab) lab-default)
+          (murdoch remote) (murdoch task progress)
           (murdoch task metric))
   (include "team.scm"))

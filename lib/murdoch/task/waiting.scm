@@ -74,6 +74,7 @@
     (give-way! w news)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
+     ((eq? (task-state t) 'let-go) (answer-offers! offers #f) 'let-go)
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
       (let ((team (if (or (pair? offers)
@@ -150,7 +151,7 @@
                          (remove (lambda (uid) (memq uid (pose-task-excluded)))
                                  (explanation-capable line)))
                        lines))
-         (others (guard (e (#t '())) (waiting-elsewhere)))
+         (others (guard (e (#t '())) (lab-waiting)))
          (exclusive (filter-map (lambda (c caps)
                                   (and (pair? (car (capability-layout
                                                     (component-capabilities c))))
@@ -166,17 +167,15 @@
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
       (remind-free! (delete-duplicates (append-map explanation-free lines)))
       (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
-      (waiter-position-set! w (place-in-line w others))
       (ask-way! w lines others)
-      (with-lock *tasks-lock*
-        (lambda ()
-          (if (eq? (task-state (waiter-task w)) 'negotiating)
-              (task-state-set! (waiter-task w) 'waiting))))
-      (for-each (lambda (c why)
-                  (component-state-set! c (list 'waiting (waiter-position w) why)))
-                cs (waiter-why w))
-      (progress (task-id (waiter-task w)) ": waiting, " (waiter-position w)
-                " in line")
+      (move-up! w others)
+      (progress (task-id (waiter-task w)) ": " (task-state (waiter-task w))
+                (if (pair? (waiter-held w))
+                    (apply string-append
+                           (map (lambda (uid) (string-append " " (symbol->string uid)))
+                                (held-uids w)))
+                    "")
+                ", " (waiter-position w) " in line")
       #f))))
 
 ;; Robots that a look finds free may have made their offers before this
@@ -198,17 +197,31 @@
            (loop (substring s 0 (- (string-length s) 1))))
           (else s))))
 
-;; Brings w's place in line, in its components' states, up to date.
-(define (move-up! w)
+;; Brings w's place in the lab's line, its state and its components'
+;; states up to date: holding while it holds a robot, each component it
+;; holds a robot for (holding UID), the others (waiting PLACE WHY).
+;; others are the lab's waiting tasks, asked for when not given.
+(define (move-up! w . others)
   (let ((place (guard (e (#t (waiter-position w)))
-                 (place-in-line w (waiting-elsewhere)))))
-    (waiter-position-set! w place)
-    (for-each (lambda (c)
-                (let ((state (component-state c)))
-                  (if (eq? (car state) 'waiting)
-                      (component-state-set! c (list 'waiting place (car (cddr state)))))))
-              (waiter-components w))))
+                 (place-in-line w (if (pair? others) (car others) (lab-waiting)))))
+        (t (waiter-task w)))
+    (with-lock *tasks-lock*
+      (lambda ()
+        (waiter-position-set! w place)
+        (if (and (pair? (waiter-why w)) (memq (task-state t) '(negotiating waiting holding)))
+            (task-state-set! t (if (pair? (waiter-held w)) 'holding 'waiting)))
+        (for-each (lambda (c why)
+                    (cond ((assv (component-index c) (waiter-held w))
+                           => (lambda (h) (component-state-set! c (list 'holding (held-uid h)))))
+                          ((and (pair? (waiter-why w))
+                                (memq (car (component-state c))
+                                      '(negotiating waiting holding)))
+                           (component-state-set! c (list 'waiting place why)))))
+                  (waiter-components w)
+                  (if (pair? (waiter-why w))
+                      (waiter-why w)
+                      (map (lambda (c) "") (waiter-components w))))))))
 
 ;; Whether a better-ranked task of the lab waits for a robot w may use.
 (define (behind-others? w)
-  (> (place-in-line w (guard (e (#t '())) (waiting-elsewhere))) 1))
+  (ahead-for-its-robots? w (guard (e (#t '())) (waiting-elsewhere))))

@@ -3,7 +3,8 @@
 
 (define-library (murdoch testing harness)
   (export make-test-lab test-lab-file test-lab-directory test-lab-port-base
-          start-process! stop-process! kill-process! reap! stop-all-processes!
+          start-process! stop-process! kill-process! reap! reaped-if-ended!
+          stop-all-processes!
           start-lab-aspace! start-murdoch-lab! median-seconds
           wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text

@@ -130,10 +130,10 @@
           (let ((t0 (monotonic-seconds))
                 (at (- (utc-seconds) start)))
             (feed-add! feed (json-text
-                                    (view-snapshot lab at
-                                                   (parameterize ((remote-timeout 1))
-                                                     (remote-apply-all aspaces proc))
-                                                   state)))
+                                    (parameterize ((remote-timeout 1))
+                                      (view-snapshot lab at
+                                                     (remote-apply-all aspaces proc)
+                                                     state (lab-line)))))
             (thread-sleep! (max 0.05 (- (+ t0 poll-seconds) (monotonic-seconds))))
             (loop))))
       'view-poll))

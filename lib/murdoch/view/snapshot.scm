@@ -138,8 +138,9 @@
 ;;> The snapshot at \var{t} seconds of the lab: \var{answers} are
 ;;> remote-apply-all's, for the lab's address spaces, of report-source;
 ;;> \var{state} what the view remembers (new-view-state), brought up to
-;;> date.
-(define (view-snapshot lab t answers state)
+;;> date; \var{line}, when given, the lab's waiting tasks as lab-line has
+;;> them, a guest's too.
+(define (view-snapshot lab t answers state . line)
   (let* ((answered (filter outcome-ok? answers))
          (boxes (view-state-boxes state)))
     (task-table-update! (view-state-table state) t
@@ -150,6 +151,7 @@
                                             (list (look-posed look))
                                             '()))))
                              answered))
+    (if (pair? line) (task-table-note-line! (view-state-table state) (car line)))
     (for-each (lambda (o) (move-boxes! boxes (outcome-value o))) answered)
     (for-each (lambda (o) (note-sonar! state (outcome-uid o) (outcome-value o)))
               answered)

@@ -29,7 +29,9 @@
   (name task-entry-name)
   (poser task-entry-poser)
   (state task-entry-state task-entry-state-set!)
-  (components task-entry-components task-entry-components-set!))
+  (components task-entry-components task-entry-components-set!)
+  ;; A detached task's (COORDINATOR STANDBY), as its coordinator says.
+  (keepers task-entry-keepers task-entry-keepers-set!))
 
 (define-record-type component-entry
   (make-component-entry index robot subjects since until end from)
@@ -117,19 +119,52 @@
 ;; by the address space that answered them.
 (define (posed-states tasks)
   (filter-map (lambda (t)
-                (and (pair? t) (listed-posed? t) (memv (length t) '(3 5))
+                (and (pair? t) (listed-posed? t) (>= (length t) 3)
                      (cons (text (listed-id t))
-                           (if (listed-place t)
-                               (string-append "waiting, " (text (listed-place t))
-                                              " in line")
-                               (text (listed-state t))))))
+                           (posed-state-text t (and (= (length t) 8) (listed-place t))))))
               tasks))
+
+;; A posed task's state as the view shows it: its word, as task-state's,
+;; then for a failed one why, for a waiting one what it holds and waits
+;; for, and its place in the lab's line.
+(define (posed-state-text t place)
+  (let ((word (text (listed-state t))))
+    (cond ((< (length t) 8) word)       ; a peer older than the word's details
+          ((memq (listed-state t) '(waiting holding))
+           (string-append word ": " (waiting-text t place)))
+          ((string? (listed-why t)) (string-append word ": " (listed-why t)))
+          (else word))))
 
 ;; Whether the table takes a posed task's (KEY . STATE): it goes on, or
 ;; it is one the table has; a task over before the view saw it is left out.
 (define (posed-news? table posed)
   (or (task-known table (car posed))
-      (not (member (cdr posed) '("done" "failed" "cancelled")))))
+      (not (any (lambda (word) (string-prefix? word (cdr posed)))
+                '("done" "failed" "cancelled" "deadline")))))
+
+;;> Brings the tasks of \var{table} that wait their turn up to date with
+;;> \var{line}, the lab's waiting tasks as lab-line has them, whoever
+;;> posed them: their state, and their place in the one line.  A task a
+;;> guest posed that has left the line is over or running, as its
+;;> components say.
+(define (task-table-note-line! table line)
+  (let ((keys (map (lambda (x) (text (listed-id (car (cddr x))))) line)))
+    (for-each (lambda (x key)
+                (task-entry-state-set! (task-named table key)
+                                       (posed-state-text (car (cddr x)) (cadr x))))
+              line keys)
+    (for-each (lambda (task)
+                (let ((state (task-entry-state task)))
+                  (if (and (string? state)
+                           (or (string-prefix? "waiting" state)
+                               (string-prefix? "holding" state))
+                           (not (member (task-entry-key task) keys)))
+                      (task-entry-state-set! task #f))))
+              (table-tasks table))))
+
+(define (string-prefix? prefix s)
+  (and (>= (string-length s) (string-length prefix))
+       (string=? prefix (substring s 0 (string-length prefix)))))
 
 ;; The entries of components-ended that a report gives, those well made.
 (define (ended-entries report)
@@ -157,6 +192,7 @@
   (or (task-known table key)
       (let* ((nt (reservation-task key))
              (t (make-task-entry key (car nt) (cadr nt) #f '())))
+        (task-entry-keepers-set! t #f)
         (table-tasks-set! table (append (table-tasks table) (list t)))
         t)))
 
@@ -185,6 +221,7 @@
 (define (components-state cs)
   (cond ((any (lambda (c) (and (open? c) (component-entry-index c))) cs) "running")
         ((any open? cs) "negotiating")
+        ((any (lambda (c) (equal? (component-entry-end c) "cancelled")) cs) "cancelled")
         ((any (lambda (c) (failed-for-good? c cs)) cs) "failed")
         ((any component-entry-index cs) "done")
         (else "not started")))
@@ -213,7 +250,17 @@
                              seen)))
           (report-components report))
          (for-each (lambda (e) (note-ended! table t robot e))
-                   (ended-entries report))))
+                   (ended-entries report))
+         (for-each (lambda (e)
+                     (when (eq? (lab-task-role e) 'coordinator)
+                       (let ((task (task-named table (text (lab-task-id e)))))
+                         (task-entry-keepers-set!
+                          task (list (text (lab-task-coordinator e))
+                                     (if (lab-task-standby e)
+                                         (text (lab-task-standby e))
+                                         'null)))
+                         (task-entry-state-set! task (text (lab-task-state e))))))
+                   (report-handed report))))
      reports)
     (let* ((answered (map (lambda (r) (text (sighting-uid r))) reports))
            (gone (note-robots! table t reports)))
@@ -360,7 +407,7 @@
     (and i (or (not j) (< i j)))))
 
 ;;> The table as JSON: the newest \var{most} tasks, each with its name,
-;;> poser, state and components (index, robot, subjects, since, until,
+;;> poser, state, coordinator and standby when it is detached, and components (index, robot, subjects, since, until,
 ;;> how it ended, and the robot it was reassigned from), by their number,
 ;;> the reservations last.
 (define (task-table->json table most)
@@ -370,6 +417,8 @@
             `((id . ,(task-entry-key task))
               (name . ,(task-entry-name task))
               (poser . ,(or (task-entry-poser task) 'null))
+              (coordinator . ,(let ((k (task-entry-keepers task))) (if k (car k) 'null)))
+              (standby . ,(let ((k (task-entry-keepers task))) (if k (cadr k) 'null)))
               (state . ,(or (task-entry-state task) (components-state cs)))
               (components
                . ,(list->vector

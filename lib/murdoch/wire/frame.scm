@@ -110,6 +110,7 @@
   (max-frame wire-max-frame)
   (max-depth wire-max-depth))
 
+;; Global: the lab's key and limits, for every frame of the process.
 (define *wire* #f)
 
 ;;> Makes the frames and datagrams of this process those of \var{lab}:
@@ -146,8 +147,7 @@
        message-kinds))
 
 ;; The text " FIELD ...)" of fields, written to one string port for every
-;; call, under its lock: a port made for each call cost it 9.7 KB of
-;; garbage (docs/speed.md).  Encoded values are plain data, whose writing
+;; call, under its lock (docs/speed.md).  Encoded values are plain data, whose writing
 ;; raises nothing, so the lock needs no dynamic-wind.
 (define fields-port (open-output-string))
 (define fields-lock (make-mutex 'fields-text))

@@ -1,0 +1,275 @@
+;;; Tasks handed to the lab, between real processes: a poser that leaves
+;;; at once, a coordinator killed mid-task, while its task waits holding
+;;; a robot, or together with its standby, and a robot lost while the
+;;; standby is in charge.  Workstations stand in for robots, as in
+;;; task-test; each component writes (begin TAG UID) and (end TAG UID) to
+;;; its own address space's log, which the tests read.
+(import (except (scheme base) lambda define) (scheme write) (scheme eval)
+        (srfi 1) (srfi 18) (chibi test)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness))
+
+(define lab-code "
+(define (tell . xs) (write xs) (newline) (flush-output-port))
+;; A component that runs rounds of 50 ms, calling out each round, as a
+;; robot command would go to its robot, so that it stops as an orphan.
+(define (work tag rounds)
+  (dynamic-wind
+   (lambda () (tell 'begin tag (local-aspace-uid)))
+   (lambda ()
+     (let loop ((n rounds))
+       (remote-apply (local-aspace) (lambda () #t))
+       (thread-sleep! 0.05)
+       (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
+   (lambda () (tell 'end tag (local-aspace-uid)))))
+;; What the tester hears: each (begin TAG) as it comes.
+(define heard '())
+(define (note-begin tag) (set! heard (append heard (list tag))) #t)
+(define (work-told tag rounds)
+  (remote-apply (uid->aspace 'tester) (lambda () (note-begin tag)))
+  (work tag rounds))
+(define (free-everywhere? subjects)
+  (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
+         (request 'all (lambda ()
+                         (filter-map (lambda (t)
+                                       (let ((s (topic-status t))) (and s (list t s))))
+                                     subjects)))))
+")
+
+(define robots '(r1 r2 r3))
+(define coordinators '(c1 c2 c3))
+
+(define lab
+  (make-test-lab
+   `((code "code.scm") (heartbeat 0.3) (lease 4)
+     (aspace tester)
+     (aspace poser)
+     ,@(map (lambda (uid load) `(aspace ,uid (position 0 0 0) (load ,load)))
+            coordinators '(0.1 0.2 0.3))
+     ,@(map (lambda (uid i) `(aspace ,uid (position ,(* 1000 i) 0 0)
+                                     (capabilities mobile) (load 0.5)))
+            robots (iota 3)))
+   `(("code.scm" . ,lab-code)
+     ("survey.scm" . "(list 'survey 1 (list '((mobile) ())) (list #f)
+                          (list (lambda () (work 'cli 60))))")
+     ("long.scm" . "(list 'long 1 (list '((mobile) ())) (list #f)
+                        (list (lambda () (work 'cancelled 2000))))"))))
+
+(define pids
+  (map (lambda (uid) (cons uid (start-lab-aspace! lab uid)))
+       (append '(poser) coordinators robots)))
+(join-lab (test-lab-file lab) 'tester)
+
+(define (lab-proc name) (eval name (lab-environment)))
+(define (all-free?) ((lab-proc 'free-everywhere?) '(mobile)))
+(define (in-dir name) (string-append (test-lab-directory lab) "/" name))
+
+;; Runs `bin/murdoch ARG ...` as a process of its own while this one
+;; serves the lab, and answers its output, then "exit CODE".
+(define commands-run 0)
+(define (murdoch-status . args)
+  (set! commands-run (+ commands-run 1))
+  (let* ((out (in-dir (string-append "command-" (number->string commands-run))))
+         (pid (start-process!
+               (append (list "sh" "-c" "\"$@\"; echo \"exit $?\"" "murdoch"
+                             (tool-path "bin/murdoch"))
+                       args)
+               out)))
+    (wait-until 60 (lambda () (reaped-if-ended! pid)))
+    (file-text out)))
+
+;; Lines of uid's log that begin with (WORD TAG.
+(define (log-lines uid word tag)
+  (filter (lambda (line)
+            (text-contains? line (string-append "(" word " " (symbol->string tag) " ")))
+          (read-lines (in-dir (string-append (symbol->string uid) ".log")))))
+
+;; Task id's entry of lab-tasks; one that no address space answers for
+;; now is (ID #f 0 #f #f #f #f #f).
+(define (entry-of id)
+  (or (find (lambda (e) (eq? (lab-task-id e) id)) (lab-tasks))
+      (list id #f 0 #f #f #f #f #f)))
+
+(define (coordinator-of id) (lab-task-coordinator (entry-of id)))
+
+(define (running-everywhere? id)
+  (every (lambda (s) (eq? (car (status-state s)) 'running)) (task-status id)))
+
+;; Kills uid's process, as a crash would; restart! starts it again.
+(define (kill! uid) (kill-process! (cdr (assq uid pids))))
+(define (restart! uid)
+  (set! pids (cons (cons uid (start-lab-aspace! lab uid))
+                   (remove (lambda (p) (eq? (car p) uid)) pids))))
+
+(test-begin "detached tasks")
+
+(test-group "the poser leaves at once; another peer reads the results"
+  (let* ((out (murdoch-status "pose" "--detach" (test-lab-file lab) (in-dir "survey.scm")))
+         (id (string->symbol (car (text-lines out)))))
+    (test "pose --detach exits 0, printing the task's id" #t (text-contains? out "exit 0"))
+    (test-assert "the poser gone, its task runs"
+      (wait-until 10 (lambda () (eq? 'running (lab-task-state (entry-of id))))))
+    (test "its coordinator is the least loaded workstation" 'c1 (coordinator-of id))
+    (test "and a standby on another" 'c2
+      (wait-until 10 (lambda () (lab-task-standby (entry-of id)))))
+    (let ((tasks (murdoch-status "tasks" (test-lab-file lab))))
+      (test "murdoch tasks lists it, with its coordinator" #t
+        (and (text-contains? tasks (symbol->string id))
+             (text-contains? tasks "coordinator c1"))))
+    (let ((waited (murdoch-status "wait" (test-lab-file lab) (symbol->string id))))
+      (test "murdoch wait, a new peer, prints its result and exits 0" #t
+        (and (text-contains? waited "exit 0")
+             (any (lambda (r) (text-contains? waited (string-append "(" (symbol->string r) ")")))
+                  robots))))
+    (test "and task-wait from any peer reads it, kept" #t
+      (and (memq (car (task-wait id 10)) robots) #t))
+    (test "murdoch status shows it with its coordinator" #t
+      (text-contains? (murdoch-status "status" (test-lab-file lab))
+                      (string-append "coordinates detached task " (symbol->string id)))))
+  (let* ((out (murdoch-status "pose" "--detach" (test-lab-file lab) (in-dir "long.scm")))
+         (id (string->symbol (car (text-lines out)))))
+    (test-assert "a long task runs"
+      (wait-until 10 (lambda () (running-everywhere? id))))
+    (test "murdoch cancel stops it" #t
+      (text-contains? (murdoch-status "cancel" (test-lab-file lab) (symbol->string id))
+                      "exit 0"))
+    (test "its component ends on its robot" #t
+      (wait-until 10 (lambda () (any (lambda (r) (pair? (log-lines r "end" 'cancelled)))
+                                     robots))))
+    (test-assert "and its state says so"
+      (wait-until 10 (lambda () (equal? '(failed "cancelled")
+                                        (status-state (car (task-status id)))))))
+    (test-assert "nothing is held" (wait-until 10 all-free?))))
+
+(test-group "the coordinator killed mid-task: its standby takes over"
+  (let ((id (remote-apply
+             (uid->aspace 'poser)
+             (eval '(lambda ()
+                      (start-task 'killed 2 (list '((mobile) ()) '((mobile) ()))
+                                  (list #f #f)
+                                  (list (lambda () (work 'killed 80))
+                                        (lambda () (work 'killed 80)))
+                                  '(1 1) '(#t #t) 'detach #t))
+                   (lab-environment)))))
+    (test-assert "both components run" (wait-until 10 (lambda () (running-everywhere? id))))
+    (test-assert "it has a standby"
+      (wait-until 10 (lambda () (lab-task-standby (entry-of id)))))
+    (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
+      (kill! old)
+      (test "the standby takes over" standby
+        (wait-until 10 (lambda ()
+                         (let ((e (entry-of id)))
+                           (and (eq? (lab-task-role e) 'coordinator)
+                                (= 2 (lab-task-epoch e))
+                                (lab-task-coordinator e))))))
+      (test-assert "and chooses a new standby"
+        (wait-until 10 (lambda ()
+                         (let ((s (lab-task-standby (entry-of id))))
+                           (and s (not (memq s (list old standby))))))))
+      (let ((results (task-wait id 30)))
+        (test "the task completes, each component on a robot of its own" 2
+          (length (delete-duplicates (filter (lambda (r) (memq r robots)) results))))
+        (test "each component's own log shows one begin and one end" '((1 1) (1 1))
+          (map (lambda (r) (list (length (log-lines r "begin" 'killed))
+                                 (length (log-lines r "end" 'killed))))
+               results))
+        (test "nothing was reassigned" '(() ())
+          (map (lambda (s) (remove (lambda (a) (eq? (cadr a) 'done)) (status-attempts s)))
+               (task-status id))))
+      (restart! old))))
+
+(test-group "the coordinator killed while its task waits, holding"
+  ;; r2 and r3 are busy; the detached task needs two robots and holds
+  ;; r1; a task posed after it also waits for two.
+  (let* ((busy (map (lambda (tag)
+                      (start-task 'busy 1 (list '((mobile) ()))
+                                  (list (location-metric-maker '(2000 0 0 0)))
+                                  (list (eval `(lambda () (work ',tag 140))
+                                              (lab-environment)))))
+                    '(busy-a busy-b)))
+         (_ (wait-until 10 (lambda () (every (lambda (t) (running-everywhere? t)) busy))))
+         (id (remote-apply
+              (uid->aspace 'poser)
+              (eval '(lambda ()
+                       (start-task 'holder 2 (list '((mobile) ()) '((mobile) ()))
+                                   (list #f #f)
+                                   (list (lambda () (work-told 'holder 10))
+                                         (lambda () (work-told 'holder 10)))
+                                   'hold #t 'detach #t))
+                    (lab-environment)))))
+    (test-assert "it waits, with a standby"
+      (wait-until 10 (lambda () (let ((e (entry-of id)))
+                                  (and (eq? 'waiting (lab-task-state e))
+                                       (lab-task-standby e))))))
+    (let ((later (start-task 'later 2 (list '((mobile) ()) '((mobile) ()))
+                             (list #f #f)
+                             (list (eval '(lambda () (work-told 'later 10)) (lab-environment))
+                                   (eval '(lambda () (work-told 'later 10)) (lab-environment)))
+                             'wait #t))
+          (old (coordinator-of id)))
+      (kill! old)
+      (test-assert "its standby takes over"
+        (wait-until 10 (lambda () (let ((c (coordinator-of id))) (and c (not (eq? c old)))))))
+      (let ((results (task-wait id 60)))
+        (test "it completes on two robots" 2
+          (length (delete-duplicates (filter (lambda (r) (memq r robots)) results)))))
+      (task-wait later 60)
+      (test "in its rank: before the task posed after it" '(holder holder later later)
+        (remote-apply (uid->aspace 'tester) (eval '(lambda () heard) (lab-environment))))
+      (for-each task-wait busy)
+      (test-assert "nothing is held after" (wait-until 10 all-free?))
+      (restart! old))))
+
+(test-group "coordinator and standby killed at once: the task fails clearly"
+  (let ((id (remote-apply
+             (uid->aspace 'poser)
+             (eval '(lambda ()
+                      (start-task 'orphaned 1 (list '((mobile) ())) (list #f)
+                                  (list (lambda () (work 'orphaned 2000))) 'detach #t))
+                   (lab-environment)))))
+    (test-assert "it runs, with a standby"
+      (wait-until 10 (lambda () (and (running-everywhere? id)
+                                     (lab-task-standby (entry-of id))))))
+    (let* ((e (entry-of id)) (coordinator (lab-task-coordinator e))
+           (standby (lab-task-standby e)))
+      (kill! coordinator)
+      (kill! standby)
+      (test-assert "task-wait says it failed, and why"
+        (text-contains? (error-text (lambda () (task-wait id 30)))
+                        "its coordinator and its standby both lost"))
+      (test-assert "its component stops on its robot, as an orphan"
+        (wait-until 10 (lambda () (any (lambda (r) (pair? (log-lines r "end" 'orphaned)))
+                                       robots))))
+      (test-assert "and nothing is held after the lease" (wait-until 6 all-free?))
+      (restart! coordinator)
+      (restart! standby))))
+
+(test-group "a robot lost while the standby is in charge"
+  (let ((id (remote-apply
+             (uid->aspace 'poser)
+             (eval '(lambda ()
+                      (start-task 'moved 1 (list '((mobile) ())) (list #f)
+                                  (list (lambda () (work 'moved 100))) '(1) '(#t)
+                                  'detach #t))
+                   (lab-environment)))))
+    (test-assert "it runs, with a standby"
+      (wait-until 10 (lambda () (and (running-everywhere? id)
+                                     (lab-task-standby (entry-of id))))))
+    (let ((old (coordinator-of id)))
+      (kill! old)
+      (test-assert "the standby takes over"
+        (wait-until 10 (lambda () (let ((c (coordinator-of id))) (and c (not (eq? c old)))))))
+      (let ((robot (cadr (status-state (car (task-status id))))))
+        (kill! robot)
+        (let ((results (task-wait id 30)))
+          (test-assert "the component is reassigned, and completes elsewhere"
+            (and (memq (car results) robots) (not (eq? (car results) robot))))
+          (test "the lost robot is among its attempts" 'lost
+            (cadr (assq robot (status-attempts (car (task-status id)))))))
+        (restart! robot))
+      (restart! old))))
+
+(test-end)
+(stop-all-processes!)
+(remove-test-lab! lab)
+(test-exit)
