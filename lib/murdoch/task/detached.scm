@@ -508,7 +508,7 @@
        (lambda ()
          (cond
           ((every (lambda (p) (and (not (plan-uid p))
-                                   (memq (car (plan-state p)) '(negotiating waiting))))
+                                   (memq (car (plan-state p)) '(negotiating waiting holding))))
                   plan)
            (for-each (lambda (c) (component-state-set! c '(negotiating)))
                      (task-components t))
@@ -569,7 +569,8 @@
 ;;> has had: 1, and 1 more a takeover.
 (define (lab-task-epoch e) (list-ref e 2))
 ;;> The state of the task of \var{e}, an entry of lab-tasks:
-;;> negotiating, waiting, running, done, failed or cancelled.
+;;> negotiating, waiting, holding, running, done, failed, cancelled or
+;;> deadline.
 (define (lab-task-state e) (list-ref e 3))
 ;;> The coordinator's uid in \var{e}, an entry of lab-tasks.
 (define (lab-task-coordinator e) (list-ref e 4))
