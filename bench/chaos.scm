@@ -42,16 +42,30 @@
 (define workstations '(k1 k2 k3))
 
 (define lab-code "
+;; On quiet, each call runs in a thread of its own, and Chibi may switch
+;; threads in the middle of a set! of inside: a leave! lost so leaves its
+;; robot counted busy, and the robot's next component counted a double
+;; booking.  Each reading and change of inside is made under its lock,
+;; and of copies under its own, held while copy-enter! asks robots.
+(define inside-lock (make-mutex 'inside))
+(define copies-lock (make-mutex 'copies))
+(define (under lock thunk)
+  (mutex-lock! lock)
+  (let ((v (thunk))) (mutex-unlock! lock) v))
 (define inside '())       ; on quiet: ((uid started-at) . n) now running
 (define double-bookings 0)
 (define (enter! who)
-  (let ((e (assoc who inside)))
-    (if (and e (> (cdr e) 0)) (set! double-bookings (+ double-bookings 1)))
-    (set! inside (cons (cons who (+ 1 (if e (cdr e) 0)))
-                       (remove (lambda (x) (equal? (car x) who)) inside)))))
+  (under inside-lock
+   (lambda ()
+     (let ((e (assoc who inside)))
+       (if (and e (> (cdr e) 0)) (set! double-bookings (+ double-bookings 1)))
+       (set! inside (cons (cons who (+ 1 (if e (cdr e) 0)))
+                          (remove (lambda (x) (equal? (car x) who)) inside)))))))
 (define (leave! who)
-  (set! inside (map (lambda (x) (if (equal? (car x) who) (cons who (- (cdr x) 1)) x))
-                    inside)))
+  (under inside-lock
+   (lambda ()
+     (set! inside (map (lambda (x) (if (equal? (car x) who) (cons who (- (cdr x) 1)) x))
+                       inside)))))
 (define (chaos-component)
   (let ((who (list (local-aspace-uid) (aspace-started-at))))
     (remote-apply (uid->aspace 'quiet) (lambda () (enter! who)))
@@ -62,9 +76,17 @@
          (remote-apply (uid->aspace 'quiet) (lambda () #t))
          (thread-sleep! 0.05)
          (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
-     (lambda ()
-       (guard (e (#t #f))
-         (remote-apply (uid->aspace 'quiet) (lambda () (leave! who))))))))
+     (lambda () (tell-quiet (lambda () (leave! who)))))))
+;; Applies thunk on quiet from a thread of its own: a component stopped
+;; by its poser (cancelled, an orphan, its robot declared lost) has its
+;; thread marked abandoned, and a remote call there raises at once, so
+;; that its leave! would never arrive and the robot's next component
+;; would be counted as a double booking.
+(define (tell-quiet thunk)
+  (thread-join!
+   (thread-start!
+    (make-thread (lambda ()
+                   (guard (e (#t #f)) (remote-apply (uid->aspace 'quiet) thunk)))))))
 ;; The copies of each detached task's component running now: (TAG UID
 ;; STARTED-AT), UID's address space as it was when the copy began.  A copy
 ;; whose robot was killed never leaves: a copy that begins finds it stale
@@ -72,25 +94,27 @@
 (define copies '())
 (define double-runs 0)
 (define (copy-enter! tag who)
-  (let ((others (filter (lambda (c) (and (equal? (car c) tag) (live-copy? c))) copies)))
-    (if (pair? others) (set! double-runs (+ double-runs 1)))
-    (set! copies (cons (cons tag who) copies))))
+  (under copies-lock
+   (lambda ()
+     (let ((others (filter (lambda (c) (and (equal? (car c) tag) (live-copy? c)))
+                           copies)))
+       (if (pair? others) (set! double-runs (+ double-runs 1)))
+       (set! copies (cons (cons tag who) copies))))))
 (define (live-copy? c)
   (guard (e (#t #f))
     (equal? (caddr c)
             (parameterize ((remote-timeout 1))
               (remote-apply (uid->aspace (cadr c)) aspace-started-at)))))
 (define (copy-leave! tag who)
-  (set! copies (remove (lambda (c) (equal? c (cons tag who))) copies)))
+  (under copies-lock
+   (lambda () (set! copies (remove (lambda (c) (equal? c (cons tag who))) copies)))))
 (define (detached-component tag)
   (let ((who (list (local-aspace-uid) (aspace-started-at))))
     (remote-apply (uid->aspace 'quiet) (lambda () (copy-enter! tag who)))
     (dynamic-wind
      (lambda () #f)
      chaos-component
-     (lambda ()
-       (guard (e (#t #f))
-         (remote-apply (uid->aspace 'quiet) (lambda () (copy-leave! tag who))))))))
+     (lambda () (tell-quiet (lambda () (copy-leave! tag who)))))))
 (define (held subjects)
   (apply + (map (lambda (r) (length (filter (lambda (s) (pair? (cadr s))) (cadr r))))
                 (request 'all (lambda ()
