@@ -61,11 +61,13 @@
   (let ((a (result (cadr direct))) (b (result (cadr through))))
     (test-assert "both answer two sonar rings and a sorted list"
       (and a b (= 3 (length a)) (= 3 (length b))))
-    ;; Within the noise and a stop within a centimetre and half a degree of
-    ;; the direct run's: 60 mm, or 3 % of a far echo's range.
+    ;; Within the noise and a stop within a centimetre and a degree or two
+    ;; of the direct run's, which at an oblique wall moves an echo by more
+    ;; than the noise: 100 mm, or 5 % of a far echo's range.  A ring read
+    ;; at another place differs by metres.
     (test "each sonar near the direct run's, at the same target" '()
           (filter-map (lambda (ring-a ring-b i)
-                        (and (not (every (lambda (x y) (< (abs (- x y)) (max 60 (* 0.03 x))))
+                        (and (not (every (lambda (x y) (< (abs (- x y)) (max 100 (* 0.05 x))))
                                          ring-a ring-b))
                              (list i ring-a ring-b)))
                       (take a 2) (take b 2) '(1 2)))))
