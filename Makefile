@@ -1,7 +1,7 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
+.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched bench-sched-scale \
 	demo demo-box bench-ros2 clean
 
 all: deps
@@ -39,6 +39,11 @@ bench-chaos: all
 
 bench-sched: all
 	tools/chibi bench/sched.scm
+
+# The scheduler with thousands queued: 64 robots of 4 kinds, 8 posers,
+# 2,500 tasks (bench/sched-scale.scm; sizes MURDOCH_SCHED_SCALE_*).
+bench-sched-scale: all
+	tools/chibi bench/sched-scale.scm
 
 # Robots through ROS 2: trip command latency and odometry age beside
 # rclpy's floor, the dual-sonar task through ROS 2 over straight (bench/ros2).
