@@ -1,7 +1,8 @@
 # Murdoch: `make demo` and `make test` do all the set-up on a fresh Debian
 # machine (see README.md).
 
-.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched bench-box \
+.PHONY: all deps native sim test bench bench-scale bench-sim bench-alloc bench-chaos bench-sched \
+	bench-sched-scale bench-box \
 	demo demo-box bench-ros2 clean
 
 all: deps
@@ -44,6 +45,11 @@ bench-sched: all
 # without a fault, BOX_FAULT_RUNS (10) with one, from seed BOX_SEED (1) on.
 bench-box: all
 	tools/chibi bench/box.scm
+
+# The scheduler with thousands queued: 64 robots of 4 kinds, 8 posers,
+# 2,500 tasks (bench/sched-scale.scm; sizes MURDOCH_SCHED_SCALE_*).
+bench-sched-scale: all
+	tools/chibi bench/sched-scale.scm
 
 # Robots through ROS 2: trip command latency and odometry age beside
 # rclpy's floor, the dual-sonar task through ROS 2 over straight (bench/ros2).

@@ -1,0 +1,376 @@
+;;> The scheduling benches' judge (bench/sched.scm, bench/sched-scale.scm):
+;;> from the tasks posed, when each was posed, and the starts and ends
+;;> their components told, what happened (spans, double bookings, stalls,
+;;> inversions, start latencies) and the ideal schedule of the same tasks,
+;;> and the figures that compare them.
+;;>
+;;> A task is (ID KINDS SECONDS PRIORITY GAP): KINDS a list, a component,
+;;> of the robot kinds that component accepts; ids are 0 to n-1.  An event
+;;> is (TIME KIND ID K UID), KIND start or end of component K of task ID on
+;;> robot UID, in time order.  Robots are ((UID . KIND) ...).
+
+(define-library (bench schedule)
+  (export make-schedule-run schedule-completed! print-schedule-figures
+          schedule-spans schedule-makespan percentile round-to bench)
+  (import (scheme base) (scheme write) (scheme inexact)
+          (srfi 1) (srfi 132))
+  (begin
+    (define-record-type schedule-run
+      (%make-schedule-run tasks posed-at posed-by events robots aging
+                          spans ready starts completed)
+      schedule-run?
+      (tasks run-tasks)
+      (posed-at run-posed-at)           ; vector by id: second before posing
+      (posed-by run-posed-by)           ; vector by id: second after
+      (events run-events)
+      (robots run-robots)
+      (aging run-aging)
+      (spans schedule-spans)            ; vector by id: (start end) or #f
+      (ready run-ready)                 ; vector by id: last release before start
+      (starts run-starts)               ; vector by id: ((time uid) ...)
+      (completed run-completed run-completed-set!))
+
+    (define (task-kinds t) (cadr t))
+    (define (task-robots t) (length (task-kinds t)))
+    (define (task-priority t) (list-ref t 3))
+
+    ;;> The run's record, its spans and releases computed once.
+    (define (make-schedule-run tasks posed-at posed-by events robots aging)
+      (let* ((n (length tasks))
+             (spans (make-vector n #f))
+             (ready (make-vector n #f))
+             (firsts (make-vector n '()))   ; (time uid) of each start
+             (lasts (make-vector n '()))
+             (ends-on '()))                 ; (uid time ...), newest first
+        (for-each
+         (lambda (e)
+           (let ((id (list-ref e 2)) (uid (list-ref e 4)))
+             (if (eq? (cadr e) 'start)
+                 (vector-set! firsts id (cons (list (car e) uid) (vector-ref firsts id)))
+                 (begin
+                   (vector-set! lasts id (cons (car e) (vector-ref lasts id)))
+                   (set! ends-on (let ((r (assq uid ends-on)))
+                                   (if r
+                                       (begin (set-cdr! r (cons (car e) (cdr r))) ends-on)
+                                       (cons (list uid (car e)) ends-on))))))))
+         events)
+        (for-each
+         (lambda (t)
+           (let ((s (vector-ref firsts (car t))) (e (vector-ref lasts (car t))))
+             (when (and (= (length s) (task-robots t)) (= (length e) (task-robots t)))
+               (let ((start (apply min (map car s))))
+                 (vector-set! spans (car t) (list start (apply max e)))
+                 ;; The last release among its robots before it started.
+                 (let ((releases
+                        (filter-map
+                         (lambda (x)
+                           (let ((before (filter (lambda (end) (<= end start))
+                                                 (cond ((assq (cadr x) ends-on) => cdr)
+                                                       (else '())))))
+                             (and (pair? before) (apply max before))))
+                         s)))
+                   (if (pair? releases)
+                       (vector-set! ready (car t) (apply max releases))))))))
+         tasks)
+        (%make-schedule-run tasks posed-at posed-by events robots aging spans ready
+                            firsts 0)))
+
+    ;;> Sets how many tasks completed, as their posers said.
+    (define (schedule-completed! run n) (run-completed-set! run n))
+
+    (define (span-of run t) (vector-ref (schedule-spans run) (car t)))
+    (define (posed run t) (vector-ref (run-posed-at run) (car t)))
+    (define (work-of run t)
+      (let ((s (span-of run t))) (and s (- (cadr s) (car s)))))
+
+    ;;> When the last component ended.
+    (define (schedule-makespan run)
+      (fold (lambda (e m) (if (eq? (cadr e) 'end) (max m (car e)) m)) 0 (run-events run)))
+
+    ;; Two components on one robot at once, seen by their starts and ends.
+    (define (double-bookings run)
+      (let loop ((es (run-events run)) (inside '()) (n 0))
+        (if (null? es)
+            n
+            (let* ((e (car es)) (uid (list-ref e 4))
+                   (k (cond ((assq uid inside) => cdr) (else 0)))
+                   (rest (remove (lambda (x) (eq? (car x) uid)) inside)))
+              (if (eq? (cadr e) 'start)
+                  (loop (cdr es) (cons (cons uid (+ k 1)) rest) (if (> k 0) (+ n 1) n))
+                  (loop (cdr es) (cons (cons uid (- k 1)) rest) n))))))
+
+    (define (rank-key run t)
+      (- (task-priority t) (* (run-aging run) (posed run t))))
+    (define (ranks-before? run)
+      (lambda (a b)
+        (or (> (rank-key run a) (rank-key run b))
+            (and (= (rank-key run a) (rank-key run b)) (< (posed run a) (posed run b))))))
+
+    ;; Whether a ranks before b whatever second within its posing call each
+    ;; was ranked by: a near tie that the calls' own times could turn either
+    ;; way is no inversion.
+    (define (surely-ranks-before? run a b)
+      (let ((key (lambda (t posed)
+                   (- (task-priority t) (* (run-aging run) (vector-ref posed (car t)))))))
+        (or (> (key a (run-posed-by run)) (key b (run-posed-at run)))
+            (and (= (task-priority a) (task-priority b))
+                 (< (vector-ref (run-posed-by run) (car a))
+                    (vector-ref (run-posed-at run) (car b)))))))
+
+    ;; The inversions: a task x starting while y, which surely ranks before
+    ;; it, waited for a robot that x took.  y waited from 0.2 s after its
+    ;; posing call until the last of the robots it started on was released,
+    ;; if that was after x started, and it had not started 0.2 s after x: a
+    ;; task that has won its robots takes a moment to tell the bench it
+    ;; started, and one whose robots were all free when x started was being
+    ;; served, and needed none more.  Every task holds what it wins, so a
+    ;; task that waits for a robot could have used any robot freed of a kind
+    ;; one of its components accepts, if only to hold it.  (x y) for each x
+    ;; and the best-ranked such y.
+    (define (waited-for-robot? run y sx)
+      (let ((sy (span-of run y)))
+        (and (< (+ (vector-ref (run-posed-by run) (car y)) 0.2) sx)
+             (or (not sy)
+                 (and (> (car sy) (+ sx 0.2))
+                      (> (or (vector-ref (run-ready run) (car y)) 0) sx))))))
+
+    (define (kinds-started-on run x)
+      (map (lambda (s) (cdr (assq (cadr s) (run-robots run))))
+           (vector-ref (run-starts run) (car x))))
+
+    (define (inversions run)
+      (let ((sorted (list-sort (ranks-before? run) (run-tasks run))))
+        (filter-map
+         (lambda (x)
+           (let ((sx (span-of run x)))
+             (and sx
+                  (let* ((kinds (kinds-started-on run x))
+                         (y (find (lambda (y)
+                                    (and (surely-ranks-before? run y x)
+                                         (waited-for-robot? run y (car sx))
+                                         (any (lambda (accepts)
+                                                (any (lambda (k) (memq k kinds)) accepts))
+                                              (task-kinds y))))
+                                  sorted)))
+                    (and y (list x y))))))
+         (run-tasks run))))
+
+    ;; Each inversion, on standard error, so that a run's can be looked into.
+    (define (tell-inversion! run xy)
+      (let ((out (current-error-port)) (x (car xy)) (y (cadr xy)))
+        (define (task-line t)
+          (let ((s (span-of run t)))
+            (string-append "task " (number->string (car t)) " of priority "
+                           (number->string (task-priority t)) ", posed at "
+                           (number->string (round-to (posed run t) 3))
+                           " s, started at "
+                           (if s
+                               (string-append (number->string (round-to (car s) 3)) " s")
+                               "never"))))
+        (write-string (string-append "sched: inversion: " (task-line x) "\n"
+                                     "  while this better-ranked one waited: "
+                                     (task-line y) "\n")
+                      out)))
+
+    ;; How many tasks were posed before second t, less how many started at
+    ;; or before it: how many waited then.
+    (define (waiting-counter run)
+      (let* ((started (filter (lambda (t) (span-of run t)) (run-tasks run)))
+             (poses (list->vector (list-sort < (map (lambda (t) (posed run t))
+                                                    (run-tasks run)))))
+             (starts (list->vector (list-sort < (map (lambda (t) (car (span-of run t)))
+                                                     started)))))
+        (lambda (t) (- (count-below poses t) (count-below starts (+ t 1e-9))))))
+
+    ;; How many of sorted vector v are below x (then at or above, for
+    ;; starts: a task starting at t waits at t).
+    (define (count-below v x)
+      (let loop ((lo 0) (hi (vector-length v)))
+        (if (>= lo hi)
+            lo
+            (let ((mid (quotient (+ lo hi) 2)))
+              (if (< (vector-ref v mid) x) (loop (+ mid 1) hi) (loop lo mid))))))
+
+    ;; Stalls: 2 s or more with a task posed and not started, and no
+    ;; component running.
+    (define (deadlocks run)
+      (let ((waiting-at (waiting-counter run))
+            (spans (filter-map (lambda (t) (span-of run t)) (run-tasks run)))
+            (makespan (schedule-makespan run)))
+        (let loop ((t 0) (quiet 0) (n 0))
+          (if (> t makespan)
+              n
+              (let* ((waiting (> (waiting-at t) 0))
+                     (running (any (lambda (s) (and (<= (car s) t) (< t (cadr s)))) spans))
+                     (quiet (if (and waiting (not running)) (+ quiet 0.1) 0)))
+                (loop (+ t 0.1) quiet (if (and (>= quiet 2) (< quiet 2.1)) (+ n 1) n)))))))
+
+    ;; From each end on a robot to the next start there, while a task
+    ;; waited; and the same where that start is of a one-robot task, which
+    ;; no task could have held for a while before it started.
+    (define (latencies-where run ok?)
+      (let ((waiting-at (waiting-counter run)))
+        (let loop ((es (reverse (run-events run))) (next-start '()) (out '()))
+          (if (null? es)
+              out
+              (let* ((e (car es)) (uid (list-ref e 4)) (next (assq uid next-start)))
+                (if (eq? (cadr e) 'start)
+                    (loop (cdr es) (cons (cons uid e) (remove (lambda (x) (eq? (car x) uid))
+                                                              next-start))
+                          out)
+                    (loop (cdr es) next-start
+                          (if (and next (ok? (cdr next)) (> (waiting-at (car e)) 0))
+                              (cons (* 1000 (- (cadr next) (car e))) out)
+                              out))))))))
+
+    ;; From the last release among the robots a task starts on to its
+    ;; start, for a task posed before that release: what the turns add,
+    ;; without the time its other robots were held for it, which 'hold means.
+    (define (last-release-latencies run)
+      (filter-map (lambda (t)
+                    (let ((last (vector-ref (run-ready run) (car t))))
+                      (and last (< (posed run t) last)
+                           (* 1000 (- (car (span-of run t)) last)))))
+                  (run-tasks run)))
+
+    ;;; The ideal schedule: the same arrivals and rank rule, the measured
+    ;;; work, no messages.  At each moment the waiting tasks, best rank
+    ;;; first, each take for each component a free robot of a kind it
+    ;;; accepts, those that accept one kind first, keeping them until they
+    ;;; have all they need, as 'hold does; a robot taken is the one free
+    ;;; longest.  Answers its makespan, and the start latency as the run's
+    ;;; is measured: from a robot's release while a task waits to the next
+    ;;; start on it.
+
+    ;; The robots free for t's components, from free, sorted by release:
+    ;; (taken . left), taken shorter than t's components when too few.
+    (define (take-robots t free)
+      (let loop ((kinds (list-sort (lambda (a b) (< (length a) (length b))) (task-kinds t)))
+                 (free free) (taken '()))
+        (if (null? kinds)
+            (cons taken free)
+            (let ((r (find (lambda (r) (memq (car r) (car kinds))) free)))
+              (if r
+                  (loop (cdr kinds) (remove (lambda (x) (eq? x r)) free) (cons r taken))
+                  (loop (cdr kinds) free taken))))))
+
+    (define (ideal-schedule run)
+      ;; pool: (kind released . waited?) of each robot not running;
+      ;; running: (end . pool entries); ranked: the tasks not started, best
+      ;; rank first.
+      (let ((worked (filter (lambda (t) (work-of run t)) (run-tasks run))))
+        (let loop ((now 0)
+                   (pool (map (lambda (r) (cons (cdr r) (cons 0 #f))) (run-robots run)))
+                   (running '())
+                   (ranked (list-sort (ranks-before? run) worked))
+                   (last 0) (latencies '()))
+          (let fill ((ws ranked)
+                     (free (list-sort (lambda (a b) (< (cadr a) (cadr b))) pool))
+                     (held '()) (left '()) (started '()) (latencies latencies))
+            (cond
+             ((and (pair? ws) (pair? free) (<= (posed run (car ws)) now))
+              (let* ((got (take-robots (car ws) free)) (taken (car got)))
+                (if (= (length taken) (task-robots (car ws)))
+                    (fill (cdr ws) (cdr got) held left (cons (cons (car ws) taken) started)
+                          (append (filter-map (lambda (r) (and (cddr r)
+                                                               (* 1000 (- now (cadr r)))))
+                                              taken)
+                                  latencies))
+                    (fill (cdr ws) (cdr got) (append taken held) (cons (car ws) left)
+                          started latencies))))
+             ((and (pair? ws) (pair? free))
+              (fill (cdr ws) free held (cons (car ws) left) started latencies))
+             (else
+              (let* ((ranked (append (reverse left) ws))
+                     (running (append (map (lambda (s) (cons (+ now (work-of run (car s)))
+                                                             (cdr s)))
+                                           started)
+                                      running))
+                     (later (filter (lambda (x) (> x now))
+                                    (map (lambda (t) (posed run t)) ranked)))
+                     (next (and (or (pair? running) (pair? later))
+                                (apply min (append (map car running) later)))))
+                (if (not next)
+                    (list last latencies)
+                    (let* ((ended (filter (lambda (r) (<= (car r) next)) running))
+                           (waited? (any (lambda (t) (< (posed run t) next)) ranked)))
+                      (loop next
+                            (append free held
+                                    (append-map (lambda (r)
+                                                  (map (lambda (p)
+                                                         (cons (car p) (cons (car r) waited?)))
+                                                       (cdr r)))
+                                                ended))
+                            (remove (lambda (r) (<= (car r) next)) running)
+                            ranked (apply max last (map car ended)) latencies))))))))))
+
+    (define (percentile xs p)
+      (if (null? xs)
+          0
+          (let ((v (list->vector (list-sort < xs))))
+            (vector-ref v (min (- (vector-length v) 1)
+                               (exact (floor (* p (vector-length v)))))))))
+
+    (define (round-to x places)
+      (let ((m (expt 10 places))) (/ (round (* x m)) m)))
+
+    ;;> Prints a line "bench: NAME VALUE UNIT".
+    (define (bench name value unit)
+      (display "bench: ") (display name) (display " ") (display value)
+      (display " ") (display unit) (newline))
+
+    ;;> Prints the run's figures beside its ideal schedule's, each name
+    ;;> starting with \var{prefix}, and tells the inversions on standard
+    ;;> error.
+    (define (print-schedule-figures run prefix)
+      (define (line name value unit) (bench (string-append prefix "-" name) value unit))
+      (let* ((tasks (run-tasks run))
+             (makespan (schedule-makespan run))
+             (robot-seconds (apply + (map (lambda (t) (* (task-robots t) (or (work-of run t) 0)))
+                                          tasks)))
+             (bound (max (/ robot-seconds (length (run-robots run)))
+                         (apply max 0 (filter-map (lambda (t) (work-of run t)) tasks))))
+             (ideal-run (ideal-schedule run))
+             (ideal (car ideal-run))
+             (inversions (inversions run))
+             (one-robot? (lambda (s) (= 1 (task-robots (list-ref tasks (list-ref s 2))))))
+             (latencies (latencies-where run (lambda (s) #t)))
+             (one-robot-latencies (latencies-where run one-robot?))
+             (last-release (last-release-latencies run)))
+        (line "tasks" (length tasks) "")
+        (line "completed" (run-completed run) "")
+        (line "lost" (- (length tasks) (run-completed run)) "")
+        (line "double-bookings" (double-bookings run) "")
+        (line "deadlocks" (deadlocks run) "")
+        (for-each (lambda (xy) (tell-inversion! run xy)) inversions)
+        (line "priority-inversions" (length inversions) "")
+        (line "makespan" (round-to makespan 2) "s")
+        (line "ideal-makespan" (round-to ideal 2) "s")
+        (line "makespan-over-ideal" (round-to (/ makespan ideal) 3) "x")
+        (line "lower-bound" (round-to bound 2) "s")
+        (line "makespan-over-bound" (round-to (/ makespan bound) 3) "x")
+        (line "start-latency-p50" (round-to (percentile latencies 0.5) 1) "ms")
+        (line "start-latency-p95" (round-to (percentile latencies 0.95) 1) "ms")
+        (line "ideal-start-latency-p50" (round-to (percentile (cadr ideal-run) 0.5) 1) "ms")
+        (line "ideal-start-latency-p95" (round-to (percentile (cadr ideal-run) 0.95) 1) "ms")
+        (line "start-latency-one-robot-p50"
+              (round-to (percentile one-robot-latencies 0.5) 1) "ms")
+        (line "start-latency-one-robot-p95"
+              (round-to (percentile one-robot-latencies 0.95) 1) "ms")
+        (line "start-latency-last-release-p50" (round-to (percentile last-release 0.5) 1) "ms")
+        (line "start-latency-last-release-p95" (round-to (percentile last-release 0.95) 1) "ms")
+        (line "utilization"
+              (round-to (* 100 (/ robot-seconds (* (length (run-robots run)) makespan))) 1) "%")
+        (for-each
+         (lambda (k)
+           (line (string-append "wait-p95-priority-" (number->string k))
+                 (round-to (percentile (filter-map (lambda (t)
+                                                     (and (= (task-priority t) k)
+                                                          (span-of run t)
+                                                          (- (car (span-of run t))
+                                                             (posed run t))))
+                                                   tasks)
+                                       0.95)
+                           2)
+                 "s"))
+         (delete-duplicates (list-sort < (map task-priority tasks))))))))
