@@ -271,8 +271,12 @@
 ;; stays put meanwhile), on the side agreed with the other pusher.  Until
 ;; it first sees the box, the user's word stands in for a sighting: the box
 ;; starts at the path's start.  A sighting is checked before the robot
-;; drives by it (sane-sighting?); it drives by one at most a second old,
-;; else it turns to where it last saw the box and looks again (look-for!).
+;; drives by it (sane-sighting?).  It counts itself at its place only by
+;; a sighting at most a second old, but drives its planned way by one up to
+;; sighting-kept seconds old, for a way round the box turns its finder away
+;; from it (seed 4: a pusher that turned back to look each second, then
+;; away to its way, turned to and fro for a minute); with none as fresh it
+;; turns to where it last saw the box and looks again (look-for!).
 ;; It fails when it has come no nearer its place for stall-seconds.
 (define (take-place previous)
   (sonar-start)
@@ -286,21 +290,26 @@
              (ok? (and sighting (sane-sighting? sighting box seen-at)))
              (box (if ok? sighting box))
              (seen-at (if ok? now seen-at))
-             (fresh? (< (- now seen-at) 1)))
+             (fresh? (< (- now seen-at) 1))
+             (kept? (< (- now seen-at) sighting-kept)))
         (cond ((and fresh? (at-place? box (* side pusher-offset)))
                (stop-base)
                (turn-to! (place-axis box))
                (list (local-aspace-uid) (role side)))
-              ((stalled? (and fresh? (distance (reckon) (place-of box side))))
+              ((stalled? (and kept? (distance (reckon) (place-of box side))))
                (stop-base)
                (error (string-append "take-place: no nearer its place behind the box in "
                                      (number->string stall-seconds) " s: " held)
                       (local-aspace-uid) (rounded (reckon)) 'box (rounded box)
                       'place (rounded (place-of box side))))
               (else
-               (if fresh? (approach! (list box '()) (* side pusher-offset)) (look-for! box))
+               (if kept? (approach! (list box '()) (* side pusher-offset)) (look-for! box))
                (thread-sleep! 0.1)
                (loop box seen-at)))))))
+
+;; How long, in seconds, a pusher taking its place drives by its last
+;; sighting of the box, which no one pushes meanwhile.
+(define sighting-kept 8)
 
 ;; Whether a sighting of the box may be driven by: it does not put the box
 ;; on this robot, and, after a sighting within the last 2 s, the box has
@@ -709,7 +718,7 @@
                  (aside (- (* (- (cadr e) (cadr place)) (cos a))
                            (* (- (car e) (car place)) (sin a)))))
              (and (< 0 ahead (+ body-radius 150)) (< (abs aside) 100))))
-         (echoes me box))))
+         (map car (echoes me box)))))
 
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
 ;; it along the box's axis: behind it, and the nearer the face the nearer
@@ -732,8 +741,8 @@
   (let ((out (if (< offset 0) -1 1)) (heard (echoes (reckon) box)))
     (define (clear p kind)
       (and (clear-of? bodies (list p))
-           (every (lambda (e) (or (> (distance e p) (+ body-radius 60))
-                                  (not (clear-of? bodies (list e) -150))))
+           (every (lambda (e) (or (not (echo-near? e p (+ body-radius 60)))
+                                  (not (clear-of? bodies (list (car e)) -150))))
                   heard)
            (cons p kind)))
     (and (clear-of? bodies (list (behind-at box axis offset)) -40)
@@ -758,7 +767,9 @@
          (blocked (make-vector (* nx ny) #f))
          (cell-of (lambda (p) (+ (exact (round (/ (- (car p) x0) cell)))
                                  (* nx (exact (round (/ (- (cadr p) y0) cell))))))))
-    (define (paint! p r . free)
+    ;; Marks the cells within r of p blocked, or, given free?, those of
+    ;; them whose middle is free? free, the others blocked.
+    (define (paint! p r . free?)
       (let ((i0 (exact (round (/ (- (car p) x0) cell))))
             (j0 (exact (round (/ (- (cadr p) y0) cell))))
             (k (exact (ceiling (/ r cell)))))
@@ -766,16 +777,22 @@
           (do ((j (- j0 k) (+ j 1))) ((> j (+ j0 k)))
             (if (and (< -1 i nx) (< -1 j ny)
                      (<= (* cell cell (+ (square (- i i0)) (square (- j j0)))) (* r r)))
-                (vector-set! blocked (+ i (* nx j)) (null? free)))))))
+                (vector-set! blocked (+ i (* nx j))
+                             (or (null? free?)
+                                 (not ((car free?) (list (+ x0 (* cell i))
+                                                         (+ y0 (* cell j))))))))))))
     (paint-box! paint! box)
     ;; A body said to lie where this robot stands has been pushed away.
     (for-each (lambda (b) (if (> (distance b me) (+ body-radius body-radius))
                               (paint! b (+ body-radius body-radius))))
               bodies)
-    (for-each (lambda (e) (paint! e (+ body-radius 80))) (echoes me box))
+    (for-each (lambda (e)
+                (paint! (car e) (+ body-radius 80)
+                        (lambda (p) (not (echo-near? e p (+ body-radius 80))))))
+              (echoes me box))
     ;; A robot hemmed in, by the box's grown edge or a robot beside it, may
     ;; still step out.
-    (paint! me 150 'free)
+    (paint! me 150 (lambda (p) #t))
     (let ((start (cell-of me)) (end (cell-of goal)))
       (let ((from (breadth-first blocked nx ny end start)))
         (and from
@@ -797,8 +814,20 @@
                       (+ (cadr box) (* u (sin a)) (* v (cos a))))
                 0)))))
 
-;; The sonar's echoes within 2.5 m of the ring, as points in the room, less those of
-;; the box itself.
+;; The sonar's echoes within 2.5 m of the ring, less those of the box
+;; itself, each as the points in the room where its cone's middle and edges
+;; (sonar-half-cone either side) reach: (MIDDLE EDGE EDGE).  A sonar says how
+;; far the nearest thing in its cone is, not where across it: a wall seen
+;; aslant echoes from the cone's edge, some 0.2 of the range off its middle
+;; (seed 4: a wall 350 mm from the staging points read as 50 mm, and the
+;; pusher found none clear).
+(define sonar-half-cone 12.5)           ; a B14's sonar, degrees
+
+;; Whether the echo e says something lies within r of p: wherever across
+;; its cone it came from, for a far echo may have come from either edge.
+(define (echo-near? e p r)
+  (every (lambda (q) (< (distance q p) r)) e))
+
 (define (echoes me box)
   (let ((a (* (list-ref box 2) degrees)))
     (let loop ((i 0) (ranges (sonar-read)) (out '()))
@@ -806,14 +835,19 @@
           out
           (let* ((r (+ (car ranges) body-radius))   ; the ring is at the body's edge
                  (t (* degrees (+ (list-ref me 2) (* i 22.5))))
-                 (p (list (+ (car me) (* r (cos t))) (+ (cadr me) (* r (sin t)))))
+                 (at (lambda (t) (list (+ (car me) (* r (cos t))) (+ (cadr me) (* r (sin t))))))
+                 (p (at t))
                  (dx (- (car p) (car box))) (dy (- (cadr p) (cadr box)))
                  (in-box? (and (< (abs (+ (* dx (cos a)) (* dy (sin a))))
                                   (+ box-half 150))
                                (< (abs (- (* dy (cos a)) (* dx (sin a))))
                                   (+ box-half 150)))))
             (loop (+ i 1) (cdr ranges)
-                  (if (or (> (car ranges) 2500) in-box?) out (cons p out))))))))
+                  (if (or (> (car ranges) 2500) in-box?)
+                      out
+                      (cons (list p (at (- t (* sonar-half-cone degrees)))
+                                  (at (+ t (* sonar-half-cone degrees))))
+                            out))))))))
 
 ;; Each cell's next cell on a shortest way to end, by a breadth-first
 ;; search from end over free cells and their eight neighbours, until it
