@@ -530,14 +530,19 @@
 
 ;; The watcher's view, while it is at most a second old and does not put
 ;; the box on this robot; else this robot's own sighting of the box, with
-;; the bodies last told; else #f: a pusher does not push on a view older
-;; than that, however slow the round.
+;; the bodies last told, which the box's turn rate is then measured by
+;; (seed 21: the watcher lost the box beyond its finder's range, and the
+;; pair steered by the turn it last measured, turning the box on round past
+;; its way); else #f: a pusher does not push on a view older than that,
+;; however slow the round.
 (define (fresh view)
   (if (and view (< (- now view-at) 1)
            (> (box-clearance (reckon) (car view)) (- body-radius 60)))
       view
       (let ((own (see-box)))
-        (and own (list own (if view (cadr view) '()))))))
+        (and own
+             (begin (note-turn! own)
+                    (list own (if view (cadr view) '())))))))
 
 ;; How many degrees left the box must turn to head for the path.
 (define (turn-error box)
@@ -598,7 +603,8 @@
     (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1) (* 0.05 side ahead)) 0.3 1.6)))
 
 ;; How fast the box turns, degrees a second, left positive, from the
-;; watcher's views at least 0.3 s apart on this robot's clock.
+;; sightings it pushes by (fresh), at least 0.3 s apart on this robot's
+;; clock.
 (define turn-rate 0)
 (define rate-from #f)                   ; (SECONDS HEADING)
 (define (note-turn! box)
