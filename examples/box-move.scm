@@ -579,13 +579,24 @@
 ;; (push-offset), and holds while the box turns faster than max-turn-rate.
 ;; A spare coming turns the box the most: once the spare has a way to its
 ;; place, the lone pusher holds at its own, leaving the spare's free.
+;; Before it is alone, it pushes from its own half only, which turns the box
+;; away from its side: while the box must turn more than 10 degrees toward
+;; that side and no spare has spoken, it stands still, not even keeping up
+;; with its place, which the box's turn moves (seed 13: the lone pusher
+;; turned the box 15 degrees the wrong way before the spare spoke, and the
+;; pair could not bring it round before the goal).  A spare that says it
+;; has no way (the lost one's body lies at its place) is let through by
+;; pushing on; alone, a pusher pushes anywhere along the face.
 (define (steer! view side offset)
   (let ((box (car view)))
-    (push-at! box (place-axis box) offset
-              (cond ((paired?) (pair-share box side))
-                    ((spare-on-its-way?) 0)
-                    ((> (abs turn-rate) max-turn-rate) 0)
-                    (else 0.5)))))
+    (if (and (not (paired?)) (not (alone?)) (>= (coming-age) 2)
+             (> (* side (turn-error box)) 10))
+        (stop-base)
+        (push-at! box (place-axis box) offset
+                  (cond ((paired?) (pair-share box side))
+                        ((spare-on-its-way?) 0)
+                        ((> (abs turn-rate) max-turn-rate) 0)
+                        (else 0.5))))))
 
 ;; A pusher's share of push-speed in a pair: both push less the further
 ;; the box is turned off its way (forward at a third from 30 degrees off),
@@ -694,7 +705,7 @@
         (set! docking (cdr stage)))
     (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box axis place))
            (set! held "something stands in its way into its place")
-           (stop-base))
+           (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
           ((and (eq? docking 'behind) (in-corridor? off 2))
            (set! held "it does not come into its place along the box's axis")
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
@@ -715,16 +726,18 @@
 
 ;; Whether the sonar hears something other than the box in the way into
 ;; the place along axis: within 150 mm ahead of the robot's body and 100
-;; mm of the place's line, where another robot would be pushed into the
-;; box.  The other pusher at its own place, 340 mm aside, is not in it.
+;; mm of the place's line, wherever across its cone the echo came from,
+;; where another robot would be pushed into the box.  The other pusher at
+;; its own place, 340 mm aside, is not in it (seed 13: its edge, 160 mm
+;; aside, read at a cone's middle, held the robot there for a minute).
 (define (blocked-ahead? box axis place)
   (let ((me (reckon)) (a (* axis degrees)))
-    (any (lambda (e)
-           (let ((ahead (+ (* (- (car e) (car me)) (cos a)) (* (- (cadr e) (cadr me)) (sin a))))
-                 (aside (- (* (- (cadr e) (cadr place)) (cos a))
-                           (* (- (car e) (car place)) (sin a)))))
-             (and (< 0 ahead (+ body-radius 150)) (< (abs aside) 100))))
-         (map car (echoes me box)))))
+    (define (in-way? e)
+      (let ((ahead (+ (* (- (car e) (car me)) (cos a)) (* (- (cadr e) (cadr me)) (sin a))))
+            (aside (- (* (- (cadr e) (cadr place)) (cos a))
+                      (* (- (car e) (car place)) (sin a)))))
+        (and (< 0 ahead (+ body-radius 150)) (< (abs aside) 100))))
+    (any (lambda (e) (every in-way? e)) (echoes me box))))
 
 ;; Whether a robot off (AHEAD LEFT) from its place may drive straight into
 ;; it along the box's axis: behind it, and the nearer the face the nearer
