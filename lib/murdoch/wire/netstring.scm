@@ -1,12 +1,8 @@
-;;;; Netstrings: the frames every Murdoch message travels in.
-;;
-;; A netstring is "LENGTH:PAYLOAD," with LENGTH in decimal (D. J. Bernstein).
-;; The reader is strict, because a frame comes from the network: digits
-;; only, no leading zero but for the empty payload, at most MAX bytes of
-;; payload, and the comma.
+;;;; Netstrings (D. J. Bernstein): "LENGTH:PAYLOAD,".  The reader is strict,
+;;;; as frames come from the network: digits only, no leading zero but for
+;;;; the empty payload, at most MAX bytes of payload, and the comma.
 
-;; What a peer sends that is not a netstring is a protocol error of the
-;; remote-error family, whose message says what was wrong, for the log.
+;; A peer's bad netstring is a protocol error of the remote-error family.
 (define (netstring-fail . parts)
   (apply protocol-fail "netstring" parts))
 
@@ -19,9 +15,8 @@
 
 (define (digit-byte? b) (and (>= b 48) (<= b 57)))
 
-;; The length prefix, read one byte at a time: it is a few bytes long, and
-;; reading no further than the colon leaves the payload in the buffer.  A
-;; length already over max takes no more digits.
+;; The length, read a byte at a time to leave the payload in the buffer;
+;; a length already over max takes no more digits.
 (define (read-netstring-length in max)
   (let loop ((n 0) (digits 0))
     (let ((b (read-u8 in)))
@@ -39,9 +34,8 @@
         (netstring-fail "length over " (number->string max) " bytes"))
        (else (loop (+ (* n 10) (- b 48)) (+ digits 1)))))))
 
-;; What the port's buffer holds is copied at once (netstring-scan.c); when
-;; it is empty, read-u8 waits for more and refills it.  The end of the port
-;; before the last byte is a fault.
+;; The buffer's bytes are copied at once (netstring-scan.c); read-u8 waits
+;; to refill an empty one.  The port's end before the last byte is a fault.
 (define (read-payload in n)
   (let ((payload (make-bytevector n)))
     (let loop ((have 0))
@@ -76,9 +70,8 @@
               (netstring-fail "missing comma after payload")))
         payload)))))
 
-;;> Writes \var{payload}, a bytevector or a string (its UTF-8 bytes), to
-;;> \var{out} as one netstring; a string is the faster (docs/speed.md).
-;;> Does not flush: the caller knows when a batch of frames is complete.
+;;> Writes \var{payload}, a bytevector or a string (faster: docs/speed.md),
+;;> to \var{out} as one netstring, unflushed.
 (define (write-netstring payload out)
   (if (string? payload)
       (begin

@@ -33,8 +33,7 @@
 ;;> A remote-error for a call that had no answer within its timeout.
 (define (remote-timeout-error? e) (remote-error-of-kind? 'timed-out e))
 
-;;> A remote-error for a target that could not be reached, or whose
-;;> connection was lost or refused.
+;;> A remote-error for a target that could not be reached, or was lost.
 (define (remote-unreachable-error? e) (remote-error-of-kind? 'unreachable e))
 
 ;;> A remote-error for a procedure that raised an error in the target.
@@ -49,18 +48,15 @@
 ;;> What went wrong, as a string.
 (define (remote-error-message e) (car (cddr (exception-irritants e))))
 
-;;> What \var{e}, any raised object, says, as one line for a log or an
-;;> answer: a remote error's own message (its uid and procedure are its
-;;> irritants, for whoever names them), else condition-message's.
+;;> What \var{e}, any raised object, says, as one line: a remote error's
+;;> own message, else condition-message's.
 (define (error-message e)
   (if (and (remote-error? e) (not (stack-guard-tripped? (current-thread))))
       (remote-error-message e)
       (condition-message e)))
 
-;;> As error-message, but a remote error's message follows the uid of the
-;;> address space it concerns, as \scheme{"praline: car: not a pair ()"}:
-;;> for an error that leaves the place that knows the uid, an answer to
-;;> another caller or the command line's ERROR line.
+;;> As error-message, a remote error's message after its uid, as
+;;> \scheme{"praline: car: not a pair ()"}, for an answer or an ERROR line.
 (define (error-message-naming e)
   (let ((uid (and (remote-error? e) (remote-error-uid e))))
     (if uid
