@@ -1,18 +1,14 @@
 ;;;; bin/murdoch: start address spaces, join a lab at a REPL.
 
 ;;> Makes this process address space \var{uid} of the lab at
-;;> \var{lab-file}, or of \var{lab} when it is already read, and starts
-;;> serving with its subscriptions and monitors; answers the environment
-;;> received code runs in.
+;;> \var{lab-file} (or \var{lab}, already read), serving with its
+;;> subscriptions and monitors; answers the received-code environment.
 (define (join-lab lab-file uid . port)
   (join-read-lab (read-lab lab-file) uid port))
 
-;; A process in a lab writes to peers that may die at any moment: a
-;; caller killed before its answer went back, a browser that closed the
-;; view.  Writing to a socket whose peer has gone raises SIGPIPE, and its
-;; default action ends the process without a word, so it is ignored, as
-;; the simulator ignores it (sim/b14.c): the peer's end shows as the end
-;; of its connection instead, to whoever reads it.
+;; SIGPIPE is ignored, as the simulator does (sim/b14.c): a peer may die at
+;; any moment, and its default action would end this process without a
+;; word; the reader of the connection sees its end instead.
 (define (join-read-lab lab uid port)
   (set-signal-action! signal/pipe #f)
   (take-tunables! lab)
@@ -24,9 +20,8 @@
     (offer-on-joining!)
     env))
 
-;; The settings that are the values of parameters, or of the thesis's
-;; globals, of the layers above the lab: each takes the lab's value here,
-;; before anything runs.  Their defaults are the lab's table's.
+;; The settings that are values of the layers' parameters or the thesis's
+;; globals, set from the lab before anything runs.
 (define tunables
   `((task-timeout . ,task-timeout) (trip-timeout . ,trip-timeout)
     (trip-motion-timeout . ,trip-motion-timeout)
@@ -37,10 +32,9 @@
 (define (take-tunables! lab)
   (for-each (lambda (t) ((cdr t) (lab-setting lab (car t)))) tunables))
 
-;; A robot's address space drives its robot through trip, at the port the
-;; lab gives it; a workstation answers safe-reckon from its lab position.
-;; The lab starts the simulator, and waits until it listens, before any
-;; address space: one attempt is enough, and a failed one says why.
+;; A robot drives its robot through trip at the lab's port; a workstation
+;; answers safe-reckon from its lab position.  The lab starts the
+;; simulator first, so one attempt is enough, and a failed one says why.
 (define (take-body! lab entry)
   (cond
    ((lab-aspace-clause entry 'robot)
@@ -62,8 +56,7 @@
   (set-process-name! (string-append "murdoch-" (symbol->string uid)))
   (join-lab lab-file uid)
   ;; After the join, not at the fork: the kernel will not collapse pages
-  ;; still shared with the loader, and the join's collections have made
-  ;; them this process's own (heap-watch.c).
+  ;; still shared with the loader (sys/heap-watch.c).
   (heap-on-huge-pages!)
   (start-heap-guard!
    (lab-setting (current-lab) 'heap-max)
@@ -73,9 +66,8 @@
             (aspace-port (local-aspace)))
   (let wait () (thread-sleep! 3600) (wait)))
 
-;;> Warns of the lab's address spaces that do not answer: a guest that
-;;> joins before the lab is up, or on another port base, would otherwise
-;;> find out only from tasks that nobody takes.
+;;> Warns of the lab's address spaces that do not answer, as a guest that
+;;> joins too early or on another port base would see only untaken tasks.
 (define (tell-who-is-away lab)
   (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                          (map lab-aspace-uid (lab-aspaces lab))))
@@ -103,15 +95,14 @@
                                  " Ctrl-D leaves\n"))
     (tell-who-is-away lab)
     (set-remote-timeout! (lab-setting lab 'repl-timeout))
-    ;; (chibi repl) is loaded here, not imported: it costs seconds, and
-    ;; only a person at a REPL needs it.
+    ;; (chibi repl) is loaded, not imported: it costs seconds.
     ((eval 'repl (environment '(chibi repl)))
           'in: (waiting-input-port)
           'environment: (with-help (make-repl-environment lab lab-env))
           'eval: eval-with-hints
           'raw?: (not (is-a-tty? (current-input-port)))
-          ;; write, not (chibi repl)'s write/ss: labels for cycles only,
-          ;; so a value met twice (task-status's outcomes) reads as itself.
+          ;; write, not write/ss: labels for cycles only, so a value met
+          ;; twice (task-status's outcomes) reads as itself.
           'printer: (lambda (value out) (write value out))
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))
@@ -138,12 +129,9 @@ docs/tutorial.md walks through these; docs/reference.md has every procedure.
 ")
 
 ;; Standard input, read so that the REPL's wait for a line lets the other
-;; threads run: they serve the lab's calls to this peer, and a task's
-;; components that Ctrl-C gave up.  A read of descriptor 0 would stop the
-;; whole process until a line came.  Its own description of the same file,
-;; not descriptor 0's, is made non-blocking, so that the shell's is left
-;; as it was.  Standard input that cannot be opened again (a socket) is
-;; read as it is.
+;; threads run (serving the lab, components Ctrl-C gave up).  Its own
+;; description of the file is made non-blocking, leaving the shell's be; one
+;; that cannot be opened again (a socket) is read as it is.
 (define (waiting-input-port)
   (let ((fd (guard (e (#t #f))
               (open "/proc/self/fd/0" (bitwise-ior open/read open/non-block)))))
