@@ -23,8 +23,8 @@
                      (Connection . "close")))
   (write-string body (request-out request)))
 
-;; The servlet: the page and its files from web, /info, /trace, /state
-;; and /events.  feed is #f in a replay.
+;; The servlet: the page and its files from web, /info, /trace, /state and
+;; /events; feed is #f in a replay.
 (define (view-servlet web trace feed info)
   (lambda (cfg request next restart)
     (let ((path (request-path request)))
@@ -48,11 +48,10 @@
         (send-events request feed))
        (else (respond request 404 "text/plain" "not found\n"))))))
 
-;; Server-sent events: each snapshot from the one the page asks for
-;; (?from=N, or the one after its Last-Event-ID when it reconnects), as
-;; "id: N" and "data: JSON", until the page goes.  A comment after 10 s
-;; without a snapshot finds out a page that went quietly.  With ?once=1,
-;; only those there are now, and the stream ends: a page that polls.
+;; Server-sent events: each snapshot from the one asked for (?from=N, or
+;; after Last-Event-ID) as "id: N" and "data: JSON", until the page goes;
+;; a comment after 10 s quiet finds a page gone.  ?once=1 sends what there
+;; is and ends, for a page that polls.
 (define (send-events request feed)
   (let ((out (request-out request))
         (once? (request-param request "once")))
@@ -80,7 +79,6 @@
         (and p (string->number p)))
       (feed-count feed)))
 
-;; A listening socket on 127.0.0.1:port, or an error that says so.
 (define (listen-on port)
   (let ((addr (get-address-info "127.0.0.1" port)))
     (guard (e (#t (error (string-append "the view cannot listen on 127.0.0.1:"
@@ -96,11 +94,10 @@
   (newline)
   (flush-output-port (current-output-port)))
 
-;;> `murdoch view LAB [PORT]`: joins the running lab at \var{lab-file} as
-;;> a peer listening on port-base + 147, polls it twice a second, appends
-;;> each snapshot to \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl),
-;;> and serves the page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
-;;> lab's port-base + 148), until killed.
+;;> `murdoch view LAB [PORT]`: joins the running lab as a peer on
+;;> port-base + 147, polls it twice a second, appends each snapshot to
+;;> \var{trace} (#f: runs/LAB-SECONDS.jsonl) and serves the page from
+;;> \var{web} on 127.0.0.1:\var{port} (#f: port-base + 148), until killed.
 (define (run-view web lab-file port trace)
   (set-process-name! "murdoch-view")
   (let* ((lab (read-lab lab-file))
@@ -109,9 +106,8 @@
          (trace (or trace (default-trace lab)))
          (uid (string->symbol
                (string-append "view-" (number->string (current-process-id)))))
-         ;; Not a guest's port, which is one of fifty by process id: the
-         ;; view stays as long as the lab, and a REPL or pose that drew
-         ;; the same would not start.
+         ;; Its own port, not a guest's (one of fifty by pid): the view
+         ;; lasts as the lab, and a REPL that drew the same would not start.
          (env (join-lab lab-file uid (lab-planned-port lab 'view-peer)))
          (proc (eval report-source (make-repl-environment lab env)))
          (aspaces (map (lambda (a) (uid->aspace (lab-aspace-uid a))) (lab-aspaces lab)))
@@ -125,8 +121,7 @@
      (make-logged-thread
       (lambda ()
         (let loop ()
-          ;; The trace counts wall-clock seconds from its start; the
-          ;; next look is due by the monotonic clock, as every deadline.
+          ;; The trace counts wall-clock seconds; looks are due by the monotonic clock.
           (let ((t0 (monotonic-seconds))
                 (at (- (utc-seconds) start)))
             (feed-add! feed (json-text
@@ -144,8 +139,8 @@
                             `((live . #t) (lab . ,(symbol->string (lab-name lab)))
                               (trace . ,trace)))))))
 
-;; The header of the trace already at path, or #f: the view started
-;; again by the lab carries on with the trace it was writing.
+;; The header of the trace at path, or #f: a view the lab restarted
+;; carries on with its trace.
 (define (trace-header path)
   (and (file-exists? path)
        (let ((line (call-with-input-file path read-line)))
@@ -160,8 +155,7 @@
             (if (eof-object? (read-line in)) n (loop (+ n 1))))))
       0))
 
-;; The trace's port: a new file that starts with the header, or the end
-;; of the trace there is.
+;; The trace's port: a new file that starts with header, or the trace's end.
 (define (open-trace path header)
   (if (trace-header path)
       (open-output-file-descriptor
@@ -172,9 +166,8 @@
         (flush-output-port out)
         out)))
 
-;;> runs/LAB-SECONDS.jsonl, or LAB-SECONDS-2.jsonl and on when a view
-;;> started in the same second has that: a name is claimed by making the
-;;> file, which only one process can.
+;;> runs/LAB-SECONDS.jsonl, or LAB-SECONDS-2.jsonl and on when taken: a
+;;> name is claimed by making the file, which only one process can.
 (define (default-trace lab)
   (let ((dir "runs")
         (stem (string-append "runs/" (symbol->string (lab-name lab)) "-"
@@ -190,8 +183,7 @@
               (else (error (string-append "cannot make the trace " name))))))))
 
 ;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
-;;> (default: port-base + 148, MURDOCH_PORT_BASE's or else 7100's, as the
-;;> view's) to play the run that \var{trace} holds.
+;;> (default port-base + 148) to play \var{trace}'s run.
 (define (run-replay web trace port)
   (if (not (file-exists? trace)) (error (string-append "no such trace " trace)))
   (let ((header (trace-header trace)))

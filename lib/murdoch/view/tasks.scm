@@ -1,26 +1,15 @@
 ;;;; The live view's table of tasks, part of (murdoch view): who holds
 ;;;; what, for which task, from what the address spaces report.
 
-;;; The tasks: what the address spaces say they hold and run
-;;
-;; A robot tells the subjects it holds and for whom -- a reservation name,
-;; NAME@POSER/N (task/pose-task.scm) -- the components it runs, (running ID
-;; INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed task's
-;; reservation name (task/running.scm), and the components that ended there
-;; lately, each with how it ended, which its poser was told.  The table
-;; remembers each component from when it is first seen on a robot to when
-;; it ended there, and how; one that ended between two looks is added
-;; whole.  A component of a started task seen on another robot than before
-;; was reassigned.  Subjects held for a task that its robot runs no
-;; component of are a reservation of its negotiation, shown without a
-;; number until a component of that task starts on that robot, or it is
-;; released.  A task's own state is what its poser says, when the poser is
-;; an address space of the lab; else what its components say: running while
-;; one runs, negotiating while only reservations are held, failed when one
-;; failed or was lost, not started when none started, else done.  A
-;; component is lost when its robot started again (its up-since moved) or
-;; has not answered for away-polls looks in a row: a robot that died does
-;; not say that it stopped, and its poser was told "connection lost".
+;;; A robot reports the subjects it holds and for whom (NAME@POSER/N,
+;;; task/pose-task.scm), the components it runs, (running ID INDEX
+;;; POSER), and those that ended lately and how.  The table keeps each
+;;; component from when it is first seen to its end; one seen on another
+;;; robot was reassigned; subjects held with no component are a
+;;; negotiation's reservation, unnumbered.  A task's state is its poser's
+;;; word when the poser is in the lab, else its components': running,
+;;; negotiating, failed, not started, or done.  A component is lost when
+;;; its robot restarted or missed away-polls looks: a dead robot cannot say.
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)
@@ -50,8 +39,7 @@
   (robots table-robots table-robots-set!)       ; seen-robots
   (tasks table-tasks table-tasks-set!))         ; task-entries, oldest first
 
-;; A robot the table has seen: when it last started, and how many looks
-;; in a row it has not answered.
+;; A robot the table has seen: when it last started, and looks missed in a row.
 (define-record-type seen-robot
   (make-seen-robot name since silent)
   seen-robot?
@@ -64,9 +52,8 @@
 
 (define away-polls 3)
 
-;;> The task name and poser that reservation name or task id \var{key}
-;;> (a string, NAME@POSER/N: task-key's) holds, as a list, or the key and
-;;> #f when it is not one.
+;;> The task name and poser that \var{key}, a reservation name or task id
+;;> (NAME@POSER/N), holds, as a list; else the key and #f.
 (define (reservation-task key)
   (or (task-key-parts key) (list key #f)))
 
@@ -75,8 +62,7 @@
   (let ((nt (reservation-task key)))
     (if (cadr nt) (string-append (car nt) "@" (cadr nt)) key)))
 
-;; A component one address space's report shows there: KEY its task's,
-;; INDEX #f when only held subjects show it.
+;; A component one report shows: KEY its task's, INDEX #f for held subjects only.
 (define-record-type shown
   (make-shown key index subjects)
   shown?
@@ -84,13 +70,11 @@
   (index shown-index)
   (subjects shown-subjects))
 
-;; The (subject . holder) of each subject a report says is held, as text.
 (define (held-texts report)
   (map (lambda (h) (cons (text (held-subject h)) (text (held-holder h))))
        (report-held report)))
 
-;; What one address space's report shows running there: a shown for
-;; each component.
+;; A shown for each component one report shows running there.
 (define (report-components report)
   (let* ((held (held-texts report))
          (running (filter-map (lambda (t)
@@ -115,8 +99,7 @@
             (make-shown holder #f (subjects-of (lambda (h) (equal? h holder)))))
           (delete-duplicates (remove covered? (map cdr held)))))))
 
-;; (KEY . STATE) for each task of tasks, entries as (tasks) answers, posed
-;; by the address space that answered them.
+;; (KEY . STATE) for each of tasks, as (tasks) answers, posed by the answerer.
 (define (posed-states tasks)
   (filter-map (lambda (t)
                 (and (pair? t) (listed-posed? t) (>= (length t) 3)
@@ -124,9 +107,8 @@
                            (posed-state-text t (and (= (length t) 8) (listed-place t))))))
               tasks))
 
-;; A posed task's state as the view shows it: its word, as task-state's,
-;; then for a failed one why, for a waiting one what it holds and waits
-;; for, and its place in the lab's line.
+;; A posed task's state as shown: task-state's word, why it failed, what
+;; a waiting one holds and waits for, and its place in line.
 (define (posed-state-text t place)
   (let ((word (text (listed-state t))))
     (cond ((< (length t) 8) word)       ; a peer older than the word's details
@@ -135,18 +117,16 @@
           ((string? (listed-why t)) (string-append word ": " (listed-why t)))
           (else word))))
 
-;; Whether the table takes a posed task's (KEY . STATE): it goes on, or
-;; it is one the table has; a task over before the view saw it is left out.
+;; Whether the table takes a posed (KEY . STATE): it goes on, or the
+;; table has it; a task over before the view saw it is left out.
 (define (posed-news? table posed)
   (or (task-known table (car posed))
       (not (any (lambda (word) (string-prefix? word (cdr posed)))
                 '("done" "failed" "cancelled" "deadline")))))
 
-;;> Brings the tasks of \var{table} that wait their turn up to date with
-;;> \var{line}, the lab's waiting tasks as lab-line has them, whoever
-;;> posed them: their state, and their place in the one line.  A task a
-;;> guest posed that has left the line is over or running, as its
-;;> components say.
+;;> Brings \var{table}'s waiting tasks up to date with \var{line}, the lab's
+;;> waiting tasks: state and place; a guest's task gone from the line is
+;;> over or running, as its components say.
 (define (task-table-note-line! table line)
   (let ((keys (map (lambda (x) (text (listed-id (car (cddr x))))) line)))
     (for-each (lambda (x key)
@@ -166,7 +146,6 @@
   (and (>= (string-length s) (string-length prefix))
        (string=? prefix (substring s 0 (string-length prefix)))))
 
-;; The entries of components-ended that a report gives, those well made.
 (define (ended-entries report)
   (filter (lambda (e)
             (and (list? e) (= (length e) 6) (exact-integer? (ended-index e))
@@ -174,8 +153,7 @@
                  (pair? (ended-end e))))
           (report-ended report)))
 
-;; (done), (failed WHY) or (lost WHY), as "done", "failed: WHY" ...; a
-;; long WHY cut short.
+;; (done), (failed WHY) or (lost WHY) as "done", "failed: WHY" ..., WHY cut short.
 (define (end-text end)
   (if (pair? (cdr end))
       (let ((why (text (cadr end))))
@@ -198,7 +176,6 @@
 
 (define (open? c) (not (component-entry-until c)))
 
-;; Whether c ended lost or failed.
 (define (failed? c)
   (let ((end (component-entry-end c)))
     (and (string? end)
@@ -207,17 +184,15 @@
                      (string=? word (substring end 0 (string-length word)))))
               '("lost:" "failed:")))))
 
-;; Whether c of cs failed or was lost, and no later entry took its number:
-;; a started task's component may be lost on one robot and done on the
-;; next.
+;; Whether c failed or was lost, and no later entry took its number (a
+;; started task's component may be lost on one robot and done on the next).
 (define (failed-for-good? c cs)
   (and (failed? c)
        (let ((k (component-entry-index c)))
          (not (and k (any (lambda (later) (eqv? (component-entry-index later) k))
                           (cdr (memq c cs))))))))
 
-;; A task's state, when its poser does not say it: what its components
-;; say.
+;; A task's state by its components, when its poser does not say.
 (define (components-state cs)
   (cond ((any (lambda (c) (and (open? c) (component-entry-index c))) cs) "running")
         ((any open? cs) "negotiating")
@@ -226,12 +201,9 @@
         ((any component-entry-index cs) "done")
         (else "not started")))
 
-;;> Brings \var{table} up to the time \var{t} (seconds since the view
-;;> started) with \var{reports}: (UID REPORT [POSED]) for each address
-;;> space that answered, REPORT as aspace-report makes it, POSED the tasks
-;;> it posed lately as (tasks) lists them, those over too (else REPORT's
-;;> TASKS).  A component that an address space that answered no longer
-;;> shows has ended: as it says, or else, a reservation, released.
+;;> Brings \var{table} up to time \var{t} with \var{reports}: (UID REPORT
+;;> [POSED]) for each address space that answered.  A component one no
+;;> longer shows has ended, as it says, or, a reservation, was released.
 (define (task-table-update! table t reports)
   (let ((seen '()))                     ; the component entries seen now
     (for-each
@@ -280,15 +252,13 @@
                    (task-entry-components task)))
        (table-tasks table)))))
 
-;; The parts of one of task-table-update!'s reports, a sighting: the
-;; (UID REPORT [POSED]) that the view makes of an outcome, and tests write.
+;; The parts of a sighting, (UID REPORT [POSED]), as the view and tests make it.
 (define (sighting-uid r) (car r))
 (define (sighting-report r) (cadr r))
 (define (sighting-posed r) (and (pair? (cddr r)) (car (cddr r))))
 
-;; Brings the table's robots up to date with reports, and answers
-;; ((ROBOT . WHY) ...) for those whose components seen before were lost:
-;; started again, or silent for away-polls looks.
+;; Brings the table's robots up to date, answering ((ROBOT . WHY) ...) for
+;; those whose components were lost: restarted, or silent away-polls looks.
 (define (note-robots! table t reports)
   (let ((gone '()))
     (for-each
@@ -351,11 +321,9 @@
                                                  (list c)))
         c)))))
 
-;; The reservations robot holds, unnumbered, for task -- under its own
-;; name, or under the name a started task negotiated with, which shares
-;; its NAME@POSER -- are the component of task that starts there now:
-;; they are taken out of the table, a task left with nothing with them,
-;; and answers when the first was seen, or #f when there was none.
+;; The unnumbered reservations robot holds for task (under its name or
+;; its NAME@POSER) become the component starting there: taken out of the
+;; table, and answers when the first was seen, or #f.
 (define (take-reservations! table task robot)
   (let ((base (key-base (task-entry-key task)))
         (since #f))
@@ -378,9 +346,8 @@
                               (table-tasks table)))
     since))
 
-;; Brings robot's component that e, an entry of ended-entries, tells of to
-;; its end: the open entry seen before, or a new one when it ended since
-;; the view started and the table has none.
+;; Brings robot's component that e tells of to its end: the open entry, or
+;; a new one when it ended unseen.
 (define (note-ended! table t robot e)
   (let* ((key (text (ended-id e)))
          (k (ended-index e))
@@ -400,16 +367,14 @@
   (component-entry-until-set! c until)
   (component-entry-end-set! c end))
 
-;; Whether component a goes before b: a smaller number, or a number
-;; before none.
+;; Whether a goes before b: a smaller number, or a number before none.
 (define (by-number a b)
   (let ((i (component-entry-index a)) (j (component-entry-index b)))
     (and i (or (not j) (< i j)))))
 
-;;> The table as JSON: the newest \var{most} tasks, each with its name,
-;;> poser, state, coordinator and standby when it is detached, and components (index, robot, subjects, since, until,
-;;> how it ended, and the robot it was reassigned from), by their number,
-;;> the reservations last.
+;;> The table as JSON: the newest \var{most} tasks, with name, poser,
+;;> state, keepers when detached, and components by number (index, robot,
+;;> subjects, since, until, end, reassigned from), reservations last.
 (define (task-table->json table most)
   (list->vector
    (map (lambda (task)
