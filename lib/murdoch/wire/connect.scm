@@ -3,11 +3,9 @@
 ;;;; waits for the socket to turn writable, which is when a connect ends.
 
 ;;> \procedure{(open-connection host port seconds)}
-;;> Connects to TCP \var{port} of \var{host}, waiting at most \var{seconds}
-;;> without blocking other threads: \scheme{(list in out)}, or a string
-;;> saying why not ("connection refused", "no such host", "no connection
-;;> within 0.3 s").  Only wrong arguments raise.  A name not in /etc/hosts
-;;> may ask DNS, which blocks the process.
+;;> Connects to \var{host}'s TCP \var{port} within \var{seconds}, blocking
+;;> no other thread: \scheme{(list in out)}, or a string saying why not.
+;;> Only wrong arguments raise; a name not in /etc/hosts may ask DNS.
 (define (open-connection host port seconds)
   (let ((sock (socket address-family/inet socket-type/stream 0)))
     (if (not (fileno? sock))
@@ -21,7 +19,6 @@
                 (await-connect sock (open-output-file-descriptor sock #t)
                                (+ (monotonic-seconds) seconds) seconds)))))))
 
-;; out is the socket's output port, the one a writable socket wakes.
 (define (await-connect sock out deadline seconds)
   (let ((done (connect-poll sock)))
     (cond
@@ -40,8 +37,7 @@
     (number->string (if (integer? rounded) (exact rounded) rounded))))
 
 ;; Closes a socket that has no ports yet through one, which marks its
-;; fileno closed (close-file-descriptor would leave the collector to close
-;; the number again, whoever has it by then); answers why.
+;; fileno closed, lest the collector close the number again later.
 (define (close-socket sock why)
   (close-port (open-input-file-descriptor sock))
   why)

@@ -1,15 +1,11 @@
 ;;;; The wire: frames, and the one table of message kinds (thesis §3.3.2).
 ;;
 ;; Procedures travel between address spaces as S-expressions
-;; (code/sendable.scm) in frames, on connections opened by the caller; the
-;; callee only answers.  A frame is a netstring whose payload is 64 hex
-;; digits of HMAC-SHA256, then an S-expression:
-;;
+;; (code/sendable.scm) in frames, on connections opened by the caller.  A
+;; frame is a netstring: 64 hex digits of HMAC-SHA256, then an S-expression,
 ;;   MAC = HMAC(key, NONCE ":" COUNT ":" S-EXPRESSION)
-;;
-;; NONCE is the receiving side's for this connection and COUNT numbers the
-;; frames sent in this direction from 1, so a recorded frame is worthless
-;; anywhere else.
+;; NONCE the receiver's for this connection, COUNT the frame's number in
+;; this direction from 1: a recorded frame is worthless anywhere else.
 ;;  1. Caller -> callee: (hello UID HOST PORT NONCE), nonce "hello", count
 ;;     0; HOST and PORT say where the caller listens.
 ;;  2. Callee -> caller: (welcome UID NONCE), the caller's nonce, count 0.
@@ -25,12 +21,10 @@
 ;;     PROC, ARGS and VALUE are encoded values; ID is the caller's, or for
 ;;     an answer the datagram sender's.
 ;;  4. Callee -> caller, in any order: (ack ID) (value ID VALUE) (error ID MESSAGE)
-;; A multicast datagram (remote/delivery.scm) is 64 hex digits of
-;; HMAC-SHA256 over "mcast:" and its text, then the text: (SENDER SEQUENCE
-;; BODY), BODY a beacon or a call.
-;; A frame that is not a netstring, fails its MAC, or is not in
-;; message-kinds closes its connection after one log line; the rest carry
-;; on.  Nothing is evaluated before its MAC checks.
+;; A datagram (remote/group.scm) is the HMAC over "mcast:" and its text,
+;; then the text.  A frame that is not a netstring, fails its MAC, or is
+;; not in message-kinds closes its connection after one log line; nothing
+;; is evaluated before its MAC checks.
 
 ;;; The message kinds
 
@@ -38,8 +32,8 @@
 (define (answer-kind? x) (memq x '(ack value error)))
 (define (call-kind? x) (memq x '(run apply)))
 
-;; Every message: its kind, then its fields, each with its check.  The
-;; datagram has no kind word of its own; the rest begin with theirs.
+;; Every message: its kind, then its fields, each with its check (the
+;; datagram has no kind word).
 (define message-kinds
   `((hello (uid ,symbol?) (host ,string?) (port ,exact-integer?)
            (nonce ,string?))
@@ -66,8 +60,7 @@
       (error "wrong number of fields for a message" kind fields))
   (cons kind fields))
 
-;;> \var{message} when it is one of \var{kinds} and each field passes its
-;;> check; else a protocol error, "expected WHAT".
+;;> \var{message} when it is one of \var{kinds} with good fields, else a protocol error.
 (define (check-message message kinds what)
   (if (not (and (pair? message) (memq (car message) kinds)
                 (fields-pass? (cdr message) (message-fields (car message)))))
@@ -101,8 +94,7 @@
 ;; Global: the lab's key and limits, for every frame of the process.
 (define *wire* #f)
 
-;;> Makes the frames and datagrams of this process those of \var{lab}:
-;;> its key, max-frame and max-depth.  Once, before any frame.
+;;> Makes this process's frames those of \var{lab}, once, before any frame.
 (define (start-wire! lab)
   (set! *wire* (make-wire (lab-key lab) (lab-setting lab 'max-frame)
                           (lab-setting lab 'max-depth))))
@@ -114,8 +106,7 @@
   (write-simple message text-port)
   (within-max-frame (get-output-string text-port)))
 
-;; The receiver would refuse a frame past max-frame and close the
-;; connection, failing the calls on it that had nothing to do with this one.
+;; The receiver would close the connection, failing calls unrelated to this one.
 (define (within-max-frame text)
   (if (> (+ 64 (string-size text)) (wire-max-frame *wire*))
       (error (string-append "the message is larger than the lab's max-frame, "
@@ -127,7 +118,6 @@
 (define (message-without-id kind fields)
   (cons (cdr (assq kind kind-heads)) (fields-text fields)))
 
-;; "(KIND " for each kind of the table, made once.
 (define kind-heads
   (map (lambda (k) (cons (car k) (string-append "(" (symbol->string (car k)) " ")))
        message-kinds))
@@ -164,16 +154,14 @@
 (define (frame-fail . parts)
   (apply protocol-fail "frame" parts))
 
-;; The next frame's message, or an eof object when the peer closed; a bad
-;; frame raises, for the connection's one handler to close it.
+;; The next frame's message, or an eof object; a bad frame raises.
 (define (read-frame in nonce count)
   (let ((payload (read-netstring in (wire-max-frame *wire*))))
     (if (eof-object? payload)
         payload
         (open-frame payload nonce count))))
 
-;;> The message of a frame whose netstring's payload is \var{payload}, the
-;;> count'th from the side whose nonce is given; raises as read-frame.
+;;> The message of the count'th frame, \var{payload}, from the side whose nonce is given.
 (define (open-frame payload nonce count)
   (parse-message
    (authentic-text payload (bytevector-length payload)
@@ -182,8 +170,7 @@
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
 (define (max-frame) (wire-max-frame *wire*))
 
-;; The text after the MAC in the first end bytes of bytes, once the MAC is
-;; that of the list parts followed by the text.
+;; The text after the MAC in bytes, once the MAC is that of parts and the text.
 (define (authentic-text bytes end parts)
   (or (hmac-sha256-open (wire-key *wire*) bytes end parts)
       (frame-fail "bad MAC")))
@@ -206,7 +193,6 @@
 (define (protocol-fault? e)
   (or (remote-protocol-error? e) (read-error? e)))
 
-;; What was wrong with a frame or datagram that raised e, for the log.
 (define (fault-message e)
   (if (read-error? e)
       (string-append "unreadable message: " (error-message e))
@@ -231,8 +217,7 @@
                                      (lambda (o) (write-simple uid o)))
                                " ")))
 
-;;> Whether the datagram in the first \var{n} bytes of \var{buffer} says,
-;;> before its MAC is checked, that it comes from \var{head}'s sender.
+;;> Whether \var{buffer}'s datagram says, unchecked, it comes from \var{head}'s sender.
 (define (datagram-from? buffer n head)
   (bytes-at? buffer 64 n head 0))
 

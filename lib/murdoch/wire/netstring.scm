@@ -6,8 +6,7 @@
 (define (netstring-fail . parts)
   (apply protocol-fail "netstring" parts))
 
-;;> Whether \var{e} is the error for a bad netstring, or any other
-;;> protocol violation: the same family (remote-error.scm).
+;;> Whether \var{e} is a bad netstring's error, or another protocol error.
 (define netstring-error? remote-protocol-error?)
 
 ;;> What was wrong with the netstring.
@@ -49,9 +48,8 @@
                   (bytevector-u8-set! payload have b)
                   (loop (+ have 1)))))))))
 
-;;> Reads one netstring from the binary port \var{in} and returns its
-;;> payload as a bytevector, or an eof object when the port ends cleanly
-;;> between frames.  Raises a protocol remote-error on anything else.
+;;> Reads one netstring from binary port \var{in}: its payload, or an eof
+;;> object at a clean end; a protocol remote-error on anything else.
 (define (read-netstring in max)
   (or (take-buffered-netstring in max)  ; netstring-scan.c: a whole frame
       (read-netstring-bytewise in max)))

@@ -1,7 +1,7 @@
 ;;;; The remote errors: one family, a kind for each way a call fails.
 ;;
-;; Its irritants are the target's uid (#f for a frame from a peer not yet
-;; known), what was called or read, and the message:
+;; Its irritants: the target's uid (#f for a peer not yet known), what was
+;; called or read, and the message.  The kinds:
 ;;   timed-out     no answer within the timeout (connecting included)
 ;;   unreachable   no connection, or it was lost or refused
 ;;   raised        the procedure raised an error at the callee
@@ -17,8 +17,7 @@
                              (string-append "protocol violation: " message))
                          (list uid what message) #f #f)))
 
-;;> Raises the protocol error for a frame from an unnamed peer, the
-;;> message made of \var{parts}.
+;;> Raises the protocol error, of \var{parts}, for a frame from an unnamed peer.
 (define (protocol-fail what . parts)
   (remote-error 'protocol #f what (apply string-append parts)))
 
