@@ -1,7 +1,6 @@
 ;;;; Address spaces: identity, peers and live membership (thesis §3.3.2).
-;;;; An address space is one Chibi process with a uid; this process joins
-;;;; its lab as one (join-lab!) and learns the others from the lab file,
-;;;; their hellos and their beacons.
+;;;; This process joins its lab as one (join-lab!) and learns the others
+;;;; from the lab file, their hellos and their beacons.
 
 
 (define-record-type aspace
@@ -38,8 +37,7 @@
 (define (with-peers thunk)
   (with-lock (membership-peers-lock (joined)) thunk))
 
-;; The peers or who answers changed: the live set is made again when next
-;; asked for.  The caller holds the peers' lock.
+;; Peers or who answers changed: the live set is remade when asked for (under the lock).
 (define (peers-changed! m) (membership-live-set! m #f))
 
 ;;> The local address space.
@@ -80,10 +78,9 @@
       (peers-changed! (joined)))))
 
 ;;; Live membership
-;; An address space that fails to connect, loses its connection or does
-;; not answer in time leaves the live set, so publish and request stop
-;; waiting on it; a prober tries it every second.  A newcomer joins by
-;; calling anyone, which learns it from its hello.
+;; One that fails to connect, loses its connection or does not answer in
+;; time leaves the live set, for a prober to try every second; a newcomer
+;; is learned from its hello.
 
 (define (note-unreachable! uid)
   (if (not (eq? uid (local-aspace-uid)))
@@ -106,8 +103,7 @@
 ;;> The uids of the address spaces that answer: the broadcast set.
 (define (live-uids) (map aspace-uid (live-aspaces)))
 
-;;> The address spaces that answer, this one among them: what a request
-;;> to all is sent to (kept until the peers change: docs/speed.md).
+;;> The address spaces that answer, this one among them (kept: docs/speed.md).
 (define (live-aspaces)
   (let ((m (joined)))
     (or (membership-live m)
@@ -126,8 +122,7 @@
 
 ;;; The timeout
 
-;;> Seconds remote-apply waits for an answer: the default for this
-;;> address space, the lab's timeout until this is called.
+;;> Seconds remote-apply waits for an answer by default (else the lab's timeout).
 (define (set-remote-timeout! seconds) (membership-timeout-set! (joined) seconds))
 
 ;;> A per-call override: (parameterize ((remote-timeout 1)) ...).
@@ -142,8 +137,7 @@
 ;;> lab's code files, without file, process, load or eval primitives.
 (define (lab-environment) (membership-environment (joined)))
 
-;; The value that received code stands for here, rebuilt in place: the
-;; code must be fresh from a frame and not used again.
+;; The value received code stands for, rebuilt in place: code fresh from a frame.
 (define (decode-value code) ((membership-decode (joined)) code))
 
 (define (describe-procedure proc)

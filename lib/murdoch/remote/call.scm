@@ -1,6 +1,4 @@
-;;;; remote-run! and remote-apply (thesis §3.3.2), and their -all forms: a
-;;;; call encodes its procedure and arguments, sends them on its target's
-;;;; connection and awaits the value, or a remote-error, by its deadline.
+;;;; remote-run! and remote-apply (thesis §3.3.2), and their -all forms.
 
 ;; A call leaving this address space, encoded once for all its targets.
 (define-record-type call
@@ -41,8 +39,7 @@
 (define (call-tail c)
   (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
 
-;; A call sent to a, its answer to come to gathering g; a peer that cannot
-;; be connected or sent to is noted unreachable.
+;; A call sent to a, answered to gathering g; a peer out of reach is noted so.
 (define (start-call a tail deadline g)
   (send-call! (connection-to a deadline) tail g))
 
@@ -64,8 +61,7 @@
       (give-up-call! (pending-call-connection p) (pending-call-id p))))
 
 ;; What pending call p's answer says: the value, or a remote-error (none
-;; came within c's seconds, and p is given up).  No match, no let
-;; (docs/speed.md).
+;; came in time: p is given up).  No match, no let (docs/speed.md).
 (define (answer-value p c)
   (answer-says p (pending-call-answer p) c))
 
@@ -91,11 +87,9 @@
   (remote-error 'timed-out uid (describe-procedure proc)
                 (string-append "no answer within " (number->string seconds) " s")))
 
-;;> Applies \var{proc} to \var{args} in each of \var{aspaces} at once, and
-;;> answers, in their order, (uid #t value) for each that answered and
-;;> (uid #f message) for each that failed or did not answer within
-;;> (remote-timeout) seconds.  Every call is sent before the first answer
-;;> is awaited, so it takes about as long as the slowest answer.
+;;> Applies \var{proc} to \var{args} in each of \var{aspaces} at once:
+;;> (uid #t value) for each that answered, (uid #f message) for each that
+;;> failed or timed out, in their order; as long as the slowest answer.
 (define (remote-apply-all aspaces proc . args)
   (map result->list (call-all aspaces 'apply proc args)))
 
@@ -202,18 +196,15 @@
       (call-to a 'run proc args)))
 
 ;;> Applies \var{proc} to \var{args} in address space \var{a} and returns
-;;> the result.  Raises a remote-error when the application raised, the
-;;> connection broke, or no answer came within (remote-timeout) seconds of
-;;> the call, connecting included.
+;;> the result; a remote-error when it raised, the connection broke, or no
+;;> answer came within (remote-timeout) seconds, connecting included.
 (define (remote-apply a proc . args)
   (check-aspace "remote-apply" a)
   (if (local? a)
       (local-call 'apply proc args)
       (call-to a 'apply proc args)))
 
-;;; The answers to datagram calls: a call multicast to the lab
-;;; (remote/delivery.scm) is answered on each peer's own connection, whose
-;;; reader hands the answer here.
+;;; The answers to datagram calls, handed here by each peer's connection reader.
 
 ;; Global: any connection's reader hands in answers to the process's calls.
 (define-record-type datagram-calls
@@ -256,8 +247,7 @@
     (set! *others* o)
     o))
 
-;; A new datagram call's id, whose answers from o come to gathering g,
-;; and its pending calls, in the order of o's uids.
+;; A new datagram call's id; its pending calls, o's order, answer to gathering g.
 (define (expect-answers! o g)
   (with-datagram-calls
     (lambda ()
@@ -269,8 +259,7 @@
                          (cons (others-places o) (list->vector ps)))
         (cons id ps)))))
 
-;; What datagram call id waits for, (places . pending-calls), or #f; no
-;; wind around the lock, as nothing under it raises.
+;; What datagram call id waits for, (places . pending-calls), or #f.
 (define (datagram-calls-waiting-for id)
   (lock! (datagram-calls-lock *datagram-calls*))
   (cell-value (unlocked (datagram-calls-lock *datagram-calls*)
@@ -282,8 +271,7 @@
   (with-datagram-calls
     (lambda () (hash-table-delete! (datagram-calls-waiting *datagram-calls*) id))))
 
-;; Hands an (answer ID KIND VALUE) frame from uid to the call that waits
-;; for it; else drops it.  No match, no let (docs/speed.md).
+;; Hands uid's (answer ID KIND VALUE) to its call, or drops it (no let).
 (define (take-datagram-answer! uid message)
   (answer-datagram-call! (pending-of uid (datagram-calls-waiting-for
                                           (message-id message)))

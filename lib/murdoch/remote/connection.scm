@@ -1,9 +1,7 @@
 ;;;; Connections to other address spaces: the caller's side of the wire.
-;;
-;; A call goes out on the one connection kept to its target, made and
-;; greeted (frame.scm's steps 1 and 2) when there is none.  One thread, the
-;; poller, reads every connection on the scheduler's epoll descriptor and
-;; hands each answer to the call that waits for it, found by id.
+;;;; A call goes out on the one connection kept to its target, greeted
+;;;; when made; one thread, the poller, reads every connection on the
+;;;; scheduler's epoll descriptor and hands each answer to its call by id.
 
 (define-record-type connection
   (make-connection uid in out text write-lock pending own-nonce welcome)
@@ -47,8 +45,7 @@
 (define *connecting* (make-hash-table eq?))   ; uid -> mutex
 (define *connections-lock* (make-mutex 'connections))
 
-;; The open connection to uid, made and greeted if there is none, by the
-;; deadline; a peer that cannot be connected to is noted unreachable.
+;; The open connection to uid, made and greeted by the deadline if there is none.
 (define (connection-to a deadline)
   (let ((uid (aspace-uid a)))
     (or (live-connection-to uid)
@@ -131,9 +128,8 @@
   (connection-fd-set! c (port-fileno (connection-in c)))   ; before the poller sees it
   (watch-port! (connection-in c) c))
 
-;;> Watches the connection served on input port \var{in}: the poller hands
-;;> \scheme{(take s items)} what it reads and \scheme{(fault s e)} what
-;;> raises.  Answers the descriptor.
+;;> Watches the connection served on \var{in}: the poller gives
+;;> \scheme{(take s items)} or \scheme{(fault s e)}; answers the descriptor.
 (define (watch-served! in s take fault)
   (watch-port! in (make-watcher s take fault)))
 
@@ -175,9 +171,8 @@
   (set! *poller-port* (poller-port))
   (thread-start! (make-logged-thread poll-connections 'poller)))
 
-;; Reads each connection as its bytes come; a frame that breaks the
-;; protocol closes its connection.  One handler for the thread's life
-;; (docs/speed.md).
+;; Reads each connection as its bytes come, under one handler (docs/speed.md);
+;; a frame that breaks the protocol closes its connection.
 (define (poll-connections)
   (let ((current #f))
     (define (take! fd)
@@ -252,8 +247,7 @@
 (define (answer-pending! p answer)
   (if p (answer-call! p answer)))       ; else the caller gave up
 
-;; Close once; every call still waiting hears the connection is lost.  The
-;; poller stops watching it before its descriptor closes.
+;; Close once; waiting calls hear the connection is lost.  Unwatched first.
 (define (close-connection! c)
   (let* ((fd #f)
          (waiting
@@ -268,14 +262,13 @@
         (lambda ()
           (vector-set! *watched* fd #f)
           (poller-unwatch! fd)))
-      ;; Closing both ports closes the socket; closing it again could close
-      ;; another connection's socket that has taken its number.
+      ;; Closed once: its number may be another socket's next.
       (guard (e (#t #f)) (close-input-port (connection-in c)))
       (guard (e (#t #f)) (close-output-port (connection-out c))))
     (for-each (lambda (p) (answer-call! p '(lost))) waiting)))
 
-;;> Sends one call, its text but the id \var{tail}, its answer to come to
-;;> gathering g; answers the pending call.  The id is drawn outside the lock.
+;;> Sends one call, \var{tail} its text but the id, answered to gathering
+;;> g; answers the pending call.
 (define (send-call! c tail g)
   (send-pending! c tail (make-pending-call (connection-uid c) c (next-call-id! c) g #f)))
 
@@ -289,11 +282,10 @@
   (connection-next-id-set! c (+ 1 (connection-next-id c)))
   (unlocked (connection-write-lock c) (connection-next-id c)))
 
-;; Sends message as c's next frame, under c's write lock, with pending call
-;; p (or #f) in c's table.  A frame that fails to go out closes the
-;; connection to calls; one that cannot be sent (too large) leaves it be;
-;; either way p is taken out and the peer noted unreachable.  One wind for
-;; lock and undo, no let (docs/speed.md).
+;; Sends message as c's next frame under c's write lock, with p (or #f)
+;; in c's table.  A failed write closes c to calls; an unsendable message
+;; leaves it be; either way p is taken out and the peer noted unreachable.
+;; One wind for lock and undo, no let (docs/speed.md).
 (define (send-counted! c message p)
   (wind (lambda () (lock! (connection-write-lock c)) (connection-stage-set! c 'before))
         (lambda () (write-counted! c message p))
@@ -325,8 +317,7 @@
   (unlock! (connection-write-lock c))
   (if (and p (not sent?)) (note-unreachable! (connection-uid c))))
 
-;;> Sends the answer to call id of a's multicast datagram, (answer ID KIND
-;;> VALUE): no acknowledgement, no worker, since a waits for it anyway.
+;;> Sends a's datagram call id its answer (answer ID KIND VALUE), unacknowledged.
 (define (send-datagram-answer! a id kind value)
   (send-counted! (connection-to a (+ (monotonic-seconds) (current-timeout)))
                  (make-message 'answer id kind value) #f))

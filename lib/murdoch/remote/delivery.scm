@@ -1,14 +1,11 @@
 ;;;; Delivery: how publish and request reach the whole lab (thesis §4.1).
-;;;; The thesis sent to each machine in turn, for want of broadcast in
-;;;; Kali.  Under (delivery multicast GROUP [PORT]), publish and the query
-;;;; phase of requests go out as one datagram to the group (group.scm); each
-;;;; address space answers over its TCP connection, as for a broadcast.  A
-;;;; message too large for a datagram goes the broadcast way.
+;;;; The thesis sent to each machine in turn; under (delivery multicast
+;;;; ...) publish and the query phase of requests are one datagram to the
+;;;; group, answered over TCP; a message too large goes the broadcast way.
 
 
-;;> remote-apply-all to every live address space (here too): by one
-;;> multicast datagram when the lab's delivery is multicast and the message
-;;> fits, else to each in turn.
+;;> remote-apply-all to every live address space (here too), by one
+;;> datagram when delivery is multicast and it fits, else to each in turn.
 (define (broadcast-apply proc . args) (broadcast 'apply proc args))
 
 ;;> remote-run-all! to every live address space, as broadcast-apply.
@@ -48,8 +45,7 @@
              (begin (forget!) #f)))))
 
 ;;; Serving the group's calls
-;; The group is read as a connection is (serve.scm): its listener applies
-;; a call itself, and the janitor gives it a new one when an apply runs long.
+;; As a connection (serve.scm): the listener applies, the janitor relieves it.
 
 ;; Serves call, unless #f, which answer answers (no let: docs/speed.md).
 (define (serve-group-call r call answer)

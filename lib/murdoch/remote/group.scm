@@ -15,8 +15,7 @@
 ;; period grows beyond 16, as RTCP's does.  start-group! is handed the
 ;; procedure that serves calls, so the group imports nothing above it.
 
-;; The lab's group as this address space joined it; #f under broadcast.
-;; Shared by its senders, its listener and its beacons.
+;; The lab's group as joined here, #f under broadcast; shared by its threads.
 (define-record-type group
   (make-group socket address buffer own-head window started sequence sequence-lock
               last-sequence last-heard last-heard-lock)
@@ -39,11 +38,10 @@
 (define max-datagram 60000)
 (define lab-beacons-per-second 16)
 
-;;> Joins \var{lab}'s multicast group when its delivery is multicast, and
-;;> starts its beacons and a thread that applies \var{serve} to
-;;> \scheme{receive-call}, which waits for the next datagram and returns
-;;> its group-call or #f (a beacon, or our own), and raises for one not
-;;> authentic or fresh; one thread at a time, as it reads into one buffer.
+;;> Joins \var{lab}'s multicast group when delivery is multicast, starting
+;;> beacons and a thread applying \var{serve} to \scheme{receive-call}, which
+;;> returns the next datagram's group-call or #f and raises for one not
+;;> authentic or fresh (one thread at a time: one buffer).
 (define (start-group! lab serve)
   ;; (multicast GROUP [PORT]) or (broadcast)
   (let ((delivery (lab-setting lab 'delivery)))
@@ -111,8 +109,7 @@
 
 ;;; Receiving
 ;;
-;; On every group call's path: no let, match, with-lock or
-;; hash-table-ref/default (docs/speed.md).
+;; On every group call's path: no let, match or with-lock (docs/speed.md).
 
 (define (receive-call)
   (let ((n (receive! (group-socket *group*) (group-buffer *group*))))
@@ -154,8 +151,7 @@
         ((< sequence (- (wall-microseconds) (* 1000000 (group-window *group*))))
          (frame-fail "older than frame-timeout"))))
 
-;;> A call that came by the group: its sender, its \var{id} there,
-;;> \var{kind} run or apply, and its procedure and arguments encoded.
+;;> A call that came by the group: sender, \var{id}, \var{kind}, procedure and arguments.
 (define-record-type group-call
   (make-group-call sender id kind proc-code args-code)
   group-call?

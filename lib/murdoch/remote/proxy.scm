@@ -1,6 +1,5 @@
-;;;; Proxies (the thesis's encap): a procedure that runs where it was made.
-;;;; It travels as its maker's uid and an id; applied elsewhere, it is a
-;;;; remote-apply back to its maker.
+;;;; Proxies (the thesis's encap): a procedure that runs where it was made,
+;;;; travelling as its maker's uid and an id.
 
 ;; Global: a proxy made in any thread is applied from any connection.
 (define-record-type proxies
@@ -37,8 +36,7 @@
         (hash-table-delete! (proxies-stubs *proxies*)
                             (cons (proxy-ref-uid ref) (proxy-ref-id ref)))))))
 
-;; The one proxy procedure for (uid . id), so a proxy sent back and forth
-;; stays the same.  Caller holds the lock.
+;; The one proxy procedure for (uid . id), kept the same; caller holds the lock.
 (define (proxy-stub uid id)
   (let ((key (cons uid id)))
     (or (hash-table-ref/default (proxies-stubs *proxies*) key #f)

@@ -6,8 +6,8 @@
 ;; (docs/speed.md); an apply that runs past takeover-seconds has the
 ;; janitor give the connection a new reader, and the old one ends after it.
 
-;; A connection being served.  Its deadline is set while a frame is half
-;; read, for the janitor to end a peer that stalls mid-frame.
+;; A connection served; its deadline, set while a frame is half read, lets
+;; the janitor end a peer that stalls.
 (define-record-type serving
   (make-serving peer host thread in out)
   serving?
@@ -24,8 +24,7 @@
   (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
   (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
 
-;; The connections this address space serves, and the lab's limits on
-;; them; shared by the accept loop, the readers and the janitor.
+;; The connections served and the lab's limits on them.
 (define-record-type server
   (make-server frame-timeout max-connections max-connections-per-host
                servings lock janitor-mutex janitor-wake janitor-resting?
@@ -71,8 +70,7 @@
       (lambda () (server-servings-set! *server* (cons s (server-servings *server*)))))
     s))
 
-;; Runs a reader's loop; the connection ends with it, unless the janitor
-;; has given it a new reader meanwhile.
+;; Runs a reader's loop; the connection ends with it, unless handed on.
 (define (read-as-reader s thunk)
   (guard (e (#t (let-go-of-writes! s)
                 (log-fault (serving-peer s) e)))
@@ -97,10 +95,8 @@
 
 ;;; Frames as the poller reads them
 
-;; The frames, eof or fault that poller-frames! read from s: the hello,
-;; then answers and abandons, served here; at the first call, s and the
-;; rest go to a reader thread.  A frame begun has frame-timeout to come
-;; whole; the hello keeps the connect's deadline.
+;; The frames, eof or fault the poller read from s: hello, answers and
+;; abandons are served here; at the first call s goes to a reader thread.
 (define (take-polled! s items)
   (cond ((null? items) (await-whole! s))
         ((bytevector? (car items))
@@ -140,9 +136,8 @@
     (with-lock (server-lock *server*) (lambda () (serving-thread-set! s t)))
     (thread-start! t)))
 
-;; The next message of s for its reader, or an eof object: a frame may take
-;; long to begin, then has frame-timeout to come whole.  No let from here
-;; to answer-call (docs/speed.md).
+;; The next message of s for its reader, or an eof object; a frame begun
+;; has frame-timeout to come whole.  No let to answer-call (docs/speed.md).
 (define (read-served s)
   (opened s (next-served-frame s)))
 
@@ -165,8 +160,7 @@
   (serving-frames-set! s (cdr frames))
   (car frames))
 
-;; The message of s's next frame, whole, checked to be one a caller may
-;; send; a deadline set for it is met.
+;; The message of s's next frame, checked to be one a caller may send.
 (define (open-served s bytes)
   (open-counted s (serving-greeting s) bytes))
 
@@ -241,9 +235,8 @@
     (unlock! (server-lock *server*))
     (if s (take-over! s))))
 
-;; Marks the start and end of the reader's inline apply of call id, during
-;; which a caller giving up finds the thread by id; ending answers whether
-;; this thread is still the reader.
+;; Marks the reader's inline apply of call id, during which a caller giving
+;; up finds the thread; ending answers whether it is still the reader.
 (define (inline-apply-begins! s id)
   (lock! (server-lock *server*))
   (serving-applying-set! s (cons (cons id (current-thread))
@@ -278,8 +271,7 @@
                   (serving-applying-set! s (without-thread (serving-applying s) thread)))
                 (server-servings *server*)))))
 
-;; The caller of apply id gave up: its thread is marked, to stop at its
-;; next call out (code/abandon.scm), unless the apply is done.
+;; The caller of apply id gave up: its thread is marked to stop (abandon.scm).
 (define (abandon-call! s id)
   (let ((a (with-lock (server-lock *server*) (lambda () (assv id (serving-applying s))))))
     (when a
@@ -321,8 +313,7 @@
     (log-warn "connection from " peer " refused: over max-connections"
               " or max-connections-per-host")))
 
-;;> Serves calls to this address space under \var{lab}'s limits, on its
-;;> port (a free one for port 0), and starts the janitor.
+;;> Serves calls here under \var{lab}'s limits, and starts the janitor.
 (define (start-serving! lab)
   (set! *server*
         (make-server (lab-setting lab 'frame-timeout) (lab-setting lab 'max-connections)

@@ -1,8 +1,6 @@
-;;;; Served calls, part of (murdoch remote serve): reading a connection's
-;;;; calls, running them and writing their answers.
+;;;; Served calls, part of (murdoch remote serve): reading, running, answering.
 
-;; A call read from a connection or the group, answered by a procedure of
-;; theirs (see reply!).
+;; A call read from a connection or the group, answered their way (reply!).
 (define-record-type served-call
   (make-served-call caller id kind proc-code args-code answer)
   served-call?
@@ -13,8 +11,7 @@
   (args-code served-call-args-code)
   (answer served-call-answer))          ; (answer C KIND VALUE)
 
-;;> Answers served call \var{c}: \var{kind} ack, value or error, and
-;;> \var{value}, the encoded value or the error's message.
+;;> Answers served call \var{c}: \var{kind} ack, value or error, and its \var{value}.
 (define (reply! c kind value) ((served-call-answer c) c kind value))
 
 ;; A thread reading s's calls, and the call it runs until answered.
@@ -41,9 +38,8 @@
                     (if (reader? s) (again))))
         (read-on r)))))
 
-;; Runs call c.  A run is acknowledged once decoded, so that a failure to
-;; decode reaches its caller, and runs in a worker; an apply runs here
-;; until the janitor gives r's connection a new reader.
+;; Runs call c: a run is acknowledged once decoded, and runs in a worker;
+;; an apply runs here until the janitor hands the connection on.
 (define (serve-call r c)
   (reading-call-set! r c)
   (if (eq? (served-call-kind c) 'run)
@@ -57,8 +53,7 @@
 
 (define (serve-apply r s c)
   (inline-apply-begins! s (served-call-id c))
-  ;; Answered while the call is r's; a value that cannot go back (too
-  ;; large) gets the error instead.
+  ;; Answered while the call is r's; a value too large gets the error.
   (reply! c 'value (encoded-result c))
   (reading-call-set! r #f)
   (inline-apply-ends! s))
@@ -117,11 +112,9 @@
                #t)))
 
 ;; The reader's answers wait in the buffer until it has read every call
-;; that arrived: a burst is answered in one write.  A value or error with
-;; no call behind it is flushed under the same lock; a run's ack waits for
-;; flush-if-idle!.  Former readers' answers go at once.  The write lock is
-;; taken by lock! (docs/speed.md); a raise under it is let go by the
-;; reader's handlers (let-go-of-writes!).
+;; that arrived, for one write.  A value or error with no call behind it is
+;; flushed under the lock; an ack waits for flush-if-idle!.  The lock is
+;; taken by lock! (docs/speed.md); the reader's handlers let go after a raise.
 (define (answer! s g message last?)
   (lock! (greeting-write-lock g))
   (write-answer! s g (frame-text (greeting-text g) message))
@@ -139,8 +132,7 @@
   (flush-output-port (serving-out s))
   (greeting-flushed-set! g (greeting-sent g)))
 
-;; No lock taken when the last frame had no answer.  Sent and flushed
-;; change under the write lock, and a writer flushes or comes here.
+;; Nothing to flush after a frame that had no answer; under the write lock.
 (define (flush-if-idle! s g)
   (when (and (not (= (greeting-flushed g) (greeting-sent g)))
              (null? (serving-frames s)))
@@ -160,14 +152,12 @@
       (serve-call r (served-call-of message uid answer))
       (serve-notice (reading-serving r) uid message)))
 
-;; The served call that message asks for, by its places in wire/frame.scm's
-;; table, not by match (docs/speed.md).
+;; The served call message asks for, by the places of wire/frame.scm's table.
 (define (served-call-of message uid answer)
   (make-served-call uid (message-id message) (car message) (list-ref message 2)
                     (list-ref message 3) answer))
 
-;; Serves a frame that needs no answer: an answer to our datagram call, or
-;; an abandon.  By cond, not match (docs/speed.md).
+;; Serves a frame that needs no answer: an answer or an abandon (by cond).
 (define (serve-notice s uid message)
   (if (eq? (car message) 'answer)
       (take-datagram-answer! uid message)

@@ -1,7 +1,6 @@
 ;;;; Workers: the threads that run what nobody waits for.
 
-;;> Starts thunk in a new thread named name, guarded from received code;
-;;> the log says when thunk raises.
+;;> Starts thunk in a thread named name, guarded from received code; logs a raise.
 (define (spawn thunk name)
   (thread-start! (make-guarded-thread (lambda () (run-logged thunk name)) name)))
 
@@ -24,8 +23,7 @@
       (mailbox-put! idle thunk)
       (spawn (lambda () (work thunk)) 'worker)))
 
-;; The mailbox of a waiting worker, taken from the pool, or #f.  The lock
-;; by lock! here and in next-job: nothing under it raises.
+;; The mailbox of a waiting worker, taken from the pool, or #f (lock!: nothing raises).
 (define (idle-worker)
   (lock! *workers-lock*)
   (let ((mb (and (pair? *idle-workers*) (car *idle-workers*))))
@@ -48,8 +46,7 @@
   (let ((next (next-job mb)))
     (if next (run-jobs next mb))))
 
-;; The next job, or #f when none came within worker-idle-seconds.  mb is
-;; in the pool only while it waits, so no caller puts to it as it is emptied.
+;; The next job, or #f after worker-idle-seconds; mb is pooled only while waiting.
 (define (next-job mb)
   (mailbox-empty! mb)
   (lock! *workers-lock*)
