@@ -1,9 +1,5 @@
 ;;;; The sandbox: where received code runs, the address space's safety
-;;;; boundary (docs/security.md): a holder of the lab's key can run what it
-;;;; allows and no more.  Each rule is kept here: the environment, imports
-;;;; that cannot be assigned, serving threads received code cannot end,
-;;;; each call's own ports and parameters, sized constructors under
-;;;; max-alloc, and threads whose death is logged.
+;;;; boundary (docs/security.md); each of its rules is kept here.
 
 (define sandbox-libraries
   '((except (scheme base) lambda define set! make-vector make-string
@@ -26,8 +22,7 @@
 
 ;;; Assignment
 
-;; The environments whose imports are guarded (their parents hold the
-;; imported cells).  Global: guarded-set! reads it as code is compiled.
+;; Global, read by guarded-set! as code compiles: environments whose imports are guarded.
 (define *guarded* '())
 
 ;;> Murdoch's set! inside the sandbox: an error at compile time for a
@@ -49,8 +44,7 @@
 
 ;;; Threads
 
-;; Global, as any layer's thread may serve calls: a reader, a worker, the
-;; multicast listener, the janitor.
+;; Global, as any layer's thread may serve calls.
 (define *protected* (make-hash-table eq?))
 (define *protected-lock* (make-mutex 'protected))
 
@@ -70,8 +64,8 @@
                                       (lambda () (protect! (current-thread) #f))))
                       name))
 
-;;> make-thread inside the sandbox: a thread that ends by raising says so
-;;> in one line of the log, and thread-join! raises the error as before.
+;;> make-thread inside the sandbox: a raise that ends the thread is logged
+;;> in one line, and thread-join! raises it as before.
 (define (make-logged-thread thunk . name)
   (apply make-thread
          (lambda ()
@@ -79,8 +73,8 @@
              (thunk)))
          name))
 
-;; Chibi writes a thread's uncaught error and a backtrace to its error
-;; port; that port is made a sink, so the line logged here is the only one.
+;; Chibi writes a thread's uncaught error and backtrace to its error port,
+;; made a sink so the line logged here is the only one.
 (define (log-thread-death e)
   (parameterize ((current-error-port (process-port sandbox-err (current-error-port))))
     (log-warn "thread " (thread-label (current-thread)) " died: " (error-message e)))
@@ -95,8 +89,7 @@
 
 ;;; Allocation
 
-;; The lab's max-alloc, read by make-lab-environment, and the process's
-;; ports that received code writes through to (set-sandbox-ports!).
+;; The lab's max-alloc and the process's ports received code writes to.
 (define-record-type sandbox
   (make-sandbox max-alloc out err)
   sandbox?
@@ -151,8 +144,7 @@
 
 ;;; Each call's own ports and parameters
 
-;;> Gives the process's standard output and error, for received code to
-;;> write through to; after make-lab-environment.
+;;> Gives the process's standard output and error, for received code to write to.
 (define (set-sandbox-ports! out err)
   (sandbox-out-set! *sandbox* out)
   (sandbox-err-set! *sandbox* err))
@@ -161,8 +153,7 @@
 (define (process-port which current)
   (or (and *sandbox* (which *sandbox*)) current))
 
-;; A port that writes through to port, closable without closing it;
-;; flushed as any port, and at the end of each call.
+;; A port that writes through to port, closable alone, flushed at each call's end.
 (define (through-port port)
   (make-custom-output-port
    (lambda (str start end)
@@ -170,9 +161,8 @@
      (flush-output-port port)
      (- end start))))
 
-;; The ports of the calls a thread runs, as its specific in a record that
-;; received code cannot make, so a worker's next call never writes to
-;; ports an earlier call chose.
+;; The ports of a thread's calls, its specific, in a record received code
+;; cannot make: a worker's next call never writes to an earlier one's ports.
 (define-record-type call-ports
   (make-call-ports in out err)
   call-ports?
@@ -203,11 +193,9 @@
 (define (sandbox-parameter! parameter)
   (set! *parameters* (cons parameter *parameters*)))
 
-;;> Applies \var{proc} to \var{args} as a received call runs: with its own
-;;> ports, flushed to the process's, and its own bindings of the sandbox's
-;;> parameters.  A call that raises leaves both to the handler around it.
-;; parameterize for parameters known only at run time, without its
-;; dynamic-wind (docs/speed.md).
+;;> Applies \var{proc} to \var{args} as a received call runs, with its own
+;;> ports and bindings of the sandbox's parameters; a raise leaves both to
+;;> the handler around it.  parameterize without dynamic-wind (docs/speed.md).
 (define (call-in-sandbox proc args)
   (sandboxed (thread-call-ports) (thread-parameters) proc args))
 
@@ -240,8 +228,7 @@
 
 ;;; Making the environments
 
-;;> A fresh environment for received code, with the lab's code files
-;;> evaluated in it, so they can use no more than received code can.
+;;> A fresh environment for received code, the lab's code files evaluated in it.
 (define (make-lab-environment lab)
   (set! *sandbox* (make-sandbox (lab-setting lab 'max-alloc) #f #f))
   (let ((env (apply mutable-environment sandbox-libraries)))
@@ -250,9 +237,8 @@
               (lab-code-files lab))
     env))
 
-;;> Raises for the first name that the lab's code files use but neither
-;;> define nor import, naming the file, line and nearest defined name: a
-;;> typo that loading lets pass would otherwise show when a robot runs it.
+;;> Raises for the first name the lab's code files use but neither define
+;;> nor import, naming file, line and nearest name, lest a robot find it.
 (define (check-lab-code lab env)
   (let ((undefined (undefined-names env)))
     (if (pair? undefined)
@@ -270,8 +256,7 @@
                                               " is used but not defined"
                                               (nearest-defined name env)))))))
 
-;; The names that code compiled in env refers to and nothing defines, as
-;; Chibi's warn-undefs finds them.
+;; The names that code compiled in env refers to and nothing defines.
 (define (undefined-names env)
   (let ((out (open-output-string)))
     (parameterize ((current-error-port out))
@@ -317,8 +302,8 @@
 (define (lab-code-files lab)
   (lab-setting lab 'code))
 
-;;> An environment for a person at a REPL: all of Chibi, Murdoch, and the
-;;> lab code's own procedures from \var{lab-env}, so they travel by name.
+;;> An environment for a person at a REPL: all of Chibi, Murdoch, and
+;;> \var{lab-env}'s own procedures, so they travel by name.
 (define (make-repl-environment lab lab-env)
   (let ((env (mutable-environment '(except (scheme base) lambda define)
                           '(scheme char) '(scheme cxr) '(scheme inexact)
@@ -337,14 +322,12 @@
 (define (read-forms file)
   (map car (car (read-source file))))
 
-;; Evaluates each form of file in env, as a load would; an error names the
-;; file and the line of its form.
+;; Evaluates each form of file in env; an error names the file and line.
 (define (load-into file env)
   (for-each (lambda (entry) (at-form-line file entry (lambda () (eval (car entry) env))))
             (car (read-source file))))
 
-;;> (thunk), its error raised again as one line naming \var{file} and
-;;> \var{entry}'s line, a (FORM . LINE) of read-source.
+;;> (thunk), its error raised again naming \var{file} and \var{entry}'s line.
 (define (at-form-line file entry thunk)
   (guard (e ((error-object? e) (error (form-line-text file entry (error-line e)))))
     (thunk)))

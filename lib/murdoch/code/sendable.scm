@@ -12,8 +12,7 @@
 ;;   #(murdoch:made NAME ARG ...)       what (NAME ARG ...) made (made-by!)
 ;;   #(murdoch:vector ELEMENT ...)      a vector, so a user's is never a tag
 ;;   #(murdoch:void) #(murdoch:eof)
-;; Anything else (a port, a thread, a record) stops at the sender with an
-;; error naming what held it.
+;; Anything else (a port, a record) stops at the sender, naming what held it.
 
 (define-record-type sendable-info
   (make-sendable-info source+names values)
@@ -36,8 +35,7 @@
 
 ;;; The lambda that keeps its source
 
-;; Every symbol of the body outside quote: a superset of the variables it
-;; references (a variable missed would be wrong).
+;; Every symbol of the body outside quote: a superset of its variables.
 (define (body-symbols body)
   (let walk ((x body) (acc '()))
     (cond
@@ -49,8 +47,7 @@
       (if (memq x acc) acc (cons x acc)))
      (else acc))))
 
-;; A variable is local when the innermost binding the expander sees for it
-;; is a lambda's parameter; Chibi marks those cells with the lambda.
+;; Local when the expander's innermost binding is a lambda's parameter.
 (define (local-variable? id env)
   (let ((cell (env-cell env id)))
     (and cell (lambda? (cdr cell)))))
@@ -62,8 +59,7 @@
                          (body-symbols body)))
          (r (lambda (name) (make-syntactic-closure mac-env '() name)))
          (info (r 'info)))
-    ;; The macro's own names are closed in its environment; the user's
-    ;; formals and body mean what they mean where the lambda is written.
+    ;; The user's formals and body mean what they mean where it is written.
     `(,(r 'let) ((,info (,(r 'make-sendable-info)
                          (,(r 'quote)
                           ,(cons `(lambda ,@(strip-syntactic-closures (cdr expr)))
@@ -74,14 +70,12 @@
         ;; closure-info finds it; Chibi drops a reference with no use.
         (,(r 'if) ,info (,(r 'let) () ,@body) #f)))))
 
-;;> Murdoch's \scheme{lambda}: an ordinary lambda whose closures can be
-;;> sent to another address space.
+;;> Murdoch's \scheme{lambda}: an ordinary lambda whose closures can travel.
 (define-syntax sendable-lambda
   (lambda (expr use-env mac-env)
     (expand-sendable-lambda expr use-env mac-env)))
 
-;;> Murdoch's \scheme{define}: as usual, but a procedure it defines is made
-;;> by the sendable lambda and carries its name.
+;;> Murdoch's \scheme{define}: as usual, a procedure made by the sendable lambda.
 (define-syntax sendable-define
   (er-macro-transformer
    (lambda (expr rename compare)
@@ -152,17 +146,15 @@
         ((procedure? x) "a procedure made without Murdoch's lambda")
         (else (string-append "a " (symbol->string (type-name (type-of x)))))))
 
-;; What held a value, for an error message; a thunk, as writing a
-;; closure's source costs more than sending it.
+;; What held a value, for an error; a thunk makes it only when needed.
 (define (what-string what) (if (procedure? what) (what) what))
 
 ;;; Limits
-;; A value from another address space is input.  Nested deep, its walk
-;; would outgrow the stack, which ends the process in Chibi, and Chibi's
-;; writer cuts what nests past 10,000; a long list walked by recursion does
-;; the same, and a circular one never ends.  So walks go down cdrs by
-;; iteration, count depth, and encoding counts pairs: more than a frame
-;; could hold is an error, which a circular value reaches too.
+;; A value from another address space is input.  Deep nesting would
+;; outgrow Chibi's stack, which ends the process, and long or circular
+;; lists do too when walked by recursion: so walks go down cdrs by
+;; iteration counting depth, and encoding counts pairs, up to a frame's.
+;; (Chibi's writer cuts what nests past 10,000: max-depth stays below.)
 
 ;; The limits of the lab this process joined, read by set-value-limits!.
 (define-record-type value-limits
@@ -174,8 +166,7 @@
 ;; Global: every value the process sends or receives is its lab's.
 (define *limits* #f)
 
-;;> Takes the limits of values from \var{lab}: max-depth, and half its
-;;> max-frame pairs (a pair is written in two bytes or more).
+;;> Takes value limits from \var{lab}: max-depth, and max-frame / 2 pairs.
 (define (set-value-limits! lab)
   (set! *limits* (make-value-limits (lab-setting lab 'max-depth)
                                     (quotient (lab-setting lab 'max-frame) 2))))
@@ -185,8 +176,7 @@
       (send-fail (what-string what) " nests deeper than the lab's max-depth, "
                  (number->string (limits-depth *limits*)))))
 
-;; (map f ls) by iteration for a list that may be improper; f takes the
-;; elements and the tail that is not a pair.
+;; (map f ls) by iteration, ls maybe improper: f gets its tail too.
 (define (map-elements f ls)
   (let loop ((x ls) (acc '()))
     (if (pair? x)
@@ -200,10 +190,8 @@
         (set-cdr! rev tail)
         (append-reverse! next rev))))
 
-;; True of data that stands for itself on the wire, so encode and decode
-;; do not copy it (docs/speed.md).  plain-within? (plain.c) gives up after
-;; a budget of pairs or the depth limit, leaving long, deep or circular
-;; values to the general way, which says what is wrong.
+;; True of data that stands for itself, left uncopied (docs/speed.md);
+;; plain-within? (plain.c) gives up at a budget of pairs or the depth limit.
 (define (plain? x) (plain-within? x 100000 (limits-depth *limits*)))
 
 ;;> The S-expression that stands for \var{x} on the wire: \var{env}'s
@@ -213,8 +201,7 @@
         ((and (procedure? x) (known-encoding x env)))
         (else (encode-compound x env what))))
 
-;; Defined at the top (docs/speed.md); left is a one-element vector, the
-;; pairs the value may still hold.
+;; Defined at the top (docs/speed.md); left is a vector of the pairs yet allowed.
 (define (encode-compound x env what)
   (enc x env what 0 (make-vector 1 (limits-pairs *limits*))))
 
@@ -270,8 +257,7 @@
                     (describe p)))))
 
 ;;> Answers \var{proc}, which \scheme{(name arg ...)} made: it travels as
-;;> that call, \var{name} being bound to the same maker where it lands
-;;> (a library's metrics, say).  At most max-known are remembered.
+;;> that call, \var{name} bound to the same maker where it lands.
 (define (made-by! proc name . args)
   (if (>= (hash-table-size *made*) max-known)
       (set! *made* (make-hash-table eq?)))
@@ -281,11 +267,9 @@
 ;; Global: a procedure's maker is the same for every thread.
 (define *made* (make-hash-table eq?))   ; procedure -> (NAME ARG ...)
 
-;; Global, a cache for every thread: the encodings of procedures that do
-;; not change, a global's kept while its name is bound to it, and a
-;; capture-free closure's by its source (the same quoted list however
-;; often the lambda is evaluated).  A request's procedures are sent again
-;; and again (docs/speed.md).  At most max-known, so new globals are let go.
+;; Global, a cache for every thread: encodings of procedures that do not
+;; change, a global's by name while bound, a capture-free closure's by its
+;; source (docs/speed.md); max-known of them, so new globals are let go.
 (define max-known 512)
 (define *known* (make-hash-table eq?))  ; procedure or source -> (env cell . code)
 
@@ -337,8 +321,7 @@
                        depth left))
             (enc-bindings source (cdr names) (cdr values) env depth left))))
 
-;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters
-;;> with "...": for messages and progress lines.
+;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters with "...".
 (define (abridged x width)
   (let ((s (let ((out (open-output-string)))
              (write x out)
@@ -349,10 +332,8 @@
 
 ;;; Decoding
 
-;; Compiling a closure's source is decoding's dear part, and the same
-;; closure comes again and again, so makers are kept by source; emptied at
-;; max-makers, as a peer could send sources without end.  Keys compare by
-;; Chibi's equal? (docs/speed.md).
+;; Makers kept by source, as compiling is decoding's dear part; emptied at
+;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
 
 (define (make-closure-compiler env)
@@ -370,10 +351,9 @@
       (let ((key (cons source names)))
         (maker (hash-table-cell makers key #f) key)))))
 
-;;> Returns a procedure that rebuilds values encoded by \scheme{encode}:
-;;> globals and closure sources are resolved in \var{env}, proxies made by
-;;> \var{proxy} (of a uid and an id).  The value is rebuilt in place, so
-;;> it must be fresh from a frame (it saves copying: docs/speed.md).
+;;> Returns a procedure that rebuilds values encoded by \scheme{encode},
+;;> resolving globals and sources in \var{env} and proxies by \var{proxy};
+;;> in place, so the value must be fresh from a frame.
 (define (make-decoder env proxy)
   (let ((compile (make-closure-compiler env)))
     (define (dec x depth)
