@@ -1,12 +1,9 @@
 ;;;; Publish/subscribe messaging (thesis §4.1, appendix A.8 publish.scm).
-;;
-;; Each address space keeps its own subscription list: subjects, each free
-;; or reserved.  A message, addressed to a subject or a list of them, is
-;; sent to every live address space (the thesis's simulated broadcast),
-;; which evaluates it only when it subscribes to every subject.  Subjects
-;; are symbols, a dot making levels (mobile.in_use); in an address * is one
-;; level and > all that follow.  A reserved subject S is joined by S.in_use
-;; while held, so a sender can see why S is not available.
+;;;; Each address space keeps its subscription list; a message, addressed
+;;;; to subjects, goes to every live address space, which evaluates it only
+;;;; when it subscribes to all of them.  A dot makes levels (mobile.in_use);
+;;;; in an address * is one level and > the rest.  A reserved subject S is
+;;;; joined by S.in_use while held, so a sender can see why S is taken.
 
 ;;; The subscription list
 
@@ -17,9 +14,8 @@
   (status subscription-status subscription-status-set!) ; (), task, shared
   (holds subscription-holds subscription-holds-set!))   ; live reservations
 
-;; The thesis's names (A.8), global as there, guarded by the lock as monitor
-;; threads change the list while messages read it.  The list is replaced,
-;; never changed, so addressed-here? reads it without the lock.
+;; The thesis's names (A.8), global as there, under the lock as monitors
+;; change the list; replaced, never changed, so addressed-here? needs no lock.
 (define *subscriptions* '())
 (define *subscriptions-lock* (make-mutex 'subscriptions))
 
@@ -122,10 +118,9 @@
          (levels-match? (cdr p) (cdr t)))
         (else #f)))
 
-;; Whether every subject of the address is subscribed (the thesis's "proper
-;; subset" means subset).  No lock: the list is read once, and its topics
-;; never change.  A subject matches itself, wildcards included, with no
-;; matcher: the common case (docs/speed.md).
+;; Whether every subject of the address is subscribed (the thesis's
+;; "proper subset" means subset), without the lock; an exact subject needs
+;; no matcher, the common case (docs/speed.md).
 (define (addressed-here? topic)
   (if (list? topic)
       (subjects-here? *subscriptions* topic)
@@ -143,9 +138,8 @@
 
 ;;; Sending
 
-;; Sends a message to the lab: a result of each address space reached.  An
-;; address that is a uid goes to that address space alone (only it
-;; subscribes to its uid): metrics ask each candidate point to point.
+;; Sends a message to the lab: a result for each address space reached; a
+;; uid goes to that address space alone, as metrics ask point to point.
 (define (deliver kind topic proc . args)
   (cond ((and (symbol? topic) (live-aspace topic))
          => (lambda (a) (call-all (list a) kind proc args)))
@@ -176,8 +170,8 @@
                      (evaluation (result-value r))))
               (told-failures what results)))
 
-;; Logs each receiver that raised or did not answer, so that a mistake in
-;; the procedure does not pass for a lab where nobody subscribes.
+;; Logs each receiver that raised or did not answer: a mistake must not
+;; pass for a lab where nobody subscribes.
 (define (told-failures what results)
   (for-each (lambda (r) (if (not (result-ok? r)) (tell-failure what r))) results)
   results)
@@ -185,8 +179,7 @@
 (define (tell-failure what r)
   (log-warn what " on " (result-uid r) " failed: " (result-value r)))
 
-;; A capability list as ((exclusive ...) (non-exclusive ...)), from any of
-;; the appendix's forms (a subject, a flat list, or the two lists).
+;; A capability list as ((exclusive ...) (non-exclusive ...)), from any appendix form.
 (define (capability-layout topic)
   (cond ((not (list? topic)) (list '() (list topic)))
         ((null? topic) (list '() '()))
@@ -216,13 +209,10 @@
                               (local-aspace-uid) proc args))))
 
 ;;> One message to the whole lab for every component of a negotiation,
-;;> where the thesis sends one each, and the metrics' askings answered in
-;;> it.  Each of \var{components} is (type layout proc askings): type
-;;> exclusive or non-exclusive, layout as capability-layout gives, the
-;;> promise's procedure, and the procedures each candidate is asked.
-;;> Answers, per component, (response asked): response as
-;;> request-exclusive or request answers; asked, ((uid answer ...) ...),
-;;> each answer (#t value) or (#f message).
+;;> with the metrics' askings, where the thesis sends one each.  Each of
+;;> \var{components} is (type layout proc askings); answers (response
+;;> asked) for each, response as request-exclusive or request gives,
+;;> asked ((uid answer ...) ...), each answer (#t value) or (#f message).
 (define (request-components task-name components)
   (let* ((n (length components))
          (rows (checked-rows (broadcast-apply receive-components components task-name
@@ -234,8 +224,7 @@
                  (column-asked rows i)))
          components (iota n))))
 
-;; rows, each receiver's result, one not of n entries made a failure:
-;; each row checked once, then read by column (docs/speed.md).
+;; rows with one not of n entries made a failure, checked once (docs/speed.md).
 (define (checked-rows rows n)
   (cond ((null? rows) '())
         ((or (not (result-ok? (car rows))) (row-of? (result-value (car rows)) n))

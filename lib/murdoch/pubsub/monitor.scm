@@ -2,7 +2,7 @@
 ;;;; (A.2): capabilities that come and go with the machine's state.
 
 ;;> The voltage, in tenths, above which a robot is taken to be on its
-;;> charging tether; below it, the battery monitor subscribes to untethered.
+;;> charging tether.
 (define *battery-charging* (lab-default 'battery-charging))
 ;;> The voltage, in tenths, below which a robot's battery is low.
 (define *battery-low* (lab-default 'battery-low))
@@ -39,8 +39,7 @@
 (define (get-system-load)
   (string-copy (load-text ((monitoring-load-source *monitoring*)))))
 
-;; The text of load, kept while the load stays (docs/speed.md); copied out,
-;; as received code may change its string.
+;; The text of load, kept while it stays (docs/speed.md), copied out for received code.
 (define (load-text load)
   (let ((last (monitoring-last-load *monitoring*)))
     (if (eqv? load (car last))
@@ -52,8 +51,7 @@
 (define (start-thread! name thunk)
   (thread-start! (make-logged-thread thunk name)))
 
-;; The thesis's names (A.6), global as there: a monitor started again
-;; ends the thread it replaces.
+;; The thesis's names (A.6), global as there: a restarted monitor ends the old thread.
 (define *load-monitor-thread* #f)
 (define *battery-monitor-thread* #f)
 
@@ -98,8 +96,7 @@
 
 ;;; Initialization (A.2), from the lab file rather than host names
 
-;; The lab's (load L) or (load ((SECONDS L) ...)): a fixed load, or one
-;; that steps to each L at SECONDS after start; else /proc/loadavg.
+;; The lab's (load L) or (load ((SECONDS L) ...)), else /proc/loadavg.
 (define (load-source clause)
   (let ((start (monotonic-seconds)))
     (cond
@@ -117,8 +114,7 @@
   (call-with-input-file "/proc/loadavg"
     (lambda (in) (read in))))
 
-;; read-loadavg at most once a second: the kernel updates it every five,
-;; and every negotiation asks.
+;; read-loadavg at most once a second: the kernel updates it every five.
 (define (loadavg-reader)
   (let ((read-at #f) (load #f))
     (lambda ()

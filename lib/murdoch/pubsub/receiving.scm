@@ -1,7 +1,5 @@
-;;;; Receiving, part of (murdoch pubsub messaging): what messaging.scm's
-;;;; senders run in each address space, and request-exclusive's
-;;;; reservations.  A receiver answers (#t UID VALUE) when it evaluated the
-;;;; message, else (#f UID); (ANSWER ASKED) a component for request-components.
+;;;; Receiving, part of (murdoch pubsub messaging): what the senders run in
+;;;; each address space, (#t UID VALUE) or (#f UID), and the reservations.
 
 (define (evaluated? answer) (car answer))
 (define (evaluation answer) (cdr answer)) ; (UID VALUE)
@@ -30,8 +28,7 @@
   (promise-for (reserve-shared! topics task-name) proc args))
 
 ;;> What request-components runs in each address space: (answer asked)
-;;> for each component, answer as receive-request-exclusive or
-;;> receive-request gives, asked the candidate's answers to the askings.
+;;> for each component.
 (define (receive-components components task-name uid)
   (map (lambda (c)
          (match c
@@ -64,8 +61,7 @@
   (deadline reservation-deadline reservation-deadline-set!)
   (state reservation-state reservation-state-set!)) ; reserved running done
 
-;; Those not yet promised away.  Global, beside the subscriptions and under
-;; their lock.
+;; Global, beside the subscriptions under their lock: those not yet promised away.
 (define *reservations* '())
 
 ;; The lab's lease and the thread that frees what outlives it.
@@ -105,9 +101,8 @@
   (let ((subs (map find-subscription topics)))
     (and (every (lambda (s) (and s (ok? s))) subs) subs)))
 
-;; Whether every subject is subscribed here by its own name, read without
-;; the lock as addressed-here? reads: most of a lab lacks one and is told
-;; so without the reservation's checks.
+;; Whether every subject is subscribed here by name, without the lock: most
+;; of a lab lacks one, and is told so without the reservation's checks.
 (define (subscribed-to-all? subjects)
   (or (null? subjects)
       (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
@@ -151,8 +146,7 @@
 (define (in-use-subject topic)
   (string->symbol (string-append (symbol->string topic) ".in_use")))
 
-;; Frees a reservation's subjects, once; a subject is free when no
-;; reservation holds it.
+;; Frees a reservation's subjects, once.
 (define (release! r)
   (if (with-subscriptions
         (lambda ()
@@ -174,13 +168,11 @@
 ;;> Sets the thunk run, outside any lock, when exclusive subjects are freed.
 (define (on-free! thunk) (set! *on-free* thunk))
 
-;; While a freed robot is offered to a waiting task's poser, exclusive
-;; subjects here go only to its requests: (uid . until) or #f.  Global,
-;; beside the subscriptions and under their lock.
+;; Global, under the subscriptions' lock: (uid . until) while a freed robot
+;; is offered to uid, a waiting task's poser, whose requests alone get it.
 (define *offered* #f)
 
-;;> For \var{seconds}, reserves exclusive subjects here for \var{uid}'s
-;;> requests alone; #f ends that.
+;;> For \var{seconds}, reserves exclusive subjects here for \var{uid}'s requests; #f ends that.
 (define (offer-subjects! uid . seconds)
   (with-subscriptions
     (lambda ()
