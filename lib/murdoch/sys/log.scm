@@ -1,5 +1,4 @@
-;;;; One-line log messages on standard error ((chibi log) loads slowly:
-;;;; docs/speed.md).
+;;;; One-line log messages on standard error ((chibi log) loads slowly).
 
 ;; Global: every thread of the process logs under one name, set at start.
 (define *log-name* "murdoch")
@@ -13,8 +12,7 @@
 ;;> Starts each log line with the UTC time to the millisecond.
 (define (stamp-log-lines!) (set! *stamped?* #t))
 
-;;> Seconds since 1970 by the system's clock, UTC; (scheme time)'s
-;;> current-second counts TAI seconds, 37 ahead.
+;;> Seconds since 1970 by the system's clock, UTC (current-second is TAI's, 37 ahead).
 (define (utc-seconds)
   (let ((tv (car (get-time-of-day))))
     (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.))))
@@ -47,8 +45,7 @@
         (string-append (make-string (- width (string-length s)) #\0) s)
         s)))
 
-;; Written whole by one write-string, so no other thread's line cuts into
-;; it (log-test).
+;; Written whole by one write-string, lest another thread's line cut in.
 (define (log-line level parts)
   (let ((err (current-error-port)))
     (write-string (line-text level parts) err)
@@ -70,8 +67,7 @@
 ;;> Logs a fault that was handled.
 (define (log-warn . parts) (log-line ": warning: " parts))
 
-;;> What \var{e}, any raised object, says, as one line: an error's message
-;;> and irritants, or what else was raised.
+;;> What \var{e}, any raised object, says, as one line.
 (define (condition-message e)
   (cond
    ((stack-guard-tripped? (current-thread))

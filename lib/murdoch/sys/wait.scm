@@ -1,10 +1,8 @@
-;;;; Waiting with a deadline: every deadline is a moment on the monotonic
-;;;; clock, and every wait for another thread a mailbox or a mutex taken by
-;;;; a deadline; no loop sleeps and looks again.
+;;;; Waiting with a deadline on the monotonic clock, by mailbox or mutex:
+;;;; no loop sleeps and looks again.
 
 ;;> Chibi's dynamic-wind without its garbage (docs/speed.md): (in), then
-;;> (body)'s value, with (out) run however body leaves.  It uses Chibi's
-;;> wind point (%dk), so call/cc and raise wind through it.
+;;> (body)'s value, (out) however body leaves, on Chibi's own wind points.
 (define (wind in body out)
   (in)
   (wound (%dk) in body out))
@@ -25,8 +23,7 @@
   (vector-set! p 3 parent)
   p)
 
-;;> srfi 18's mutex-lock! and mutex-unlock! with no timeout and no
-;;> condition variable, without their optional arguments' garbage.
+;;> srfi 18's mutex-lock! and mutex-unlock!, no timeout or condition variable, no garbage.
 (define (lock! m)
   (or (%mutex-lock! m #f #t)
       (begin (thread-yield!) (mutex-lock! m))))   ; as srfi 18's, once it failed
@@ -67,8 +64,7 @@
 (define (waited? m cv left)
   (and (> left 0.) (mutex-unlock! m cv left)))
 
-;;> Calls thunk; when it leaves by raising, calls undo on the way out (a
-;;> wind point, not a guard: docs/speed.md).
+;;> Calls thunk; should it raise, calls undo on the way out (docs/speed.md).
 (define (undo-on-raise undo thunk)
   (undone-on-raise (%dk) undo thunk))
 
@@ -80,8 +76,7 @@
   (%dk here)
   value)
 
-;;> (map proc items), where an item whose (proc item) raises gives
-;;> (on-raise item e), under one handler (docs/speed.md).
+;;> (map proc items), a raising item giving (on-raise item e) (docs/speed.md).
 (define (map-guarded proc items on-raise)
   (let ((done '()) (rest items))
     (let run ()
@@ -95,8 +90,8 @@
             (loop)))))
     (reverse done)))
 
-;; A one-shot mailbox: the reader thread puts an answer, the caller takes it
-;; or gives up; its taker may empty it once no other thread can put to it.
+;; A one-shot mailbox: the reader puts an answer, the caller takes it or
+;; gives up; emptied by its taker once no other thread can put to it.
 (define-record-type mailbox
   (%make-mailbox mutex condvar value full?)
   mailbox?
@@ -122,8 +117,7 @@
   (mailbox-full?-set! mb #f)
   (unlock! (mailbox-mutex mb)))
 
-;; The mailbox's value, or (timed-out) once the deadline has passed; waits
-;; are given as seconds left, as SRFI-18 time objects count whole seconds.
+;; The value, or (timed-out) past the deadline; SRFI-18 waits count whole seconds.
 (define (mailbox-take mb deadline timed-out)
   (lock! (mailbox-mutex mb))
   (if (mailbox-full? mb)
@@ -138,8 +132,7 @@
 
 ;;; Mailboxes by id: a connection's calls waiting for their answers
 
-;;> The mailbox that \var{table} (id -> mailbox, an SRFI 69 table) holds
-;;> for \var{id}, taken out of it, or #f; the caller holds its lock.
+;;> The mailbox \var{table} holds for \var{id}, taken out, or #f; under the table's lock.
 (define (take-mailbox! table id)
   (taken table id (hash-table-cell table id #f)))
 
@@ -161,9 +154,8 @@
 
 ;;; Gatherings: one wake for the answers to many calls
 
-;;> A gathering: the poller hands in the answers to a caller's calls one
-;;> at a time, and the caller, waiting for n of them, wakes once, when the
-;;> nth has come or at its deadline; a mailbox each would wake it n times.
+;;> A gathering: the poller hands in the answers to a caller's calls, and
+;;> the caller wakes once, at the nth or its deadline, not n times.
 (define-record-type gathering
   (%make-gathering mutex condvar got wanted)
   gathering?
@@ -175,8 +167,7 @@
 (define (make-gathering)
   (%make-gathering (make-mutex) (make-condition-variable) 0 #f))
 
-;;> Gives \var{item} the answer \var{value}, by \scheme{(put item value)},
-;;> under the gathering's lock, unless \scheme{(get item)} shows one.
+;;> Gives \var{item} \var{value} by \scheme{(put item value)} unless \scheme{(get item)} has one.
 (define (gathering-put! g item value get put)
   (lock! (gathering-mutex g))
   (when (not (get item))
