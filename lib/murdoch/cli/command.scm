@@ -1,14 +1,12 @@
 ;;;; bin/murdoch: start address spaces, join a lab at a REPL.
 
 ;;> Makes this process address space \var{uid} of the lab at
-;;> \var{lab-file} (or \var{lab}, already read), serving with its
-;;> subscriptions and monitors; answers the received-code environment.
+;;> \var{lab-file}, serving; answers the received-code environment.
 (define (join-lab lab-file uid . port)
   (join-read-lab (read-lab lab-file) uid port))
 
-;; SIGPIPE is ignored, as the simulator does (sim/b14.c): a peer may die at
-;; any moment, and its default action would end this process without a
-;; word; the reader of the connection sees its end instead.
+;; SIGPIPE is ignored, as by the simulator: a peer may die at any moment,
+;; and its end is seen by the connection's reader, not this process's death.
 (define (join-read-lab lab uid port)
   (set-signal-action! signal/pipe #f)
   (take-tunables! lab)
@@ -20,8 +18,7 @@
     (offer-on-joining!)
     env))
 
-;; The settings that are values of the layers' parameters or the thesis's
-;; globals, set from the lab before anything runs.
+;; The settings that are the layers' parameters or globals, set before anything runs.
 (define tunables
   `((task-timeout . ,task-timeout) (trip-timeout . ,trip-timeout)
     (trip-motion-timeout . ,trip-motion-timeout)
@@ -32,9 +29,8 @@
 (define (take-tunables! lab)
   (for-each (lambda (t) ((cdr t) (lab-setting lab (car t)))) tunables))
 
-;; A robot drives its robot through trip at the lab's port; a workstation
-;; answers safe-reckon from its lab position.  The lab starts the
-;; simulator first, so one attempt is enough, and a failed one says why.
+;; A robot drives its robot through trip; a workstation answers safe-reckon
+;; from its position.  The simulator is up first, so one try is enough.
 (define (take-body! lab entry)
   (cond
    ((lab-aspace-clause entry 'robot)
@@ -66,8 +62,7 @@
             (aspace-port (local-aspace)))
   (let wait () (thread-sleep! 3600) (wait)))
 
-;;> Warns of the lab's address spaces that do not answer, as a guest that
-;;> joins too early or on another port base would see only untaken tasks.
+;;> Warns of the lab's address spaces that do not answer (a guest too early?).
 (define (tell-who-is-away lab)
   (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                          (map lab-aspace-uid (lab-aspaces lab))))
@@ -101,8 +96,7 @@
           'environment: (with-help (make-repl-environment lab lab-env))
           'eval: eval-with-hints
           'raw?: (not (is-a-tty? (current-input-port)))
-          ;; write, not write/ss: labels for cycles only, so a value met
-          ;; twice (task-status's outcomes) reads as itself.
+          ;; write, not write/ss, so a value met twice reads as itself.
           'printer: (lambda (value out) (write value out))
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))
@@ -129,9 +123,7 @@ docs/tutorial.md walks through these; docs/reference.md has every procedure.
 ")
 
 ;; Standard input, read so that the REPL's wait for a line lets the other
-;; threads run (serving the lab, components Ctrl-C gave up).  Its own
-;; description of the file is made non-blocking, leaving the shell's be; one
-;; that cannot be opened again (a socket) is read as it is.
+;; threads run: its own file description made non-blocking, not the shell's.
 (define (waiting-input-port)
   (let ((fd (guard (e (#t #f))
               (open "/proc/self/fd/0" (bitwise-ior open/read open/non-block)))))

@@ -1,18 +1,11 @@
-;;;; Hints: the REPL's eval, for a person who typed something wrong.
-;;
-;; Chibi reports an error at the line it was raised, which is in Chibi's or
-;; Murdoch's files, not where the person went wrong.  The first mistakes
-;; at Murdoch's REPL get a hint:
-;;   - code sent elsewhere names something defined at the REPL;
-;;   - a value that cannot travel (a port, a mutex) is sent;
-;;   - a wrong number of arguments, said in words;
-;;   - a name not defined, or a uid not the lab's, with the nearest one;
-;;   - a call that timed out, whose procedure may still run there
-;;     (docs/architecture.md, "Waiting and giving up").
+;;;; Hints: the REPL's eval, for a person who typed something wrong.  Chibi
+;;;; names the line an error was raised at, in its files or ours, not where
+;;;; the person went wrong.  A hint for: code naming a REPL definition, a
+;;;; value that cannot travel, a wrong number of arguments, an unknown name
+;;;; or uid, and a call that timed out (docs/architecture.md).
 
-;;> Evaluates \var{expr} in \var{env} as the REPL's eval: an error raised
-;;> in Murdoch's or Chibi's files is raised again without that place, with
-;;> a hint for the mistakes above.
+;;> Evaluates \var{expr} in \var{env} as the REPL's eval, an error raised
+;;> again without Chibi's or Murdoch's place, with a hint.
 (define (eval-with-hints expr env)
   (guard (e ((and (exception? e) (arity-error? e)) (raise (arity-recast e)))
             ((and (exception? e) (undefined-variable e))
@@ -60,8 +53,7 @@
                ((identifier? name) (identifier->symbol name))
                (else #f)))))
 
-;; "troyy is not defined; did you mean 'troy, a uid?": the nearest name
-;; defined in env, or the nearest uid, quoted, for one typed unquoted.
+;; "troyy is not defined; did you mean 'troy, a uid?"
 (define (undefined-recast name env)
   (let* ((text (symbol->string name))
          (uids (map symbol->string (known-uids)))
@@ -94,7 +86,6 @@
                                  " (known-uids) lists those that are")
                   '() #f #f))
 
-;; The uid of the error "no address space of this uid is known" UID, or #f.
 (define (unknown-uid e)
   (and (equal? (error-object-message e) "no address space of this uid is known")
        (pair? (error-object-irritants e))

@@ -1,7 +1,5 @@
-;;;; bin/murdoch lab, pose and demo.  Supervising processes is left to the
-;;;; sh scripts bin/murdoch-lab and bin/murdoch-demo; this side reads the
-;;;; lab file and hands them what they need.  The lab's address spaces are
-;;;; forked by its loader, which has Murdoch loaded already.
+;;;; bin/murdoch lab, pose and demo: this side reads the lab file for the
+;;;; sh scripts bin/murdoch-lab and bin/murdoch-demo, which supervise.
 
 ;;> One line per address space of \var{lab} not in \var{except}, as
 ;;> \scheme{"moseley 127.0.0.1:7100 robot (trip 127.0.0.1:7200) sonar mobile"}.
@@ -23,11 +21,9 @@
       (list "workstation")))
 
 ;;; Robots reached through ROS 2 (docs/ros2.md)
-;; A robot with a (ros2 ...) clause has a trip server of its own,
-;; robot/ros2/trip_ros2.py, started by the lab unless (trip-host ...) puts
-;; it elsewhere.  With MURDOCH_ROS2=1 every simulated robot goes so too:
-;; the simulator's trip servers move to face-trip (port-base + 150 + i),
-;; where robot/ros2/b14_face.py gives them a ROS 2 face.
+;; A (ros2 ...) robot has its own trip server, robot/ros2/trip_ros2.py,
+;; started by the lab unless on a trip-host.  Under MURDOCH_ROS2=1 the
+;; simulated robots too, behind robot/ros2/b14_face.py at face-trip.
 
 (define (ros2-everywhere?)
   (equal? (get-environment-variable "MURDOCH_ROS2") "1"))
@@ -42,18 +38,16 @@
              ,@face-arrival))
           (else #f))))
 
-;; A simulated B14 ends its motions within half a millimetre and a
-;; twentieth of a degree (sim/world.c); through its face nearly as near,
-;; so it senses from where a direct run would.
+;; A simulated B14 stops within 0.5 mm and 0.05° (sim/world.c); through
+;; its face nearly as near, to sense from where a direct run would.
 (define face-arrival '((arrive-mm 1) (arrive-deg 0.1)))
 
 (define (simulated? a)
   (and (lab-aspace-clause a 'robot)
        (not (assq 'ros2 (filter pair? (cdr (lab-aspace-clause a 'robot)))))))
 
-;; One line per trip server the lab starts for a ROS 2 robot, "ros2 NAME
-;; PORT-BASE ARG ..." (trip_ros2.py's arguments), and "face PORT-BASE
-;; NAME=HOST:PORT ..." for the simulator's face.
+;; A line per trip server the lab starts: "ros2 NAME PORT-BASE ARG ..."
+;; (trip_ros2.py's), and "face PORT-BASE NAME=HOST:PORT ..." for the face.
 (define (ros2-lines lab)
   (let ((base (number->string (lab-port-base lab))))
     (append
@@ -103,9 +97,8 @@
 (define (string-join words)
   (fold (lambda (w acc) (string-append acc " " w)) (car words) (cdr words)))
 
-;;> `murdoch lab LAB`: becomes bin/murdoch-lab (in \var{bin}) for the lab
-;;> at \var{lab-file}, but for the address spaces in \var{except}, which
-;;> someone starts by hand.  It first forks the lab's loader (serve-loader).
+;;> `murdoch lab LAB`: becomes bin/murdoch-lab (in \var{bin}) for the lab,
+;;> but for the address spaces in \var{except}, after forking the loader.
 (define (run-lab bin lab-file except logs trace speed start-aspace)
   (let* ((lab (read-lab lab-file))
          (requests (open-pipe))         ; bin/murdoch-lab -> the loader
@@ -138,15 +131,13 @@
                                            (planned-port 0 'trip)))))
         (else "sim")))
 
-;; Closes a fileno through a port, which marks it closed: the collector
-;; closes an open fileno's descriptor, whatever it is by then.
+;; Closes a fileno through a port, marking it closed for the collector.
 (define (close-fileno fileno open-port)
   (close-port (open-port fileno)))
 
 (define (close-on-exec! fd) (set-file-descriptor-flags! fd 1))   ; FD_CLOEXEC
 
-;; Makes the descriptors fds into the numbers to for exec, by way of
-;; numbers nothing holds, so that none is overwritten before it is copied.
+;; Moves the descriptors fds to the numbers to for exec, by way of free ones.
 (define (renumber-for-exec! fds to)
   (let ((spare (map (lambda (n) (+ n 90)) to)))
     (for-each duplicate-file-descriptor-to fds spare)
@@ -155,12 +146,10 @@
 
 ;;; The lab's loader
 ;; Loading Murdoch costs a process most of a second (docs/speed.md), so
-;; address spaces are forks of a loader forked from `murdoch lab` with it
-;; loaded and nothing started (no thread, socket or poller).  It answers
-;; bin/murdoch-lab's requests, one a line, until their end:
-;;   start UID       forks UID, its output to the file the next line
-;;                   names; answers the child's pid;
-;;   reap            "PID STATUS" ($?'s) for each child ended, then "end".
+;; address spaces are forks of a loader with it loaded and nothing started.
+;; Its requests from bin/murdoch-lab, one a line:
+;;   start UID    forks UID, logging to the next line's file; answers the pid
+;;   reap         "PID STATUS" ($?'s) for each child ended, then "end"
 (define (serve-loader in out start-aspace)
   (set-process-name! "murdoch-loader")
   ;; Ctrl-C is for bin/murdoch-lab; the children inherit this, as sh's `&`'s do.
@@ -199,9 +188,8 @@
         (bitwise-and (arithmetic-shift status -8) #xff)
         (+ 128 signal))))
 
-;; Forks address space uid, writing to log, reading nothing, as sh's
-;; `>>LOG 2>&1 &`.  It dies with the loader, since bin/murdoch-lab signals
-;; only the loader's children.
+;; Forks address space uid as sh's `>>LOG 2>&1 &`, dying with the loader,
+;; as bin/murdoch-lab signals only the loader's children.
 (define (fork-aspace uid log in out start-aspace)
   (let* ((loader (current-process-id))
          (pid (fork)))
@@ -228,8 +216,7 @@
     (duplicate-file-descriptor-to fileno fd)
     (close-fileno fileno open-input-file-descriptor)))
 
-;;> `murdoch check LAB`: reads the lab file and loads its code files as an
-;;> address space does; an error names the file and line.  Starts nothing.
+;;> `murdoch check LAB`: reads the lab file and loads its code, starting nothing.
 (define (run-check lab-file)
   (let ((lab (read-lab lab-file)))
     (check-lab-code lab (make-lab-environment lab)))
@@ -240,18 +227,15 @@
   (execute "/bin/sh" (list "/bin/sh" (string-append bin "/murdoch-demo")
                            lab-file)))
 
-;;> `murdoch pose LAB FILE`: joins the lab as a guest, evaluates
-;;> \var{task-file}'s forms as a REPL would, poses the task its last form
-;;> names (task-of), writing progress and the result.  Exits 0 when it
-;;> completed, else 1.  With \var{detach}, the task goes to the lab, its id
-;;> is written and it exits 0.
+;;> `murdoch pose LAB FILE`: joins as a guest, poses the task
+;;> \var{task-file} names (task-of) and writes its progress and result;
+;;> exits 0 when it completed, else 1.  \var{detach} hands it to the lab.
 (define (run-pose lab-file task-file detach)
   (let* ((lab (read-lab lab-file))
          (env (make-repl-environment lab (join-guest lab-file "pose"))))
     (tell-who-is-away lab)
     (eval `(pose-task-progress (current-output-port)) env)
-    ;; A task file answers pose-task's arguments, a task started, or a
-    ;; handed task's id: each is waited for, but with detach.
+    ;; Pose-task's arguments, a task started, or a handed task's id.
     (let ((task (task-of task-file env)))
       (cond
        (detach
@@ -269,8 +253,7 @@
         (write-result-and-exit "murdoch pose" (task-wait task) (task-status task)))
        (else (wait-and-exit (if (task? task) task (apply start-task task))))))))
 
-;; Waits for task t as murdoch pose does (Ctrl-C or SIGTERM cancel it),
-;; writes its results and word, and exits 0 when it is done.
+;; Waits for task t as murdoch pose does, exiting 0 when it is done.
 (define (wait-and-exit t)
   (let* ((signalled (cancel-on-signals! t))
          (result (wait-for-task t signalled)))
@@ -312,8 +295,7 @@
     (for-each (lambda (e) (write-string (string-append (lab-task-line e) "\n"))) tasks)
     (exit 0)))
 
-;;> `murdoch wait LAB ID`: waits for task \var{id} handed to the lab and
-;;> writes its results as `murdoch pose` does, exiting 0 if it completed.
+;;> `murdoch wait LAB ID`: waits for task \var{id} handed to the lab, as `murdoch pose`.
 (define (run-wait lab-file id)
   (join-guest lab-file "wait")
   (guard (e (#t (write-string (string-append "murdoch wait: " (error-message e) "\n")
@@ -332,8 +314,7 @@
     (write-string (string-append "cancelled " (symbol->string id) "\n"))
     (exit 0)))
 
-;; Whether a task waited for by id did not complete: every component of
-;; every step must be done.
+;; Whether a task waited for by id failed: every component must be done.
 (define (task-failed? result status)
   (or (symbol? result) (any failed-status? status)))
 
@@ -342,8 +323,8 @@
       (any failed-status? (step-status-entries s))
       (not (eq? (car (status-state s)) 'done))))
 
-;; On SIGINT or SIGTERM t is cancelled, its robots stopping where they are;
-;; a second signal ends the pose.  Answers a thunk of the signal, or #f.
+;; SIGINT or SIGTERM cancel t, a second one ends the pose; answers a thunk
+;; of the signal, or #f.
 (define (cancel-on-signals! t)
   (let ((caught #f))
     (for-each (lambda (signal)
@@ -355,8 +336,7 @@
               (list signal/interrupt signal/term))
     (lambda () caught)))
 
-;; What task-wait answers for t; after a signal at most ten seconds more,
-;; as a component that neither moves nor calls stops only at its end.
+;; What task-wait answers for t, at most ten seconds after a signal.
 (define (wait-for-task t signalled)
   (let loop ((cancelled-at #f))
     (cond ((guard (e (#t #f)) (list (task-wait t 0.5))) => car)
@@ -369,7 +349,7 @@
         (else (string-append "signal " (number->string n)))))
 
 ;;> `murdoch status LAB`: what each address space says of itself
-;;> (show-status), away after two seconds.  Exits 1 when none answers.
+;;> (show-status); exits 1 when none answers.
 (define (run-status lab-file)
   (join-guest lab-file "status")
   (cond ((zero? (parameterize ((remote-timeout 2)) (write-lab-status)))
@@ -380,8 +360,8 @@
            (exit 1))
           (else (exit 0))))
 
-;;> The task \var{file} evaluates to in \var{env}: its last form's value,
-;;> or what a procedure of no arguments it defines answers.
+;;> The task \var{file} evaluates to: its last form's value, or what the
+;;> procedure of no arguments it defines answers.
 (define (task-of file env)
   (let* ((entries (car (read-source file)))     ; ((FORM . LINE) ...)
          (last-value (fold (lambda (entry acc) (eval-at file entry env)) #f entries))
@@ -392,8 +372,7 @@
         (eval-at file (cons (cadr last-form) (cdr last-entry)) env)
         last-value)))
 
-;; The value of entry's form in env, as the REPL evaluates it, hints and
-;; all; an error names the file and line.
+;; The value of entry's form in env, as the REPL's; errors name file and line.
 (define (eval-at file entry env)
   (at-form-line file entry (lambda () (eval-with-hints (car entry) env))))
 
