@@ -1,21 +1,16 @@
 ;;;; The MOVER robot primitives, spoken over trip (docs/trip-protocol.md).
 ;;;
-;;; One connection per robot, shared by the address space's threads.  A
-;;; thread sends its request under the connection's lock and lets go; the
-;;; reader thread hands each reply to the mailbox of its tag, and drops the
-;;; rest (tag 0, or an asker that gave up).  A reply not back within
-;;; (trip-timeout) raises a trip error naming robot and command.  A motion
-;;; ends with `base await', answered when the motion is over: its thread
-;;; waits up to (trip-motion-timeout) while others (the view) read the robot;
-;;; an abandoned one (code/abandon.scm) is woken and stops the robot.
-;;; The primitives act on (current-robot); devices open on first use, or
-;;; all at once with (im), as MOVER's did.
+;;; One connection a robot, shared by the address space's threads: a
+;;; request is sent under its lock, and the reader thread hands each reply
+;;; to its tag's mailbox, so no request holds the connection while it
+;;; waits.  A motion ends with `base await', answered when it is over; an
+;;; abandoned mover (code/abandon.scm) is woken and stops the robot.
+;;; Devices open on first use, or all with (im), as MOVER's did.
 
 ;;> Seconds to wait for any reply (the lab's trip-timeout, for the process's one robot).
 (define trip-timeout (make-parameter (lab-default 'trip-timeout)))
 
-;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is
-;;> stopped and an error raised.
+;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is stopped.
 (define trip-motion-timeout (make-parameter (lab-default 'trip-motion-timeout)))
 
 ;;> The connection the primitives use: #f on a workstation.  Global, as a
@@ -60,15 +55,13 @@
     (write-u8 etx out)
     (flush-output-port out)))
 
-;; The next byte or an eof object, waiting on the socket (port-wait!) with
-;; no deadline: each request has its own.
+;; The next byte or an eof object, waiting on the socket (port-wait!).
 (define (next-byte in)
   (if (u8-ready? in)
       (read-u8 in)
       (begin (port-wait! in 3600) (next-byte in))))
 
-;; The next whole frame's payload as a string, or an eof object; broken
-;; frames, which the server never sends, are skipped.
+;; The next whole frame's payload as a string, or an eof object.
 (define (read-frame in)
   (let outside ()
     (let ((b (next-byte in)))
@@ -116,8 +109,7 @@
       (string-append (trip-connection-host c) ":"
                      (number->string (trip-connection-port c)))))
 
-;;> Connects to the trip server of one robot and returns the connection,
-;;> named as the server says.
+;;> Connects to the trip server of one robot and returns the connection.
 (define (trip-connect host port)
   (let ((io (open-connection host port (trip-timeout))))
     (if (string? io)
@@ -140,8 +132,7 @@
 (define (trip-close c)
   (with-lock (trip-connection-lock c) (lambda () (shut! c))))
 
-;; Close the socket once, under the lock: closing its number again could
-;; close a socket that has taken it.  The reader then ends.
+;; Close the socket once, under the lock, lest its number be another's.
 (define (shut! c)
   (when (trip-connection-open? c)
     (trip-connection-open?-set! c #f)
@@ -172,9 +163,8 @@
       (shut! c)
       (take-all-mailboxes! (trip-connection-waiting c)))))
 
-;; A connection the server ended (its lab restarts a dead trip server)
-;; connects again, once, for the request about to go, and reopens its
-;; devices; a server still away is the error closed.
+;; A connection the server ended (a restarted trip server) connects again,
+;; once, and reopens its devices; a server still away is the error closed.
 (define (reconnect! c command)
   (with-lock (trip-connection-relock c)
     (lambda ()
@@ -222,9 +212,8 @@
 
 (define (reply-value w) (or (string->number w) w))
 
-;; Sends one request and returns its ok reply's values; raises a trip
-;; error for an err reply, a lost connection, no reply in time, or an
-;; abandoned call (instead of sending).
+;; Sends one request and returns its ok reply's values, or raises a trip
+;; error (err reply, lost connection, timeout, abandoned call).
 (define (request c . words)
   (let ((command (join (map ->word words))))
     (exchange c command (+ (monotonic-seconds) (trip-timeout))
@@ -233,9 +222,8 @@
                             (string-append "no reply within "
                                            (number->string (trip-timeout)) " s"))))))
 
-;; Sends command and returns its ok reply's values by deadline, else calls
-;; too-late.  The thread waits in a mailbox, not holding the connection,
-;; woken should its caller give up.
+;; Sends command and returns its reply's values by deadline, else
+;; (too-late); waits in a mailbox, woken should its caller give up.
 (define (exchange c command deadline too-late)
   (let ((mb (make-mailbox)))
     (define (fail code text) (trip-error (robot-name c) command code text))
@@ -277,8 +265,7 @@
       (fail (if (pair? (cddr reply)) (car (cddr reply)) "protocol")
             (join (if (pair? (cddr reply)) (cdr (cddr reply)) reply)))))
 
-;;> One raw request on connection \var{c}, words joined with spaces; the
-;;> reply's values.  For tools and tests: \scheme{(trip-request c 'buttons 'press 2)}.
+;;> One raw request on \var{c}, words joined with spaces: \scheme{(trip-request c 'buttons 'press 2)}.
 (define trip-request request)
 
 ;;; Devices
@@ -301,8 +288,7 @@
     (apply request c device words)))
 
 ;;> MOVER's initialisation: opens every device of the current robot, so
-;;> that one held elsewhere shows now, not mid-task; one the robot has not
-;;> (\scheme{unknown}) stays closed.
+;;> that one held elsewhere shows now, not mid-task.
 (define (im)
   (for-each (lambda (d)
               (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) #f))
@@ -312,8 +298,8 @@
 
 ;;; Motion
 
-;; Waits for the base's motion to end (base await): the final odometry
-;; pose.  Stopped past (trip-motion-timeout), or when the caller gave up.
+;; Waits for the motion's end (base await): the final pose.  Stopped past
+;; (trip-motion-timeout), or when the caller gave up.
 (define (await-motion what)
   (let* ((c (robot))
          (end (guard (e ((abandoned-error? e)
@@ -328,8 +314,7 @@
         (trip-error (robot-name c) what "stalled" "the base is blocked"))
     (list (car end) (cadr end) (car (cddr end)) 0)))
 
-;;> Drives to \var{xy}, a list (x y) in millimetres of the odometry frame:
-;;> turns to face it, then goes.  Returns the pose reached, as reckon.
+;;> Drives to \var{xy}, (x y) in mm of the odometry frame, facing it first; the pose reached.
 (define (goto-xy xy)
   (let ((c (robot)))
     (dynamic-wind
@@ -344,8 +329,8 @@
   (let ((c (current-robot)))
     (and c (trip-connection-goal c))))
 
-;;> \scheme{(rotate 'by degrees)} turns in place by an angle (counter-
-;;> clockwise positive); \scheme{(rotate 'to heading)} turns to a heading.
+;;> \scheme{(rotate 'by degrees)} turns in place (counter-clockwise positive);
+;;> \scheme{(rotate 'to heading)} turns to a heading.
 (define (rotate how degrees)
   (let ((by (case how
               ((by) degrees)
@@ -401,8 +386,7 @@
 ;;> The buttons pressed since the last call, as four 0/1.
 (define (buttons-read) (device 'buttons "read"))
 
-;;> Sets the four LEDs from a list or four arguments of 0/1 or #f/#t;
-;;> with none, answers them.
+;;> Sets the four LEDs from a list or four 0/1 or #f/#t; with none, answers them.
 (define (lights . which)
   (let ((ls (if (and (pair? which) (list? (car which))) (car which) which)))
     (if (null? ls)
@@ -422,9 +406,7 @@
   #t)
 
 ;;> The boxes the fiducial finder sees (docs/trip-protocol.md), nearest
-;;> first, as (ID RANGE BEARING ORIENTATION): the box's index in the lab,
-;;> mm to its centre, degrees from the heading (counter-clockwise), and its
-;;> heading less the robot's.  () when none in range, view and sight.
+;;> first, as (ID RANGE BEARING ORIENTATION), in mm and degrees; () for none.
 (define (fiducials)
   (let loop ((words (cdr (device 'fiducial "read"))) (seen '()))
     (if (null? words)
@@ -446,8 +428,7 @@
 ;;> The ORIENTATION in degrees of \var{f}, one of fiducials'.
 (define (fiducial-orientation f) (cadr (cddr f)))
 
-;;> The battery in tenths of a volt, an integer (136 for 13.6 V), the
-;;> thesis's unit (130 charging, 100 low).
+;;> The battery in tenths of a volt, an integer (136 for 13.6 V), the thesis's unit.
 (define (battery-voltage)
   (exact (round (* 10 (car (device 'battery "read"))))))
 
@@ -462,8 +443,7 @@
 (define (safe-im)
   (if (current-robot) (im) #t))
 
-;;> The battery on a robot; elsewhere, or with no reading (a ROS 2 robot
-;;> without BatteryState), 140, enough to count as charging.
+;;> The battery on a robot; elsewhere, or with no reading, 140: enough to count as charging.
 (define (safe-battery-voltage)
   (if (current-robot)
       (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) 140))
@@ -474,8 +454,8 @@
 ;;> process is one machine: set it once, \scheme{(workstation-position '(-1524 -2743.2 90))}.
 (define workstation-position (make-parameter #f))
 
-;;> \scheme{reckon} on a robot; on a workstation its fixed \var{position},
-;;> by default \scheme{(workstation-position)}, as (x y heading 0), or #f.
+;;> \scheme{reckon} on a robot; on a workstation its fixed \var{position}
+;;> (default \scheme{(workstation-position)}) as (x y heading 0), or #f.
 (define (safe-reckon . position)
   (let ((p (if (pair? position) (car position) (workstation-position))))
     (cond ((current-robot) (reckon))
