@@ -1,13 +1,9 @@
 ;;;; The live view, (murdoch view): its snapshots.
 ;;
-;; One process, a guest of the lab, asks every address space twice a
-;; second how it is (task/status.scm's aspace-report, and a robot's sonar
-;; and fiducials) and makes a snapshot of the answers: one JSON object of
-;; the time, the address spaces, the boxes and the tasks, appended to the
-;; run's trace after a line for the room.  The page (web/view.html,
-;; view.js) reads /trace, then /events as server-sent events; a replay
-;; serves a finished trace to the same page.  A box is drawn where the lab
-;; file puts it until a robot sees it; a robot's pose is its odometry.
+;; A guest of the lab asks every address space twice a second how it is
+;; (aspace-report, a robot's sonar and fiducials) and makes a snapshot: a
+;; JSON object appended to the run's trace after a line for the room.  The
+;; page (web/view.js) reads /trace, then /events; a replay serves a trace.
 
 (define poll-seconds 0.5)
 
@@ -16,8 +12,7 @@
 
 ;;; JSON
 
-;;> \var{x} written as JSON, to a string: objects are alists of symbols,
-;;> arrays vectors (chibi json).
+;;> \var{x} written as JSON, to a string ((chibi json): alists and vectors).
 (define (json-text x)
   (let ((out (open-output-string)))
     (json-write x out)
@@ -42,8 +37,7 @@
 ;;; The room: the first line of a trace
 
 ;;> The first line of a trace, as JSON: the lab's name, robot radius,
-;;> walls (x1 y1 x2 y2 thickness), boxes (x y width depth heading), and
-;;> address spaces.
+;;> walls, boxes, and address spaces.
 (define (lab-header lab)
   `((kind . "lab")
     (lab . ,(symbol->string (lab-name lab)))
@@ -68,8 +62,7 @@
 
 (define (degrees->radians d) (* d (/ (acos -1) 180)))
 
-;;> Where box \var{id} is, (x y heading), from a robot at \var{pose} that
-;;> sees it at \var{range} mm, \var{bearing} and \var{orientation} degrees.
+;;> Where box \var{id} is, (x y heading), seen from a robot at \var{pose}.
 (define (box-seen pose range bearing orientation)
   (let ((a (degrees->radians (+ (list-ref pose 2) bearing))))
     (list (+ (car pose) (* range (cos a)))
@@ -79,8 +72,7 @@
 ;;; Snapshots
 
 ;; What each address space is asked: its report, a robot's sonar and
-;; fiducials (#f on a workstation), and the tasks it posed lately, over
-;; or not, as a task ends in the state its poser gives it.
+;; fiducials, and the tasks it posed lately, over or not.
 (define report-source
   '(lambda ()
      (list (aspace-report)
@@ -103,8 +95,7 @@
   (pose ring-pose))
 
 ;; What the view remembers between polls: the boxes, the task table, and
-;; each robot's last sonar ring with the pose it was first seen at (a ring
-;; stays readable after sonar-stop, drawn from where it was read).
+;; each robot's last sonar ring with the pose it was read at.
 (define-record-type view-state
   (make-view-state boxes table sonars)
   view-state?
@@ -117,9 +108,8 @@
   (make-view-state (list->vector (vector->list (cdr (assq 'boxes header))))
                    (make-task-table) '()))
 
-;;> The snapshot at \var{t} seconds of the lab, from \var{answers}
-;;> (remote-apply-all's of report-source) and \var{state}, brought up to
-;;> date; \var{line}, when given, the lab's waiting tasks.
+;;> The snapshot at \var{t} seconds of the lab, from \var{answers} and
+;;> \var{state}, brought up to date; \var{line} the lab's waiting tasks.
 (define (view-snapshot lab t answers state . line)
   (let* ((answered (filter outcome-ok? answers))
          (boxes (view-state-boxes state)))
@@ -203,8 +193,7 @@
 
 ;;; The feed: snapshots for the trace file and the pages that follow
 
-;; The trace is written a line at a time, so a lab stopped any way leaves
-;; one to replay; following pages wait on changed.
+;; The trace is written a line at a time, so a lab stopped any way leaves one.
 (define-record-type feed
   (%make-feed trace out count recent lock changed)
   feed?
@@ -232,8 +221,7 @@
         (feed-count-set! feed (+ k 1))
         (condition-variable-broadcast! (feed-changed feed))))))
 
-;; The feed's snapshots numbered next or later, oldest first, once there
-;; is one, or none after seconds.
+;; The feed's snapshots from next on, once there is one, or none after seconds.
 (define (feed-after feed next seconds)
   (let ((deadline (+ (monotonic-seconds) seconds)))
     (let loop ()

@@ -1,15 +1,9 @@
-;;;; The live view's table of tasks, part of (murdoch view): who holds
-;;;; what, for which task, from what the address spaces report.
-
-;;; A robot reports the subjects it holds and for whom (NAME@POSER/N,
-;;; task/pose-task.scm), the components it runs, (running ID INDEX
-;;; POSER), and those that ended lately and how.  The table keeps each
-;;; component from when it is first seen to its end; one seen on another
-;;; robot was reassigned; subjects held with no component are a
-;;; negotiation's reservation, unnumbered.  A task's state is its poser's
-;;; word when the poser is in the lab, else its components': running,
-;;; negotiating, failed, not started, or done.  A component is lost when
-;;; its robot restarted or missed away-polls looks: a dead robot cannot say.
+;;;; The live view's table of tasks, part of (murdoch view): who holds what
+;;;; for which task, from the robots' reports of subjects held (NAME@POSER/N),
+;;;; components running and ended.  A component seen on another robot was
+;;;; reassigned; subjects held with none are a negotiation's reservation.  A
+;;;; task's state is its poser's word, else its components'.  A component is
+;;;; lost when its robot restarted or missed away-polls looks.
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)
@@ -52,8 +46,7 @@
 
 (define away-polls 3)
 
-;;> The task name and poser that \var{key}, a reservation name or task id
-;;> (NAME@POSER/N), holds, as a list; else the key and #f.
+;;> The task name and poser of \var{key} (NAME@POSER/N) as a list, else (key #f).
 (define (reservation-task key)
   (or (task-key-parts key) (list key #f)))
 
@@ -107,8 +100,7 @@
                            (posed-state-text t (and (= (length t) 8) (listed-place t))))))
               tasks))
 
-;; A posed task's state as shown: task-state's word, why it failed, what
-;; a waiting one holds and waits for, and its place in line.
+;; A posed task's state as shown: its word, why it failed, or what it waits for.
 (define (posed-state-text t place)
   (let ((word (text (listed-state t))))
     (cond ((< (length t) 8) word)       ; a peer older than the word's details
@@ -117,16 +109,13 @@
           ((string? (listed-why t)) (string-append word ": " (listed-why t)))
           (else word))))
 
-;; Whether the table takes a posed (KEY . STATE): it goes on, or the
-;; table has it; a task over before the view saw it is left out.
+;; Whether the table takes a posed (KEY . STATE): a task over unseen is left out.
 (define (posed-news? table posed)
   (or (task-known table (car posed))
       (not (any (lambda (word) (string-prefix? word (cdr posed)))
                 '("done" "failed" "cancelled" "deadline")))))
 
-;;> Brings \var{table}'s waiting tasks up to date with \var{line}, the lab's
-;;> waiting tasks: state and place; a guest's task gone from the line is
-;;> over or running, as its components say.
+;;> Brings \var{table}'s waiting tasks up to date with \var{line}, the lab's.
 (define (task-table-note-line! table line)
   (let ((keys (map (lambda (x) (text (listed-id (car (cddr x))))) line)))
     (for-each (lambda (x key)
@@ -184,8 +173,7 @@
                      (string=? word (substring end 0 (string-length word)))))
               '("lost:" "failed:")))))
 
-;; Whether c failed or was lost, and no later entry took its number (a
-;; started task's component may be lost on one robot and done on the next).
+;; Whether c failed or was lost, and no later entry took its number.
 (define (failed-for-good? c cs)
   (and (failed? c)
        (let ((k (component-entry-index c)))
@@ -201,9 +189,8 @@
         ((any component-entry-index cs) "done")
         (else "not started")))
 
-;;> Brings \var{table} up to time \var{t} with \var{reports}: (UID REPORT
-;;> [POSED]) for each address space that answered.  A component one no
-;;> longer shows has ended, as it says, or, a reservation, was released.
+;;> Brings \var{table} up to time \var{t} with \var{reports}, (UID REPORT
+;;> [POSED]) each; a component no longer shown has ended or was released.
 (define (task-table-update! table t reports)
   (let ((seen '()))                     ; the component entries seen now
     (for-each
@@ -257,8 +244,7 @@
 (define (sighting-report r) (cadr r))
 (define (sighting-posed r) (and (pair? (cddr r)) (car (cddr r))))
 
-;; Brings the table's robots up to date, answering ((ROBOT . WHY) ...) for
-;; those whose components were lost: restarted, or silent away-polls looks.
+;; Brings the table's robots up to date: ((ROBOT . WHY) ...) for those lost.
 (define (note-robots! table t reports)
   (let ((gone '()))
     (for-each
@@ -321,9 +307,8 @@
                                                  (list c)))
         c)))))
 
-;; The unnumbered reservations robot holds for task (under its name or
-;; its NAME@POSER) become the component starting there: taken out of the
-;; table, and answers when the first was seen, or #f.
+;; The unnumbered reservations robot holds for task become the component
+;; starting there; answers when the first was seen, or #f.
 (define (take-reservations! table task robot)
   (let ((base (key-base (task-entry-key task)))
         (since #f))
@@ -346,8 +331,7 @@
                               (table-tasks table)))
     since))
 
-;; Brings robot's component that e tells of to its end: the open entry, or
-;; a new one when it ended unseen.
+;; Ends robot's component that e tells of: the open entry, or a new one.
 (define (note-ended! table t robot e)
   (let* ((key (text (ended-id e)))
          (k (ended-index e))
@@ -372,9 +356,7 @@
   (let ((i (component-entry-index a)) (j (component-entry-index b)))
     (and i (or (not j) (< i j)))))
 
-;;> The table as JSON: the newest \var{most} tasks, with name, poser,
-;;> state, keepers when detached, and components by number (index, robot,
-;;> subjects, since, until, end, reassigned from), reservations last.
+;;> The table as JSON: the newest \var{most} tasks and their components.
 (define (task-table->json table most)
   (list->vector
    (map (lambda (task)
