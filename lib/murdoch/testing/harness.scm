@@ -1,5 +1,4 @@
-;;;; What the multi-process tests share: labs in temporary folders on free
-;;;; ports, and child processes that are always stopped.
+;;;; What the multi-process tests share: labs on free ports, children stopped.
 
 ;; The repository: MURDOCH_TOP, as tests/run sets it, else the current folder.
 (define top
@@ -8,8 +7,7 @@
 ;; The lab file's port base rules; an exported one would move only this process.
 (unsetenv "MURDOCH_PORT_BASE")
 
-;; A test writes to children that may have died; SIGPIPE would end it
-;; without its summary, so the write raises instead.
+;; A write to a dead child raises, rather than SIGPIPE ending the test unreported.
 (set-signal-action! signal/pipe #f)
 
 ;;> The path of a file of the repository.
@@ -22,10 +20,9 @@
   (directory test-lab-directory)
   (port-base test-lab-port-base))
 
-;; The first line \var{cmd} prints; an error giving its wait status when
-;; none.  Not call-with-process-io, which closes its pipes with
-;; close-file-descriptor, leaving the collector to close those numbers
-;; again later, by then another pipe's or socket's.
+;; The first line \var{cmd} prints, else an error with its wait status.
+;; Not call-with-process-io, whose close-file-descriptor leaves the
+;; collector to close the numbers again later, by then others'.
 (define (command-output cmd)
   (let* ((pipe (open-pipe))
          (pid (fork)))
@@ -46,8 +43,7 @@
                 (error "a command printed nothing; its wait status:" cmd status))
             line)))))))
 
-;;> A fresh folder under $TMPDIR, readable by its owner alone, named by this
-;;> process's id and a count, as mktemp -d would make but with no process.
+;;> A fresh folder under $TMPDIR for its owner alone, as mktemp -d makes.
 (define (temporary-directory)
   (let ((base (or (get-environment-variable "TMPDIR") "/tmp")))
     (let loop ((tries 0))
@@ -62,8 +58,8 @@
 
 (define folders-made 0)
 
-;;> A port base B with nothing listening on B to B + 199, claimed while this
-;;> process lives, or while \var{folder} exists (tools/free-port-base).
+;;> A port base B, free from B to B + 199, held while this process lives
+;;> or \var{folder} exists.
 (define (free-port-base . folder)
   (string->number (command-output (cons (tool-path "tools/free-port-base") folder))))
 
@@ -87,8 +83,7 @@
     (let ((line (read-line in)))
       (if (eof-object? line) (reverse acc) (loop (cons line acc))))))
 
-;;> The message of the error \var{thunk} raises (a remote-error's from the
-;;> other address space), or no-error.
+;;> The message of the error \var{thunk} raises, or no-error.
 (define (error-text thunk)
   (guard (e ((remote-error? e) (remote-error-message e))
             ((error-object? e) (error-object-message e)))
@@ -102,8 +97,7 @@
       (and (<= (+ i n) (string-length text))
            (or (string=? word (substring text i (+ i n))) (loop (+ i 1)))))))
 
-;;> Writes a lab file with \var{clauses}, and \var{files}' (name . text)
-;;> beside it, into a fresh folder, on a port base no other lab uses.
+;;> Writes a lab file of \var{clauses} and \var{files} in a fresh folder, on a free port base.
 (define (make-test-lab clauses . files)
   (let* ((dir (temporary-directory))
          (base (free-port-base dir))
@@ -118,8 +112,7 @@
               (if (pair? files) (car files) '()))
     (%make-test-lab file dir base)))
 
-;;> Removes the lab's folder; when a test failed, the last lines of each log
-;;> go to standard error first, as a dead address space leaves no other trace.
+;;> Removes the lab's folder, after a failure showing each log's last lines.
 (define (remove-test-lab! lab)
   (if (positive? (test-failure-count))
       (show-log-tails (test-lab-directory lab) 30))
@@ -141,8 +134,7 @@
 ;; Global: the test process's children, all stopped at its end.
 (define *children* '())
 
-;;> Starts \var{args} logging to \var{log-file}, without MURDOCH_PORT_BASE;
-;;> answers the pid.
+;;> Starts \var{args} logging to \var{log-file}; answers the pid.
 (define (start-process! args log-file)
   (let ((pid (fork)))
     (cond
@@ -185,16 +177,14 @@
 (define (stop-all-processes!)
   (for-each stop-process! *children*))
 
-;;> Waits until \var{thunk} answers true, every 50 ms, for at most
-;;> \var{seconds}; answers its last value.
+;;> Waits until \var{thunk} answers true, for at most \var{seconds}; its last value.
 (define (wait-until seconds thunk)
   (let loop ((left (* seconds 20)))
     (or (thunk)
         (and (> left 0)
              (begin (thread-sleep! 0.05) (loop (- left 1)))))))
 
-;;> Starts address space \var{uid} of the test lab, logging to UID.log in
-;;> its folder; answers its pid once it listens.
+;;> Starts address space \var{uid} of the test lab; answers its pid once it listens.
 (define (start-lab-aspace! lab uid)
   (let* ((entry (lab-aspace-by-uid (read-lab (test-lab-file lab)) uid))
          (pid (start-process!
@@ -207,9 +197,8 @@
                (test-lab-directory lab)))
     pid))
 
-;;> Starts `bin/murdoch lab` with \var{args}, output to \var{out}, and
-;;> answers its pid once ready; if it gives up, an error holds its output.
-;;> \var{port-base}, if given, is its MURDOCH_PORT_BASE.
+;;> Starts `bin/murdoch lab` with \var{args}, output to \var{out}; its pid
+;;> once ready, else an error with its output.
 (define (start-murdoch-lab! args out . port-base)
   (let ((pid (start-process!
               (append (if (pair? port-base)
@@ -249,11 +238,9 @@
                     (close-output-port (cadr io))
                     #t))))))
 
-;;> A loopback TCP listener on a port of its own, for a test or bench
-;;> without a lab: (listener . port), a non-blocking fileno for
-;;> \scheme{accept}; keep it while in use, as the collector closes a fileno
-;;> nothing refers to.  The port is drawn at random from spare-ports,
-;;> stepping over those held, so runs at once each get their own.
+;;> A loopback TCP listener on a port of its own, (listener . port): keep
+;;> the listener while in use, as the collector closes a fileno nothing
+;;> refers to.  Drawn at random from spare-ports, so runs at once differ.
 (define (listen-on-free-port)
   (let-values (((low high) (spare-ports)))
     (let ((n (- high low)))
@@ -263,8 +250,7 @@
          ((listener-on port) => (lambda (sock) (cons sock port)))
          (else (try (+ tries 1) (+ low (modulo (- (+ port 1) low) n)))))))))
 
-;; The ports [low, high) that no lab (tools/free-port-base: 10000 + 200k,
-;; 200 each) nor the kernel's ephemeral range hands out: 200 to 399.
+;; The ports [low, high) that neither labs (tools/free-port-base) nor the kernel hand out.
 (define (spare-ports)
   (let* ((high (ephemeral-port-start))
          (low (+ 10000 (* 200 (quotient (- high 10200) 200)))))
@@ -287,10 +273,8 @@
 
 (define eaddrinuse 98)          ; Linux's EADDRINUSE, which Chibi does not name
 
-;; A listener on 127.0.0.1:port, or #f when the port is taken.  Not
-;; make-listener-socket, whose failed bind closes by close-file-descriptor,
-;; so the collector later closes the next socket's number; a socket that
-;; fails is closed through a port.
+;; A listener on 127.0.0.1:port, or #f when taken; a failed socket is
+;; closed through a port (see command-output).
 (define (listener-on port)
   (let* ((addr (get-address-info "127.0.0.1" port))
          (sock (socket (address-info-family addr)

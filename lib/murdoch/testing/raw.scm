@@ -46,8 +46,7 @@
 (define (counted key nonce count datum)
   (framed (frame-mac key nonce count (text-of datum)) (text-of datum)))
 
-;;> The message of the next frame on \var{conn}, its MAC unchecked, or an
-;;> eof object when the other side closed.
+;;> The message of the next frame on \var{conn}, unchecked, or an eof object.
 (define (raw-answer conn)
   (let ((payload (guard (e (#t (eof-object)))
                    (read-netstring (car conn) 10000000))))
@@ -56,8 +55,7 @@
         (let ((text (utf8->string payload)))
           (read (open-input-string (substring text 64 (string-length text))))))))
 
-;;> A connection to \var{port} said hello as \var{nonce} and welcomed:
-;;> (connection . the callee's nonce).
+;;> A connection to \var{port} welcomed after hello: (connection . callee's nonce).
 (define (welcomed-raw-connect key port nonce)
   (let ((conn (raw-connect port)))
     (raw-send! conn (hello-frame key nonce))

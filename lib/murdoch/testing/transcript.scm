@@ -51,10 +51,9 @@
           (loop rest lab as (cons (cons line (car steps)) (cdr steps))
                 shell))))))))
 
-;;> The REPL sessions a document shows, as one transcript: each code block
-;;> starting with a prompt ("guest-1234> ") is a step, at one REPL of the
-;;> lab "<!-- transcript lab: FILE -->" names; numbers match any number
-;;> ({number}) and "..." any text ({any}).
+;;> A document's REPL sessions as one transcript: code blocks that start
+;;> with a prompt, at the lab "<!-- transcript lab: FILE -->" names; a
+;;> number matches any number, "..." any text.
 (define (read-doc-transcript file)
   (let ((lines (read-lines file)))
     (make-transcript
@@ -133,8 +132,7 @@
         (loop (+ j 1))
         j)))
 
-;;> What to do, in order: input lines as strings, and (shell COMMAND K)
-;;> to run once the REPL answered its first K inputs.
+;;> What to do: input lines, and (shell COMMAND K) to run after K answers.
 (define (transcript-script t)
   (let loop ((k 0) (steps (transcript-steps t)) (shell (transcript-shell t)))
     (cond ((and (pair? shell) (= k (caar shell)))
@@ -143,8 +141,7 @@
            (cons (caar steps) (loop (+ k 1) (cdr steps) shell)))
           (else '()))))
 
-;;> The readable mismatches between the REPL's \var{output}, whose prompt
-;;> is \var{prompt}, and transcript \var{t}; empty when all matched.
+;;> The mismatches between the REPL's \var{output} and \var{t}; empty when none.
 (define (transcript-mismatches t prompt output)
   (let ((answers (split-at-prompts output prompt))
         (steps (transcript-steps t)))
@@ -220,11 +217,9 @@
             (string->number (substring line l e)))
           (iota (- (string-length line) l) (+ l 1))))
 
-;;; Replaying: bin/murdoch lab on a free port base, then bin/murdoch repl
-;;; with the transcript's input typed through a pipe.
+;;; Replaying: bin/murdoch lab, then bin/murdoch repl fed through a pipe.
 
-;; The lab of transcript t, started in dir on a free port base, without the
-;; REPL's own address space; answers (pid . port-base) once ready.
+;; Starts t's lab in dir on a free port base; answers (pid . port-base).
 (define (start-lab! t dir)
   (let ((base (free-port-base dir)))
     (cons (start-murdoch-lab!
@@ -236,8 +231,7 @@
            base)
           (number->string base))))
 
-;; The REPL's whole output for t's input, typed through a pipe a line at a
-;; time, so a shell command runs only after the inputs before it.
+;; The REPL's whole output for t's input, typed a line at a time.
 (define (replay t dir base lab-pid)
   (let ((out (string-append dir "/output")))
     (call-with-process-io
@@ -254,8 +248,7 @@
        (waitpid pid 0)))
     (file-text out)))
 
-;; Types an input line; a shell command waits for the REPL (60 s at most),
-;; then runs with LAB_PID and MURDOCH_PORT_BASE set.
+;; Types an input line; a shell command waits for the REPL (60 s at most).
 (define (perform! item t in out base lab-pid)
   (cond
    ((string? item)
