@@ -75,7 +75,7 @@
         (else (cdr (assq 'port-base settings)))))
 
 ;;> A guest's port: 0, a free one the kernel chooses, which the guest says
-;;> in its hellos (ports derived from process ids clashed).
+;;> in its hellos (docs/architecture.md says why not one by process id).
 (define (lab-guest-port lab) 0)
 
 ;;> Reads the lab file at \var{path}; errors name the file, line and fault.
