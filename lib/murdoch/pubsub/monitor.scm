@@ -1,6 +1,8 @@
 ;;;; Monitors (thesis A.6) and each address space's first subscriptions
 ;;;; (A.2): capabilities that come and go with the machine's state.
 
+;; The thesis's names (A.5, A.6), global as there; received code cannot
+;; assign them (code/sandbox.scm) but uses their procedures.
 ;;> The voltage, in tenths, above which a robot is taken to be on its
 ;;> charging tether.
 (define *battery-charging* (lab-default 'battery-charging))
@@ -10,9 +12,6 @@
 ;;> The load, a string such as ".75" (as the thesis sent it between
 ;;> machines), below which the load monitor subscribes to idle.
 (define *load-threshold* (lab-default 'load-threshold))
-
-;; The thesis's names (A.5, A.6), global as there; received code cannot
-;; assign them (sandbox.scm) but uses their procedures.
 
 ;;> Sets *battery-charging*, in tenths of a volt.
 (define (set-battery-charging! tenths) (set! *battery-charging* tenths))
