@@ -206,7 +206,6 @@
 
 ;;; The answers to datagram calls, handed here by each peer's connection reader.
 
-;; Global: any connection's reader hands in answers to the process's calls.
 (define-record-type datagram-calls
   (make-datagram-calls waiting lock next-id)
   datagram-calls?
@@ -214,6 +213,7 @@
   (lock datagram-calls-lock)
   (next-id datagram-calls-next-id datagram-calls-next-id-set!))
 
+;; Global: any connection's reader hands in answers to the process's calls.
 (define *datagram-calls* (make-datagram-calls (make-hash-table eq?)
                                               (make-mutex 'datagram-calls) 0))
 

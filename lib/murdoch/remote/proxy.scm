@@ -1,7 +1,6 @@
 ;;;; Proxies (the thesis's encap): a procedure that runs where it was made,
 ;;;; travelling as its maker's uid and an id.
 
-;; Global: a proxy made in any thread is applied from any connection.
 (define-record-type proxies
   (make-proxies made stubs lock next-id)
   proxies?
@@ -10,6 +9,7 @@
   (lock proxies-lock)
   (next-id proxies-next-id proxies-next-id-set!))
 
+;; Global: a proxy made in any thread is applied from any connection.
 (define *proxies* (make-proxies (make-hash-table eqv?) (make-hash-table equal?)
                                 (make-mutex 'proxies) 0))
 
