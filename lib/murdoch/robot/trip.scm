@@ -10,7 +10,7 @@
 ;;> Seconds to wait for any reply (the lab's trip-timeout, for the process's one robot).
 (define trip-timeout (make-parameter (lab-default 'trip-timeout)))
 
-;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is stopped.
+;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is stopped (the lab's).
 (define trip-motion-timeout (make-parameter (lab-default 'trip-motion-timeout)))
 
 ;;> The connection the primitives use: #f on a workstation.  Global, as a
