@@ -62,10 +62,10 @@
                  "an IPv4 address, in quotes"))
     (key-file "murdoch.key" ,(text "a file name, in quotes"))
     (max-frame 1048576 ,positive-count)
-    ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
+    ;; Chibi's writer cuts what nests deeper than 10,000 (code/sendable.scm).
     (max-depth 4000 ,(whole-from 1 9000 "a whole number from 1 to 9000"))
     (timeout 5 ,seconds)
-    ;; At a REPL a person waits, and Ctrl-C gives a call up (command.scm).
+    ;; At a REPL a person waits, and Ctrl-C gives a call up (cli/command.scm).
     (repl-timeout 600 ,seconds)
     (frame-timeout 5 ,seconds)
     (lease 30 ,seconds)
@@ -88,7 +88,7 @@
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" ,(make-reader size-bytes
                                    "bytes, or a size in quotes such as \"512M\""))
-    ;; Chibi grows its heap by twice one allocation (sandbox.scm).
+    ;; Chibi grows its heap by twice one allocation (code/sandbox.scm).
     (max-alloc "32M" ,(make-reader size-bytes
                                    "bytes, or a size in quotes such as \"32M\""))
     ;; Defaults of the layers' parameters and globals, set as an address
