@@ -1,5 +1,5 @@
 ;;;; Starting an address space, and the thesis's aux.scm helpers.  The
-;;;; layer bottom to top: the wire, address spaces (aspace.scm), calls
+;;;; layer bottom to top: the wire, address spaces (remote/aspace.scm), calls
 ;;;; (connection, worker, call), the group, serving, proxies and delivery;
 ;;;; start-aspace! starts them in that order.
 

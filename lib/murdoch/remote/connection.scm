@@ -322,7 +322,7 @@
   (send-counted! (connection-to a (+ (monotonic-seconds) (current-timeout)))
                  (make-message 'answer id kind value) #f))
 
-;; Forgets call id, telling the callee if the connection stands (abandon.scm).
+;; Forgets call id, telling the callee if the connection stands (code/abandon.scm).
 (define (give-up-call! c id)
   (with-lock (connection-write-lock c)
     (lambda () (hash-table-delete! (connection-pending c) id)))

@@ -271,7 +271,7 @@
                   (serving-applying-set! s (without-thread (serving-applying s) thread)))
                 (server-servings *server*)))))
 
-;; The caller of apply id gave up: its thread is marked to stop (abandon.scm).
+;; The caller of apply id gave up: its thread is marked to stop (code/abandon.scm).
 (define (abandon-call! s id)
   (let ((a (with-lock (server-lock *server*) (lambda () (assv id (serving-applying s))))))
     (when a
