@@ -96,7 +96,6 @@
       (hash-table-delete! (membership-unreachable (joined)) uid)
       (peers-changed! (joined)))))
 
-;; The uids taken out of the live set, for the prober to try again.
 (define (unreachable-uids)
   (with-peers (lambda () (hash-table-keys (membership-unreachable (joined))))))
 

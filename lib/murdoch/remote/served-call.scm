@@ -86,7 +86,6 @@
        (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
                     (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))))
 
-;; See read-calls.
 (define (serve-greeted s)
   (read-calls s (lambda (r) (read-on s r))
               (lambda (c e)
@@ -175,7 +174,6 @@
   (encode (call-in-sandbox (served-procedure c) (served-arguments c))
           (lab-environment) "the result"))
 
-;; The procedure and the arguments of served call c, decoded.
 (define (served-procedure c)
   (checked-procedure (decode-value (served-call-proc-code c))))
 
