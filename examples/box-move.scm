@@ -579,24 +579,13 @@
 ;; (push-offset), and holds while the box turns faster than max-turn-rate.
 ;; A spare coming turns the box the most: once the spare has a way to its
 ;; place, the lone pusher holds at its own, leaving the spare's free.
-;; Before it is alone, it pushes from its own half only, which turns the box
-;; away from its side: while the box must turn more than 10 degrees toward
-;; that side and no spare has spoken, it stands still, not even keeping up
-;; with its place, which the box's turn moves (seed 13: the lone pusher
-;; turned the box 15 degrees the wrong way before the spare spoke, and the
-;; pair could not bring it round before the goal).  A spare that says it
-;; has no way (the lost one's body lies at its place) is let through by
-;; pushing on; alone, a pusher pushes anywhere along the face.
 (define (steer! view side offset)
   (let ((box (car view)))
-    (if (and (not (paired?)) (not (alone?)) (>= (coming-age) 2)
-             (> (* side (turn-error box)) 10))
-        (stop-base)
-        (push-at! box (place-axis box) offset
-                  (cond ((paired?) (pair-share box side))
-                        ((spare-on-its-way?) 0)
-                        ((> (abs turn-rate) max-turn-rate) 0)
-                        (else 0.5))))))
+    (push-at! box (place-axis box) offset
+              (cond ((paired?) (pair-share box side))
+                    ((spare-on-its-way?) 0)
+                    ((> (abs turn-rate) max-turn-rate) 0)
+                    (else 0.5)))))
 
 ;; A pusher's share of push-speed in a pair: both push less the further
 ;; the box is turned off its way (forward at a third from 30 degrees off),
@@ -786,9 +775,9 @@
          (blocked (make-vector (* nx ny) #f))
          (cell-of (lambda (p) (+ (exact (round (/ (- (car p) x0) cell)))
                                  (* nx (exact (round (/ (- (cadr p) y0) cell))))))))
-    ;; Marks the cells within r of p blocked, or, given free?, those of
-    ;; them whose middle is free? free, the others blocked.
-    (define (paint! p r . free?)
+    ;; Marks the cells within r of p blocked; given 'free, free; given a
+    ;; predicate, blocked those whose middle it holds for, leaving the others.
+    (define (paint! p r . how)
       (let ((i0 (exact (round (/ (- (car p) x0) cell))))
             (j0 (exact (round (/ (- (cadr p) y0) cell))))
             (k (exact (ceiling (/ r cell)))))
@@ -796,10 +785,10 @@
           (do ((j (- j0 k) (+ j 1))) ((> j (+ j0 k)))
             (if (and (< -1 i nx) (< -1 j ny)
                      (<= (* cell cell (+ (square (- i i0)) (square (- j j0)))) (* r r)))
-                (vector-set! blocked (+ i (* nx j))
-                             (or (null? free?)
-                                 (not ((car free?) (list (+ x0 (* cell i))
-                                                         (+ y0 (* cell j))))))))))))
+                (cond ((null? how) (vector-set! blocked (+ i (* nx j)) #t))
+                      ((eq? (car how) 'free) (vector-set! blocked (+ i (* nx j)) #f))
+                      (((car how) (list (+ x0 (* cell i)) (+ y0 (* cell j))))
+                       (vector-set! blocked (+ i (* nx j)) #t))))))))
     (paint-box! paint! box)
     ;; A body said to lie where this robot stands has been pushed away.
     (for-each (lambda (b) (if (> (distance b me) (+ body-radius body-radius))
@@ -807,11 +796,11 @@
               bodies)
     (for-each (lambda (e)
                 (paint! (car e) (+ body-radius 80)
-                        (lambda (p) (not (echo-near? e p (+ body-radius 80))))))
+                        (lambda (p) (echo-near? e p (+ body-radius 80)))))
               (echoes me box))
     ;; A robot hemmed in, by the box's grown edge or a robot beside it, may
     ;; still step out.
-    (paint! me 150 (lambda (p) #t))
+    (paint! me 150 'free)
     (let ((start (cell-of me)) (end (cell-of goal)))
       (let ((from (breadth-first blocked nx ny end start)))
         (and from
