@@ -132,11 +132,11 @@
          (levels-match? (cdr p) (cdr t)))
         (else #f)))
 
-;; True when every subject of the address is among the subscriptions
-;; (the thesis says "proper subset"; it means subset).  It takes no lock:
-;; it reads the list once, and then only the topics, which never change.
-;; A subject subscribed as it is matches itself, wildcards included: the
-;; common case (all, a uid), which needs no matcher (docs/speed.md).
+;;> True when every subject of the address is among the subscriptions
+;;> (the thesis says "proper subset"; it means subset).  It takes no lock:
+;;> it reads the list once, and then only the topics, which never change.
+;;> A subject subscribed as it is matches itself, wildcards included: the
+;;> common case (all, a uid), which needs no matcher (docs/speed.md).
 (define (addressed-here? topic)
   (if (list? topic)
       (subjects-here? *subscriptions* topic)

@@ -436,16 +436,16 @@
 ;;> listed- procedures read them.
 (define (tasks)
   (let* ((posed (with-lock *tasks-lock* posed-tasks))
-         (others (and (any task-waiter posed)
-                      (guard (e (#t '())) (lab-waiting)))))
-    (append (map (lambda (t) (posed-entry t others)) posed)
+         (line (and (any task-waiter posed)
+                    (line-of (guard (e (#t '())) (lab-waiting))))))
+    (append (map (lambda (t) (posed-entry t line)) posed)
             (map (lambda (r) (cons 'running r)) (components-running)))))
 
 ;; t as (tasks) lists it; a waiting task as waiting-entry has it, with
-;; its place in the lab's line of others, the lab's waiting tasks.
-(define (posed-entry t others)
+;; its place in line, the ranks of the lab's waiting tasks (line-of).
+(define (posed-entry t line)
   (let ((w (task-waiter t)))
     (if w
-        (begin (move-up! w others) (waiting-entry w))
+        (begin (move-up! w line) (waiting-entry w))
         (list 'posed (task-id t) (task-state t) (task-why t) #f
               (and (task-turn t) (turn-priority (task-turn t))) '() '()))))

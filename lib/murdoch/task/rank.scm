@@ -89,6 +89,8 @@
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
   (position waiter-position waiter-position-set!)
   (why waiter-why waiter-why-set!)               ; a line a component
+  (never waiter-never waiter-never-set!)         ; why it never can start, or #f
+  (excluded waiter-excluded waiter-excluded-set!) ; its pose-task-excluded
   (news waiter-news waiter-news-set!)
   (bell waiter-bell waiter-bell-set!))
 
@@ -134,12 +136,22 @@
 
 (define (held-uids w) (map held-uid (waiter-held w)))
 
-;; w's place in the lab's line, others being every task of the lab that
-;; waits: 1 + how many of them rank before it.  One order for the whole
-;; lab, 1 to n, whatever robots each may use.
-(define (place-in-line w others)
-  (+ 1 (count (lambda (other) (rank<? (waiting-there-rank other) (waiter-rank w)))
-              others)))
+;; w's place in the lab's line, line being the ranks of every task of
+;; the lab that waits, as line-of orders them: 1 + how many rank before
+;; it.  One order for the whole lab, 1 to n, whatever robots each may
+;; use; found by halving, as a look numbers all of its poser's tasks.
+(define (place-in-line w line)
+  (let loop ((lo 0) (hi (vector-length line)))
+    (if (= lo hi)
+        (+ lo 1)
+        (let ((mid (quotient (+ lo hi) 2)))
+          (if (rank<? (vector-ref line mid) (waiter-rank w))
+              (loop (+ mid 1) hi)
+              (loop lo mid))))))
+
+;; The ranks of others, waiting-theres, best first.
+(define (line-of others)
+  (list->vector (list-sort rank<? (map waiting-there-rank others))))
 
 ;; Whether one of others that ranks before w may use a robot w may use.
 (define (ahead-for-its-robots? w others)
