@@ -125,18 +125,28 @@
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
 (define *waiters-seen* #f)
 
-(define (offer-round)
-  (let ((me (local-aspace-uid)))
+;; Each poser answers its best offer-depth tasks that may use the robot,
+;; and the robot asks for twice as many when every one declined it: the
+;; best-ranked of the lab are among them, and a round costs the same
+;; with 20 tasks waiting or 2,000 (docs/allocation.md).
+(define offer-depth 4)
+
+(define (offer-round . depth)
+  (let ((me (local-aspace-uid))
+        (depth (if (pair? depth) (car depth) offer-depth)))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
     (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
-    (let ((waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
-                              (guard (e (#t '()))
-                                (append-map cadr (request 'waiting-tasks waiting-for me
-                                                          (subjects-here)))))))
+    (let* ((answers (guard (e (#t '()))
+                      (request 'waiting-tasks waiting-for me (subjects-here) depth)))
+           (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
+                               (append-map cadr answers))))
       (set! *waiters-seen* (pair? waiting))
       (if (pair? waiting) (set! *waiters-here?* #t))
-      (offer-to me waiting))))
+      (offer-to me waiting)
+      (if (and (free-here?) (not *new-waiters*)
+               (any (lambda (a) (>= (length (cadr a)) depth)) answers))
+          (offer-round (* 2 depth))))))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))

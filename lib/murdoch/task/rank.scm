@@ -94,11 +94,14 @@
   (news waiter-news waiter-news-set!)
   (bell waiter-bell waiter-bell-set!))
 
-;; The tasks waiting here, under *tasks-lock*.
+;; The tasks waiting here, best rank first, under *tasks-lock*.
 (define *waiters* '())
 
 (define (waiters) *waiters*)
-(define (add-waiter! w) (set! *waiters* (cons w *waiters*)))
+(define (add-waiter! w)
+  (let-values (((before after)
+                (break (lambda (x) (rank<? (waiter-rank w) (waiter-rank x))) *waiters*)))
+    (set! *waiters* (append before (cons w after)))))
 (define (drop-waiter! w) (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*)))
 
 ;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
@@ -153,32 +156,19 @@
 (define (line-of others)
   (list->vector (list-sort rank<? (map waiting-there-rank others))))
 
-;; Whether one of others that ranks before w may use a robot w may use.
-(define (ahead-for-its-robots? w others)
-  (any (lambda (other)
-         (and (rank<? (waiting-there-rank other) (waiter-rank w))
-              (may-use? other (waiter-capable w))))
-       others))
-
-;; Whether other, a waiting-there, may use one of uids.
-(define (may-use? other uids)
-  (or (eq? (waiting-there-capable other) #t) (eq? uids #t)
-      (any (lambda (uid) (memq uid (waiting-there-capable other))) uids)))
-
-;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
-;;> of the robots it may use (#t before it has looked), and of those it
-;;> holds.
+;;> The (RANK HELD) of each task waiting here: its rank, and the uids of
+;;> the robots it holds.  The robots each may use stay here: a line of
+;;> 2,000 tasks that carried them was megabytes a second.
 (define (waiting-ranks)
-  (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
+  (map (lambda (w) (list (waiter-rank w) (held-uids w)))
        (with-lock *tasks-lock* waiters)))
 
 ;; A task that waits at poser, as its entry of waiting-ranks says.
 (define-record-type waiting-there
-  (make-waiting-there poser rank capable held)
+  (make-waiting-there poser rank held)
   waiting-there?
   (poser waiting-there-poser)
   (rank waiting-there-rank)
-  (capable waiting-there-capable)
   (held waiting-there-held))
 
 ;; Every task of the lab that waits, each a waiting-there; request
@@ -217,13 +207,24 @@
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
 ;;> when it last looked, or that has a component those subjects serve (a
-;;> robot that joined since).
-(define (waiting-for uid . subjects)
-  (filter-map (lambda (w)
-                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w))
-                         (and (pair? subjects) (serves? (car subjects) w)))
-                     (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
-              (with-lock *tasks-lock* waiters)))
+;;> robot that joined since).  Best rank first, and only the first
+;;> \var{limit} if given: a robot offers itself to the best first, and
+;;> asks for more only when those all decline it, so that an offer round
+;;> does not carry every waiting task of the lab.
+(define (waiting-for uid . subjects+limit)
+  (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
+        (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
+                    (cadr subjects+limit))))
+    (let loop ((ws (with-lock *tasks-lock* waiters)) (n 0) (out '()))
+      (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
+            ((let ((w (car ws)))
+               (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w))
+                   (and subjects (serves? subjects w))))
+             (loop (cdr ws) (+ n 1)
+                   (cons (list (waiter-rank (car ws)) (local-aspace-uid)
+                               (task-id (waiter-task (car ws))))
+                         out)))
+            (else (loop (cdr ws) n out))))))
 
 ;; Whether a robot subscribed to subjects could take a component of w.
 (define (serves? subjects w)

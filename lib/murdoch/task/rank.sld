@@ -14,8 +14,8 @@
           waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter!
           news-kind offer? offer-reply offer-uid give-way-uid tell-waiter!
           take-news! answer-offers! held-index held-winner held-type held-uid
-          held-uids place-in-line line-of ahead-for-its-robots? may-use? waiting-ranks waiting-there?
-          waiting-there-poser waiting-there-rank waiting-there-capable
+          held-uids place-in-line line-of waiting-ranks waiting-there?
+          waiting-there-poser waiting-there-rank
           waiting-there-held waiting-elsewhere lab-waiting waiting-for waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id)

@@ -89,7 +89,7 @@
 
 ;; Tries, answers the offers that woke it, and waits for the next.  It
 ;; tries only when a robot offered itself, or when it was posed with no
-;; better-ranked task waiting for a robot it may use: a robot's offers
+;; better-ranked task waiting in the lab: a robot's offers
 ;; come in rank order, and a try out of turn could take a robot freed for
 ;; a better-ranked task.  It asks its poser to look at the lab again when
 ;; what it holds changed, or a second after its last look: an offer is
@@ -306,6 +306,7 @@
                       (waiter-why w)
                       (map (lambda (c) "") (waiter-components w))))))))
 
-;; Whether a better-ranked task of the lab waits for a robot w may use.
+;; Whether a better-ranked task of the lab waits: w, just posed, has not
+;; looked at which robots it may use.
 (define (behind-others? w)
-  (ahead-for-its-robots? w (guard (e (#t '())) (lab-waiting))))
+  (> (place-in-line w (line-of (guard (e (#t '())) (lab-waiting)))) 1))
