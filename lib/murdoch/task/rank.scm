@@ -87,6 +87,8 @@
   (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
+  (capables waiter-capables waiter-capables-set!) ; ((COMPONENT UID ...) ...), or ()
+  (offered waiter-offered waiter-offered-set!)   ; the uids offered to its try
   (position waiter-position waiter-position-set!)
   (why waiter-why waiter-why-set!)               ; a line a component
   (never waiter-never waiter-never-set!)         ; why it never can start, or #f

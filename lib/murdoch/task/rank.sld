@@ -8,7 +8,8 @@
           make-waiter waiter? waiter-task waiter-components waiter-rank
           waiter-held waiter-held-set! waiter-looked waiter-looked-set!
           waiter-kept waiter-kept-set! waiter-yielded waiter-yielded-set!
-          waiter-capable waiter-capable-set! waiter-position waiter-position-set!
+          waiter-capable waiter-capable-set! waiter-capables
+          waiter-capables-set! waiter-offered waiter-offered-set! waiter-position waiter-position-set!
           waiter-why waiter-why-set! waiter-never waiter-never-set!
           waiter-excluded waiter-excluded-set! waiter-news waiter-news-set!
           waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter!

@@ -25,6 +25,8 @@
   (waiter-kept-set! w (monotonic-seconds))
   (waiter-yielded-set! w '())
   (waiter-capable-set! w #t)            ; any robot, until it has looked
+  (waiter-capables-set! w '())
+  (waiter-offered-set! w '())
   (waiter-position-set! w #f)
   (waiter-why-set! w '())
   (waiter-never-set! w #f)
@@ -137,6 +139,7 @@
 (define (try-in-turn w try offered)
   (with-lock *try-lock*
     (lambda ()
+      (waiter-offered-set! w offered)
       (quiet-try (lambda ()
                    (parameterize ((pose-task-excluded (append (offered-to-others w)
                                                               (not-offered w offered)
@@ -244,6 +247,7 @@
       (tell-waiter! w '(looked)))
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (waiter-capables-set! w (map cons cs capable))
       (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
       (ask-way! w lines others)
       (move-up! w line)
