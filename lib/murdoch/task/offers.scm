@@ -126,14 +126,16 @@
 (define *waiters-seen* #f)
 
 ;; Each poser answers its best offer-depth tasks that may use the robot,
-;; and the robot asks for twice as many when every one declined it: the
-;; best-ranked of the lab are among them, and a round costs the same
-;; with 20 tasks waiting or 2,000 (docs/allocation.md).
+;; and the robot asks for twice as many when every one declined it, in
+;; this round or the next, until it is taken: the best-ranked of the lab
+;; are among them, and a round costs the same with 20 tasks waiting or
+;; 2,000 (docs/allocation.md).
 (define offer-depth 4)
+(define *depth* offer-depth)
 
-(define (offer-round . depth)
+(define (offer-round)
   (let ((me (local-aspace-uid))
-        (depth (if (pair? depth) (car depth) offer-depth)))
+        (depth *depth*))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
     (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
@@ -144,9 +146,10 @@
       (set! *waiters-seen* (pair? waiting))
       (if (pair? waiting) (set! *waiters-here?* #t))
       (offer-to me waiting)
-      (if (and (free-here?) (not *new-waiters*)
-               (any (lambda (a) (>= (length (cadr a)) depth)) answers))
-          (offer-round (* 2 depth))))))
+      (cond ((not (free-here?)) (set! *depth* offer-depth))
+            ((any (lambda (a) (>= (length (cadr a)) depth)) answers)
+             (set! *depth* (* 2 depth))
+             (if (not *new-waiters*) (offer-round)))))))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))

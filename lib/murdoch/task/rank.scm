@@ -219,14 +219,27 @@
                     (cadr subjects+limit))))
     (let loop ((ws (with-lock *tasks-lock* waiters)) (n 0) (out '()))
       (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
-            ((let ((w (car ws)))
-               (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w))
-                   (and subjects (serves? subjects w))))
+            ((wants? (car ws) uid subjects)
              (loop (cdr ws) (+ n 1)
                    (cons (list (waiter-rank (car ws)) (local-aspace-uid)
                                (task-id (waiter-task (car ws))))
                          out)))
             (else (loop (cdr ws) n out))))))
+
+;; Whether w may use robot uid, subscribed to subjects (or #f): for a
+;; component it does not hold, when it has looked; a robot its look did
+;; not know, if subjects serve a component.  Offered to a task that held
+;; the one component it could take, a robot went down its round to no
+;; avail, and sat free while tasks waited for it further down.
+(define (wants? w uid subjects)
+  (let ((capable (waiter-capable w)))
+    (cond ((eq? capable #t) #t)
+          ((memq uid capable)
+           (any (lambda (cc)
+                  (and (not (assv (component-index (car cc)) (waiter-held w)))
+                       (memq uid (cdr cc))))
+                (waiter-capables w)))
+          (else (and subjects (serves? subjects w))))))
 
 ;; Whether a robot subscribed to subjects could take a component of w.
 (define (serves? subjects w)
