@@ -121,7 +121,9 @@
                    (k (cond ((assq uid inside) => cdr) (else 0)))
                    (rest (remove (lambda (x) (eq? (car x) uid)) inside)))
               (if (eq? (cadr e) 'start)
-                  (loop (cdr es) (cons (cons uid (+ k 1)) rest) (if (> k 0) (+ n 1) n))
+                  (begin
+                    (if (> k 0) (tell-double-booking! run e))
+                    (loop (cdr es) (cons (cons uid (+ k 1)) rest) (if (> k 0) (+ n 1) n)))
                   (loop (cdr es) (cons (cons uid (- k 1)) rest) n))))))
 
     (define (rank-key run t)
@@ -181,6 +183,23 @@
          (run-tasks run))))
 
     ;; Each inversion, on standard error, so that a run's can be looked into.
+    ;; Names on standard error the start e, (TIME start ID K UID), and
+    ;; the last start on its robot before it.
+    (define (tell-double-booking! run e)
+      (let ((before (find (lambda (b) (and (eq? (cadr b) 'start) (eq? (list-ref b 4) (list-ref e 4))
+                                           (< (car b) (car e))))
+                          (reverse (run-events run)))))
+        (write-string (string-append "sched: double booking: " (event-line e)
+                                     "\n  while on it: "
+                                     (if before (event-line before) "?") "\n")
+                      (current-error-port))))
+
+    (define (event-line e)
+      (string-append "component " (number->string (list-ref e 3)) " of task "
+                     (number->string (list-ref e 2)) " on "
+                     (symbol->string (list-ref e 4)) " at "
+                     (number->string (round-to (car e) 3)) " s"))
+
     (define (tell-inversion! run xy)
       (let ((out (current-error-port)) (x (car xy)) (y (cadr xy)))
         (define (task-line t)

@@ -159,11 +159,15 @@
   (list->vector (list-sort rank<? (map waiting-there-rank others))))
 
 ;;> The (RANK HELD) of each task waiting here: its rank, and the uids of
-;;> the robots it holds.  The robots each may use stay here: a line of
-;;> 2,000 tasks that carried them was megabytes a second.
-(define (waiting-ranks)
-  (map (lambda (w) (list (waiter-rank w) (held-uids w)))
-       (with-lock *tasks-lock* waiters)))
+;;> the robots it holds; only of those that hold one if \var{holding} is
+;;> given and true.  The robots each may use stay here: a line of 2,000
+;;> tasks that carried them was megabytes a second.
+(define (waiting-ranks . holding)
+  (filter-map (lambda (w)
+                (let ((held (held-uids w)))
+                  (and (or (null? holding) (not (car holding)) (pair? held))
+                       (list (waiter-rank w) held))))
+              (with-lock *tasks-lock* waiters)))
 
 ;; A task that waits at poser, as its entry of waiting-ranks says.
 (define-record-type waiting-there
@@ -185,26 +189,44 @@
 ;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*.
 (define *lab-waiting* #f)
 
-;; Every task of the lab that waits, as waiting-elsewhere answers, asked
-;; of the lab at most once a heartbeat for all the tasks waiting here,
-;; this poser's own as they are now.  Each waiting task's look numbers
-;; its place in the line: with W tasks waiting, a look that asked every
-;; poser each time cost W squared a period lab-wide.  A place may so be a
-;; heartbeat old; who is offered a robot is decided by the robot's own
-;; round, never by this list.
-(define (lab-waiting)
+;; The waiting tasks of the other posers, as waiting-elsewhere answers,
+;; asked of the lab at most once a heartbeat for every 100 tasks it
+;; waited last time, for all the tasks waiting here.  Each look numbers
+;; its tasks' places in the line: with W tasks waiting, a look that asked
+;; every poser each time cost W squared a period lab-wide, and one a
+;; heartbeat, 2,500 tasks' entries twice a second a poser.  A place may
+;; so be W/100 heartbeats old for tasks posed elsewhere; who is offered a
+;; robot is decided by the robot's own round, never by this list, and who
+;; holds what is asked afresh (lab-holders).
+(define (waiting-at-others)
   (let* ((now (monotonic-seconds))
          (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
          (all (if (and cached
-                       (< (- now (car cached)) (lab-setting (current-lab) 'heartbeat)))
+                       (< (- now (car cached))
+                          (* (lab-setting (current-lab) 'heartbeat)
+                             (max 1 (/ (length (cdr cached)) 100)))))
                   (cdr cached)
                   (let ((fresh (waiting-elsewhere)))
                     (with-lock *tasks-lock*
                       (lambda () (set! *lab-waiting* (cons now fresh))))
                     fresh)))
          (me (local-aspace-uid)))
-    (append (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)
-            (map (lambda (e) (apply make-waiting-there me e)) (waiting-ranks)))))
+    (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)))
+
+;; Every task of the lab that waits: the other posers' as
+;; waiting-at-others has them, this poser's as they are now.
+(define (lab-waiting)
+  (append (waiting-at-others)
+          (map (lambda (e) (apply make-waiting-there (local-aspace-uid) e))
+               (waiting-ranks))))
+
+;; Every task of the lab that waits holding robots, asked afresh: no more
+;; of them than robots.
+(define (lab-holders)
+  (append-map (lambda (answer)
+                (map (lambda (e) (apply make-waiting-there (car answer) e))
+                     (cadr answer)))
+              (request 'waiting-tasks waiting-ranks #t)))
 
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}, whose subjects are \var{subjects}: one it found capable

@@ -201,27 +201,30 @@
       (looker))))
 
 ;; Looks at the lab for the waiting tasks ws: one request for the takers
-;; of all their components, and the lab's waiting tasks as lab-waiting
-;; has them, whatever the number of tasks.
+;; of all their components, one for the tasks that hold robots, and the
+;; lab's line as lab-waiting has it, whatever the number of tasks.
 (define (look-all! ws)
   (let* ((layouts (delete-duplicates (append-map waiter-layouts ws)))
          (lines (map cons layouts (explain-components layouts)))
-         (others (guard (e (#t '())) (lab-waiting)))
-         (line (line-of others)))
+         (line (line-of (guard (e (#t '())) (lab-waiting))))
+         ;; Those that hold robots, no more than the robots: each task
+         ;; asks those of them that rank after it to give way.
+         (holders (guard (e (#t '())) (lab-holders))))
     (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines))))
     (for-each (lambda (w)
                 (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
-                       others line))
+                       holders line))
               ws)))
 
 (define (waiter-layouts w)
   (map (lambda (c) (capability-layout (component-capabilities c))) (waiter-components w)))
 
 ;; What a look tells w, from lines, the explanations of its components,
-;; and others, the lab's waiting tasks, line their ranks in order: why it
-;; waits, and its place in line, in its components' states; or why it
-;; never can be served, its waiting task told.
-(define (look! w lines others line)
+;; holders, the lab's waiting tasks that hold robots, and line, the ranks
+;; of all its waiting tasks in order: why it waits, and its place in line,
+;; in its components' states; or why it never can be served, its waiting
+;; task told.
+(define (look! w lines holders line)
   (waiter-looked-set! w (monotonic-seconds))
   (let* ((cs (waiter-components w))
          (capable (map (lambda (line)
@@ -249,7 +252,7 @@
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
       (waiter-capables-set! w (map cons cs capable))
       (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
-      (ask-way! w lines others)
+      (ask-way! w lines holders)
       (move-up! w line)
       (progress (task-id (waiter-task w)) ": " (task-state (waiter-task w))
                 (if (pair? (waiter-held w))
@@ -313,4 +316,6 @@
 ;; Whether a better-ranked task of the lab waits: w, just posed, has not
 ;; looked at which robots it may use.
 (define (behind-others? w)
-  (> (place-in-line w (line-of (guard (e (#t '())) (lab-waiting)))) 1))
+  (or (rank<? (waiter-rank (car (with-lock *tasks-lock* waiters))) (waiter-rank w))
+      (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
+           (guard (e (#t '())) (waiting-at-others)))))
