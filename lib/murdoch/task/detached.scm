@@ -200,7 +200,10 @@
 ;; the components that ended, by id.
 (define (fresh-id name)
   (let ((id (task-key name)))
-    (if (or (holder-of id) (pair? (components-of id))) (fresh-id name) id)))
+    (if (or (holder-of id) (pair? (components-of id))
+            (pair? (components-of (step-task-id id 1))))
+        (fresh-id name)
+        id)))
 
 ;; Starts the threads of h's coordinator: one keeps its standby's copy,
 ;; one waits for the task's end.
@@ -412,37 +415,64 @@
   (let ((copy (handed-copy h)))
     (cond
      ((copy-results copy) #f)
-     ((eq? (handed-kind h) 'steps)
-      (let ((why "its coordinator was lost, and a task of steps is not taken over"))
-        (handed-copy-set! h (list 'failed (copy-status copy) (list 'error #f why)
-                                  (copy-turn copy) (utc-seconds)))))
      (else
       (handed-task-set!
        h (parameterize ((heartbeat-patience detached-patience))
-           (adopt-task (handed-id h) (copy-turn copy) (adoption-plan h copy)
-                       (handed-args h)))))))
+           (if (eq? (handed-kind h) 'steps)
+               (adopt-steps h copy)
+               (adopt-task (handed-id h) (copy-turn copy)
+                           (adoption-plan (handed-id h) (copy-status copy))
+                           (handed-args h))))))))
   (coordinate! h))
 
-;; For each component of the copy, (STATE ATTEMPTS UID): UID the robot
-;; where it runs, or ended lately, that is to be adopted, else #f.  A
-;; component found running anywhere is adopted there, whatever the copy
-;; says: its start may have come after the copy was sent.
-(define (adoption-plan h copy)
-  (let ((seen (components-of (handed-id h))))
+;; For each component of task id, whose status entries are statuses,
+;; (STATE ATTEMPTS UID): UID the robot where it runs, or ended lately,
+;; that is to be adopted, else #f.  A component found running anywhere
+;; is adopted there, whatever the copy says: its start may have come
+;; after the copy was sent; so is one found ended that the copy has
+;; running there, or not yet started.
+(define (adoption-plan id statuses)
+  (let ((seen (components-of id)))
     (map (lambda (s)
            (let* ((k (status-index s)) (state (status-state s))
                   (running (find (lambda (x) (and (= (cadr x) k) (eq? (car (cddr x)) 'running)))
                                  seen))
-                  (ended (find (lambda (x) (and (= (cadr x) k)
-                                                (eq? (car state) 'running)
-                                                (eq? (car x) (cadr state))))
+                  (ended (find (lambda (x)
+                                 (and (= (cadr x) k)
+                                      (if (eq? (car state) 'running)
+                                          (eq? (car x) (cadr state))
+                                          (and (memq (car state) '(negotiating waiting holding))
+                                               (null? (status-attempts s))))))
                                seen)))
              (list state (status-attempts s)
                    (cond (running (car running))
                          ((memq (car state) '(done failed)) #f)
                          (ended (car ended))
                          (else #f)))))
-         (copy-status copy))))
+         statuses)))
+
+;; The task record of the detached task of steps of h, taken over here
+;; with copy: each step the copy has, or whose components are found in
+;; the lab, is adopted as adopt-task adopts a task, the one the copy was
+;; running at its rank; a finished one so ends at once, with its
+;; results, and the step after it starts.  So no step starts twice, and
+;; no finished step's results are lost.
+(define (adopt-steps h copy)
+  (let* ((args (handed-args h)) (copied (copy-status copy)))
+    (resume-steps
+     (handed-id h) (car args) (map (lambda (parts) (apply task-step parts)) (cadr args))
+     (car (cddr args))
+     (lambda (i id step-args)
+       (let* ((entry (find (lambda (e) (= (step-status-index e) i)) copied))
+              (plan (adoption-plan
+                     id
+                     (if entry
+                         (step-status-entries entry)
+                         (map (lambda (k) (list k '(negotiating) '()))
+                              (iota (cadr step-args) 1))))))
+         (and (or entry (any plan-uid plan))
+              (adopt-task id (and entry (= i (length copied)) (copy-turn copy)) plan
+                          step-args)))))))
 
 ;; (UID INDEX running) or (UID INDEX ended) for each component of task id
 ;; that runs, or ended lately, anywhere in the lab.
@@ -463,19 +493,11 @@
 
 ;;; Letting a task go, and adopting it
 
-;; Stops acting for t, a detached task whose standby may be taking it
-;; over: no heartbeat, start or negotiation more (life-cycle.scm's let-go?
-;; checks), and nothing cancelled; what it holds while it waits is given
-;; back.
-(define (let-task-go! t)
-  (task-state-set! t 'let-go)
-  (if (task-waiter t) (tell-waiter! (task-waiter t) '(cancel)))
-  (mailbox-put! (task-done t) 'let-go))
-
 ;; What t's rank and deadline are made of, as data that travels: (WAIT
-;; HOLD PRIORITY DEADLINE POSED), DEADLINE a utc-seconds or #f.
+;; HOLD PRIORITY DEADLINE POSED), DEADLINE a utc-seconds or #f.  A task
+;; of steps waits in its step's turn, the last begun.
 (define (task-turn-copy t)
-  (let ((turn (task-turn t)))
+  (let ((turn (task-turn (if (pair? (task-steps t)) (last (task-steps t)) t))))
     (and turn
          (list (turn-wait? turn) (turn-hold? turn) (turn-priority turn)
                (and (turn-deadline turn)
@@ -515,8 +537,7 @@
            (run-task t priorities))
           (else
            (task-state-set! t 'running)
-           (task-team-set! t (map (lambda (p) (or (plan-uid p) (state-uid (plan-state p))))
-                                  plan))
+           (task-team-set! t (map plan-robot plan))
            (supervise-all t (map (lambda (c p) (lambda () (go-on t c p)))
                                  (task-components t) plan))))))
       id))
@@ -526,6 +547,12 @@
 (define (plan-state p) (car p))
 (define (plan-attempts p) (cadr p))
 (define (plan-uid p) (car (cddr p)))
+
+;; The robot of an entry of adopt-task's plan: where it runs, or last
+;; ran.
+(define (plan-robot p)
+  (or (plan-uid p) (state-uid (plan-state p))
+      (and (pair? (plan-attempts p)) (car (last (plan-attempts p))))))
 
 ;; The robot a component's state names, or #f.
 (define (state-uid state)
