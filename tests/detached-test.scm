@@ -178,6 +178,73 @@
                (task-status id))))
       (restart! old))))
 
+(test-group "the coordinator killed mid-step: its standby takes the steps over"
+  ;; Step 1 has one component, step 2 two, each handed step 1's results;
+  ;; the coordinator of one task is killed in its step 1, of another in
+  ;; its step 2.
+  (define (tagged tag part)
+    (string->symbol (string-append (symbol->string tag) part)))
+  (define (steps-task tag)
+    (remote-apply
+     (uid->aspace 'poser)
+     (eval `(lambda ()
+              (start-steps ',tag
+                           (task-step (list '((mobile) ())) (list #f)
+                                      (list (lambda (previous)
+                                              (work ',(tagged tag "-one") 60))))
+                           (task-step (list '((mobile) ()) '((mobile) ())) (list #f #f)
+                                      (list (lambda (previous)
+                                              (list previous
+                                                    (work ',(tagged tag "-two") 60)))
+                                            (lambda (previous)
+                                              (list previous
+                                                    (work ',(tagged tag "-two") 60)))))
+                           'detach #t))
+           (lab-environment))))
+  (define (in-step? id i)
+    (let ((steps (task-status id)))
+      (and (= i (length steps))
+           (every (lambda (s) (eq? (car (status-state s)) 'running))
+                  (step-status-entries (list-ref steps (- i 1)))))))
+  (define (begins-and-ends tag)
+    (map (lambda (r) (list r (length (log-lines r "begin" tag)) (length (log-lines r "end" tag))))
+         robots))
+  (for-each
+   (lambda (tag step)
+     (let ((id (steps-task tag)))
+       (test-assert (string-append "step " (number->string step) " runs, with a standby")
+         (wait-until 15 (lambda () (and (in-step? id step) (lab-task-standby (entry-of id))))))
+       (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
+         (kill! old)
+         (test "the standby takes over" standby
+           (wait-until 10 (lambda ()
+                            (let ((e (entry-of id)))
+                              (and (eq? (lab-task-role e) 'coordinator)
+                                   (= 2 (lab-task-epoch e))
+                                   (lab-task-coordinator e))))))
+         (let* ((waited (murdoch-status "wait" (test-lab-file lab) (symbol->string id)))
+                (results (task-wait id 30))
+                (one (car (car results)))
+                (two (map cadr (cadr results))))
+           (test-assert "the task completes, read by a new peer, murdoch wait"
+             (text-contains? waited "exit 0"))
+           (test "step 1's result, and step 2's, each handed step 1's"
+             (list (list one) (map (lambda (u) (list (list one) u)) two))
+             (task-wait id 5))
+           (test "step 1 ran once: one begin and one end, in its robot's own log"
+             (list (list one 1 1))
+             (filter (lambda (x) (> (+ (cadr x) (car (cddr x))) 0))
+                     (begins-and-ends (tagged tag "-one"))))
+           (test "step 2's two ran once each, on robots of their own"
+             (filter-map (lambda (r) (and (memq r two) (list r 1 1))) robots)
+             (filter (lambda (x) (> (+ (cadr x) (car (cddr x))) 0))
+                     (begins-and-ends (tagged tag "-two"))))
+           (test "murdoch wait prints both steps' results" #t
+             (every (lambda (u) (text-contains? waited (symbol->string u)))
+                    (cons one two))))
+         (restart! old))))
+   '(stepped-a stepped-b) '(1 2)))
+
 (test-group "the coordinator killed while its task waits, holding"
   ;; r2 and r3 are busy; the detached task needs two robots and holds
   ;; r1; a task posed after it also waits for two.
