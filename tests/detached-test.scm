@@ -2,15 +2,16 @@
 ;;; at once, a coordinator killed mid-task, while its task waits holding
 ;;; a robot, or together with its standby, and a robot lost while the
 ;;; standby is in charge.  Workstations stand in for robots, as in
-;;; task-test; each component writes (begin TAG UID) and (end TAG UID) to
-;;; its own address space's log, which the tests read.
-(import (except (scheme base) lambda define) (scheme write) (scheme eval)
-        (srfi 1) (srfi 18) (chibi test)
+;;; task-test; each component writes (begin TAG UID SECOND) and (end TAG
+;;; UID SECOND) to its own address space's log, which the tests read.
+(import (except (scheme base) lambda define) (scheme write) (scheme read) (scheme eval)
+        (srfi 1) (srfi 18) (srfi 132) (chibi test)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
-(define (tell . xs) (write xs) (newline) (flush-output-port))
+(define (tell . xs) (write (append xs (list (time->seconds (current-time))))) (newline)
+  (flush-output-port))
 ;; A component that runs rounds of 50 ms, calling out each round, as a
 ;; robot command would go to its robot, so that it stops as an orphan.
 (define (work tag rounds)
@@ -22,12 +23,6 @@
        (thread-sleep! 0.05)
        (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
    (lambda () (tell 'end tag (local-aspace-uid)))))
-;; What the tester hears: each (begin TAG) as it comes.
-(define heard '())
-(define (note-begin tag) (set! heard (append heard (list tag))) #t)
-(define (work-told tag rounds)
-  (remote-apply (uid->aspace 'tester) (lambda () (note-begin tag)))
-  (work tag rounds))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
          (request 'all (lambda ()
@@ -83,6 +78,14 @@
   (filter (lambda (line)
             (text-contains? line (string-append "(" word " " (symbol->string tag) " ")))
           (read-lines (in-dir (string-append (symbol->string uid) ".log")))))
+
+;; The second at which each component tagged tag began, from the robots'
+;; own logs, earliest first.
+(define (begin-seconds tag)
+  (list-sort < (append-map (lambda (r)
+                             (map (lambda (line) (list-ref (read (open-input-string line)) 3))
+                                  (log-lines r "begin" tag)))
+                           robots)))
 
 ;; Task id's entry of lab-tasks; one that no address space answers for
 ;; now is (ID #f 0 #f #f #f #f #f).
@@ -246,43 +249,54 @@
    '(stepped-a stepped-b) '(1 2)))
 
 (test-group "the coordinator killed while its task waits, holding"
-  ;; r2 and r3 are busy; the detached task needs two robots and holds
-  ;; r1; a task posed after it also waits for two.
-  (let* ((busy (map (lambda (tag)
+  ;; r2 and r3 are busy, r3 for longer; the detached task needs two
+  ;; robots and holds r1; a task posed after it, at its priority, waits
+  ;; for one.  Its coordinator killed, the lab frees r1 at the lease, and
+  ;; the standby's negotiation must take it again in the task's rank:
+  ;; were the rank lost, the later task would start on r1 at once, not
+  ;; on r3 once r2 has gone to the task.
+  (let* ((busy (map (lambda (tag rounds)
                       (start-task 'busy 1 (list '((mobile) ()))
                                   (list (location-metric-maker '(2000 0 0 0)))
-                                  (list (eval `(lambda () (work ',tag 140))
+                                  (list (eval `(lambda () (work ',tag ,rounds))
                                               (lab-environment)))))
-                    '(busy-a busy-b)))
+                    '(busy-a busy-b) '(200 300)))
          (_ (wait-until 10 (lambda () (every (lambda (t) (running-everywhere? t)) busy))))
          (id (remote-apply
               (uid->aspace 'poser)
               (eval '(lambda ()
                        (start-task 'holder 2 (list '((mobile) ()) '((mobile) ()))
                                    (list #f #f)
-                                   (list (lambda () (work-told 'holder 10))
-                                         (lambda () (work-told 'holder 10)))
+                                   (list (lambda () (work 'holder 10))
+                                         (lambda () (work 'holder 10)))
                                    'hold #t 'detach #t))
                     (lab-environment)))))
-    (test-assert "it waits, with a standby"
+    (test-assert "it holds a robot and waits for another, with a standby"
       (wait-until 10 (lambda () (let ((e (entry-of id)))
-                                  (and (memq (lab-task-state e) '(waiting holding))
+                                  (and (eq? (lab-task-state e) 'holding)
                                        (lab-task-standby e))))))
-    (let ((later (start-task 'later 2 (list '((mobile) ()) '((mobile) ()))
-                             (list #f #f)
-                             (list (eval '(lambda () (work-told 'later 10)) (lab-environment))
-                                   (eval '(lambda () (work-told 'later 10)) (lab-environment)))
+    (let ((later (start-task 'later 1 (list '((mobile) ())) (list #f)
+                             (list (eval '(lambda () (work 'later 10)) (lab-environment)))
                              'wait #t))
           (old (coordinator-of id)))
+      (test-assert "the task posed after it waits"
+        (wait-until 10 (lambda () (eq? 'waiting (task-state later)))))
       (kill! old)
       (test-assert "its standby takes over"
         (wait-until 10 (lambda () (let ((c (coordinator-of id))) (and c (not (eq? c old)))))))
+      (test-assert "and holds a robot again, the first given back at the lease"
+        (wait-until 10 (lambda () (let ((e (entry-of id)))
+                                    (and (= 2 (lab-task-epoch e))
+                                         (eq? (lab-task-state e) 'holding))))))
       (let ((results (task-wait id 60)))
         (test "it completes on two robots" 2
           (length (delete-duplicates (filter (lambda (r) (memq r robots)) results)))))
       (task-wait later 60)
-      (test "in its rank: before the task posed after it" '(holder holder later later)
-        (remote-apply (uid->aspace 'tester) (eval '(lambda () heard) (lab-environment))))
+      (let ((holder (begin-seconds 'holder)) (after (begin-seconds 'later)))
+        (test "each began once, in the robots' logs" '(2 1)
+          (list (length holder) (length after)))
+        (test "in its rank: no begin of the later task's before its components'" '()
+          (filter (lambda (s) (< s (last holder))) after)))
       (for-each task-wait busy)
       (test-assert "nothing is held after" (wait-until 10 all-free?))
       (restart! old))))
