@@ -248,7 +248,16 @@
   (let ((t (handed-task h)) (old (handed-copy h)))
     (if (or (not t) (copy-results old))
         old
-        (list (task-state t) (task-status t) #f (task-turn-copy t) #f))))
+        (list (state-now t) (task-status t) #f (task-turn-copy t) #f))))
+
+;; t's state; a task of steps that is not over is in its step's, and
+;; running between two steps.
+(define (state-now t)
+  (let ((steps (task-steps t)))
+    (if (and (pair? steps) (eq? (task-state t) 'negotiating))
+        (let ((state (task-state (last steps))))
+          (if (memq state '(negotiating waiting holding running)) state 'running))
+        (task-state t))))
 
 ;; Whether a finished task's copy has been kept for keep-results.
 (define (kept-enough? copy)
