@@ -59,6 +59,9 @@
   (test "a delivery that is neither" #t
     (says? "(lab x (delivery carrier-pigeon))" "delivery takes broadcast, or multicast"))
   (test "the file is named" #t (says? "(lab x (timout 3))" file))
+  (test "a ROS 2 robot's clause, within its robot" #t
+    (says? "(lab x (aspace a (robot (ros2 (namespace \"/a\") (arrive-mm 0)))))"
+           "(arrive-mm 0): arrive-mm takes a positive number of millimetres"))
   (test "two address spaces of one name: the later, with the other's line" #t
     (says? "(lab x\n (aspace a)\n (aspace b)\n (aspace a))"
            ":4: (aspace a): two address spaces of this name: the other on line 2"))

@@ -30,6 +30,11 @@
   (goto-xy '(2000 0))
   (local-aspace-uid))
 (define (pose-now) (reckon))
+;; Drives toward (x y): the error's message if trip refuses, else arrived.
+(define (try-goto x y)
+  (guard (e ((error-object? e) (error-object-message e)))
+    (goto-xy (list x y))
+    'arrived))
 ")
 
 (define lab
@@ -245,6 +250,17 @@
       (let ((p (remote-apply (uid->aspace 'tb1) (lab-proc 'pose-now))))
         (< (sqrt (+ (square (- (car p) 1000)) (square (- (cadr p) 500)))) 20)))))
 
+(test-group "wheels that jam: stalled, with its odometry still coming"
+  (let ((log (in-dir "logs/trip-tb2.log")))
+    (kill tb2-robot 12)                 ; SIGUSR2: its wheels jam
+    (test "goto-xy ends in trip's stalled error" "trip: tb2: goto-xy: the base is blocked"
+          (remote-apply (uid->aspace 'tb2) (lab-proc 'try-goto) 1500 1000))
+    (test-assert "and the trip server's log says why: not moved, on the robot's clock"
+      (text-contains? (file-text log) "tb2: stalled in goto: not moved for"))
+    (kill tb2-robot 12)                 ; freed again
+    (test "freed, it drives there" 'arrived
+          (remote-apply (uid->aspace 'tb2) (lab-proc 'try-goto) 0 1000))))
+
 (test-group "odometry that stops: stalled, the robot lost, the component moves"
   (let ((t (start-task 'drive 1 (list '((mobile) ()))
                        (list (metric-by (lambda (uid) (if (eq? uid 'tb1) 0 1))))
@@ -257,7 +273,10 @@
       (test "the component moves to tb2, which drives there" '(tb2) r)
       (test "tb1 is recorded as lost" '(tb1 lost) (list (car a) (cadr a)))
       (test-assert "for its base, which trip said stalled"
-        (text-contains? (car (cddr a)) "stalled")))))
+        (text-contains? (car (cddr a)) "stalled"))
+      (test-assert "and its trip server's log says why"
+        (text-contains? (file-text (in-dir "logs/trip-tb1.log"))
+                        "tb1: stalled in goto: no odometry on /tb1/odom")))))
 
 ;; What the shell command prints, every line.
 (define (shell-output command)

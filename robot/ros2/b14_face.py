@@ -39,33 +39,46 @@ BATTERY_EVERY = 50              # one a second
 
 
 class Trip:
-    """A blocking trip client of one simulated robot, for one thread at a
-    time (the lock)."""
+    """A blocking trip client of one simulated robot, used by the main
+    loop only: each period's requests go out together, tagged, and their
+    answers are read back in one round trip."""
 
     def __init__(self, host, port):
         self.sock = socket.create_connection((host, port), timeout=10)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.parser = trip_frame.Parser(65536)
-        self.lock = threading.Lock()
         self.tag = 0
         self.frames = []
 
     def ask(self, *words):
-        with self.lock:
+        return self.ask_all([words])[0]
+
+    def ask_all(self, requests):
+        """The numbers each request answers, in order."""
+        tags = []
+        out = b""
+        for words in requests:
             self.tag = self.tag % 999999998 + 1
-            tag = str(self.tag)
-            self.sock.sendall(trip_frame.encode(" ".join([tag] + [str(w) for w in words])))
-            while True:
-                while self.frames:
-                    reply = self.frames.pop(0).decode("latin-1").split(" ")
-                    if reply[0] == tag:
-                        if reply[1] != "ok":
-                            raise RuntimeError("b14: %s: %s" % (" ".join(words), " ".join(reply)))
-                        return [float(w) for w in reply[2:]]
-                data = self.sock.recv(65536)
-                if not data:
-                    raise ConnectionError("the simulator closed the connection")
-                self.frames += [v for k, v in self.parser.feed(data) if k == "frame"]
+            tags.append(str(self.tag))
+            out += trip_frame.encode(" ".join([tags[-1]] + [str(w) for w in words]))
+        self.sock.sendall(out)
+        answers = {}
+        while len(answers) < len(tags):
+            while self.frames:
+                reply = self.frames.pop(0).decode("latin-1").split(" ")
+                if reply[0] in tags:
+                    if reply[1] != "ok":
+                        words = requests[tags.index(reply[0])]
+                        raise RuntimeError("b14: %s: %s" % (" ".join(map(str, words)),
+                                                            " ".join(reply)))
+                    answers[reply[0]] = [float(w) for w in reply[2:]]
+            if len(answers) == len(tags):
+                break
+            data = self.sock.recv(65536)
+            if not data:
+                raise ConnectionError("the simulator closed the connection")
+            self.frames += [v for k, v in self.parser.feed(data) if k == "frame"]
+        return [answers[t] for t in tags]
 
 
 def quaternion(heading_deg):
@@ -90,18 +103,27 @@ class Face:
         node.create_subscription(TwistStamped if stamped else Twist, ns + "/cmd_vel",
                                  self.on_cmd_vel, QoSProfile(depth=10))
         self.count = 0
+        self.cmd_lock = threading.Lock()
+        self.cmd = None                 # the newest cmd_vel not yet sent on
 
     def on_cmd_vel(self, m):
+        """Kept for the main loop to send on: a callback that waited for the
+        simulator would hold up the next, and they would queue."""
         t = m.twist if isinstance(m, TwistStamped) else m
-        self.trip.ask("base", "vel", "%.1f" % (t.linear.x * 1000.0),
-                      "%.2f" % math.degrees(t.angular.z))
+        with self.cmd_lock:
+            self.cmd = ("base", "vel", "%.1f" % (t.linear.x * 1000.0),
+                        "%.2f" % math.degrees(t.angular.z))
 
     def publish(self):
+        with self.cmd_lock:
+            cmd, self.cmd = self.cmd, None
+        asks = ([cmd] if cmd else []) + [("time",), ("base", "reckon")]
+        answers = self.trip.ask_all(asks)
         # Stamped with the simulator's clock, which runs at its own speed:
         # the robot's clock, as trip_ros2's `time` answers it.
-        ms = int(self.trip.ask("time")[0])
+        ms = int(answers[-2][0])
         now = Time(sec=ms // 1000, nanosec=(ms % 1000) * 1000000)
-        x, y, th = self.trip.ask("base", "reckon")
+        x, y, th = answers[-1]
         o = Odometry()
         o.header.stamp = now
         o.header.frame_id = self.name + "/odom"

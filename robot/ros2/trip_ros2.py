@@ -11,8 +11,9 @@ and drives the robot through ROS 2's standard messages:
 
     base      geometry_msgs/Twist or TwistStamped out on cmd_vel; the pose
               from nav_msgs/Odometry; translate, rotate and goto a closed
-              loop here on odometry, stalled when odometry stops or does
-              not move for stall seconds
+              loop here on odometry, stalled when odometry does not move
+              for stall seconds of the robot's clock (its odometry's
+              stamps) or stops for odom-timeout seconds
     sonar     sensor_msgs/LaserScan folded into the B14's 16 sectors, or
               sensor_msgs/Range topics, one per sonar
     battery   sensor_msgs/BatteryState
@@ -56,6 +57,7 @@ MAX_FRAME_ERRORS = 16
 MAX_BACKLOG = 65536
 READ_SLICE = 16384
 TICK = 0.02                     # seconds between steps of the controller
+KEEP_ALIVE = 0.1                # seconds between repeats of an unchanged cmd_vel
 CMD_VEL_TYPES = {"twist": "geometry_msgs/msg/Twist",
                  "stamped": "geometry_msgs/msg/TwistStamped"}
 
@@ -77,6 +79,12 @@ def wrap180(a):
     elif a <= -180:
         a += 360
     return a
+
+
+def approach(left, gain, floor, limit):
+    """As sim/world.c's: proportional with a floor, so a motion ends
+    rather than creeps."""
+    return math.copysign(min(max(abs(left) * gain, floor), limit), left)
 
 
 def angle_text(a, digits):
@@ -110,6 +118,7 @@ class Robot:
         self.publisher = self.node.create_publisher(
             TwistStamped if self.stamped else Twist, self.cmd_vel_topic, QoSProfile(depth=10))
         self.lock = threading.Lock()
+        self.sent = (None, 0.0)         # the last cmd_vel (tv, rv) and when
         self.odom = None                # (x mm, y mm, heading deg) as the robot has it
         self.odom_at = None             # monotonic seconds of the newest
         self.odom_count = 0
@@ -199,7 +208,13 @@ class Robot:
             self.battery = m.voltage
 
     def drive(self, tv, rv):
-        """tv mm/s, rv deg/s, on cmd_vel."""
+        """tv mm/s, rv deg/s, on cmd_vel: when they change, else every
+        KEEP_ALIVE seconds, for drivers that stop a robot whose cmd_vel
+        goes quiet; not every tick, which only queues up in a slow driver."""
+        now = time.monotonic()
+        if (tv, rv) == self.sent[0] and now - self.sent[1] < KEEP_ALIVE:
+            return
+        self.sent = ((tv, rv), now)
         t = Twist()
         t.linear.x = tv / 1000.0
         t.angular.z = math.radians(rv)
@@ -256,7 +271,8 @@ class Base:
         self.tv = self.rv = 0.0
         self.stalled = 0
         self.goal = None
-        self.progress = None                    # (monotonic, pose) of the last progress
+        self.turning = False                    # goto: still facing the goal
+        self.progress = None                    # (robot's ms, pose) of the last progress
 
     def pose(self):
         with self.robot.lock:
@@ -281,7 +297,8 @@ class Base:
 
     def start(self, kind, goal=None):
         self.kind, self.goal, self.stalled = kind, goal, 0
-        self.progress = (time.monotonic(), self.pose())
+        self.turning = kind == "goto"
+        self.progress = (self.robot.now_ms(), self.pose())
         if kind == "translate":
             x, y, th = self.pose()
             self.goal = (x, y, goal)
@@ -316,7 +333,9 @@ class Base:
             return
         x, y, th = self.pose()
         a = self.args
-        if self._stalled(x, y, th):
+        why = self._stalled(x, y, th)
+        if why:
+            say(self.robot.args.name, "stalled in %s: %s" % (self.kind, why))
             self.stop()
             self.stalled = 1
             return
@@ -334,32 +353,45 @@ class Base:
                 return self.stop()
             self.set(0, math.copysign(min(a.turn_speed, 2.0 * abs(left) + 3), left))
         elif self.kind == "goto":
-            gx, gy = self.goal
-            dist = math.hypot(gx - x, gy - y)
-            if dist <= a.arrive_mm:
-                return self.stop()
-            off = wrap180(math.degrees(math.atan2(gy - y, gx - x)) - th)
-            if dist < 4 * a.arrive_mm and abs(off) > 60:
-                return self.stop()                  # passed it: as near as it gets
-            turn = math.copysign(min(a.turn_speed, 2.0 * abs(off) + 3), off)
-            if abs(off) > 10:
-                self.set(0, turn)                   # face it first
-            else:
-                self.set(min(a.speed, 2.0 * dist + 20), turn)
+            self.goto_step(x, y, th)
+
+    def goto_step(self, x, y, th):
+        """As sim/world.c's goto: face the goal, then close in along the
+        heading, steering only while farther than 60 mm (so near it, it
+        does not chase the bearing round), so that a robot ends a goto
+        facing as the simulator's B14 does."""
+        a = self.args
+        gx, gy = self.goal
+        dist = math.hypot(gx - x, gy - y)
+        off = wrap180(math.degrees(math.atan2(gy - y, gx - x)) - th)
+        if self.turning and dist > 3 * a.arrive_mm and abs(off) > a.arrive_deg:
+            return self.set(0, approach(off, 3, 1, a.turn_speed))
+        self.turning = False
+        along = dist * math.cos(math.radians(off))
+        if abs(along) <= a.arrive_mm:
+            return self.stop()
+        steer = max(-a.turn_speed, min(a.turn_speed, 3 * off)) if dist > 60 else 0
+        self.set(approach(along, 3, 5, a.speed), steer)
 
     def _stalled(self, x, y, th):
-        """Blocked for stall seconds: no odometry, or odometry that does not
-        move while the base is told to."""
-        now = time.monotonic()
+        """Why the base is blocked, else None: odometry silent for
+        odom-timeout seconds here, or not moving for stall seconds of the
+        robot's own clock while the base is told to (its clock, so that a
+        slow simulator or a loaded host is not taken for a blocked base)."""
         with self.robot.lock:
             at = self.robot.odom_at
-        if at is None or now - at > self.args.stall:
-            return True
+        silent = time.monotonic() - at if at is not None else None
+        if silent is None or silent > self.args.odom_timeout:
+            return "no odometry on %s for %.1f s" % (self.robot.odom_topic,
+                                                     silent or self.args.odom_timeout)
+        now = self.robot.now_ms()
         t0, p0 = self.progress
         if math.hypot(x - p0[0], y - p0[1]) > 5 or abs(wrap180(th - p0[2])) > 1:
             self.progress = (now, (x, y, th))
-            return False
-        return now - t0 > self.args.stall
+            return None
+        if now - t0 > 1000 * self.args.stall:
+            return "not moved for %.1f s at %.0f %.0f %.1f" % ((now - t0) / 1000, x, y, th)
+        return None
 
 
 # ---- trip: sessions and requests -------------------------------------------
@@ -737,6 +769,7 @@ def main():
     p.add_argument("--lock-dir", default=None)
     p.add_argument("--appear-timeout", type=float, default=20.0)
     p.add_argument("--stall", type=float, default=2.0)
+    p.add_argument("--odom-timeout", type=float, default=5.0)
     p.add_argument("--stall-timeout", type=float, default=10.0)
     p.add_argument("--max-frame", type=int, default=1024)
     p.add_argument("--speed", type=float, default=400.0)

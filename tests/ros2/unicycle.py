@@ -9,7 +9,9 @@ would: nav_msgs/Odometry on odom (its true pose, in metres), a 360-beam
 sensor_msgs/LaserScan on scan (the walls of the room, |x| and |y| up to
 HALF mm, measured from its centre), and, if given, sensor_msgs/BatteryState
 on battery_state.  SIGUSR1 stops its odometry for good, as a crashed
-driver would.  It says `unicycle: ready`.
+driver would; SIGUSR2 jams its wheels, or frees them again: jammed, it
+does not move, and its odometry goes on saying so.  It says
+`unicycle: ready`.
 """
 
 import argparse
@@ -52,7 +54,8 @@ def main():
     rclpy.init()
     node = rclpy.create_node("unicycle", namespace=args.namespace)
     state = {"x": args.pose[0] / 1000, "y": args.pose[1] / 1000,
-             "th": math.radians(args.pose[2]), "v": 0.0, "w": 0.0, "odom": True}
+             "th": math.radians(args.pose[2]), "v": 0.0, "w": 0.0, "odom": True,
+             "jammed": False}
     lock = threading.Lock()
 
     def on_cmd(m):
@@ -67,11 +70,14 @@ def main():
     battery = (node.create_publisher(BatteryState, "battery_state", qos_profile_sensor_data)
                if args.battery else None)
     signal.signal(signal.SIGUSR1, lambda *_: state.__setitem__("odom", False))
+    signal.signal(signal.SIGUSR2, lambda *_: state.__setitem__("jammed", not state["jammed"]))
     threading.Thread(target=rclpy.spin, args=(node,), daemon=True).start()
     print("unicycle: ready", flush=True)
     dt, k, next_at = 0.02, 0, time.monotonic()
     while True:
         with lock:
+            if state["jammed"]:
+                state["v"] = state["w"] = 0.0
             state["th"] += state["w"] * dt
             state["x"] += state["v"] * math.cos(state["th"]) * dt
             state["y"] += state["v"] * math.sin(state["th"]) * dt

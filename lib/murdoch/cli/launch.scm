@@ -48,8 +48,14 @@
     (cond ((not robot) #f)
           ((assq 'ros2 (filter pair? (cdr robot))) => cdr)
           ((ros2-everywhere?)
-           `((namespace ,(string-append "/" (symbol->string (lab-aspace-uid a))))))
+           `((namespace ,(string-append "/" (symbol->string (lab-aspace-uid a))))
+             ,@face-arrival))
           (else #f))))
+
+;; A simulated B14 ends its own motions within half a millimetre and a
+;; twentieth of a degree (sim/world.c); through its face it is asked to end
+;; them nearly as near, so that it senses from where a direct run would.
+(define face-arrival '((arrive-mm 1) (arrive-deg 0.1)))
 
 (define (simulated? a)
   (and (lab-aspace-clause a 'robot)

@@ -46,7 +46,9 @@
                            "one to sixteen ROS 2 topic names, in quotes"))
     (battery . ,topic-name)
     (fiducials . ,topic-name)
-    (appear-timeout . ,(values-of 1 positive-real? "a positive number of seconds"))))
+    (appear-timeout . ,(values-of 1 positive-real? "a positive number of seconds"))
+    (arrive-mm . ,(values-of 1 positive-real? "a positive number of millimetres"))
+    (arrive-deg . ,(values-of 1 positive-real? "a positive number of degrees"))))
 
 (define robot-table
   `((ros2 . ,ros2-table)
