@@ -297,9 +297,16 @@
                     (let ((r (task-wait id 60)))
                       (cond ((symbol? r) r)
                             ((if steps? (every done-one? r) (done-one? r)) 'done)
-                            (else 'failed))))))
+                            (else (tell-failed id (if steps? (apply append r) r)) 'failed))))))
     (if steps? (locked (lambda () (set! steps-tasks (+ steps-tasks 1)))))
     (locked (lambda () (set! detached-outcomes (cons outcome detached-outcomes))))))
+
+;; Why a detached task failed, from its components' results: each
+;; (error UID WHY).
+(define (tell-failed id results)
+  (display (string-append "chaos: detached " (symbol->string id) " failed: "))
+  (write (filter (lambda (x) (and (pair? x) (eq? (car x) 'error))) results))
+  (newline))
 
 (define (detached-step tag)
   (task-step (list '((mobile) ())) (list #f)
