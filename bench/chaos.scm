@@ -296,6 +296,7 @@
          (outcome (guard (e (#t (display (error-message e)) (newline) 'lost))
                     (let ((r (task-wait id 60)))
                       (cond ((symbol? r) r)
+                            ((and steps? (find symbol? r)))  ; a step's not-enough-takers
                             ((if steps? (every done-one? r) (done-one? r)) 'done)
                             (else (tell-failed id (if steps? (apply append r) r)) 'failed))))))
     (if steps? (locked (lambda () (set! steps-tasks (+ steps-tasks 1)))))
