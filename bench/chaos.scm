@@ -284,6 +284,7 @@
 ;; each component a copy of its own, (N) or (N STEP).
 (define (one-detached-task)
   (let* ((tag (locked (lambda () (set! tags (+ tags 1)) tags)))
+         (began (monotonic-seconds))
          (steps? (even? tag))
          (id (if steps?
                  (apply start-steps 'handed-steps
@@ -298,15 +299,20 @@
                       (cond ((symbol? r) r)
                             ((and steps? (find symbol? r)))  ; a step's not-enough-takers
                             ((if steps? (every done-one? r) (done-one? r)) 'done)
-                            (else (tell-failed id (if steps? (apply append r) r)) 'failed))))))
+                            (else (tell-failed id (if steps? (apply append r) r) began) 'failed))))))
     (if steps? (locked (lambda () (set! steps-tasks (+ steps-tasks 1)))))
     (locked (lambda () (set! detached-outcomes (cons outcome detached-outcomes))))))
 
-;; Why a detached task failed, from its components' results: each
-;; (error UID WHY).
-(define (tell-failed id results)
+;; Why a detached task posed at began failed, from its components'
+;; results: each (error UID WHY), and whether the killer killed UID since.
+(define (tell-failed id results began)
   (display (string-append "chaos: detached " (symbol->string id) " failed: "))
-  (write (filter (lambda (x) (and (pair? x) (eq? (car x) 'error))) results))
+  (for-each (lambda (x)
+              (when (and (pair? x) (eq? (car x) 'error))
+                (write x)
+                (display (if (killed-after (cadr x) began) " (its robot killed) "
+                             " (its robot not killed) "))))
+            results)
   (newline))
 
 (define (detached-step tag)

@@ -6,6 +6,7 @@
 ;;; UID SECOND) to its own address space's log, which the tests read.
 (import (except (scheme base) lambda define) (scheme write) (scheme read) (scheme eval)
         (srfi 1) (srfi 18) (srfi 132) (chibi test)
+        (only (chibi process) kill signal/stop signal/continue)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness))
 
@@ -300,6 +301,41 @@
       (for-each task-wait busy)
       (test-assert "nothing is held after" (wait-until 10 all-free?))
       (restart! old))))
+
+(test-group "the standby stalled: a peer's wait follows the task as it moves"
+  ;; The standby frozen (SIGSTOP), its coordinator lets the task go and
+  ;; nobody coordinates it until the standby wakes and takes it over.  A
+  ;; peer's task-wait meanwhile waits on; its task-status, bounded, says
+  ;; the task is moving, not that it failed.
+  (let ((id (remote-apply
+             (uid->aspace 'poser)
+             (eval '(lambda ()
+                      (start-task 'stalled 1 (list '((mobile) ())) (list #f)
+                                  (list (lambda () (work 'stalled 60))) '(1) '(#t)
+                                  'detach #t))
+                   (lab-environment)))))
+    (test-assert "it runs, with a standby"
+      (wait-until 10 (lambda () (and (running-everywhere? id)
+                                     (lab-task-standby (entry-of id))))))
+    (let* ((e (entry-of id)) (coordinator (lab-task-coordinator e))
+           (standby (lab-task-standby e)) (pid (cdr (assq standby pids))))
+      (kill pid signal/stop)
+      (test-assert "its standby frozen, the coordinator lets the task go"
+        (wait-until 10 (lambda () (eq? 'let-go (remote-apply (uid->aspace coordinator)
+                                                             handed-role-of id)))))
+      (let* ((asking (lambda (thunk)
+                       (thread-start!
+                        (make-thread (lambda () (guard (e ((error-object? e) (error-object-message e)))
+                                                   (thunk)))))))
+             (waited (asking (lambda () (task-wait id 60))))
+             (status (asking (lambda () (task-status id)))))
+        (thread-sleep! 7)
+        (kill pid signal/continue)
+        (test-assert "task-status says it is moving"
+          (let ((s (thread-join! status))) (and (string? s) (text-contains? s "is moving"))))
+        (test-assert "task-wait waits on, and answers once the standby has it"
+          (pair? (thread-join! waited)))
+        (test "the standby took it over" standby (coordinator-of id))))))
 
 (test-group "coordinator and standby killed at once: the task fails clearly"
   (let ((id (remote-apply

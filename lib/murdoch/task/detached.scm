@@ -638,31 +638,53 @@
                            (remove (lambda (e) (eq? (lab-task-role e) 'let-go)) entries))))
     (and (pair? ranked) (car ranked))))
 
-;; The uid that answers for task id now, or #f.
+;; The uid that answers for task id now; moving while the only member
+;; that holds it has let it go, its standby silent (it takes the task
+;; back, or the standby takes it over, within take-over-periods); or #f.
 (define (holder-of id)
-  (let ((e (best-entry (append-map cadr
-                                   (guard (e (#t '()))
-                                     (request 'lab-tasks
-                                              (sendable-lambda ()
-                                                (filter (lambda (e) (eq? (lab-task-id e) id))
-                                                        (handed-entries)))))))))
-    (and e (if (eq? (lab-task-role e) 'standby)
-               (lab-task-standby e)
-               (lab-task-coordinator e)))))
+  (let* ((entries (append-map cadr
+                              (guard (e (#t '()))
+                                (parameterize ((remote-timeout (max 1 (* 2 (period)))))
+                                  (request 'lab-tasks
+                                           (sendable-lambda ()
+                                             (filter (lambda (e) (eq? (lab-task-id e) id))
+                                                     (handed-entries))))))))
+         (e (best-entry entries)))
+    (cond (e (if (eq? (lab-task-role e) 'standby)
+                 (lab-task-standby e)
+                 (lab-task-coordinator e)))
+          ((pair? entries) 'moving)
+          (else #f))))
 
 ;; Applies proc to id's record where it is held, trying for a few periods
-;; while a takeover is under way; raises a clear error when nobody holds it.
-(define (at-holder who id proc . args)
-  (let try ((left 2))
-    (let ((uid (holder-of id)))
-      (cond
-       ((and (not uid) (> left 0)) (thread-sleep! (period)) (try (- left 1)))
-       ((not uid) (error (string-append who ": " (not-held-text id))))
-       (else
-        (guard (e ((and (remote-error? e) (not (remote-raised-error? e)) (> left 0))
-                   (thread-sleep! (period))
-                   (try (- left 1))))
-          (apply remote-apply (uid->aspace uid) proc id args)))))))
+;; while a takeover is under way, and for up to moving seconds while the
+;; task is moving; raises a clear error when nobody holds it.
+(define (at-holder who id moving proc . args)
+  (let ((moving-until (+ (monotonic-seconds) moving)))
+    (let try ((left 2))
+      (let ((uid (holder-of id)))
+        (cond
+         ((and (eq? uid 'moving) (< (monotonic-seconds) moving-until))
+          (thread-sleep! (period))
+          (try left))
+         ((and (memq uid '(#f moving)) (> left 0)) (thread-sleep! (period)) (try (- left 1)))
+         ((eq? uid 'moving) (error (string-append who ": " (moving-text id))))
+         ((not uid) (error (string-append who ": " (not-held-text id))))
+         (else
+          (guard (e ((and (remote-error? e) (not (remote-raised-error? e)) (> left 0))
+                     (thread-sleep! (period))
+                     (try (- left 1))))
+            (apply remote-apply (uid->aspace uid) proc id args))))))))
+
+;; How long task-status and cancel-task wait for a task that moves: its
+;; standby takes over, or its coordinator takes it back, within
+;; take-over-periods, unless a partition parts them.
+(define (moving-seconds) (* (+ take-over-periods 4) (period)))
+
+(define (moving-text id)
+  (string-append "the task " (symbol->string id) " is moving: the member that"
+                 " coordinated it let it go, its standby silent (stalled, or cut off"
+                 " from it); one of them takes it, or it fails; ask again in a moment"))
 
 ;; Why nobody holds task id.
 (define (not-held-text id)
@@ -718,7 +740,7 @@
 ;;> detached task's id: see task-status in (murdoch task life-cycle).
 (define (task-status task)
   (if (symbol? task)
-      (at-holder "task-status" task handed-status)
+      (at-holder "task-status" task (moving-seconds) handed-status)
       (status-here task)))
 
 ;;> Waits for \var{task}, a record or a detached task's id, as task-wait
@@ -729,8 +751,10 @@
       (let ((until (and (pair? seconds) (+ (monotonic-seconds) (car seconds)))))
         (let loop ()
           (let* ((left (if until (- until (monotonic-seconds)) 10))
+                 ;; A task that moves is waited for as one that runs.
                  (answer (parameterize ((remote-timeout (+ (min left 10) 5)))
-                           (at-holder "task-wait" task handed-wait (max 0 (min left 10))))))
+                           (at-holder "task-wait" task (if until (max 0 left) 3600)
+                                      handed-wait (max 0 (min left 10))))))
             (cond ((eq? (car answer) 'done) (cadr answer))
                   ((and until (<= (- until (monotonic-seconds)) 0))
                    (error (string-append "task-wait: " (symbol->string task)
@@ -743,5 +767,5 @@
 ;;> in (murdoch task life-cycle).
 (define (cancel-task task)
   (if (symbol? task)
-      (at-holder "cancel-task" task handed-cancel)
+      (at-holder "cancel-task" task (moving-seconds) handed-cancel)
       (cancel-here task)))
