@@ -441,7 +441,9 @@
 ;; after the copy was sent; so is one found ended that the copy has
 ;; running there, or not yet started.
 (define (adoption-plan id statuses)
-  (let ((seen (components-of id)))
+  (let ((seen (if (every (lambda (s) (memq (car (status-state s)) '(done failed))) statuses)
+                  '()                   ; a finished step's: none to look for
+                  (components-of id))))
     (map (lambda (s)
            (let* ((k (status-index s)) (state (status-state s))
                   (running (find (lambda (x) (and (= (cadr x) k) (eq? (car (cddr x)) 'running)))
@@ -472,16 +474,18 @@
      (handed-id h) (car args) (map (lambda (parts) (apply task-step parts)) (cadr args))
      (car (cddr args))
      (lambda (i id step-args)
-       (let* ((entry (find (lambda (e) (= (step-status-index e) i)) copied))
-              (plan (adoption-plan
-                     id
-                     (if entry
-                         (step-status-entries entry)
-                         (map (lambda (k) (list k '(negotiating) '()))
-                              (iota (cadr step-args) 1))))))
-         (and (or entry (any plan-uid plan))
-              (adopt-task id (and entry (= i (length copied)) (copy-turn copy)) plan
-                          step-args)))))))
+       ;; Only the step after the copy's last may have begun unseen.
+       (let ((entry (find (lambda (e) (= (step-status-index e) i)) copied)))
+         (and (<= i (+ 1 (length copied)))
+              (let ((plan (adoption-plan
+                           id
+                           (if entry
+                               (step-status-entries entry)
+                               (map (lambda (k) (list k '(negotiating) '()))
+                                    (iota (cadr step-args) 1))))))
+                (and (or entry (any plan-uid plan))
+                     (adopt-task id (and entry (= i (length copied)) (copy-turn copy))
+                                 plan step-args)))))))))
 
 ;; (UID INDEX running) or (UID INDEX ended) for each component of task id
 ;; that runs, or ended lately, anywhere in the lab.
