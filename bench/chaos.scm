@@ -26,6 +26,9 @@
 ;;;                                    where the task's components run
 ;;;   bench: detached-lost N           tasks whose result no peer could read
 ;;;   bench: detached-double-runs N    a component running twice at once
+;;; and tells each failed detached task, and each component begun again
+;;; after it completed; a task lost or a component run twice keeps the
+;;; lab's logs, and says where.
 ;;; MURDOCH_CHAOS_SECONDS sets how long the kills go on (default 90).
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme process-context) (scheme inexact) (scheme time)
@@ -416,5 +419,13 @@
                           " (a robot killed before its result was read, or a step run"
                           " again)")))))
 
+;; A detached task lost, or a component run twice, keeps the lab's logs.
+(define keep-logs?
+  (or (memq 'lost detached-outcomes)
+      (positive? (+ (at-quiet 'double-runs) (at-quiet 'reruns)))))
 (stop-all-processes!)
-(remove-test-lab! lab)
+(if keep-logs?
+    (begin (display (string-append "chaos: the lab's logs are kept in "
+                                   (test-lab-directory lab)))
+           (newline))
+    (remove-test-lab! lab))
