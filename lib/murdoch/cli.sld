@@ -1,7 +1,5 @@
 ;;> The command line: hints, the address-space and REPL commands, and
 ;;> the lab's launcher.
-;;> Its members are each a library of their own in cli/; this umbrella
-;;> exports what the families above use of them.
 
 (define-library (murdoch cli)
   (export join-lab run-aspace run-repl tell-who-is-away make-repl-environment

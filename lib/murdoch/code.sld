@@ -1,7 +1,5 @@
 ;;> Code that travels: sendable closures, abandoning a call, and the
 ;;> sandbox where received code runs.
-;;> Its members are each a library of their own in code/; this umbrella
-;;> exports what the families above use of them.
 
 (define-library (murdoch code)
   (export abandon-thread! forget-abandoned! abandoned? check-not-abandoned

@@ -1,7 +1,5 @@
 ;;> Publish/subscribe messaging (appendix A.8): subjects, requests and
 ;;> their promises, and the monitors (A.6, A.2).
-;;> Its members are each a library of their own in pubsub/; this umbrella
-;;> exports what the families above use of them.
 
 (define-library (murdoch pubsub)
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!

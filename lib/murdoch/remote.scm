@@ -1,16 +1,11 @@
-;;;; Starting an address space, and the thesis's aux.scm helpers.
-;;
-;; The remote layer, bottom to top: the wire (frame.scm, the protocol and
-;; its message kinds), address spaces (aspace.scm), calls
-;; (connection.scm, worker.scm, call.scm), the lab's multicast group
-;; (group.scm), serving calls (serve.scm), proxies (proxy.scm) and
-;; delivery to the whole lab (delivery.scm).  This library starts them,
-;; in that order, and is what the layers above import.
+;;;; Starting an address space, and the thesis's aux.scm helpers.  The
+;;;; layer bottom to top: the wire, address spaces (remote/aspace.scm), calls
+;;;; (connection, worker, call), the group, serving, proxies and delivery;
+;;;; start-aspace! starts them in that order.
 
-;;> Makes this process the address space \var{uid} of \var{lab} (a lab
-;;> record, see read-lab), with \var{environment} as the environment that
-;;> received code runs in, and starts answering calls.  \var{port} may
-;;> override the lab's port for uid.
+;;> Makes this process the address space \var{uid} of \var{lab}, received
+;;> code running in \var{environment}, and starts answering calls;
+;;> \var{port} may override the lab's port for uid.
 (define (start-aspace! lab uid environment . port)
   (let ((entry (lab-aspace-by-uid lab uid)))
     (join-lab! lab uid
@@ -37,8 +32,7 @@
     ((var-ref uid var)
      (remote-apply (uid->aspace uid) (sendable-lambda () var)))))
 
-;;> Assigns \var{value} (evaluated here) to \var{var} in address space
-;;> \var{uid}.
+;;> Assigns \var{value} (evaluated here) to \var{var} in address space \var{uid}.
 (define-syntax var-set!
   (syntax-rules ()
     ((var-set! uid var value)

@@ -1,7 +1,5 @@
-;;> The remote layer as one import: address spaces, remote-run! and
-;;> remote-apply (thesis §3.3.2), their errors, proxies and delivery, and
-;;> start-aspace!, which starts them.  Each part is a library of its own;
-;;> see lib/murdoch/remote.scm for their order.
+;;> The remote layer as one import: address spaces, remote calls (thesis
+;;> §3.3.2), their errors, proxies, delivery, and start-aspace!.
 
 (define-library (murdoch remote)
   (export aspace? aspace-uid aspace-host aspace-port local-aspace

@@ -1,6 +1,4 @@
 ;;> The robot: the B14's primitives over trip.
-;;> Its members are each a library of their own in robot/; this umbrella
-;;> exports what the families above use of them.
 
 (define-library (murdoch robot)
   (export trip-timeout trip-motion-timeout trip-connect set-current-robot!

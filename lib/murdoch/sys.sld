@@ -1,7 +1,5 @@
 ;;> The process: green threads over ppoll, the heap guard, the process's
-;;> name and the signal it ends by when its parent does, one-line logs,
-;;> and one clock and one way to wait.
-;;> Its members are each a library of their own in sys/; this umbrella
+;;> name and death signal, one-line logs, one clock and one way to wait.
 ;;> exports what the families above use of them.
 
 (define-library (murdoch sys)

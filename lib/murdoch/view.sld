@@ -1,7 +1,5 @@
-;;> The live view: a page on localhost that draws the lab as it runs --
-;;> the room, the robots, their paths and sonar, the tasks -- and replays
-;;> a finished run from the trace it wrote.  \scheme{murdoch lab LAB
-;;> --view}, \scheme{murdoch view} and \scheme{murdoch replay}.
+;;> The live view: a page on localhost that draws the lab as it runs and
+;;> replays a finished run from its trace (\scheme{murdoch view}, \scheme{murdoch replay}).
 (define-library (murdoch view)
   (export run-view run-replay
           ;; the parts, for tests

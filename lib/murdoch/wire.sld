@@ -1,7 +1,5 @@
 ;;> The wire: remote errors, netstrings and the nesting scan, HMAC,
 ;;> multicast sockets, connecting with a timeout, and frames.
-;;> Its members are each a library of their own in wire/; this umbrella
-;;> exports what the families above use of them.
 
 (define-library (murdoch wire)
   (export open-connection socket-port make-message message-id check-message

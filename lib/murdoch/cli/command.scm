@@ -1,18 +1,12 @@
 ;;;; bin/murdoch: start address spaces, join a lab at a REPL.
 
 ;;> Makes this process address space \var{uid} of the lab at
-;;> \var{lab-file}, or of \var{lab} when it is already read, and starts
-;;> serving with its subscriptions and monitors; answers the environment
-;;> received code runs in.
+;;> \var{lab-file}, serving; answers the received-code environment.
 (define (join-lab lab-file uid . port)
   (join-read-lab (read-lab lab-file) uid port))
 
-;; A process in a lab writes to peers that may die at any moment: a
-;; caller killed before its answer went back, a browser that closed the
-;; view.  Writing to a socket whose peer has gone raises SIGPIPE, and its
-;; default action ends the process without a word, so it is ignored, as
-;; the simulator ignores it (sim/b14.c): the peer's end shows as the end
-;; of its connection instead, to whoever reads it.
+;; SIGPIPE is ignored, as by the simulator: a peer may die at any moment,
+;; and its end is seen by the connection's reader, not this process's death.
 (define (join-read-lab lab uid port)
   (set-signal-action! signal/pipe #f)
   (take-tunables! lab)
@@ -24,9 +18,7 @@
     (offer-on-joining!)
     env))
 
-;; The settings that are the values of parameters, or of the thesis's
-;; globals, of the layers above the lab: each takes the lab's value here,
-;; before anything runs.  Their defaults are the lab's table's.
+;; The settings that are the layers' parameters or globals, set before anything runs.
 (define tunables
   `((task-timeout . ,task-timeout) (trip-timeout . ,trip-timeout)
     (trip-motion-timeout . ,trip-motion-timeout)
@@ -37,10 +29,8 @@
 (define (take-tunables! lab)
   (for-each (lambda (t) ((cdr t) (lab-setting lab (car t)))) tunables))
 
-;; A robot's address space drives its robot through trip, at the port the
-;; lab gives it; a workstation answers safe-reckon from its lab position.
-;; The lab starts the simulator, and waits until it listens, before any
-;; address space: one attempt is enough, and a failed one says why.
+;; A robot drives its robot through trip; a workstation answers safe-reckon
+;; from its position.  The simulator is up first, so one try is enough.
 (define (take-body! lab entry)
   (cond
    ((lab-aspace-clause entry 'robot)
@@ -62,8 +52,7 @@
   (set-process-name! (string-append "murdoch-" (symbol->string uid)))
   (join-lab lab-file uid)
   ;; After the join, not at the fork: the kernel will not collapse pages
-  ;; still shared with the loader, and the join's collections have made
-  ;; them this process's own (heap-watch.c).
+  ;; still shared with the loader (sys/heap-watch.c).
   (heap-on-huge-pages!)
   (start-heap-guard!
    (lab-setting (current-lab) 'heap-max)
@@ -73,9 +62,7 @@
             (aspace-port (local-aspace)))
   (let wait () (thread-sleep! 3600) (wait)))
 
-;;> Warns of the lab's address spaces that do not answer: a guest that
-;;> joins before the lab is up, or on another port base, would otherwise
-;;> find out only from tasks that nobody takes.
+;;> Warns of the lab's address spaces that do not answer (a guest too early?).
 (define (tell-who-is-away lab)
   (let* ((others (remove (lambda (uid) (eq? uid (local-aspace-uid)))
                          (map lab-aspace-uid (lab-aspaces lab))))
@@ -103,15 +90,13 @@
                                  " Ctrl-D leaves\n"))
     (tell-who-is-away lab)
     (set-remote-timeout! (lab-setting lab 'repl-timeout))
-    ;; (chibi repl) is loaded here, not imported: it costs seconds, and
-    ;; only a person at a REPL needs it.
+    ;; (chibi repl) is loaded, not imported: it costs seconds.
     ((eval 'repl (environment '(chibi repl)))
           'in: (waiting-input-port)
           'environment: (with-help (make-repl-environment lab lab-env))
           'eval: eval-with-hints
           'raw?: (not (is-a-tty? (current-input-port)))
-          ;; write, not (chibi repl)'s write/ss: labels for cycles only,
-          ;; so a value met twice (task-status's outcomes) reads as itself.
+          ;; write, not write/ss, so a value met twice reads as itself.
           'printer: (lambda (value out) (write value out))
           'make-prompt: (lambda (module)
                           (string-append (symbol->string uid) "> ")))
@@ -138,12 +123,7 @@ docs/tutorial.md walks through these; docs/reference.md has every procedure.
 ")
 
 ;; Standard input, read so that the REPL's wait for a line lets the other
-;; threads run: they serve the lab's calls to this peer, and a task's
-;; components that Ctrl-C gave up.  A read of descriptor 0 would stop the
-;; whole process until a line came.  Its own description of the same file,
-;; not descriptor 0's, is made non-blocking, so that the shell's is left
-;; as it was.  Standard input that cannot be opened again (a socket) is
-;; read as it is.
+;; threads run: its own file description made non-blocking, not the shell's.
 (define (waiting-input-port)
   (let ((fd (guard (e (#t #f))
               (open "/proc/self/fd/0" (bitwise-ior open/read open/non-block)))))

@@ -1,25 +1,11 @@
-;;;; Hints: the REPL's eval, for a person who typed something wrong.
-;;
-;; Chibi reports an error with the line of the file it was raised in:
-;; a wrong number of arguments to remote-apply shows a line of init-7.scm,
-;; a var-ref without its quote a line of remote.scm.  Neither is where the
-;; person went wrong.  Three mistakes come first at Murdoch's REPL, and get
-;; a hint:
-;;   - code sent elsewhere names something defined at the REPL, which the
-;;     receiver does not have (it sees (murdoch) and the lab's code);
-;;   - a value that cannot travel (a port, a mutex) is sent;
-;;   - a procedure is given the wrong number of arguments: said in words,
-;;     not as Chibi's "not enough args" with the procedure and a count;
-;;   - a name that is not defined, or a uid that is not the lab's: said in
-;;     one line, with the nearest name or uid, not as (chibi repl)'s search
-;;     of every module for it;
-;;   - a call that timed out: the procedure may still run there, and a
-;;     loop that never calls out cannot be stopped (docs/architecture.md,
-;;     "Waiting and giving up").
+;;;; Hints: the REPL's eval, for a person who typed something wrong.  Chibi
+;;;; names the line an error was raised at, in its files or ours, not where
+;;;; the person went wrong.  A hint for: code naming a REPL definition, a
+;;;; value that cannot travel, a wrong number of arguments, an unknown name
+;;;; or uid, and a call that timed out (docs/architecture.md).
 
-;;> Evaluates \var{expr} in \var{env} as the REPL's eval: an error raised
-;;> in Murdoch's or Chibi's own files is raised again without that place,
-;;> and with a hint when one of the mistakes above caused it.
+;;> Evaluates \var{expr} in \var{env} as the REPL's eval, an error raised
+;;> again without Chibi's or Murdoch's place, with a hint.
 (define (eval-with-hints expr env)
   (guard (e ((and (exception? e) (arity-error? e)) (raise (arity-recast e)))
             ((and (exception? e) (undefined-variable e))
@@ -37,8 +23,7 @@
              (or (string-contains (car source) "/lib/murdoch/")
                  (string-contains (car source) "/chibi/"))))))
 
-;; e again, with no procedure or file, and hint, when there is one, after
-;; its message.
+;; e again, with no procedure or file, and hint after its message.
 (define (recast e hint)
   (make-exception (exception-kind e)
                   (if hint
@@ -60,7 +45,6 @@
     => (lambda (name) (and (defined-here? name env) (definition-hint name e))))
    (else #f)))
 
-;; NAME of Chibi's error "undefined variable" NAME, or #f.
 (define (undefined-variable e)
   (and (equal? (error-object-message e) "undefined variable")
        (pair? (error-object-irritants e))
@@ -69,8 +53,7 @@
                ((identifier? name) (identifier->symbol name))
                (else #f)))))
 
-;; "troyy is not defined; did you mean 'troy, a uid?": the nearest name
-;; defined in env, or the nearest uid, quoted, for one typed unquoted.
+;; "troyy is not defined; did you mean 'troy, a uid?"
 (define (undefined-recast name env)
   (let* ((text (symbol->string name))
          (uids (map symbol->string (known-uids)))
@@ -103,7 +86,6 @@
                                  " (known-uids) lists those that are")
                   '() #f #f))
 
-;; The uid of the error "no address space of this uid is known" UID, or #f.
 (define (unknown-uid e)
   (and (equal? (error-object-message e) "no address space of this uid is known")
        (pair? (error-object-irritants e))
@@ -133,7 +115,6 @@
 (define (arguments n)
   (string-append (number->string n) (if (= n 1) " argument" " arguments")))
 
-;; NAME of the message "undefined variable NAME", or #f.
 (define (undefined-name message)
   (let ((prefix "undefined variable "))
     (and (string? message)

@@ -1,6 +1,5 @@
-;;> What the REPL adds to an error that a person's own mistake caused: the
-;;> error as the person's, not as the library's line where it surfaced,
-;;> and a hint for the mistakes a newcomer meets first.
+;;> What the REPL adds to an error a person's own mistake caused: the
+;;> error as theirs, and a hint for a newcomer's first mistakes.
 
 (define-library (murdoch cli hints)
   (export eval-with-hints)

@@ -1,23 +1,15 @@
 ;;;; Abandoned calls: a procedure stops when nobody waits for it any more.
-;;
-;; A caller that gives up on a remote-apply tells the callee (remote.scm,
-;; the abandon frame), and the callee marks the thread that runs the call.
-;; Chibi stops a thread from outside only at whatever instruction it has
-;; reached, which can leave a lock taken for good; so a marked thread stops
-;; itself, where it waits on something of Murdoch's: each robot command
-;; (robot/trip.scm) and each remote call (remote.scm) raises in it.  A
-;; procedure that calls neither runs to its end.  A thread in a long wait
-;; (a robot's motion) is woken when it is marked, by the procedure it gave
-;; with-wake-on-abandon, rather than look at its mark again and again.
+;;;; The callee marks the thread of an abandoned call; since Chibi stops a
+;;;; thread from outside wherever it is, maybe holding a lock, the thread
+;;;; stops itself at its next robot command or remote call, or is woken
+;;;; from a long wait by the procedure it gave with-wake-on-abandon.
 
-;; Global: a caller gives up from its connection's thread, and the mark
-;; is read in the thread it stops.
+;; Global: a caller gives up from its connection's thread, read in the marked one.
 (define *abandoned* '())                ; the marked threads
 (define *wakers* '())                   ; ((thread . wake) ...), innermost first
 (define *abandoned-lock* (make-mutex 'abandoned))
 
-;;> Marks \var{thread}: the call it runs has been given up by its caller.
-;;> A thread in with-wake-on-abandon is woken.
+;;> Marks \var{thread}, whose call its caller gave up; wakes it if need be.
 (define (abandon-thread! thread)
   (let ((waker (with-lock *abandoned-lock*
                  (lambda ()
@@ -26,10 +18,8 @@
                    (assq thread *wakers*)))))
     (if waker ((cdr waker)))))
 
-;;> Applies \var{thunk}, calling \var{wake} (from another thread, no
-;;> arguments) should the current thread be marked meanwhile: wake ends
-;;> thunk's wait, and thunk then calls check-not-abandoned.  So that no mark
-;;> is missed, thunk checks after wake is in place.
+;;> Applies \var{thunk}, calling \var{wake} from another thread should this
+;;> one be marked meanwhile; thunk checks its mark after wake is in place.
 (define (with-wake-on-abandon wake thunk)
   (let ((waker (cons (current-thread) wake)))
     (dynamic-wind
@@ -49,8 +39,7 @@
 (define (abandoned?)
   (and (pair? *abandoned*) (memq (current-thread) *abandoned*) #t))
 
-;;> Raises, in a thread marked abandoned, an error saying that \var{who}
-;;> was not done because the caller gave up.
+;;> Raises, in a thread marked abandoned, an error saying \var{who} was not done.
 (define (check-not-abandoned who)
   (if (abandoned?)
       (raise (make-exception 'abandoned
@@ -61,8 +50,7 @@
 (define (abandoned-error? e)
   (and (exception? e) (eq? (exception-kind e) 'abandoned)))
 
-;;> Runs \var{thunk} unmarked, then marks the thread again if it was: to
-;;> tidy up on the way out of an abandoned call, e.g. stop the robot.
+;;> Runs \var{thunk} unmarked, then marks the thread again if it was: to tidy up.
 (define (despite-abandonment thunk)
   (if (abandoned?)
       (let ((me (current-thread)))

@@ -1,14 +1,5 @@
-;;;; The sandbox: where received code runs.
-;;
-;; It is the safety boundary of an address space: a peer that holds the
-;; lab's key can run anything this sandbox allows, and nothing more.
-;;
-;; docs/security.md says what it allows; here, each rule where it is
-;; kept: the environment (sandbox-libraries), imports that cannot be
-;; assigned (Assignment), a serving thread received code cannot end
-;; (make-guarded-thread), each call's own ports and parameters
-;; (sandbox-parameter!), sized constructors under max-alloc, and threads
-;; that say in one line of the log that they died (make-logged-thread).
+;;;; The sandbox: where received code runs, the address space's safety
+;;;; boundary (docs/security.md); each of its rules is kept here.
 
 (define sandbox-libraries
   '((except (scheme base) lambda define set! make-vector make-string
@@ -31,14 +22,11 @@
 
 ;;; Assignment
 
-;; The environments whose imports are guarded: their parents hold the
-;; imported cells (a mutable environment's own frame holds what is
-;; defined in it).  Global: guarded-set! reads it as code is compiled.
+;; Global, read by guarded-set! as code compiles: environments whose imports are guarded.
 (define *guarded* '())
 
-;;> Murdoch's set! inside the sandbox: an ordinary set! of a local
-;;> variable or of something the lab's code defined; an error, raised when
-;;> the code is compiled, for a binding imported from a library.
+;;> Murdoch's set! inside the sandbox: an error at compile time for a
+;;> binding imported from a library, else an ordinary set!.
 (define-syntax guarded-set!
   (lambda (expr use-env mac-env)
     (let ((target (and (pair? (cdr expr)) (cadr expr))))
@@ -56,8 +44,7 @@
 
 ;;; Threads
 
-;; The threads that serve calls: a reader, a worker, the multicast
-;; listener, the janitor.  Global: any layer's thread may be one.
+;; Global, as any layer's thread may serve calls.
 (define *protected* (make-hash-table eq?))
 (define *protected-lock* (make-mutex 'protected))
 
@@ -77,9 +64,8 @@
                                       (lambda () (protect! (current-thread) #f))))
                       name))
 
-;;> make-thread inside the sandbox: a thread that ends by raising says so
-;;> in one line of the log, naming the address space, the thread and the
-;;> error, and thread-join! raises the error as before.
+;;> make-thread inside the sandbox: a raise that ends the thread is logged
+;;> in one line, and thread-join! raises it as before.
 (define (make-logged-thread thunk . name)
   (apply make-thread
          (lambda ()
@@ -87,10 +73,8 @@
              (thunk)))
          name))
 
-;; Chibi writes a thread's uncaught error to the thread's current error
-;; port, as "ERROR in child thread: #<Context ...>" and a backtrace; the
-;; thread's last binding of that port is made a sink, so that the line
-;; logged here is the only one.
+;; Chibi writes a thread's uncaught error and backtrace to its error port,
+;; made a sink so the line logged here is the only one.
 (define (log-thread-death e)
   (parameterize ((current-error-port (process-port sandbox-err (current-error-port))))
     (log-warn "thread " (thread-label (current-thread)) " died: " (error-message e)))
@@ -105,10 +89,7 @@
 
 ;;; Allocation
 
-;; The sandbox of this process: the lab's max-alloc, read by
-;; make-lab-environment, and the process's ports that received code
-;; writes through to, given by set-sandbox-ports!.  Global: every call
-;; received runs in it.
+;; The lab's max-alloc and the process's ports received code writes to.
 (define-record-type sandbox
   (make-sandbox max-alloc out err)
   sandbox?
@@ -119,7 +100,6 @@
 ;; Global: the lab's max-alloc, for every call the process serves.
 (define *sandbox* #f)
 
-;; Refuses count items of unit bytes each, past the lab's max-alloc.
 (define (check-alloc! who count unit)
   (let ((most (and *sandbox* (sandbox-max-alloc *sandbox*))))
     (if (and most (real? count) (> (* count unit) most))
@@ -127,7 +107,6 @@
                               " would take more than the lab's max-alloc, "
                               (number->string most) " bytes")))))
 
-;; A constructor whose first argument is a count of unit bytes each.
 (define (sized who unit make)
   (lambda (count . rest)
     (check-alloc! who count unit)
@@ -157,8 +136,7 @@
             (check-alloc! "expt" (abs power) (/ (log digits 2) 8)))))
   (expt base power))
 
-;;> thread-terminate! inside the sandbox: for the threads received code
-;;> made, not for those that serve calls.
+;;> thread-terminate! inside the sandbox: not for the threads that serve calls.
 (define (guarded-thread-terminate! thread)
   (if (hash-table-ref/default *protected* thread #f)
       (error "thread-terminate!: this thread serves calls, and a call cannot end it"))
@@ -166,21 +144,16 @@
 
 ;;; Each call's own ports and parameters
 
-;;> Gives the ports that received code writes through to: the process's
-;;> standard output and error, taken at start-up, after
-;;> make-lab-environment.
+;;> Gives the process's standard output and error, for received code to write to.
 (define (set-sandbox-ports! out err)
   (sandbox-out-set! *sandbox* out)
   (sandbox-err-set! *sandbox* err))
 
-;; The process's port that received code writes through to, by
-;; which, sandbox-out or sandbox-err, else the current one.
+;; The process's port, by which (sandbox-out or sandbox-err), else current.
 (define (process-port which current)
   (or (and *sandbox* (which *sandbox*)) current))
 
-;; A port that writes through to port, and can be closed without closing
-;; it.  It holds what is written until it is flushed, as any port, and at
-;; the end of each call.
+;; A port that writes through to port, closable alone, flushed at each call's end.
 (define (through-port port)
   (make-custom-output-port
    (lambda (str start end)
@@ -188,10 +161,8 @@
      (flush-output-port port)
      (- end start))))
 
-;; The ports of the calls a thread runs, made again when a call closed
-;; one.  Kept as the thread's specific, in a record that received code
-;; cannot make, so that a worker's next call, from anyone, never writes
-;; to ports that a call before it chose.
+;; The ports of a thread's calls, its specific, in a record received code
+;; cannot make: a worker's next call never writes to an earlier one's ports.
 (define-record-type call-ports
   (make-call-ports in out err)
   call-ports?
@@ -217,22 +188,14 @@
 ;; Global: each layer adds its own as it loads (sandbox-parameter!).
 (define *parameters* '())
 
-;;> Gives each received call a binding of \var{parameter} of its own, so
-;;> that the call setting it sets nothing for the process: for a layer's
-;;> settings made as parameters, such as remote-timeout.
+;;> Gives each received call its own binding of \var{parameter}, such as
+;;> remote-timeout, so a call setting it sets nothing for the process.
 (define (sandbox-parameter! parameter)
   (set! *parameters* (cons parameter *parameters*)))
 
-;;> Applies \var{proc} to \var{args} as a received call runs: with ports
-;;> of its own, whose output reaches the process's when flushed and when
-;;> the call ends, and with its own bindings of the sandbox's parameters.
-;;> A call that raises leaves both to the handler around it, whose way out
-;;> (a guard's) gives the thread back the parameters it had when the
-;;> handler was entered, and which calls \scheme{flush-call-ports!}.
-;; What parameterize does, for a list of parameters known only when the
-;; process runs, without its dynamic-wind (docs/speed.md, What Chibi
-;; charges).  A binding is a pair in the
-;; thread's list of them, which setting the parameter changes.
+;;> Applies \var{proc} to \var{args} as a received call runs, with its own
+;;> ports and bindings of the sandbox's parameters; a raise leaves both to
+;;> the handler around it.  parameterize without dynamic-wind (docs/speed.md).
 (define (call-in-sandbox proc args)
   (sandboxed (thread-call-ports) (thread-parameters) proc args))
 
@@ -245,7 +208,6 @@
   (flush-ports p)
   value)
 
-;; The bindings of a call that runs with ports p, in front of outer.
 (define (call-bindings p outer)
   (fresh-bindings *parameters*
                   (cons (cons current-input-port (call-ports-in p))
@@ -253,24 +215,20 @@
                               (cons (cons current-error-port (call-ports-err p))
                                     outer)))))
 
-;; fresh-bindings, in C (call-bindings.c): each parameter's pair, in
-;; front of bindings.
+;; fresh-bindings is C (call-bindings.c).
 
 (define (flush-ports p)
   (flush-if-open (call-ports-out p))
   (flush-if-open (call-ports-err p)))
 
-;;> Flushes the ports of the calls this thread runs: for the handler of a
-;;> call that raised, so that what it wrote reaches the process's output.
+;;> Flushes the ports of this thread's calls, for the handler of one that raised.
 (define (flush-call-ports!)
   (let ((p (thread-specific (current-thread))))
     (if (call-ports? p) (flush-ports p))))
 
 ;;; Making the environments
 
-;;> A fresh environment for received code, with the lab's code files
-;;> loaded.  Each file is read here and evaluated in the environment, so
-;;> the files themselves can use no more than received code can.
+;;> A fresh environment for received code, the lab's code files evaluated in it.
 (define (make-lab-environment lab)
   (set! *sandbox* (make-sandbox (lab-setting lab 'max-alloc) #f #f))
   (let ((env (apply mutable-environment sandbox-libraries)))
@@ -279,11 +237,8 @@
               (lab-code-files lab))
     env))
 
-;;> Raises for the first name that the lab's code files use but neither
-;;> define nor import, naming the file and the line of the first form
-;;> that uses it, and the nearest defined name: a typo in a procedure's
-;;> body, which loading lets pass, would otherwise show only when a robot
-;;> runs it.  \var{env} is the lab's environment, made from \var{lab}.
+;;> Raises for the first name the lab's code files use but neither define
+;;> nor import, naming file, line and nearest name, lest a robot find it.
 (define (check-lab-code lab env)
   (let ((undefined (undefined-names env)))
     (if (pair? undefined)
@@ -301,8 +256,7 @@
                                               " is used but not defined"
                                               (nearest-defined name env)))))))
 
-;; The names that code compiled in env refers to and nothing defines, as
-;; Chibi's own warn-undefs finds them, which writes them as warnings.
+;; The names that code compiled in env refers to and nothing defines.
 (define (undefined-names env)
   (let ((out (open-output-string)))
     (parameterize ((current-error-port out))
@@ -336,8 +290,7 @@
   (let loop ((env env) (acc '()))
     (if env (loop (env-parent env) (append (env-exports env) acc)) acc)))
 
-;;> The string of \var{names} nearest \var{text}, at most two edits away
-;;> and less than half of it, or #f: for "did you mean".
+;;> The string of \var{names} nearest \var{text} (two edits, under half), or #f.
 (define (nearest-name text names)
   (let ((near (find-nearest-edits text names)))
     (and (pair? near)
@@ -349,9 +302,8 @@
 (define (lab-code-files lab)
   (lab-setting lab 'code))
 
-;;> An environment for a person at a REPL: everything Chibi has, Murdoch,
-;;> and the very procedures the lab's code defined in \var{lab-env}, so
-;;> that they travel by name.
+;;> An environment for a person at a REPL: all of Chibi, Murdoch, and
+;;> \var{lab-env}'s own procedures, so they travel by name.
 (define (make-repl-environment lab lab-env)
   (let ((env (mutable-environment '(except (scheme base) lambda define)
                           '(scheme char) '(scheme cxr) '(scheme inexact)
@@ -370,15 +322,12 @@
 (define (read-forms file)
   (map car (car (read-source file))))
 
-;; Evaluates each form of file in env, as a load would; an error, in
-;; reading or in evaluating, names the file and the line of its form.
+;; Evaluates each form of file in env; an error names the file and line.
 (define (load-into file env)
   (for-each (lambda (entry) (at-form-line file entry (lambda () (eval (car entry) env))))
             (car (read-source file))))
 
-;;> (thunk), where an error it raises is raised again as one line that
-;;> names \var{file} and the line of \var{entry}, a (FORM . LINE) of
-;;> read-source: for the forms of a lab's code file or a task file.
+;;> (thunk), its error raised again naming \var{file} and \var{entry}'s line.
 (define (at-form-line file entry thunk)
   (guard (e ((error-object? e) (error (form-line-text file entry (error-line e)))))
     (thunk)))
@@ -386,7 +335,6 @@
 (define (form-line-text file entry text)
   (string-append file ":" (number->string (cdr entry)) ": " text))
 
-;; An error's message and irritants, on one line.
 (define (error-line e)
   (let ((text (error-message e)))
     (if (> (string-length text) 200)

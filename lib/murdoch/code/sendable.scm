@@ -1,28 +1,18 @@
 ;;;; Sendable procedures: closures that travel as S-expressions.
 ;;
-;; Kali-Scheme copied closures between address spaces frame by frame.
-;; Chibi keeps no source for a compiled lambda, so Murdoch's own `lambda`
-;; keeps it: it compiles the ordinary lambda and lets the closure carry a
-;; `sendable-info` holding the lambda's source and a thunk that answers the
-;; current values of the local variables the body mentions.  Globals are
-;; not captured: they are looked up by name where the closure lands, which
-;; is what the thesis's var-ref relies on.
-;;
-;; A value travels as an S-expression written with `write`.  Data stands
-;; for itself; what `read` cannot rebuild is a tagged vector:
-;;
-;;   #(murdoch:global NAME)             a procedure bound to NAME in the
-;;                                      environment received code runs in
+;; Chibi keeps no source for a compiled lambda, so Murdoch's `lambda`
+;; does: its closure carries a `sendable-info` with the source and a thunk
+;; that answers the local variables the body mentions.  Globals are looked
+;; up by name where the closure lands, as the thesis's var-ref relies on.
+;; A value travels written with `write`; data stands for itself, and what
+;; `read` cannot rebuild is a tagged vector:
+;;   #(murdoch:global NAME)             a procedure bound to NAME where it lands
 ;;   #(murdoch:closure SOURCE ((NAME . VALUE) ...))
 ;;   #(murdoch:proxy UID ID)            a procedure made by encap
-;;   #(murdoch:made NAME ARG ...)       a procedure that (NAME ARG ...) made,
-;;                                      NAME bound where it lands (made-by!)
-;;   #(murdoch:vector ELEMENT ...)      a vector (vectors are encoded too,
-;;                                      so a user's vector is never a tag)
+;;   #(murdoch:made NAME ARG ...)       what (NAME ARG ...) made (made-by!)
+;;   #(murdoch:vector ELEMENT ...)      a vector, so a user's is never a tag
 ;;   #(murdoch:void) #(murdoch:eof)
-;;
-;; Anything else (a port, a thread, a mutex, a record) stops at the sender
-;; with an error that names the variable or argument that held it.
+;; Anything else (a port, a record) stops at the sender, naming what held it.
 
 (define-record-type sendable-info
   (make-sendable-info source+names values)
@@ -36,8 +26,7 @@
   (uid proxy-ref-uid)
   (id proxy-ref-id))
 
-;;> Raised when a value cannot travel: an error object whose message
-;;> names what held it.
+;;> Raised when a value cannot travel, naming what held it.
 (define (send-fail . parts)
   (raise (make-exception 'send-error (apply string-append parts) '() #f #f)))
 
@@ -46,9 +35,7 @@
 
 ;;; The lambda that keeps its source
 
-;; Every symbol of the body outside quote: a superset of the variables it
-;; references.  Over-approximating costs at most a captured value; a
-;; variable missed would be wrong.
+;; Every symbol of the body outside quote: a superset of its variables.
 (define (body-symbols body)
   (let walk ((x body) (acc '()))
     (cond
@@ -60,8 +47,7 @@
       (if (memq x acc) acc (cons x acc)))
      (else acc))))
 
-;; A variable is local when the innermost binding the expander sees for it
-;; is a lambda's parameter; Chibi marks those cells with the lambda.
+;; Local when the expander's innermost binding is a lambda's parameter.
 (define (local-variable? id env)
   (let ((cell (env-cell env id)))
     (and cell (lambda? (cdr cell)))))
@@ -73,9 +59,7 @@
                          (body-symbols body)))
          (r (lambda (name) (make-syntactic-closure mac-env '() name)))
          (info (r 'info)))
-    ;; What the macro brings is closed in its own environment; the user's
-    ;; formals and body are left as they came, so that they mean what they
-    ;; mean where the lambda is written, globals defined later included.
+    ;; The user's formals and body mean what they mean where it is written.
     `(,(r 'let) ((,info (,(r 'make-sendable-info)
                          (,(r 'quote)
                           ,(cons `(lambda ,@(strip-syntactic-closures (cdr expr)))
@@ -86,14 +70,12 @@
         ;; closure-info finds it; Chibi drops a reference with no use.
         (,(r 'if) ,info (,(r 'let) () ,@body) #f)))))
 
-;;> Murdoch's \scheme{lambda}: an ordinary lambda whose closures can be
-;;> sent to another address space.
+;;> Murdoch's \scheme{lambda}: an ordinary lambda whose closures can travel.
 (define-syntax sendable-lambda
   (lambda (expr use-env mac-env)
     (expand-sendable-lambda expr use-env mac-env)))
 
-;;> Murdoch's \scheme{define}: as usual, but a procedure it defines is made
-;;> by the sendable lambda and carries its name.
+;;> Murdoch's \scheme{define}: as usual, a procedure made by the sendable lambda.
 (define-syntax sendable-define
   (er-macro-transformer
    (lambda (expr rename compare)
@@ -124,8 +106,7 @@
 
 ;;; Proxies
 
-;; A proxy is a closure of this one lambda over a proxy-ref: encoding
-;; recognises it by its code, so no table of proxies is needed.
+;; A proxy is a closure of this one lambda, recognised by its code.
 (define (make-proxy-procedure ref call)
   (lambda args (call ref args)))
 
@@ -165,37 +146,27 @@
         ((procedure? x) "a procedure made without Murdoch's lambda")
         (else (string-append "a " (symbol->string (type-name (type-of x)))))))
 
-;; What held a value, for an error message; made only when needed, since
-;; writing a closure's source costs more than sending it.
+;; What held a value, for an error; a thunk makes it only when needed.
 (define (what-string what) (if (procedure? what) (what) what))
 
 ;;; Limits
-;;
-;; A value from another address space is input: nested deep enough, its
-;; walk here would outgrow the stack, which ends the whole process in
-;; Chibi, not the call, and Chibi's writer silently cuts what nests deeper
-;; than 10,000 (so the lab's max-depth leaves room below that for a
-;; message's envelope); long enough, a list walked by recursion down its
-;; cdrs does the same, and a circular one never ends.  So every walk below
-;; goes down cdrs by iteration and counts its depth in cars and vectors,
-;; and encoding counts the pairs it meets: more than a frame could hold is
-;; an error, which a circular value reaches too.
+;; A value from another address space is input.  Deep nesting would
+;; outgrow Chibi's stack, which ends the process, and long or circular
+;; lists do too when walked by recursion: so walks go down cdrs by
+;; iteration counting depth, and encoding counts pairs, up to a frame's.
+;; (Chibi's writer cuts what nests past 10,000: max-depth stays below.)
 
-;; The limits of the lab this process joined, read once by
-;; set-value-limits!, since every pair walked reads them.  Global: every
-;; value sent or received is that lab's.
+;; The limits of the lab this process joined, read by set-value-limits!.
 (define-record-type value-limits
   (make-value-limits depth pairs)
   value-limits?
   (depth limits-depth)                  ; the lab's max-depth
   (pairs limits-pairs))                 ; a frame of max-frame bytes holds fewer
 
-;; Global: the lab's limits, for every value the process sends.
+;; Global: every value the process sends or receives is its lab's.
 (define *limits* #f)
 
-;;> Takes the limits of values from \var{lab}: the deepest nesting a value
-;;> may have, its max-depth, and the most pairs one may hold, half its
-;;> max-frame (a pair is written in two bytes or more).
+;;> Takes value limits from \var{lab}: max-depth, and max-frame / 2 pairs.
 (define (set-value-limits! lab)
   (set! *limits* (make-value-limits (lab-setting lab 'max-depth)
                                     (quotient (lab-setting lab 'max-frame) 2))))
@@ -205,8 +176,7 @@
       (send-fail (what-string what) " nests deeper than the lab's max-depth, "
                  (number->string (limits-depth *limits*)))))
 
-;; (map f ls) for a list that may be improper, by iteration: f takes each
-;; element, and the tail that is not a pair.
+;; (map f ls) by iteration, ls maybe improper: f gets its tail too.
 (define (map-elements f ls)
   (let loop ((x ls) (acc '()))
     (if (pair? x)
@@ -220,25 +190,18 @@
         (set-cdr! rev tail)
         (append-reverse! next rev))))
 
-;; True of data that stands for itself on the wire, pairs of it included:
-;; encode and decode give it back as it is instead of copying it
-;; (docs/speed.md).  The look (plain-within?,
-;; in plain.c, beside plain-atom?, the atoms that do) stops after a
-;; budget of pairs, or at the depth limit, so that a long, deep or
-;; circular value goes the general way, which says what is wrong with it.
+;; True of data that stands for itself, left uncopied (docs/speed.md);
+;; plain-within? (plain.c) gives up at a budget of pairs or the depth limit.
 (define (plain? x) (plain-within? x 100000 (limits-depth *limits*)))
 
-;;> The S-expression that stands for \var{x} on the wire.  \var{env} is the
-;;> environment whose procedures travel by name; \var{what} names \var{x}
-;;> in an error message (a string, or a thunk that makes one).
+;;> The S-expression that stands for \var{x} on the wire: \var{env}'s
+;;> procedures travel by name; \var{what} names \var{x} in errors.
 (define (encode x env what)
   (cond ((plain? x) x)
         ((and (procedure? x) (known-encoding x env)))
         (else (encode-compound x env what))))
 
-;; The walk's procedures are defined at the top, not inside
-;; encode-compound (docs/speed.md, What Chibi charges).  left is a
-;; one-element vector, the pairs the value may still hold.
+;; Defined at the top (docs/speed.md); left is a vector of the pairs yet allowed.
 (define (encode-compound x env what)
   (enc x env what 0 (make-vector 1 (limits-pairs *limits*))))
 
@@ -293,34 +256,24 @@
    (else (send-fail "cannot send " (what-string what) ": it is "
                     (describe p)))))
 
-;;> Answers \var{proc}, which \scheme{(name arg ...)} made: it travels
-;;> as that call, made again where it lands, where \var{name} is bound to
-;;> the same maker.  So a library's procedures that users pass on, such as
-;;> metrics, can travel though no Murdoch lambda made them.  At most
-;;> max-known are remembered, as the encodings below.
+;;> Answers \var{proc}, which \scheme{(name arg ...)} made: it travels as
+;;> that call, \var{name} bound to the same maker where it lands.
 (define (made-by! proc name . args)
   (if (>= (hash-table-size *made*) max-known)
       (set! *made* (make-hash-table eq?)))
   (hash-table-set! *made* proc (cons name args))
   proc)
 
+;; Global: a procedure's maker is the same for every thread.
 (define *made* (make-hash-table eq?))   ; procedure -> (NAME ARG ...)
 
-;; The encodings of procedures that do not change: a global's, kept by
-;; the procedure while its name is bound to it, and a closure's that
-;; captures no variable, kept by its source (the quoted list the lambda
-;; carries, the same object however often the lambda is evaluated; one
-;; bound to a global name after it was first sent still goes as its
-;; source, which means the same there).  The same procedures are sent
-;; again and again: a request's, and its user's closure, made afresh for
-;; each request; so they are kept by name, not by closure (docs/speed.md).
-;; At most max-known
-;; are kept, so that a program that sends ever new globals is let go.
-;; Global: a cache for every thread.
+;; Global, a cache for every thread: encodings of procedures that do not
+;; change, a global's by name while bound, a capture-free closure's by its
+;; source (docs/speed.md); max-known of them, so new globals are let go.
 (define max-known 512)
 (define *known* (make-hash-table eq?))  ; procedure or source -> (env cell . code)
 
-;; hash-table-cell, and no let: docs/speed.md, What Chibi charges.
+;; hash-table-cell, and no let (docs/speed.md).
 (define (known-encoding p env)
   (or (known-code (hash-table-cell *known* p #f) p env)
       (known-source-code (capture-free-source p) env)))
@@ -328,8 +281,7 @@
 (define (known-source-code source env)
   (and source (known-code (hash-table-cell *known* source #f) #f env)))
 
-;; The code of entry, (key . (env cell . code)), if it is still p's in
-;; env: a global's cell still holds p; a closure's cell is #f.
+;; The code of entry, (key . (env cell . code)), if still p's in env.
 (define (known-code entry p env)
   (and entry
        (eq? (cadr entry) env)
@@ -351,15 +303,13 @@
   (hash-table-set! *known* key (cons env (cons cell code)))
   code)
 
-;; A captured value is written inside the closure's vector, its list of
-;; bindings and its binding: three levels down.
+;; A captured value is written three levels down.
 (define (enc-closure info env depth left)
   (let ((source+names (sendable-info-source+names info)))
     (vector 'murdoch:closure (car source+names)
             (enc-bindings (car source+names) (cdr source+names)
                           ((sendable-info-values info)) env (+ depth 3) left))))
 
-;; ((NAME . VALUE) ...) of a closure's captured variables.
 (define (enc-bindings source names values env depth left)
   (if (null? names)
       '()
@@ -371,8 +321,7 @@
                        depth left))
             (enc-bindings source (cdr names) (cdr values) env depth left))))
 
-;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters,
-;;> ending in "...", when it is longer: for messages and progress lines.
+;;> \var{x} as \scheme{write} writes it, cut to \var{width} characters with "...".
 (define (abridged x width)
   (let ((s (let ((out (open-output-string)))
              (write x out)
@@ -383,18 +332,13 @@
 
 ;;; Decoding
 
-;; Compiling a closure's source is the dear part of decoding, and the same
-;; closure is sent again and again, so makers are kept by source.  A peer
-;; could send sources without end, so the table is emptied when it holds
-;; max-makers: a program sends far fewer lambdas than that.  The table
-;; compares keys with Chibi's own equal? (docs/speed.md); a source nests
-;; no deeper than max-depth, below where it stops looking.
+;; Makers kept by source, as compiling is decoding's dear part; emptied at
+;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
 
 (define (make-closure-compiler env)
   (let ((makers (make-hash-table chibi-equal?)))
-    ;; See known-encoding for hash-table-cell, and for passing entry on
-    ;; instead of binding it in a let.
+    ;; See known-encoding.
     (define (maker entry key)
       (if entry (cdr entry) (compile! key)))
     (define (compile! key)
@@ -407,14 +351,9 @@
       (let ((key (cons source names)))
         (maker (hash-table-cell makers key #f) key)))))
 
-;;> Returns a procedure that rebuilds values encoded by \scheme{encode}:
-;;> globals and closure sources are resolved in \var{env}, and proxies
-;;> are made by \var{proxy}, a procedure of a uid and an id.  The value
-;;> given is rebuilt where it lies: it is one that the reader has just
-;;> made from a frame, for this decoding alone.
-;; Rebuilding in place, each tagged element put in the pair that held it,
-;; saves copying the lists around it, most of decoding a request's
-;; arguments beside its closure.
+;;> Returns a procedure that rebuilds values encoded by \scheme{encode},
+;;> resolving globals and sources in \var{env} and proxies by \var{proxy};
+;;> in place, so the value must be fresh from a frame.
 (define (make-decoder env proxy)
   (let ((compile (make-closure-compiler env)))
     (define (dec x depth)
@@ -424,8 +363,7 @@
                   x)
        ((not (vector? x)) x)
        (else (dec-tagged x depth))))
-    ;; By iteration down the cdrs, and the tail that is not a pair.  No
-    ;; let here or below: see known-encoding.
+    ;; By iteration down the cdrs; no let (see known-encoding).
     (define (dec-elements! p depth)
       (if (or (pair? (car p)) (vector? (car p)))
           (set-car! p (dec (car p) depth)))

@@ -1,9 +1,6 @@
-;;;; Within aspace, robot, world, simulator and b14, part of (murdoch
-;;;; lab): what each clause may hold.
-
-;; What each may hold, as the address spaces and sim/lab.c read it: for
-;; each name, a reader of the clause's values, the list after its name;
-;; a robot's values are clauses of their own, in a table.
+;;;; Within aspace, robot, world, simulator and b14, part of (murdoch lab):
+;;;; what each clause may hold, as the address spaces and sim/lab.c read
+;;;; it: a reader for each name's values, a robot's in a table of their own.
 
 (define (values-of n check what)
   (make-reader (lambda (xs) (and (= (length xs) n) (every check xs))) what))
@@ -101,7 +98,6 @@
     (max-frame . ,(values-of 1 (lambda (x) (and (exact-integer? x) (<= 64 x 65536)))
                               "a whole number from 64 to 65536"))))
 
-;; Each of the items of clause c against table.
 (define (check-within path c items table)
   (for-each (lambda (item) (check-item path c item table)) items))
 
@@ -123,7 +119,6 @@
                     (string-append "no such clause in " (symbol->string (car outer))
                                    (did-you-mean (car item) (map car table)))))))
 
-;; A top-level clause that holds clauses of its own.
 (define (check-inside path c)
   (case (car c)
     ((aspace)

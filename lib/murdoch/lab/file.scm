@@ -1,7 +1,5 @@
-;;;; The lab file (docs/lab-file.md): who is in the lab and where.
-;;
-;; Every peer reads the same file, so the lab needs no registry: a uid
-;; names an address space, and the file says where it listens.
+;;;; The lab file (docs/lab-file.md): who is in the lab and where.  Every
+;;;; peer reads the same file, so the lab needs no registry.
 
 (define-record-type lab
   (make-lab name directory settings aspaces clauses)
@@ -17,14 +15,12 @@
 (define (lab-robot-radius lab)
   (robot-radius (lab-clauses lab)))
 
-;;> The lab file's top-level clause \scheme{(key ...)}, such as its
-;;> \scheme{world}, or #f.
+;;> The lab file's top-level clause \scheme{(key ...)}, or #f.
 (define (lab-clause lab key)
   (clause key (lab-clauses lab)))
 
-;;> One address space of the lab file.  \var{clauses} keeps the clauses that
-;;> later layers read (robot, position, capabilities, load); \var{form} is
-;;> its whole (aspace NAME ...) clause, for errors to name with its line.
+;;> One address space of the lab file: \var{clauses}, those later layers
+;;> read, and \var{form}, its whole clause, for errors to name its line.
 (define-record-type lab-aspace
   (make-lab-aspace uid index host port clauses form)
   lab-aspace?
@@ -41,6 +37,7 @@
 (define (clause-value key clauses default)
   (cond ((clause key clauses) => cadr) (else default)))
 
+;;> The clause \scheme{(key ...)} of an address space, or #f.
 (define (lab-aspace-clause a key)
   (clause key (lab-aspace-clauses a)))
 
@@ -48,9 +45,8 @@
 (define (lab-port-base lab)
   (settings-port-base (lab-settings lab)))
 
-;;> The port plan: what listens at port-base + offset, the offset plus
-;;> its index in the file for an address space or a robot.  sim/lab.c
-;;> gives a trip server the same port.
+;;> The port plan: what listens at port-base + offset (+ its index for an
+;;> address space or a robot); sim/lab.c gives trip servers the same.
 (define port-plan
   '((aspace . 0)                        ; address space i
     (trip . 100)                        ; robot i's trip server
@@ -60,9 +56,8 @@
     (face-trip . 150)))                 ; robot i's B14 behind its ROS 2 face,
                                         ; when MURDOCH_ROS2=1 (docs/ros2.md)
 
-;;> The port of \var{what} in the port plan (\scheme{aspace}, \scheme{trip},
-;;> \scheme{face-trip}, \scheme{view-peer}, \scheme{view} or \scheme{multicast}) from port base
-;;> \var{base}, and \var{index} for an address space's or a robot's.
+;;> The port of \var{what} in the port plan from port base \var{base}, and
+;;> \var{index} for an address space's or a robot's.
 (define (planned-port base what . index)
   (+ base (cdr (assq what port-plan)) (if (pair? index) (car index) 0)))
 
@@ -70,8 +65,7 @@
 (define (lab-planned-port lab what . index)
   (apply planned-port (lab-port-base lab) what index))
 
-;;> The port base where no lab file is read (murdoch replay):
-;;> MURDOCH_PORT_BASE, else port-base's default.
+;;> The port base where no lab file is read (murdoch replay).
 (define (unread-lab-port-base)
   (settings-port-base
    (list (cons 'port-base (setting-default (setting-named 'port-base))))))
@@ -80,13 +74,11 @@
   (cond ((get-environment-variable "MURDOCH_PORT_BASE") => string->number)
         (else (cdr (assq 'port-base settings)))))
 
-;;> The port for a guest, an address space the file does not name (a REPL
-;;> that joins the lab): 0, a free one that the kernel chooses, which the
-;;> guest says in its hellos; ports derived from process ids clashed.
+;;> A guest's port: 0, a free one the kernel chooses, which the guest says
+;;> in its hellos (docs/architecture.md says why not one by process id).
 (define (lab-guest-port lab) 0)
 
-;;> Reads the lab file at \var{path}.  Errors name the file, the line and
-;;> the fault.
+;;> Reads the lab file at \var{path}; errors name the file, line and fault.
 (define (read-lab path)
   (let* ((source (read-source path))
          (data (car source)))
@@ -104,13 +96,6 @@
              (lab-file-error path (car (car data))
                              "a lab file holds one (lab NAME CLAUSE ...) form"))
             (else (parse-lab path (car (car data))))))))
-
-;;> The data of the Scheme file at \var{path} and where they are:
-;;> (((DATUM . LINE) ...) (LIST . LINE) ...), every list within by eq?.
-;;> The end of the file inside a list is an error that names the list
-;;> most likely left open: the first whose column a later line starts at
-;;> or left of, as when a clause lacks its ), or else the innermost.
-;;> Lists are read here, for their lines; other data with read.
 
 (define (parse-lab path form)
   (let* ((clauses (cddr form))
@@ -131,9 +116,8 @@
     (check-room path clauses)
     lab))
 
-;; What no one clause shows: two address spaces of one name, two things
-;; on one port, a code file that is not there.  The one of two named is
-;; the later, with the line of the other.
+;; What no one clause shows: two address spaces of one name, two things on
+;; one port, a missing code file; the later of two is named.
 (define (check-lab path lab)
   (let loop ((as (lab-aspaces lab)))
     (when (pair? as)
@@ -189,7 +173,6 @@
                  '()))))
    (lab-aspaces lab)))
 
-;; form was checked by check-inside.
 (define (parse-aspace path form index base interface)
   (let ((clauses (cddr form)))
     (make-lab-aspace (cadr form) index
@@ -214,14 +197,12 @@
 (define (lab-aspace-by-uid lab uid)
   (find (lambda (a) (eq? (lab-aspace-uid a) uid)) (lab-aspaces lab)))
 
-;;> The port of the trip server of robot \var{a}: its (robot (trip-port N))
-;;> or port-base + 100 + its index.
+;;> The port of robot \var{a}'s trip server: its trip-port or port-base + 100 + index.
 (define (lab-trip-port lab a)
   (robot-setting a 'trip-port (lab-planned-port lab 'trip (lab-aspace-index a))))
 
-;;> The host of the trip server of robot \var{a}: its (robot (trip-host
-;;> "ADDR")), for a robot whose address space runs on another host than
-;;> the simulator, or else its address space's host.
+;;> The host of robot \var{a}'s trip server: its trip-host, when the
+;;> simulator runs elsewhere, else its address space's host.
 (define (lab-trip-host lab a)
   (robot-setting a 'trip-host (lab-aspace-host a)))
 

@@ -2,10 +2,9 @@
 
 (define key-bytes 32)
 
-;;> The lab's key as a bytevector, read from its key file.  When the file
-;;> does not exist it is made: written under a temporary name with mode
-;;> 0600 and linked into place, so that peers starting at once all end up
-;;> with the one key that won, and none reads a half-written file.
+;;> The lab's key as a bytevector, from its key file, made when missing:
+;;> written under a temporary name, mode 0600, and linked into place, so
+;;> peers starting at once all take the one that won, never half a file.
 (define (lab-key lab)
   (let ((file (lab-path lab (lab-setting lab 'key-file))))
     (if (not (file-exists? file))

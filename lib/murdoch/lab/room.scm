@@ -1,9 +1,7 @@
-;;;; The room, checked before anything starts: a robot placed inside a
-;;;; wall, or on another robot or a box, is a mistake that the simulator
-;;;; would undo without a word, by pushing the bodies apart; one outside
-;;;; the walls of a rectangular room would drive about outside it.  Of
-;;;; two robots on each other, the later in the file is named, as the
-;;;; one placed where the other stood.
+;;;; The room, checked before anything starts: a robot inside a wall, on
+;;;; another robot or a box, or outside a rectangular room's walls, which
+;;;; the simulator would fix or allow without a word.  Of two robots on
+;;;; each other, the later in the file is named.
 
 (define default-robot-radius 180)       ; sim/lab.c's B14
 (define default-wall-thickness 50)
@@ -35,8 +33,7 @@
                     before)
           (loop (cdr robots) (cons r before)))))))
 
-;; Whether point is outside the bounding box of walls that enclose it:
-;; a wall along each of its four sides.
+;; Whether point is outside the bounding box of walls enclosing it on four sides.
 (define (outside? point walls)
   (and (pair? walls)
        (let* ((ends (append (map wall-from walls) (map wall-to walls)))
@@ -59,8 +56,7 @@
                                        thing
                                        (clause-text thing))))))
 
-;; The world's walls or boxes (kind) in clauses, each with at least the
-;; numbers its fields below read.
+;; The world's walls or boxes (kind) in clauses, with the numbers read below.
 (define (world-items clauses kind)
   (let ((world (or (clause 'world clauses) '(world)))
         (n (if (eq? kind 'wall) 4 5)))
@@ -69,10 +65,8 @@
                              (every real? (cdr i))))
             (cdr world))))
 
-;;> The walls and the boxes of \var{lab}'s world, each the clause
-;;> (wall X1 Y1 X2 Y2 [THICK]) or (box X Y W D HEADING [MASS]), read by
-;;> wall-from, wall-to, wall-thickness, box-centre, box-width, box-depth
-;;> and box-heading.
+;;> The walls and the boxes of \var{lab}'s world, as clauses (wall X1 Y1 X2
+;;> Y2 [THICK]) and (box X Y W D HEADING [MASS]), read by the fields below.
 (define (lab-walls lab) (world-items (lab-clauses lab) 'wall))
 (define (lab-boxes lab) (world-items (lab-clauses lab) 'box))
 
@@ -84,7 +78,7 @@
            => cadr)
           (else default-robot-radius))))
 
-;; Where the robot of an address space clause stands: its pose's point.
+;; Where the robot of an address space clause stands.
 (define-record-type place
   (make-place aspace point)
   place?
@@ -93,7 +87,6 @@
 
 (define (place-uid p) (cadr (place-aspace p)))
 
-;; The place of an address space with a robot at a pose, or #f.
 (define (robot-place c)
   (and (pair? c) (eq? (car c) 'aspace) (list? c) (pair? (cdr c))
        (let* ((robot (clause 'robot (cddr c)))
@@ -135,7 +128,6 @@
          (y (- (cadr point) (cadr (box-centre b))))
          (hw (/ (box-width b) 2)) (hd (/ (box-depth b) 2))
          (a (* (box-heading b) (/ (acos -1) 180)))
-         ;; point in the box's frame
          (u (+ (* x (cos a)) (* y (sin a))))
          (v (- (* y (cos a)) (* x (sin a)))))
     (distance (list u v) (list (max (- hw) (min hw u)) (max (- hd) (min hd v))))))

@@ -1,10 +1,9 @@
 ;;;; The settings table, part of (murdoch lab): every setting a lab file
 ;;;; may give, its default and its reader, and how read-lab reads them.
 
-;; Every setting a lab file may give, in one table: its name, its
-;; default, and its reader.  Most take one value; code and delivery take
-;; the rest of their clause.  read-lab reads each once, and every place
-;; that needs one asks lab-setting.
+;; Every setting a lab file may give, in one table: name, default, reader.
+;; Most take one value; code and delivery the rest of their clause.
+;; read-lab reads each once; every user asks lab-setting.
 
 (define-record-type setting
   (make-setting name default reader)
@@ -13,8 +12,8 @@
   (default setting-default)
   (reader setting-reader))
 
-;; What a clause's value may be: read answers the value to use for what
-;; the file wrote, or #f when that will not do, and what says what will.
+;; What a clause's value may be: read answers the value for what the file
+;; wrote, or #f, and what says what will do.
 (define-record-type reader
   (make-reader read what)
   reader?
@@ -63,43 +62,37 @@
                  "an IPv4 address, in quotes"))
     (key-file "murdoch.key" ,(text "a file name, in quotes"))
     (max-frame 1048576 ,positive-count)
-    ;; Chibi's writer cuts what nests deeper than 10,000 (sendable.scm).
+    ;; Chibi's writer cuts what nests deeper than 10,000 (code/sendable.scm).
     (max-depth 4000 ,(whole-from 1 9000 "a whole number from 1 to 9000"))
     (timeout 5 ,seconds)
-    ;; At a REPL a person waits, and Ctrl-C gives a call up: a robot's
-    ;; motion there runs to its end (command.scm).
+    ;; At a REPL a person waits, and Ctrl-C gives a call up (cli/command.scm).
     (repl-timeout 600 ,seconds)
     (frame-timeout 5 ,seconds)
     (lease 30 ,seconds)
     (monitor-period 60 ,seconds)
-    ;; A started task's components and their poser hear from each other
-    ;; every heartbeat seconds (task/life-cycle.scm).
+    ;; How often a started task's components and poser hear from each other.
     (heartbeat 0.5 ,seconds)
     (max-attempts 3 ,positive-count)
-    ;; A detached task's results stay readable from any peer this many
-    ;; seconds after it ends (task/detached.scm).
+    ;; How long a detached task's results stay readable after it ends.
     (keep-results 3600 ,seconds)
-    ;; A started task that finds too few capable robots free waits for
-    ;; them or fails with not-enough-takers; its priority rises by aging
-    ;; a second while it waits; a poser keeps at most max-waiting such
-    ;; tasks (task/life-cycle.scm, docs/tasks.md).
+    ;; A task that finds too few robots free waits or fails; its priority
+    ;; rises by aging a second; a poser keeps max-waiting (docs/tasks.md).
     (when-robots-busy fail
                       ,(make-reader (lambda (x) (and (memq x '(fail wait)) x))
                                     "fail or wait"))
     (aging 0.1 ,rate)
     (max-waiting 100 ,positive-count)
-    ;; A poser's (tasks) keeps the newest tasks-kept of its tasks that are
-    ;; over, and forgets the others (task/record.scm).
+    ;; How many of a poser's tasks that are over (tasks) keeps.
     (tasks-kept 20 ,(whole-from 0 1000000 "a whole number, 0 or more"))
     (max-connections 256 ,positive-count)
     (max-connections-per-host 64 ,positive-count)
     (heap-max "512M" ,(make-reader size-bytes
                                    "bytes, or a size in quotes such as \"512M\""))
-    ;; Chibi grows its heap by twice one allocation (sandbox.scm).
+    ;; Chibi grows its heap by twice one allocation (code/sandbox.scm).
     (max-alloc "32M" ,(make-reader size-bytes
                                    "bytes, or a size in quotes such as \"32M\""))
-    ;; The defaults of parameters and globals of the layers above, which
-    ;; take the lab's values as an address space joins (cli/command.scm).
+    ;; Defaults of the layers' parameters and globals, set as an address
+    ;; space joins (cli/command.scm).
     (task-timeout 600 ,seconds)
     (trip-timeout 5 ,seconds)
     (trip-motion-timeout 120 ,seconds)
@@ -119,8 +112,7 @@
 (define settings-table
   (map (lambda (entry) (apply make-setting entry)) setting-entries))
 
-;; The clauses the simulator reads (docs/trip-protocol.md), and address
-;; spaces.
+;; The clauses the simulator reads (docs/trip-protocol.md), and aspace.
 (define other-clauses '(world simulator b14 aspace))
 
 (define multi-valued '(code delivery))

@@ -1,15 +1,14 @@
 ;;;; Reading a Scheme file with the lines of its lists, part of (murdoch
 ;;;; lab), and errors that name the file, the line and the clause.
 
-;; Where each list of the lab file being read starts: ((LIST . LINE) ...),
-;; by eq?, for its errors.
+;; The lines where the lists of the file being read start, ((LIST . LINE)
+;; ...) by eq?, for its errors: a parameter, as each read binds its own.
 (define clause-lines (make-parameter '()))
 
 (define (clause-line c)
   (cond ((assq c (clause-lines)) => cdr) (else #f)))
 
-;; An error that names the file, the line of clause c, c shortened to one
-;; line, and why.
+;; An error naming the file, the line of clause c, c on one line, and why.
 (define (lab-file-error path c why)
   (let ((line (clause-line c)))
     (error (string-append path (if line (string-append ":" (number->string line)) "")
@@ -23,12 +22,14 @@
         (string-append (substring text 0 56) " ...")
         text)))
 
-;;> The clause \scheme{(key ...)} of an address space, or #f.
-
 (define (line-words c)
   (cond ((clause-line c) => (lambda (n) (string-append " on line " (number->string n))))
         (else "")))
 
+;;> The data of the Scheme file at \var{path} and their lines: (((DATUM .
+;;> LINE) ...) (LIST . LINE) ...), lists by eq?.  A list left open is named
+;;> as the first whose column a later line starts at or left of, else the
+;;> innermost.
 (define (read-source path)
   (let ((in (guard (e ((file-error? e)
                         (error (string-append "cannot read " path

@@ -1,17 +1,9 @@
 ;;;; Publish/subscribe messaging (thesis §4.1, appendix A.8 publish.scm).
-;;
-;; Each address space keeps its own subscription list: the subjects it
-;; answers to, each free or reserved.  A message is addressed to a subject
-;; or a list of them and carries a procedure; it is sent to every live
-;; address space (the thesis's simulated broadcast), and an address space
-;; evaluates it only when every subject of the address is one of its
-;; subscriptions.
-;;
-;; Subjects are symbols; a dot makes levels (mobile.in_use).  In an
-;; address, * stands for one level and > for all the levels that follow,
-;; so mobile.* reaches mobile.in_use.  An exclusively reserved subject S is
-;; joined by S.in_use while it is held, so that a sender can see why S is
-;; not available, and request-status says who holds what.
+;;;; Each address space keeps its subscription list; a message, addressed
+;;;; to subjects, goes to every live address space, which evaluates it only
+;;;; when it subscribes to all of them.  A dot makes levels (mobile.in_use);
+;;;; in an address * is one level and > the rest.  A reserved subject S is
+;;;; joined by S.in_use while held, so a sender can see why S is taken.
 
 ;;; The subscription list
 
@@ -22,11 +14,8 @@
   (status subscription-status subscription-status-set!) ; (), task, shared
   (holds subscription-holds subscription-holds-set!))   ; live reservations
 
-;; The thesis's names (A.8), global as there.  Guarded by
-;; *subscriptions-lock*, as in the thesis: monitor threads change the
-;; list while messages read it.  The list itself is never
-;; changed, only replaced (add-subscription!, remove-subscription!), so
-;; that addressed-here?, on every message, can read it without the lock.
+;; The thesis's names (A.8), global as there, under the lock as monitors
+;; change the list; replaced, never changed, so addressed-here? needs no lock.
 (define *subscriptions* '())
 (define *subscriptions-lock* (make-mutex 'subscriptions))
 
@@ -34,7 +23,7 @@
 
 (define (find-subscription topic) (subscription-in *subscriptions* topic))
 
-;; A loop of its own, not find (docs/speed.md, What Chibi charges).
+;; A loop of its own, not find (docs/speed.md).
 (define (subscription-in subscriptions topic)
   (cond ((null? subscriptions) #f)
         ((eq? (subscription-topic (car subscriptions)) topic) (car subscriptions))
@@ -67,8 +56,7 @@
   (with-subscriptions (lambda () (map subscription-topic *subscriptions*))))
 
 ;;> The status of \var{topic}: () when free, the task-name that holds it
-;;> exclusively, \scheme{shared} while non-exclusive readers hold it, or
-;;> #f when not subscribed.
+;;> exclusively, \scheme{shared}, or #f when not subscribed.
 (define (topic-status topic)
   (with-subscriptions
     (lambda ()
@@ -94,8 +82,7 @@
 
 (define (subject-list topic) (if (list? topic) topic (list topic)))
 
-;; Wrong arguments are refused where the call is made, naming the call,
-;; rather than answered by every receiver with an error of its own.
+;; Wrong arguments are refused here, naming the call, not by every receiver.
 (define (check-subjects who subjects)
   (for-each (lambda (s)
               (if (not (symbol? s))
@@ -116,8 +103,7 @@
              (loop (+ i 1) (+ i 1) (cons (substring s start i) acc)))
             (else (loop start (+ i 1) acc))))))
 
-;; A predicate true of the topics the address subject pattern reaches,
-;; made once per message (docs/speed.md).
+;; A predicate of the topics pattern reaches, made once a message.
 (define (subject-matcher pattern)
   (let ((levels (subject-levels pattern)))
     (if (or (member "*" levels) (member ">" levels))
@@ -132,11 +118,9 @@
          (levels-match? (cdr p) (cdr t)))
         (else #f)))
 
-;; True when every subject of the address is among the subscriptions
-;; (the thesis says "proper subset"; it means subset).  It takes no lock:
-;; it reads the list once, and then only the topics, which never change.
-;; A subject subscribed as it is matches itself, wildcards included: the
-;; common case (all, a uid), which needs no matcher (docs/speed.md).
+;; Whether every subject of the address is subscribed (the thesis's
+;; "proper subset" means subset), without the lock; an exact subject needs
+;; no matcher, the common case (docs/speed.md).
 (define (addressed-here? topic)
   (if (list? topic)
       (subjects-here? *subscriptions* topic)
@@ -154,11 +138,8 @@
 
 ;;; Sending
 
-;; Sends a message to the lab: a result (call.scm) of each address space
-;; that it reached.  An address that is one address space's uid reaches
-;; that address space alone (each subscribes to its own uid and to no
-;; other's), so it is sent there only: metrics ask each candidate point to
-;; point, and would otherwise cost N messages each.
+;; Sends a message to the lab: a result for each address space reached; a
+;; uid goes to that address space alone, as metrics ask point to point.
 (define (deliver kind topic proc . args)
   (cond ((and (symbol? topic) (live-aspace topic))
          => (lambda (a) (call-all (list a) kind proc args)))
@@ -166,8 +147,7 @@
 
 ;;> Publishes a message (asynchronous, Figure 4.1): each live address
 ;;> space subscribed to every subject of \var{topic} applies \var{proc} to
-;;> \var{args}.  Answers the uids of the address spaces that acknowledged,
-;;> which says nothing of who evaluated it.
+;;> \var{args}.  Answers the uids that acknowledged.
 (define (publish topic proc . args)
   (check-subjects-and-procedure "publish" (subject-list topic) proc)
   (filter-map (lambda (r) (and (result-ok? r) (result-uid r)))
@@ -176,28 +156,22 @@
                                       (local-aspace-uid) proc args))))
 
 ;;> Publishes and waits for the results (synchronous, Figure 4.2): answers
-;;> ((uid result) ...) for the address spaces that evaluated the message,
-;;> possibly none.  One where the procedure raises is left out, and one
-;;> that dies or stalls after (remote-timeout) seconds; the log tells of
-;;> each.
+;;> ((uid result) ...) for the address spaces that evaluated the message;
+;;> one that raised, died or stalled is left out, and logged.
 (define (request topic proc . args)
   (check-subjects-and-procedure "request" (subject-list topic) proc)
   (answers 'request (deliver 'apply topic receive-request topic
                              (local-aspace-uid) proc args)))
 
-;; The evaluators' (uid value) from results whose values are receivers'
-;; answers (see receive-request); the failures are told (see
-;; told-failures).
+;; The evaluators' (uid value) from results; failures are told.
 (define (answers what results)
   (filter-map (lambda (r)
                 (and (result-ok? r) (evaluated? (result-value r))
                      (evaluation (result-value r))))
               (told-failures what results)))
 
-;; A receiver whose evaluation raised, or that did not answer, is left out
-;; of what publish and request answer; the log says which and why, so that
-;; a mistake in the procedure does not pass for a lab where nobody is
-;; subscribed.  Answers results.
+;; Logs each receiver that raised or did not answer: a mistake must not
+;; pass for a lab where nobody subscribes.
 (define (told-failures what results)
   (for-each (lambda (r) (if (not (result-ok? r)) (tell-failure what r))) results)
   results)
@@ -205,9 +179,7 @@
 (define (tell-failure what r)
   (log-warn what " on " (result-uid r) " failed: " (result-value r)))
 
-;; A capability list in the ((exclusive ...) (non-exclusive ...)) layout,
-;; from any of the appendix's forms: a bare subject or a flat list of
-;; subjects, needed non-exclusively, or the two lists.
+;; A capability list as ((exclusive ...) (non-exclusive ...)), from any appendix form.
 (define (capability-layout topic)
   (cond ((not (list? topic)) (list '() (list topic)))
         ((null? topic) (list '() '()))
@@ -215,13 +187,11 @@
         (else (list (car topic) (if (pair? (cdr topic)) (cadr topic) '())))))
 
 ;;> Reserves, then promises (Figure 4.3): each live address space that has
-;;> every subject of \var{topic}, with the exclusive ones free (or held for
-;;> \var{task-name}), reserves the exclusive ones for \var{task-name} and
-;;> answers a promise.  Answers ((uid promise) ...).  A promise applied to
-;;> #t applies \var{proc} to \var{args} there, frees the subjects and
-;;> returns the result; applied to #f it only frees them; applied to
-;;> \scheme{keep}, it holds them for another lease.  A promise never
-;;> applied is freed after the lab's lease.
+;;> every subject of \var{topic}, the exclusive ones free for
+;;> \var{task-name}, reserves them and answers a promise: ((uid promise)
+;;> ...).  A promise applied to #t applies \var{proc} to \var{args} there,
+;;> frees the subjects and returns the result; to #f only frees them; to
+;;> \scheme{keep} holds them another lease.  Unapplied, the lease frees them.
 (define (request-exclusive topic task-name proc . args)
   (let ((layout (capability-layout topic)))
     (check-subjects-and-procedure "request-exclusive" (apply append layout) proc)
@@ -229,9 +199,8 @@
              (broadcast-apply receive-request-exclusive layout task-name
                               (local-aspace-uid) proc args))))
 
-;;> As request-exclusive, but the subjects of \var{topic} are reserved for
-;;> sharing: other non-exclusive requests still get them, exclusive ones
-;;> are refused until every promise is applied (the thesis's chapter 6).
+;;> As request-exclusive, but the subjects are shared: other non-exclusive
+;;> requests still get them, exclusive ones wait for every promise (ch. 6).
 (define (request-non-exclusive topic task-name proc . args)
   (let ((subjects (subject-list topic)))
     (check-subjects-and-procedure "request-non-exclusive" subjects proc)
@@ -239,19 +208,11 @@
              (broadcast-apply receive-request-non-exclusive subjects task-name
                               (local-aspace-uid) proc args))))
 
-;;> One message to the whole lab for every component of a negotiation
-;;> (pose-task's round), where the thesis sends each its own
-;;> request-exclusive or request, each to the whole lab: a lab of N then
-;;> reads N messages a round, not N for each component, and answers the
-;;> metrics' askings in the same message, not in a round of their own.
-;;> Each of \var{components} is (type layout proc askings): type
-;;> exclusive or non-exclusive, layout as capability-layout gives it, the
-;;> procedure a promise applies (request's, for a non-exclusive one), and
-;;> the procedures that each candidate is asked for its measures.
-;;> Answers, per component in order, (response asked): response as
-;;> request-exclusive, or request to the layout's non-exclusive subjects,
-;;> answers; asked, ((uid answer ...) ...), each candidate's answers to the
-;;> askings, (#t value) or (#f message) each.
+;;> One message to the whole lab for every component of a negotiation,
+;;> with the metrics' askings, where the thesis sends one each.  Each of
+;;> \var{components} is (type layout proc askings); answers (response
+;;> asked) for each, response as request-exclusive or request gives,
+;;> asked ((uid answer ...) ...), each answer (#t value) or (#f message).
 (define (request-components task-name components)
   (let* ((n (length components))
          (rows (checked-rows (broadcast-apply receive-components components task-name
@@ -263,9 +224,7 @@
                  (column-asked rows i)))
          components (iota n))))
 
-;; rows, each receiver's result, with the value of one that is not n
-;; entries (answer asked) made a failure: each row is checked once, and
-;; each component's column read from it after (docs/speed.md).
+;; rows with one not of n entries made a failure, checked once (docs/speed.md).
 (define (checked-rows rows n)
   (cond ((null? rows) '())
         ((or (not (result-ok? (car rows))) (row-of? (result-value (car rows)) n))
@@ -282,8 +241,7 @@
       (and (list? (car value)) (= (length (car value)) 2) (pair? (caar value))
            (entries? (cdr value)))))
 
-;; Component i's answers, as request-exclusive's or request's: what each
-;; receiver that evaluated it answered; a failed row is logged as what's.
+;; Component i's answers, as request-exclusive's or request's.
 (define (column-answers what rows i)
   (cond ((null? rows) '())
         ((not (result-ok? (car rows)))
@@ -293,8 +251,7 @@
          (cons (evaluation (row-answer (car rows) i)) (column-answers what (cdr rows) i)))
         (else (column-answers what (cdr rows) i))))
 
-;; Component i's askings' answers, (uid answer ...) for each receiver
-;; that evaluated it.
+;; Component i's askings' answers, (uid answer ...) for each evaluator.
 (define (column-asked rows i)
   (cond ((null? rows) '())
         ((and (result-ok? (car rows)) (evaluated? (row-answer (car rows) i)))

@@ -1,39 +1,28 @@
-;;;; Monitors (thesis appendix A.6 monitor.scm) and each address space's
-;;;; first subscriptions (A.2 initial.scm): capabilities that come and go
-;;;; with the machine's state, subscribed through pubsub/messaging.scm.
+;;;; Monitors (thesis A.6) and each address space's first subscriptions
+;;;; (A.2): capabilities that come and go with the machine's state.
 
-;;; Monitors (A.6): capabilities that come and go with the machine's state
-
+;; The thesis's names (A.5, A.6), global as there; received code cannot
+;; assign them (code/sandbox.scm) but uses their procedures.
 ;;> The voltage, in tenths, above which a robot is taken to be on its
-;;> charging tether; below it, the battery monitor subscribes to untethered.
+;;> charging tether.
 (define *battery-charging* (lab-default 'battery-charging))
 ;;> The voltage, in tenths, below which a robot's battery is low.
 (define *battery-low* (lab-default 'battery-low))
 
-;; A string, as in the thesis, where it crossed differently byte-ordered
-;; machines.
-;;> The load, a string such as ".75", below which the load monitor
-;;> subscribes to idle.
+;;> The load, a string such as ".75" (as the thesis sent it between
+;;> machines), below which the load monitor subscribes to idle.
 (define *load-threshold* (lab-default 'load-threshold))
 
-;; The thesis's names (A.5, A.6), global as there.  Received code reads
-;; these and cannot assign them (sandbox.scm): a setting meant to change
-;; changes through its procedure.
-
-;;> Sets *battery-charging*, the voltage in tenths above which a robot is
-;;> taken to be on its charging tether.
+;;> Sets *battery-charging*, in tenths of a volt.
 (define (set-battery-charging! tenths) (set! *battery-charging* tenths))
 
 ;;> Sets *battery-low*, in tenths of a volt.
 (define (set-battery-low! tenths) (set! *battery-low* tenths))
 
-;;> Sets *load-threshold*, a string such as ".75": below it the load
-;;> monitor subscribes to idle.
+;;> Sets *load-threshold*, a string such as ".75".
 (define (set-load-threshold! load) (set! *load-threshold* load))
 
-;; What the monitors take from the lab, made by initialize-subscriptions!:
-;; its monitor-period, and where the load comes from.  Global: the
-;; monitors are the thesis's procedures of no arguments.
+;; What the monitors take from the lab: monitor-period, and the load's source.
 (define-record-type monitoring
   (make-monitoring period load-source last-load)
   monitoring?
@@ -41,6 +30,7 @@
   (load-source monitoring-load-source)  ; a thunk answering a number
   (last-load monitoring-last-load monitoring-last-load-set!)) ; (LOAD . TEXT)
 
+;; Global: the monitors are the thesis's procedures of no arguments.
 (define *monitoring* #f)
 
 ;;> This machine's load as a string, e.g. "0.42": from the lab's (load ...)
@@ -48,9 +38,7 @@
 (define (get-system-load)
   (string-copy (load-text ((monitoring-load-source *monitoring*)))))
 
-;; The text of load, kept while the load stays the same: every negotiation
-;; asks for it (docs/speed.md).  Copied out, as received code
-;; may change the string it is given.
+;; The text of load, kept while it stays (docs/speed.md), copied out for received code.
 (define (load-text load)
   (let ((last (monitoring-last-load *monitoring*)))
     (if (eqv? load (car last))
@@ -62,13 +50,11 @@
 (define (start-thread! name thunk)
   (thread-start! (make-logged-thread thunk name)))
 
-;; The thesis's names (A.6), global as there: a monitor started again
-;; ends the thread it replaces.
+;; The thesis's names (A.6), global as there: a restarted monitor ends the old thread.
 (define *load-monitor-thread* #f)
 (define *battery-monitor-thread* #f)
 
-;; A monitor keeps subject in the subscription list while present? holds,
-;; looking every monitor-period seconds.
+;; Keeps subject subscribed while present? holds, every monitor-period.
 (define (watch subject present?)
   (lambda ()
     (let loop ()
@@ -100,8 +86,7 @@
                           load-monitor-procedure))
   #t)
 
-;;> Subscribes to untethered while the battery is under
-;;> *battery-charging*, as when its charging tether is off.
+;;> Subscribes to untethered while the battery is under *battery-charging*.
 (define (battery-monitor)
   (set! *battery-monitor-thread*
         (restart-monitor! *battery-monitor-thread* 'battery-monitor
@@ -110,8 +95,7 @@
 
 ;;; Initialization (A.2), from the lab file rather than host names
 
-;; The lab's (load L) or (load ((SECONDS L) ...)): a fixed load, or one
-;; that steps to each L at SECONDS after start; else /proc/loadavg.
+;; The lab's (load L) or (load ((SECONDS L) ...)), else /proc/loadavg.
 (define (load-source clause)
   (let ((start (monotonic-seconds)))
     (cond
@@ -129,9 +113,7 @@
   (call-with-input-file "/proc/loadavg"
     (lambda (in) (read in))))
 
-;; read-loadavg, read again a second after the last reading at most: the
-;; kernel updates the average every five seconds, and every negotiation
-;; asks for it (a file port and three system calls each time).
+;; read-loadavg at most once a second: the kernel updates it every five.
 (define (loadavg-reader)
   (let ((read-at #f) (load #f))
     (lambda ()
@@ -143,10 +125,8 @@
 
 ;;> Sets up this address space's subscriptions and monitors from its lab
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
-;;> capabilities, and coordinator for a workstation (one with a
-;;> position); idle through load-monitor; untethered through
-;;> battery-monitor on robots.  \var{on-free} runs, outside any lock, each
-;;> time exclusive subjects here are freed: the task layer's hook.
+;;> capabilities, coordinator on a workstation, idle and untethered.
+;;> \var{on-free} runs, outside any lock, when exclusive subjects are freed.
 (define (initialize-subscriptions! lab entry on-free)
   (on-free! on-free)
   (set! *monitoring*
@@ -157,7 +137,7 @@
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
                   (else '())))
-  ;; A workstation may coordinate the tasks handed to the lab (detached.scm).
+  ;; A workstation may coordinate the tasks handed to the lab (task/detached.scm).
   (if (and entry (lab-aspace-clause entry 'position)) (subscribe 'coordinator))
   (load-monitor)
   (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))

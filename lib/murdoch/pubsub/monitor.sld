@@ -1,6 +1,5 @@
-;;> Monitors (appendix A.6): idle while the load is low, untethered while
-;;> the battery is off its charger; and the first subscriptions of an
-;;> address space, from its lab clause (A.2).
+;;> Monitors (A.6): idle while the load is low, untethered off the charger;
+;;> and an address space's first subscriptions, from its lab clause (A.2).
 
 (define-library (murdoch pubsub monitor)
   (export get-system-load load-monitor battery-monitor

@@ -1,12 +1,5 @@
-;;;; Receiving, part of (murdoch pubsub messaging): what the senders of
-;;;; messaging.scm run in each address space, and the reservations that
-;;;; request-exclusive makes.
-
-;;; Receiving
-;;
-;; What a receiver answers travels back as a list: (#t UID VALUE) when it
-;; evaluated the message, else (#f UID); for request-components, (ANSWER
-;; ASKED) for each component.
+;;;; Receiving, part of (murdoch pubsub messaging): what the senders run in
+;;;; each address space, (#t UID VALUE) or (#f UID), and the reservations.
 
 (define (evaluated? answer) (car answer))
 (define (evaluation answer) (cdr answer)) ; (UID VALUE)
@@ -19,15 +12,13 @@
       (apply proc args))
   #t)
 
-;;> Evaluates a request if it is addressed here: (#t uid result) or
-;;> (#f uid).
+;;> Evaluates a request if it is addressed here: (#t uid result) or (#f uid).
 (define (receive-request topic uid proc args)
   (if (addressed-here? topic)
       (list #t (local-aspace-uid) (apply proc args))
       (list #f (local-aspace-uid))))
 
-;;> Reserves and promises, if addressed here and free: (#t uid promise)
-;;> or (#f uid).
+;;> Reserves and promises, if addressed here and free: (#t uid promise) or (#f uid).
 (define (receive-request-exclusive topiclist task-name uid proc args)
   (promise-for (reserve! (car topiclist) (cadr topiclist) task-name uid)
                proc args))
@@ -36,12 +27,8 @@
 (define (receive-request-non-exclusive topics task-name uid proc args)
   (promise-for (reserve-shared! topics task-name) proc args))
 
-;;> What request-components runs in each address space: for each (type
-;;> layout proc askings) of \var{components}, in order, (answer asked).
-;;> answer is what receive-request-exclusive answers for an exclusive
-;;> component and receive-request, addressed to the layout's non-exclusive
-;;> subjects, for another; asked, when answer makes this address space a
-;;> candidate, its answer to each asking, (#t value) or (#f message).
+;;> What request-components runs in each address space: (answer asked)
+;;> for each component.
 (define (receive-components components task-name uid)
   (map (lambda (c)
          (match c
@@ -52,14 +39,12 @@
               (list answer (if (evaluated? answer) (map ask-here askings) '()))))))
        components))
 
-;; An asking is the user's code, so that one raising costs only its own
-;; answer (a guard only where user code runs: docs/speed.md).
+;; An asking is user code: one raising costs only its answer (docs/speed.md).
 (define (ask-here proc)
   (guard (e (#t (list #f (error-message e))))
     (list #t (proc))))
 
-;;> Whether \var{a}, a candidate's answer to an asking of
-;;> request-components, (#t value) or (#f message), was a value.
+;;> Whether \var{a}, a candidate's answer to an asking, was a value.
 (define (asked-ok? a) (car a))
 
 ;;> The value of \var{a}, a candidate's answer to an asking, or why none.
@@ -76,13 +61,10 @@
   (deadline reservation-deadline reservation-deadline-set!)
   (state reservation-state reservation-state-set!)) ; reserved running done
 
-;; Those not yet promised away.  Global, beside the subscriptions, and
-;; under their lock: a reservation holds subscriptions.
+;; Global, beside the subscriptions under their lock: those not yet promised away.
 (define *reservations* '())
 
-;; The leases, made by start-leases!: the lab's lease, read there, and
-;; the thread that frees what outlives it.  Global: one per process, read
-;; by every reservation.
+;; The lab's lease and the thread that frees what outlives it.
 (define-record-type leases
   (make-leases seconds keeper)
   leases?
@@ -94,16 +76,14 @@
 
 (define (lease) (lease-seconds *leases*))
 
-;;> Starts freeing the subjects of promises unapplied for \var{lab}'s
-;;> lease.
+;;> Starts freeing the subjects of promises unapplied for \var{lab}'s lease.
 (define (start-leases! lab)
   (set! *leases* (make-leases (lab-setting lab 'lease)
                               (make-logged-thread lease-keeper 'lease-keeper)))
   (thread-start! (lease-keeper-thread *leases*)))
 
-;; A subject is free for task when it is free or already held by task: two
-;; components of one task may both get a promise from one robot, and
-;; conflict resolution gives that robot at most one of them.
+;; Free for task when free or held by task: one robot may promise two of a
+;; task's components, and conflict resolution gives it at most one.
 (define (free-for? s task)
   (let ((status (subscription-status s)))
     (or (null? status) (eq? status task))))
@@ -116,17 +96,13 @@
   (subscription-status-set! s status)
   (subscription-holds-set! s (+ 1 (subscription-holds s))))
 
-;; Caller holds the lock.  Answers the subscriptions, or #f if one is
-;; missing or not acceptable.
+;; Caller holds the lock.  The subscriptions, or #f if one is missing or not ok?.
 (define (subscriptions-if topics ok?)
   (let ((subs (map find-subscription topics)))
     (and (every (lambda (s) (and s (ok? s))) subs) subs)))
 
-;; Whether every one of subjects is subscribed here, by its own name: an
-;; address space that lacks one reserves nothing, and is told so without
-;; the lock and the reservation's checks (most of a lab, for a robot's
-;; component).  Read without the lock, as addressed-here? reads: the
-;; list is replaced, not changed.
+;; Whether every subject is subscribed here by name, without the lock: most
+;; of a lab lacks one, and is told so without the reservation's checks.
 (define (subscribed-to-all? subjects)
   (or (null? subjects)
       (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
@@ -170,8 +146,7 @@
 (define (in-use-subject topic)
   (string->symbol (string-append (symbol->string topic) ".in_use")))
 
-;; Frees a reservation's subjects, once.  A subject is free again when no
-;; reservation holds it any more.
+;; Frees a reservation's subjects, once.
 (define (release! r)
   (if (with-subscriptions
         (lambda ()
@@ -186,24 +161,18 @@
                  (pair? (reservation-exclusive r))))))
       (*on-free*)))
 
-;; What runs when a reservation of exclusive subjects here ends: tasks
-;; that wait for robots hear of it (task/offers.scm).  Global, as the
-;; subscriptions are: the task layer's hook, which the address space's
-;; start passes to initialize-subscriptions!.
+;; Global, as the subscriptions are: the task layer's hook (task/offers.scm),
+;; run when exclusive subjects here are freed, passed in at start.
 (define *on-free* (lambda () #f))
 
-;;> Sets the thunk that runs, outside any lock, each time exclusive
-;;> subjects here are freed.
+;;> Sets the thunk run, outside any lock, when exclusive subjects are freed.
 (define (on-free! thunk) (set! *on-free* thunk))
 
-;; While a freed robot is offered to a waiting task's poser, exclusive
-;; subjects here are reserved for that poser's requests only: (uid
-;; . until), until a monotonic-seconds, or #f.  Global, beside the
-;; subscriptions and under their lock.
+;; Global, under the subscriptions' lock: (uid . until) while a freed robot
+;; is offered to uid, a waiting task's poser, whose requests alone get it.
 (define *offered* #f)
 
-;;> For \var{seconds}, reserves exclusive subjects here only at the
-;;> request of address space \var{uid}; #f for \var{uid} ends that.
+;;> For \var{seconds}, reserves exclusive subjects here for \var{uid}'s requests; #f ends that.
 (define (offer-subjects! uid . seconds)
   (with-subscriptions
     (lambda ()
@@ -252,9 +221,8 @@
                             (lambda () (release! r)))))))))
               promise))))
 
-;; A promise applied to keep holds its subjects for another lease: a task
-;; that holds what it has while it waits for the rest (task/life-cycle.scm).
-;; Answers whether it still holds them.
+;; A promise applied to keep holds its subjects another lease, for a task
+;; waiting for the rest (task/holding.scm); answers whether it still does.
 (define (renew! r)
   (with-subscriptions
     (lambda ()
@@ -262,8 +230,7 @@
            (begin (reservation-deadline-set! r (+ (monotonic-seconds) (lease)))
                   #t)))))
 
-;; Frees the reservations whose promise was never applied: the sender
-;; died, or the network broke.  No subject is held for ever.
+;; Frees reservations whose promise was never applied: nothing is held for ever.
 (define (lease-keeper)
   (thread-sleep! (min 1 (/ (lease) 4)))
   (for-each (lambda (r)

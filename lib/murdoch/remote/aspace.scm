@@ -1,11 +1,7 @@
 ;;;; Address spaces: identity, peers and live membership (thesis §3.3.2).
-;;
-;; An address space is one Chibi process with a uid; the lab file says
-;; where each listens.  This process joins its lab as one of them
-;; (join-lab!), once, and learns the others from the lab and from their
-;; hellos and beacons.
+;;;; This process joins its lab as one (join-lab!) and learns the others
+;;;; from the lab file, their hellos and their beacons.
 
-;;; Address spaces
 
 (define-record-type aspace
   (make-aspace uid host port)
@@ -16,8 +12,7 @@
   (host aspace-host)
   (port aspace-port))
 
-;; This process as an address space of its lab: made by join-lab!, once.
-;; Global: a process is one address space, and every layer above asks it.
+;; This process as an address space of its lab, made once by join-lab!.
 (define-record-type membership
   (make-membership lab started-at environment decode timeout peers unreachable
                    peers-lock)
@@ -42,15 +37,13 @@
 (define (with-peers thunk)
   (with-lock (membership-peers-lock (joined)) thunk))
 
-;; A change to the peers or to who answers: the live set is made again
-;; when next asked for.  The caller holds the peers' lock.
+;; Peers or who answers changed: the live set is remade when asked for (under the lock).
 (define (peers-changed! m) (membership-live-set! m #f))
 
 ;;> The local address space.
 (define (local-aspace) (membership-local (joined)))
 
-;;> Makes \var{port} the local address space's: the free one the kernel
-;;> chose for a guest, which listens on port 0 and says where in its hellos.
+;;> Makes \var{port} the local address space's: a guest's, listening on port 0.
 (define (local-aspace-port-set! port)
   (let ((local (local-aspace)))
     (membership-local-set! (joined)
@@ -68,7 +61,7 @@
   (or (known-aspace (joined) uid)
       (error "no address space of this uid is known" uid)))
 
-;; The lock without a wind, since nothing under it raises (docs/speed.md).
+;; No wind around the lock: nothing under it raises (docs/speed.md).
 (define (known-aspace m uid)
   (lock! (membership-peers-lock m))
   (unlocked (membership-peers-lock m)
@@ -85,12 +78,9 @@
       (peers-changed! (joined)))))
 
 ;;; Live membership
-;;
-;; Address spaces come and go.  One that fails to connect, loses its
-;; connection or does not answer in time is taken out of the live set, so
-;; that publish and request stop waiting on it; a prober tries it again
-;; every second and puts it back when it answers.  A newcomer is learned
-;; from its hello, so it joins by calling anyone.
+;; One that fails to connect, loses its connection or does not answer in
+;; time leaves the live set, for a prober to try every second; a newcomer
+;; is learned from its hello.
 
 (define (note-unreachable! uid)
   (if (not (eq? uid (local-aspace-uid)))
@@ -106,16 +96,13 @@
       (hash-table-delete! (membership-unreachable (joined)) uid)
       (peers-changed! (joined)))))
 
-;; The uids taken out of the live set, for the prober to try again.
 (define (unreachable-uids)
   (with-peers (lambda () (hash-table-keys (membership-unreachable (joined))))))
 
 ;;> The uids of the address spaces that answer: the broadcast set.
 (define (live-uids) (map aspace-uid (live-aspaces)))
 
-;;> The address spaces that answer, this one among them: what a request
-;;> to all is sent to.  Kept until the peers or who answers change
-;;> (docs/speed.md).
+;;> The address spaces that answer, this one among them (kept: docs/speed.md).
 (define (live-aspaces)
   (let ((m (joined)))
     (or (membership-live m)
@@ -134,9 +121,7 @@
 
 ;;; The timeout
 
-;;> Seconds remote-apply waits for an answer: the default for this
-;;> address space, the lab's timeout until this is called (a REPL gives
-;;> its repl-timeout).
+;;> Seconds remote-apply waits for an answer by default (else the lab's timeout).
 (define (set-remote-timeout! seconds) (membership-timeout-set! (joined) seconds))
 
 ;;> A per-call override: (parameterize ((remote-timeout 1)) ...).
@@ -148,12 +133,10 @@
 ;;; The environment received code runs in
 
 ;;> The environment received code runs in: R7RS base, Murdoch's API and the
-;;> lab's code files; no file, process, load or eval primitives.
+;;> lab's code files, without file, process, load or eval primitives.
 (define (lab-environment) (membership-environment (joined)))
 
-;; The value that received code, an encoded value, stands for here.  The
-;; code is rebuilt in place (make-decoder): it must be the reader's, fresh
-;; from a frame, and is not used again.
+;; The value received code stands for, rebuilt in place: code fresh from a frame.
 (define (decode-value code) ((membership-decode (joined)) code))
 
 (define (describe-procedure proc)
@@ -167,9 +150,8 @@
 ;;> The lab this address space belongs to.
 (define (current-lab) (membership-lab (joined)))
 
-;;> Makes this process the address space \var{uid} of \var{lab}, listening
-;;> on \var{port}, receiving code into \var{environment} and decoding what
-;;> it receives with \var{decode}; answers the local aspace.
+;;> Makes this process the address space \var{uid} of \var{lab}, on
+;;> \var{port}, receiving code into \var{environment} via \var{decode}.
 (define (join-lab! lab uid host port environment decode)
   (set! *membership*
         (make-membership lab (utc-seconds) environment decode

@@ -1,11 +1,6 @@
 ;;;; remote-run! and remote-apply (thesis §3.3.2), and their -all forms.
-;;
-;; A call encodes its procedure and arguments (sendable.scm), sends them
-;; on the connection to its target (connection.scm) and awaits the answer
-;; by its deadline: the value, or a remote-error of one of its kinds.
 
-;; A call as it leaves this address space, to one target or many: what it
-;; applies, encoded once for all of them, and how long it waits.
+;; A call leaving this address space, encoded once for all its targets.
 (define-record-type call
   (make-call kind proc args proc-code args-code seconds)
   call?
@@ -16,15 +11,13 @@
   (args-code call-args-code)
   (seconds call-seconds))               ; its answers are awaited so long
 
-;;> The call of \var{kind}, run or apply, of \var{proc} to \var{args},
-;;> encoded, to wait (remote-timeout) seconds.
+;;> The call of \var{kind}, run or apply, of \var{proc} to \var{args}, encoded.
 (define (new-call kind proc args)
   (let ((seconds (current-timeout)))
     (make-call kind proc args (encode proc (lab-environment) "the procedure")
                (encode-arguments args) seconds)))
 
-;;> The outcome of a call to one of many address spaces: its uid, and the
-;;> value, or why there is none.
+;;> The outcome of a call to one of many address spaces.
 (define-record-type result
   (make-result uid ok? value)
   result?
@@ -36,7 +29,6 @@
 
 (define (caller-name kind) (if (eq? kind 'run) "remote-run!" "remote-apply"))
 
-;; A call of proc to args in address space a: its value, or a remote-error.
 (define (call-to a kind proc args)
   (check-not-abandoned (caller-name kind))
   (let ((c (new-call kind proc args)))
@@ -44,25 +36,20 @@
           (g (make-gathering)))
       (finish-call (start-call a (call-tail c) deadline g) g deadline c))))
 
-;; The text of call c's frames but their ids (message-without-id).
 (define (call-tail c)
   (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
 
-;; A call sent to a, its frame's text but the id tail, its answer to come
-;; to gathering g.  A peer that cannot be connected to or sent to is
-;; noted unreachable (connection.scm).
+;; A call sent to a, answered to gathering g; a peer out of reach is noted so.
 (define (start-call a tail deadline g)
   (send-call! (connection-to a deadline) tail g))
 
-;; The answer to p, pending call c, by the deadline (on the monotonic
-;; clock): the value, or a remote-error.
+;; The answer to p, pending call c, by the deadline: value or remote-error.
 (define (finish-call p g deadline c)
   (await-answers g (list p) deadline)
   (answer-value p c))
 
-;; Waits until each pending call of ps has its answer, or the deadline
-;; has passed.  A wait interrupted (Ctrl-C) gives up every call that has
-;; none.
+;; Waits for each pending call of ps, or the deadline; a wait interrupted
+;; (Ctrl-C) gives up every call that has no answer.
 (define (await-answers g ps deadline)
   (undo-on-raise
    (lambda () (for-each give-up! ps))
@@ -73,10 +60,8 @@
   (if (and (not (pending-call-answer p)) (pending-call-connection p))
       (give-up-call! (pending-call-connection p) (pending-call-id p))))
 
-;; What the answer of pending call p, of call c, says: the value, or a
-;; remote-error; none came within c's seconds, and p is given up.
-;; Answers are (ack ID), (value ID VALUE), (error ID MESSAGE) or (lost).
-;; By cond, not match or case, and no let (docs/speed.md).
+;; What pending call p's answer says: the value, or a remote-error (none
+;; came in time: p is given up).  No match, no let (docs/speed.md).
 (define (answer-value p c)
   (answer-says p (pending-call-answer p) c))
 
@@ -94,23 +79,17 @@
          (remote-error 'unreachable (pending-call-uid p)
                        (describe-procedure (call-proc c)) "connection lost"))))
 
-;; The value of a value answer, the message of an error answer: the field
-;; after the id.
+;; The field after the id: a value answer's value, an error's message.
 (define (answer-field answer) (car (cddr answer)))
 
-;; The call of proc to uid has had no answer within seconds.
 (define (timed-out uid proc seconds)
   (note-unreachable! uid)
   (remote-error 'timed-out uid (describe-procedure proc)
                 (string-append "no answer within " (number->string seconds) " s")))
 
-;;> Applies \var{proc} to \var{args} in each address space of
-;;> \var{aspaces} at once, and answers, in their order, (uid #t value) for
-;;> each that answered and (uid #f message) for each that failed or did not
-;;> answer within (remote-timeout) seconds: outcomes, read by outcome-uid,
-;;> outcome-ok? and outcome-value.  The procedure is encoded once,
-;;> and every call is sent before the first answer is awaited, so the time
-;;> taken is about that of the slowest answer, not their sum.
+;;> Applies \var{proc} to \var{args} in each of \var{aspaces} at once:
+;;> (uid #t value) for each that answered, (uid #f message) for each that
+;;> failed or timed out, in their order; as long as the slowest answer.
 (define (remote-apply-all aspaces proc . args)
   (map result->list (call-all aspaces 'apply proc args)))
 
@@ -118,8 +97,7 @@
 (define (remote-run-all! aspaces proc . args)
   (map result->list (call-all aspaces 'run proc args)))
 
-;; An outcome, one of remote-apply-all's answers, stays a list: the REPL
-;; shows it as it reads, and its readers below are its users' names.
+;; An outcome stays a list, which the REPL shows as it reads.
 
 ;;> The uid of outcome \var{o}, one of remote-apply-all's answers.
 (define (outcome-uid o) (car o))
@@ -130,22 +108,19 @@
 ;;> The value of outcome \var{o} when it answered, else why not.
 (define (outcome-value o) (car (cddr o)))
 
-;;> As remote-apply-all and remote-run-all!, for \var{kind} apply or run,
-;;> answering a result for each address space.
+;;> As remote-apply-all and remote-run-all!, for \var{kind}: a result each.
 (define (call-all aspaces kind proc args)
   (let ((who (if (eq? kind 'run) "remote-run-all!" "remote-apply-all")))
     (check-not-abandoned who)
     (for-each (lambda (a) (check-aspace who a)) aspaces))
   (send-all aspaces (new-call kind proc args)))
 
-;;> Sends call \var{c} to each of \var{aspaces} in turn, then awaits their
-;;> answers: a result for each.
+;;> Sends call \var{c} to each of \var{aspaces}, then awaits the answers.
 (define (send-all aspaces c)
   (let* ((deadline (+ (monotonic-seconds) (call-seconds c)))
          (g (make-gathering))
          (tail (call-tail c))
-         ;; A pending call for each call sent; a result for the local call
-         ;; and for each that could not be sent.
+         ;; A pending call for each call sent; a result for the rest.
          (started
           (capture-each aspace-uid
                         (lambda (a)
@@ -163,21 +138,18 @@
                         x))
                   started)))
 
-;; The uid of what send-all started: a pending call or a result.
 (define (started-uid x)
   (if (pending-call? x) (pending-call-uid x) (result-uid x)))
 
-;; A call to this address space is a remote call too: an abandoned thread
-;; stops at it (abandon.scm), as a component cut off from its poser whose
-;; commands go to its own address space must.
+;; A call to this address space is a remote call too, so an abandoned
+;; thread stops at it (code/abandon.scm).
 (define (local-call kind proc args)
   (check-not-abandoned (caller-name kind))
   (if (eq? kind 'run)
       (begin (run-in-worker (lambda () (apply proc args))) #t)
       (apply-here (local-aspace-uid) proc args)))
 
-;;> The result of \scheme{(thunk)} as that of address space \var{uid}, or,
-;;> when it raises, why.
+;;> The result of \scheme{(thunk)} as that of \var{uid}, or why it raised.
 (define (capture uid thunk)
   (guard (e (#t (failure-result uid e)))
     (make-result uid #t (thunk))))
@@ -185,8 +157,7 @@
 (define (failure-result uid e)
   (make-result uid #f (error-message e)))
 
-;;> (map entry items); an item whose entry raised gives the result of
-;;> its failure, for the uid (uid-of item).
+;;> (map entry items); an item whose entry raised gives its failure's result.
 (define (capture-each uid-of entry items)
   (map-guarded entry items (lambda (item e) (failure-result (uid-of item) e))))
 
@@ -217,8 +188,7 @@
     (apply proc args)))
 
 ;;> Applies \var{proc} to \var{args} in a new thread of address space
-;;> \var{a}; returns #t once \var{a} has acknowledged.  The result is
-;;> discarded.
+;;> \var{a}; returns #t once \var{a} has acknowledged.
 (define (remote-run! a proc . args)
   (check-aspace "remote-run!" a)
   (if (local? a)
@@ -226,24 +196,16 @@
       (call-to a 'run proc args)))
 
 ;;> Applies \var{proc} to \var{args} in address space \var{a} and returns
-;;> the result.  Raises a remote-error naming \var{a}, the procedure and
-;;> the message when the application raised, the connection broke, or no
-;;> answer came within (remote-timeout) seconds, counted from the call:
-;;> connecting and greeting, when there is no connection yet, count too.
+;;> the result; a remote-error when it raised, the connection broke, or no
+;;> answer came within (remote-timeout) seconds, connecting included.
 (define (remote-apply a proc . args)
   (check-aspace "remote-apply" a)
   (if (local? a)
       (local-call 'apply proc args)
       (call-to a 'apply proc args)))
 
-;;; The answers to datagram calls
-;;
-;; A call sent to the whole lab by one multicast datagram (delivery.scm)
-;; is answered by each address space over its own connection, with an
-;; answer frame, which that connection's reader hands here.
+;;; The answers to datagram calls, handed here by each peer's connection reader.
 
-;; The datagram calls that wait for answers.  Global: any connection's
-;; reader hands in the answers, which come to the caller that sent them.
 (define-record-type datagram-calls
   (make-datagram-calls waiting lock next-id)
   datagram-calls?
@@ -251,6 +213,7 @@
   (lock datagram-calls-lock)
   (next-id datagram-calls-next-id datagram-calls-next-id-set!))
 
+;; Global: any connection's reader hands in answers to the process's calls.
 (define *datagram-calls* (make-datagram-calls (make-hash-table eq?)
                                               (make-mutex 'datagram-calls) 0))
 
@@ -258,8 +221,7 @@
   (with-lock (datagram-calls-lock *datagram-calls*) thunk))
 
 ;; Whom a datagram call waits for: the live set but this address space,
-;; and each one's place among them, by which an answer finds its pending
-;; call (docs/speed.md).  Kept while the live set is the same list.
+;; and each one's place, by which an answer finds its call (docs/speed.md).
 (define-record-type others
   (make-others live uids places)
   others?
@@ -270,8 +232,7 @@
 ;; Global: the peers of the process's one address space.
 (define *others* (make-others #f '() (make-hash-table eq?)))
 
-;;> The others that a datagram call to the live set waits for answers from
-;;> (expect-answers!).
+;;> The others a datagram call to the live set waits for.
 (define (datagram-others)
   (if (eq? (others-live *others*) (live-aspaces))
       *others*
@@ -286,9 +247,7 @@
     (set! *others* o)
     o))
 
-;; A new datagram call's id, whose answers from each of the others o
-;; (datagram-others) will come to gathering g; answers it and their
-;; pending calls, in the order of o's uids.
+;; A new datagram call's id; its pending calls, o's order, answer to gathering g.
 (define (expect-answers! o g)
   (with-datagram-calls
     (lambda ()
@@ -300,9 +259,7 @@
                          (cons (others-places o) (list->vector ps)))
         (cons id ps)))))
 
-;; What datagram call id waits for, (places . pending-calls), or #f.  The
-;; lock without a dynamic-wind: nothing under it raises, and every answer
-;; comes here.
+;; What datagram call id waits for, (places . pending-calls), or #f.
 (define (datagram-calls-waiting-for id)
   (lock! (datagram-calls-lock *datagram-calls*))
   (cell-value (unlocked (datagram-calls-lock *datagram-calls*)
@@ -310,15 +267,11 @@
                                          id #f))
               #f))
 
-;; Nobody waits for the answers to datagram call id any longer.
 (define (forget-answers! id)
   (with-datagram-calls
     (lambda () (hash-table-delete! (datagram-calls-waiting *datagram-calls*) id))))
 
-;; Hands an (answer ID KIND VALUE) frame from address space uid to the
-;; call that waits for it; one for a call no longer waited for, or from
-;; an address space it was not sent to, is dropped.  No match, no let
-;; (docs/speed.md).
+;; Hands uid's (answer ID KIND VALUE) to its call, or drops it (no let).
 (define (take-datagram-answer! uid message)
   (answer-datagram-call! (pending-of uid (datagram-calls-waiting-for
                                           (message-id message)))
@@ -333,13 +286,11 @@
 (define (pending-at place pending-calls)
   (and place (vector-ref pending-calls place)))
 
-;; The answer is given as a connection's: (KIND ID VALUE).
 (define (answer-datagram-call! p message)
   (if p
       (answer-call! p (list (datagram-answer-kind message) (message-id message)
                             (datagram-answer-value message)))))
 
-;; The fields of an (answer ID KIND VALUE) message after its id.
 (define (datagram-answer-kind message) (list-ref message 2))
 (define (datagram-answer-value message) (list-ref message 3))
 
@@ -347,8 +298,7 @@
 
 (define probe-seconds 1)
 
-;; Tries each address space out of the live set every probe-seconds, and
-;; puts back each that answers.
+;; Tries each address space out of the live set every probe-seconds.
 (define (prober)
   (thread-sleep! probe-seconds)
   (for-each (lambda (uid)

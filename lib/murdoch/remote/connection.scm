@@ -1,11 +1,7 @@
 ;;;; Connections to other address spaces: the caller's side of the wire.
-;;
-;; A call goes out on the one connection this address space keeps to its
-;; target, made and greeted (steps 1 and 2 of frame.scm's protocol) when
-;; there is none.  One thread, the poller, reads every connection: it
-;; waits on the scheduler's one epoll descriptor, takes each connection's
-;; frames as their bytes come, and hands each answer to the call that
-;; waits for it, found by id.  No thread waits on a connection of its own.
+;;;; A call goes out on the one connection kept to its target, greeted
+;;;; when made; one thread, the poller, reads every connection on the
+;;;; scheduler's epoll descriptor and hands each answer to its call by id.
 
 (define-record-type connection
   (make-connection uid in out text write-lock pending own-nonce welcome)
@@ -26,9 +22,8 @@
   (stage connection-stage connection-stage-set!) ; of the send under the lock
   (open? connection-open? connection-open?-set!))
 
-;;> A call on its way to uid, or, with no connection, the answer of uid to
-;;> a datagram call.  Its answer, #f until it comes, is handed in through
-;;> its gathering, which a caller shares among all the calls it awaits.
+;;> A call on its way to uid, or uid's answer to a datagram call; its
+;;> answer, #f until it comes, is handed in through its gathering.
 (define-record-type pending-call
   (make-pending-call uid connection id gathering answer)
   pending-call?
@@ -43,18 +38,14 @@
   (gathering-put! (pending-call-gathering p) p answer
                   pending-call-answer pending-call-answer-set!))
 
-;; The open connections, and a lock for each uid that one thread holds
-;; while it connects to that uid: a peer that does not answer holds up the
-;; calls to it for their timeout, and no call to another peer.  Global:
-;; one connection to each peer for the whole process, made by the first
-;; call to it, from any thread.
+;; Global: one connection to each peer for the process, made by the first
+;; call to it, from any thread; and a lock for each uid being connected
+;; to, so that a peer that does not answer holds up only the calls to it.
 (define *connections* (make-hash-table eq?))  ; uid -> connection
 (define *connecting* (make-hash-table eq?))   ; uid -> mutex
 (define *connections-lock* (make-mutex 'connections))
 
-;; The open connection to uid, made (and greeted) if there is none, by
-;; the deadline (on the monotonic clock).  A peer that cannot be
-;; connected to is noted unreachable (aspace.scm).
+;; The open connection to uid, made and greeted by the deadline if there is none.
 (define (connection-to a deadline)
   (let ((uid (aspace-uid a)))
     (or (live-connection-to uid)
@@ -72,8 +63,7 @@
                        (lambda () (hash-table-set! *connections* uid c)))
                      c)))))))))
 
-;; The lock without a dynamic-wind: nothing under it raises, and this is
-;; on the way of every call.
+;; No wind around the lock: nothing under it raises, and every call comes here.
 (define (live-connection-to uid)
   (lock! *connections-lock*)
   (open-in (unlocked *connections-lock* (hash-table-cell *connections* uid #f))))
@@ -128,10 +118,9 @@
 
 ;;; The poller
 
-;; The watched connections by descriptor: a vector, which the poller reads
-;; without a lock (a vector-set! is whole), replaced by a larger one under
-;; *connections-lock* when a descriptor is past its end.  Global, as the
-;; connections: the process has one poller, started by the first connect.
+;; Global, as the process has one poller: the watched connections by
+;; descriptor, a vector the poller reads without a lock (a vector-set! is
+;; whole), replaced by a larger one under *connections-lock*.
 (define *watched* (make-vector 64 #f))
 (define *poller-port* #f)               ; on the epoll descriptor
 
@@ -139,18 +128,14 @@
   (connection-fd-set! c (port-fileno (connection-in c)))   ; before the poller sees it
   (watch-port! (connection-in c) c))
 
-;;> Watches the connection served on input port \var{in}, \var{s} to the
-;;> serving side: the poller hands \scheme{(take s items)} what
-;;> poller-frames! reads, and \scheme{(fault s e)} what it raises.
-;;> Answers the descriptor.
+;;> Watches the connection served on \var{in}: the poller gives
+;;> \scheme{(take s items)} or \scheme{(fault s e)}; answers the descriptor.
 (define (watch-served! in s take fault)
   (watch-port! in (make-watcher s take fault)))
 
-;; The poller reads input port in, its descriptor's entry in *watched*
-;; being entry; answers the descriptor.  The entry is set before epoll
-;; watches it: the poller, a thread that may run between any two steps of
-;; this one, drops a ready descriptor it does not know, and with it the
-;; welcome that came first.
+;; The poller reads input port in, as entry; answers the descriptor.  The
+;; entry is set before epoll watches it, since the poller drops a ready
+;; descriptor it does not know, and with it the welcome.
 (define (watch-port! in entry)
   (with-lock *connections-lock*
     (lambda ()
@@ -162,16 +147,14 @@
         (poller-watch! in)
         fd))))
 
-;;> The poller stops reading served descriptor \var{fd}: for good
-;;> (poller-unwatch!), or, with \var{keep?}, leaving its buffer to a
-;;> thread of its own (poller-release!).
+;;> The poller stops reading served descriptor \var{fd}: for good, or with
+;;> \var{keep?} leaving its buffer to a thread of its own.
 (define (unwatch-served! fd keep?)
   (with-lock *connections-lock*
     (lambda ()
       (vector-set! *watched* fd #f)
       (if keep? (poller-release! fd) (poller-unwatch! fd)))))
 
-;; A served connection as the poller knows it.
 (define-record-type watcher
   (make-watcher serving take fault)
   watcher?
@@ -188,9 +171,8 @@
   (set! *poller-port* (poller-port))
   (thread-start! (make-logged-thread poll-connections 'poller)))
 
-;; Reads each connection as its bytes come.  A frame that breaks the
-;; protocol closes its connection; the others carry on.  One handler for
-;; the thread's life, entered again after each fault (docs/speed.md).
+;; Reads each connection as its bytes come, under one handler (docs/speed.md);
+;; a frame that breaks the protocol closes its connection.
 (define (poll-connections)
   (let ((current #f))
     (define (take! fd)
@@ -210,7 +192,6 @@
                 (for-each take! fds)))
           (loop))))))
 
-;; The frames, eof or fault that poller-frames! read from c.
 (define (take-frames! c taken)
   (when (pair? taken)
     (take-frame! c (car taken))
@@ -236,18 +217,16 @@
   (connection-nonce-set! c (welcome-nonce w (connection-uid c)))
   (mailbox-put! (connection-welcome c) #t))
 
-;; The welcome mailbox gets what was wrong with the welcome, which the
-;; call reports: only faults after the welcome are logged, so that the
-;; prober, trying a gone peer every second, does not fill the log.
+;; The welcome mailbox gets what was wrong with the welcome: only faults
+;; after it are logged, lest the prober's tries of a gone peer fill the log.
 (define (connection-fault! c e)
   (if (connection-nonce c)
       (log-fault (connection-uid c) e)
       (mailbox-put! (connection-welcome c) e))
   (close-connection! c))
 
-;; The nonce of w, the welcome from uid.  A welcome from another address
-;; space is refused: one that came after uid left, on the port it had,
-;; would answer in its name, and uid would never drop out of the lab.
+;; The nonce of w, the welcome from uid.  One from another address space,
+;; on the port uid had, would answer in its name: uid would never leave.
 (define (welcome-nonce w uid)
   (if (eof-object? w)
       (error "the connection closed before its welcome"))
@@ -257,8 +236,7 @@
          (error (string-append "found " (symbol->string found) " at its address")))
      nonce)))
 
-;; Hands an answer to its call; the lock without a dynamic-wind, since
-;; nothing under it raises, and no match or let (docs/speed.md).
+;; No wind around the lock (nothing under it raises), no match or let.
 (define (deliver-answer! c answer)
   (check-message answer '(ack value error) "an answer")
   (lock! (connection-write-lock c))
@@ -269,8 +247,7 @@
 (define (answer-pending! p answer)
   (if p (answer-call! p answer)))       ; else the caller gave up
 
-;; Close once; every call still waiting hears that the connection is lost.
-;; The poller stops watching it before its descriptor closes.
+;; Close once; waiting calls hear the connection is lost.  Unwatched first.
 (define (close-connection! c)
   (let* ((fd #f)
          (waiting
@@ -285,15 +262,13 @@
         (lambda ()
           (vector-set! *watched* fd #f)
           (poller-unwatch! fd)))
-      ;; Closing both ports closes the socket; closing it again could close
-      ;; another connection's socket that has taken its number.
+      ;; Closed once: its number may be another socket's next.
       (guard (e (#t #f)) (close-input-port (connection-in c)))
       (guard (e (#t #f)) (close-output-port (connection-out c))))
     (for-each (lambda (p) (answer-call! p '(lost))) waiting)))
 
-;;> Sends one call, its text but the id \var{tail} (message-without-id),
-;;> whose answer its gathering g will be handed; answers the pending call.
-;;> Its id is drawn first, so that its text is made outside the lock.
+;;> Sends one call, \var{tail} its text but the id, answered to gathering
+;;> g; answers the pending call.
 (define (send-call! c tail g)
   (send-pending! c tail (make-pending-call (connection-uid c) c (next-call-id! c) g #f)))
 
@@ -301,19 +276,16 @@
   (send-counted! c (spliced-text tail (pending-call-id p)) p)
   p)
 
-;; An id no other call on c has; the lock without a dynamic-wind, since
-;; nothing under it raises.
+;; An id no other call on c has (no wind: nothing under the lock raises).
 (define (next-call-id! c)
   (lock! (connection-write-lock c))
   (connection-next-id-set! c (+ 1 (connection-next-id c)))
   (unlocked (connection-write-lock c) (connection-next-id c)))
 
-;; Sends message, or its text, as c's next frame, under c's write lock,
-;; with pending call p (or #f) in c's table.  A frame that fails to go
-;; out leaves the connection closed to calls; a message that cannot be
-;; sent (too large, say) leaves it as it was.  Either way p is taken out,
-;; and its peer is noted unreachable.  One wind for the lock and the undo,
-;; its stage kept by the connection under the lock; no let (docs/speed.md).
+;; Sends message as c's next frame under c's write lock, with p (or #f)
+;; in c's table.  A failed write closes c to calls; an unsendable message
+;; leaves it be; either way p is taken out and the peer noted unreachable.
+;; One wind for lock and undo, no let (docs/speed.md).
 (define (send-counted! c message p)
   (wind (lambda () (lock! (connection-write-lock c)) (connection-stage-set! c 'before))
         (lambda () (write-counted! c message p))
@@ -345,15 +317,12 @@
   (unlock! (connection-write-lock c))
   (if (and p (not sent?)) (note-unreachable! (connection-uid c))))
 
-;;> Sends the answer to call id of a multicast datagram that a, its sender,
-;; sent: (answer ID KIND VALUE), which a's reader hands on as it reads it
-;; -- no acknowledgement, no worker -- since a waits for it anyway.
+;;> Sends a's datagram call id its answer (answer ID KIND VALUE), unacknowledged.
 (define (send-datagram-answer! a id kind value)
   (send-counted! (connection-to a (+ (monotonic-seconds) (current-timeout)))
                  (make-message 'answer id kind value) #f))
 
-;; Forgets call id, and tells the callee, if the connection still stands,
-;; that nobody waits for it (see abandon.scm).
+;; Forgets call id, telling the callee if the connection stands (code/abandon.scm).
 (define (give-up-call! c id)
   (with-lock (connection-write-lock c)
     (lambda () (hash-table-delete! (connection-pending c) id)))

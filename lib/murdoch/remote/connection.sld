@@ -1,6 +1,5 @@
 ;;> The caller's side of the wire: one greeted connection to each address
-;;> space called, and the poller that reads them all and hands each
-;;> answer to the call awaiting it.
+;;> space called, and the poller that reads them all.
 
 (define-library (murdoch remote connection)
   (export connection-to send-call! give-up-call! send-datagram-answer!

@@ -1,19 +1,11 @@
 ;;;; Delivery: how publish and request reach the whole lab (thesis §4.1).
-;;
-;; The thesis sent each message to every machine in turn, for want of
-;; broadcast in Kali (§4.1), and wished for IP multicast (§1.2).  With
-;; (delivery multicast GROUP [PORT]) in the lab file, publish and the query
-;; phase of request and request-exclusive go out as one datagram to the
-;; lab's group (group.scm); each address space answers the sender point to
-;; point over its TCP connection, with an answer frame
-;; (send-datagram-answer!), so the semantics are the broadcast's.  A
-;; message too large for a datagram goes the broadcast way.
+;;;; The thesis sent to each machine in turn; under (delivery multicast
+;;;; ...) publish and the query phase of requests are one datagram to the
+;;;; group, answered over TCP; a message too large goes the broadcast way.
 
-;;; Broadcast
 
-;;> remote-apply-all to every live address space (here too): by one
-;;> multicast datagram when the lab's delivery is multicast and the message
-;;> fits, else to each in turn.  Answers a result (call.scm) for each.
+;;> remote-apply-all to every live address space (here too), by one
+;;> datagram when delivery is multicast and it fits, else to each in turn.
 (define (broadcast-apply proc . args) (broadcast 'apply proc args))
 
 ;;> remote-run-all! to every live address space, as broadcast-apply.
@@ -27,8 +19,7 @@
 
 ;;; Multicast
 
-;; send-all over multicast, when it is on and call c fits a datagram:
-;; answers send-all's results, or #f to send the broadcast way.
+;; send-all by multicast when it is on and c fits, else #f.
 (define (multicast-call-all c)
   (and (eq? (delivery-mode) 'multicast)
        (let* ((g (make-gathering))
@@ -54,14 +45,9 @@
              (begin (forget!) #f)))))
 
 ;;; Serving the group's calls
-;;
-;; The group is read as a connection is (serve.scm): its listener applies
-;; a call itself, and the janitor gives the group a new listener when an
-;; apply runs long.
+;; As a connection (serve.scm): the listener applies, the janitor relieves it.
 
-;; Serves call, unless #f, which answer answers.  A procedure of its own
-;; where a let made a closure for every datagram (docs/speed.md, What
-;; Chibi charges).
+;; Serves call, unless #f, which answer answers (no let: docs/speed.md).
 (define (serve-group-call r call answer)
   (if call
       (serve-call r (make-served-call (uid->aspace (group-call-sender call))
@@ -69,16 +55,14 @@
                                       (group-call-proc-code call)
                                       (group-call-args-code call) answer))))
 
-;;> Serves the calls that \scheme{(receive-call)} gives, the multicast
-;;> group's: start-aspace! hands it to start-group!.  A call's error is
-;;> its answer; any other failure drops the datagram.
+;;> Serves the calls that \scheme{(receive-call)} gives, the group's; a
+;;> call's error is its answer, any other failure drops the datagram.
 (define (serve-group receive-call)
   (let ((s (new-serving! "the multicast group" #f #f #f)))
     (serving-read-on-set! s (lambda () (serve-group-calls s receive-call)))
     (read-as-reader s (serving-read-on s))))
 
-;; Serves the group's calls while this thread is its listener (see
-;; read-calls).  A call is answered to its sender over TCP.
+;; Serves the group's calls while this thread is its listener (read-calls).
 (define (serve-group-calls s receive-call)
   (define (answer c kind value)
     (send-datagram-answer! (served-call-caller c) (served-call-id c) kind value))

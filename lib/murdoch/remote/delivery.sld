@@ -1,6 +1,5 @@
-;;> Delivery: broadcast-apply and broadcast-run! reach every live address
-;;> space, by one multicast datagram when the lab says so, else each in
-;;> turn; serve-group serves the calls that come by the group.
+;;> Delivery: broadcast-apply and broadcast-run! to every live address
+;;> space, and serve-group for the calls that come by the group.
 
 (define-library (murdoch remote delivery)
   (export broadcast-apply broadcast-run! serve-group)

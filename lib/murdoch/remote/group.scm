@@ -1,34 +1,21 @@
-;;;; The lab's multicast group: datagrams that prove the lab's key and
-;;;; cannot be replayed, and beacons that keep the live set.
+;;;; The lab's multicast group (thesis §1.2's wish): datagrams that prove
+;;;; the lab's key and cannot be replayed, and beacons that keep the live set.
 ;;
-;; The thesis wished for IP multicast (§1.2).  With (delivery multicast
-;; GROUP [PORT]) in the lab file, every address space joins the group.
-;; A datagram is 64 hex digits of HMAC-SHA256 under the lab's key over
-;; "mcast:" and the text, then the text: (SENDER SEQUENCE BODY).  SEQUENCE
-;; is the sender's clock when it sent, in microseconds since 1970, and
-;; grows with every datagram of a sender, so a restarted sender does not go
-;; back.  A recorded datagram cannot be replayed, to any receiver: one
-;; drops a datagram
-;;   - whose sequence it has passed (it heard that one, or a later one);
-;;   - sent before it started (it joined late, or restarted, since);
-;;   - sent more than frame-timeout ago (the window a datagram may take,
-;;     and the most that the hosts' clocks may differ).
-;; BODY is one of
+;; With (delivery multicast GROUP [PORT]) every address space joins the
+;; group.  A datagram is 64 hex digits of HMAC-SHA256 under the lab's key
+;; over "mcast:" and the text, then the text: (SENDER SEQUENCE BODY).
+;; SEQUENCE is the sender's clock in microseconds since 1970, growing with
+;; each datagram, so a restarted sender does not go back.  A receiver drops
+;; a datagram whose sequence it has passed, sent before it started, or sent
+;; more than frame-timeout ago (the most a datagram may take, and the hosts'
+;; clocks differ).  BODY is one of
 ;;   (beacon UID HOST PORT)         every beacon period: here I am
 ;;   (call ID KIND PROC ARGS)       KIND run or apply, as on a connection
-;;
-;; Beacons are live membership without a registry (docs/architecture.md,
-;; "Delivery and membership"); the period grows with the lab beyond 16,
-;; as RTCP's report interval grows with a session.
-;;
-;; The group knows nothing of what a call means.  start-group! is handed
-;; the procedure that serves the group's calls, as Chibi's run-net-server
-;; is handed its handler: serving (delivery.scm) imports the group, and
-;; the group imports nothing above it.
+;; Beacons keep membership without a registry (docs/architecture.md); their
+;; period grows beyond 16, as RTCP's does.  start-group! is handed the
+;; procedure that serves calls, so the group imports nothing above it.
 
-;; The lab's group as this address space joined it, made by start-group!;
-;; #f while the lab's delivery is broadcast.  Global: one per process,
-;; shared by its senders, its listener and its beacons.
+;; The lab's group as joined here, #f under broadcast; shared by its threads.
 (define-record-type group
   (make-group socket address buffer own-head window started sequence sequence-lock
               last-sequence last-heard last-heard-lock)
@@ -51,14 +38,10 @@
 (define max-datagram 60000)
 (define lab-beacons-per-second 16)
 
-;;> Joins \var{lab}'s multicast group when the lab's delivery is
-;;> multicast, and starts its beacons and a thread that applies
-;;> \var{serve} to \scheme{receive-call}: a procedure of no arguments that
-;;> waits for the group's next datagram and returns the group-call it
-;;> carries, or #f when it carried none (a beacon, or our own datagram
-;;> looped back).  It raises for a datagram
-;;> that is not authentic or not fresh.  Only one thread at a time may
-;;> call it: the datagram is read into one buffer.
+;;> Joins \var{lab}'s multicast group when delivery is multicast, starting
+;;> beacons and a thread applying \var{serve} to \scheme{receive-call}, which
+;;> returns the next datagram's group-call or #f and raises for one not
+;;> authentic or fresh (one thread at a time: one buffer).
 (define (start-group! lab serve)
   ;; (multicast GROUP [PORT]) or (broadcast)
   (let ((delivery (lab-setting lab 'delivery)))
@@ -80,14 +63,13 @@
         (spawn (lambda () (serve receive-call)) 'multicast)
         (spawn send-beacons 'beacon)))))
 
-;;> How publish and request reach the lab: \scheme{multicast} or
-;;> \scheme{broadcast}.
+;;> How publish and request reach the lab: \scheme{multicast} or \scheme{broadcast}.
 (define (delivery-mode) (if *group* 'multicast 'broadcast))
 
 ;;; Sending
 
-;; The sequence of the next datagram: two threads sending at once take
-;; two, else the receivers would drop the second as a replay.
+;; The next datagram's sequence: two threads sending at once take two,
+;; lest receivers drop the second as a replay.
 (define (next-sequence!)
   (with-lock (group-sequence-lock *group*)
     (lambda ()
@@ -108,8 +90,7 @@
 (define (beacon-seconds)
   (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
 
-;; A beacon each period, and out of the live set with whoever has not
-;; sent one for three.
+;; A beacon each period; out of the live set goes whoever missed three.
 (define (send-beacons)
   (let ((me (local-aspace)))
     (send-datagram! (make-message 'beacon (aspace-uid me) (aspace-host me)
@@ -128,8 +109,7 @@
 
 ;;; Receiving
 ;;
-;; On the path of every call that comes by the group: no let, match,
-;; with-lock or hash-table-ref/default (docs/speed.md, What Chibi charges).
+;; On every group call's path: no let, match or with-lock (docs/speed.md).
 
 (define (receive-call)
   (let ((n (receive! (group-socket *group*) (group-buffer *group*))))
@@ -137,11 +117,9 @@
          (not (datagram-from? (group-buffer *group*) n (group-own-head *group*)))
          (heard (open-datagram (group-buffer *group*) n)))))
 
-;; The call that datagram d carries, once its sender is heard from.  Our
-;; own datagrams, looped back, are dropped before (receive-call), unread:
-;; a multicast requester read its every call back.  One that names us
-;; otherwise written (only a holder of the key could send it) is dropped
-;; here.  Our own uid thus has no last-heard, and never leaves the live set.
+;; The call datagram d carries, once its sender is heard from.  Our own,
+;; looped back, are dropped unread before (receive-call); one naming us
+;; otherwise written is dropped here, so our uid never leaves the live set.
 (define (heard d)
   (lock! (group-last-heard-lock *group*))
   (hash-table-set! (group-last-heard *group*) (datagram-sender d) (monotonic-seconds))
@@ -149,8 +127,7 @@
   (and (not (eq? (datagram-sender d) (local-aspace-uid)))
        (datagram-call (datagram-sender d) (datagram-body d))))
 
-;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram, the first n
-;; bytes of buffer.
+;; The (SENDER SEQUENCE BODY) of an authentic, fresh datagram in buffer.
 (define (open-datagram buffer n)
   (fresh-datagram (check-datagram (open-datagram-text buffer n))))
 
@@ -160,7 +137,6 @@
                    (datagram-sequence d))
   d)
 
-;; A datagram's fields, as check-datagram passed them.
 (define (datagram-sender d) (car d))
 (define (datagram-sequence d) (cadr d))
 (define (datagram-body d) (list-ref d 2))
@@ -175,9 +151,7 @@
         ((< sequence (- (wall-microseconds) (* 1000000 (group-window *group*))))
          (frame-fail "older than frame-timeout"))))
 
-;;> A call that came by the group: from address space \var{sender}, its
-;;> \var{id} there, \var{kind} run or apply, and its procedure and
-;;> arguments encoded.
+;;> A call that came by the group: sender, \var{id}, \var{kind}, procedure and arguments.
 (define-record-type group-call
   (make-group-call sender id kind proc-code args-code)
   group-call?
@@ -187,13 +161,11 @@
   (proc-code group-call-proc-code)
   (args-code group-call-args-code))
 
-;; A beacon brings its sender (back) into the live set; a call is the
-;; caller's to serve.
+;; A beacon brings its sender (back) into the live set; a call is served.
 (define (datagram-call sender body)
   (group-call-of sender (check-message body '(beacon call) "a beacon or a call")))
 
-;; A call's fields taken by their places in the wire's table of messages
-;; (wire/frame.scm).
+;; By the places in wire/frame.scm's table of messages.
 (define (group-call-of sender message)
   (if (eq? (car message) 'call)
       (make-group-call sender (message-id message) (list-ref message 2)

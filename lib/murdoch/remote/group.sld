@@ -1,6 +1,5 @@
 ;;> The lab's multicast group: authentic datagrams that cannot be
-;;> replayed, and beacons that keep the live set.  What a call means is
-;;> left to the procedure start-group! is handed.
+;;> replayed, and beacons that keep the live set.
 
 (define-library (murdoch remote group)
   (export start-group! delivery-mode send-datagram!

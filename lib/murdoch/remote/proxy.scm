@@ -1,10 +1,6 @@
-;;;; Proxies (the thesis's encap): a procedure that runs where it was made.
-;;
-;; A proxy travels as its maker's uid and an id (sendable.scm); applied
-;; elsewhere, it is a remote-apply back to its maker.
+;;;; Proxies (the thesis's encap): a procedure that runs where it was made,
+;;;; travelling as its maker's uid and an id.
 
-;; The proxies made here and the stubs of those made elsewhere.  Global:
-;; a proxy made in any thread is applied from any connection.
 (define-record-type proxies
   (make-proxies made stubs lock next-id)
   proxies?
@@ -13,6 +9,7 @@
   (lock proxies-lock)
   (next-id proxies-next-id proxies-next-id-set!))
 
+;; Global: a proxy made in any thread is applied from any connection.
 (define *proxies* (make-proxies (make-hash-table eqv?) (make-hash-table equal?)
                                 (make-mutex 'proxies) 0))
 
@@ -28,9 +25,8 @@
         (hash-table-set! (proxies-made *proxies*) id proc)
         (proxy-stub (local-aspace-uid) id)))))
 
-;;> Forgets \var{proxy} here: where it was made, the procedure behind it,
-;;> so that applying it afterwards raises an error; elsewhere, only this
-;;> address space's copy of it, which a later message may bring back.
+;;> Forgets \var{proxy} here: where it was made, applying it afterwards
+;;> raises; elsewhere only this copy goes, which a later message may bring back.
 (define (release-proxy! proxy)
   (let ((ref (proxy-procedure-ref proxy)))
     (with-proxies
@@ -40,8 +36,7 @@
         (hash-table-delete! (proxies-stubs *proxies*)
                             (cons (proxy-ref-uid ref) (proxy-ref-id ref)))))))
 
-;; The one proxy procedure this address space has for (uid . id), so that
-;; a proxy sent back and forth stays the same proxy.  Caller holds the lock.
+;; The one proxy procedure for (uid . id), kept the same; caller holds the lock.
 (define (proxy-stub uid id)
   (let ((key (cons uid id)))
     (or (hash-table-ref/default (proxies-stubs *proxies*) key #f)

@@ -1,18 +1,13 @@
 ;;;; Serving calls: the callee's side of the wire.
 ;;
-;; The poller (connection.scm) reads each connection from its hello until
-;; its first call: the hello, the answers to our datagram calls and the
-;; abandons need no thread, and a requester gets an answer to each of its
-;; multicast requests on every peer's connection.  At its first call the
-;; connection gets a reader thread of its own, which reads on from the
-;; poller's buffer and runs an apply itself, not in a worker (docs/speed.md,
-;; What Chibi charges).  So that a long apply holds up the calls behind it
-;; on its connection for takeover-seconds at most, the janitor then gives
-;; the connection a new reader; the old one answers its call and ends.
+;; The poller (connection.scm) reads a connection until its first call:
+;; the hello, answers to our datagram calls and abandons need no thread.
+;; Then the connection gets a reader thread, which runs each apply itself
+;; (docs/speed.md); an apply that runs past takeover-seconds has the
+;; janitor give the connection a new reader, and the old one ends after it.
 
-;; A connection being served.  Its deadline is set while a frame is half
-;; read: a peer that stalls mid-frame would otherwise hold a thread and a
-;; socket for ever, so the janitor ends it when the deadline passes.
+;; A connection served; its deadline, set while a frame is half read, lets
+;; the janitor end a peer that stalls.
 (define-record-type serving
   (make-serving peer host thread in out)
   serving?
@@ -29,9 +24,7 @@
   (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
   (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
 
-;; The server: the connections this address space serves, and the lab's
-;; limits on them, made by start-serving!.  Global: one per process, shared
-;; by its accept loop, its readers and the janitor.
+;; The connections served and the lab's limits on them.
 (define-record-type server
   (make-server frame-timeout max-connections max-connections-per-host
                servings lock janitor-mutex janitor-wake janitor-resting?
@@ -59,14 +52,12 @@
     (serving-thread-set! s #f)
     (serving-fd-set! s (port-fileno (serving-in s)))
     ;; The hello, which proves the key, is due within frame-timeout of the
-    ;; connect: anyone can connect, and an idle connection holds a
-    ;; descriptor.
+    ;; connect: anyone can connect, and a connection holds a descriptor.
     (serving-deadline-set! s (+ (monotonic-seconds) (server-frame-timeout *server*)))
     (janitor-wanted!)
     (watch-served! (serving-in s) s take-polled! polled-fault!)))
 
-;; A connection (or the multicast group: no ports, no host) that this
-;; thread reads, among those the janitor watches.
+;; A connection (or the multicast group) that this thread reads.
 (define (new-serving! peer host in out)
   (let ((s (make-serving peer host (current-thread) in out)))
     (serving-deadline-set! s #f)
@@ -79,8 +70,7 @@
       (lambda () (server-servings-set! *server* (cons s (server-servings *server*)))))
     s))
 
-;; Runs a reader's loop; the connection ends with it, unless the janitor
-;; has given it a new reader meanwhile.
+;; Runs a reader's loop; the connection ends with it, unless handed on.
 (define (read-as-reader s thunk)
   (guard (e (#t (let-go-of-writes! s)
                 (log-fault (serving-peer s) e)))
@@ -89,9 +79,8 @@
 
 (define (reader? s) (eq? (current-thread) (serving-thread s)))
 
-;; Once: the janitor and the connection's reader may both end it.  The
-;; poller lets go of the descriptor before it closes: a closed number may
-;; be another connection's next.
+;; Once: the janitor and the reader may both end it.  The poller lets go of
+;; the descriptor first, as a closed number may be another connection's next.
 (define (end-serving! s)
   (when (with-lock (server-lock *server*)
           (lambda ()
@@ -106,12 +95,8 @@
 
 ;;; Frames as the poller reads them
 
-;; The frames, eof or fault that poller-frames! read from s, whose
-;; reader is the poller: the hello; then the answers to our datagram calls
-;; and abandons, served here; at the first call, s and what is left of
-;; items go to a reader thread.  A frame begun and not whole has
-;; frame-timeout to come whole (the janitor ends s if not); the hello
-;; keeps the deadline of the connect.
+;; The frames, eof or fault the poller read from s: hello, answers and
+;; abandons are served here; at the first call s goes to a reader thread.
 (define (take-polled! s items)
   (cond ((null? items) (await-whole! s))
         ((bytevector? (car items))
@@ -123,7 +108,6 @@
         ((eof-object? (car items)) (end-serving! s))
         (else (protocol-fail "netstring" (car items)))))
 
-;; A procedure of its own, not a let (docs/speed.md).
 (define (take-opened! s message rest)
   (if (memq (car message) '(run apply))
       (hand-to-reader! s (cons message rest))
@@ -138,13 +122,11 @@
            (janitor-wanted!)))
         ((serving-greeting s) (serving-deadline-set! s #f))))
 
-;; A frame that breaks the protocol, or a hello that is wrong, ends its
-;; connection, and the log says why.
+;; A frame that breaks the protocol, or a wrong hello, ends its connection.
 (define (polled-fault! s e)
   (log-fault (serving-peer s) e)
   (end-serving! s))
 
-;; s gets a reader thread, which serves frames first.
 (define (hand-to-reader! s frames)
   (unwatch-served! (serving-fd s) #t)
   (serving-frames-set! s frames)
@@ -154,10 +136,8 @@
     (with-lock (server-lock *server*) (lambda () (serving-thread-set! s t)))
     (thread-start! t)))
 
-;; The next message of s for its reader thread, or an eof object; waits
-;; as long as need be for a frame to begin, then gives it the lab's
-;; frame-timeout to come whole.  From here to answer-call, no let
-;; (docs/speed.md, What Chibi charges).
+;; The next message of s for its reader, or an eof object; a frame begun
+;; has frame-timeout to come whole.  No let to answer-call (docs/speed.md).
 (define (read-served s)
   (opened s (next-served-frame s)))
 
@@ -180,9 +160,7 @@
   (serving-frames-set! s (cdr frames))
   (car frames))
 
-;; The message of the frame whose payload is bytes, s's next, checked to
-;; be one a caller may send.  It came whole: a deadline set for it is met
-;; (await-whole! sets one for the next when part of it waits).
+;; The message of s's next frame, checked to be one a caller may send.
 (define (open-served s bytes)
   (open-counted s (serving-greeting s) bytes))
 
@@ -201,19 +179,17 @@
   (rest-while-idle)
   (janitor))
 
-;; The connections whose (moment s) is before time.
 (define (serving-where moment time)
   (with-lock (server-lock *server*)
     (lambda ()
       (filter (lambda (s) (let ((t (moment s))) (and t (< t time))))
               (server-servings *server*)))))
 
-;; The janitor rests while no frame is half read and no apply runs in a
-;; reader (docs/speed.md).  A reader that begins either wakes it
-;; (janitor-wanted!).  The janitor raises its flag before it looks and holds
-;; its mutex from the flag to the wait; a reader sets what it begins before
-;; it reads the flag.  So either the look sees what the reader began, or the
-;; reader sees the flag and its wake-up finds the janitor waiting.
+;; The janitor rests while no frame is half read and no reader applies
+;; (docs/speed.md).  It raises its flag before it looks and holds its
+;; mutex from the flag to the wait; a reader sets what it begins before it
+;; reads the flag: so either the look sees it, or its wake-up finds the
+;; janitor waiting.
 (define (rest-while-idle)
   (let ((m (server-janitor-mutex *server*)))
     (lock! m)
@@ -249,9 +225,8 @@
       (thread-start! t)))
   (unlock! (server-lock *server*)))
 
-;;> Run by an apply served here that runs long, a task's component say:
-;;> its connection gets a new reader at once, so that the caller's next
-;;> calls do not wait behind it for the janitor's takeover.
+;;> Run by an apply that runs long, a task's component say: its connection
+;;> gets a new reader now, so the caller's next calls do not wait.
 (define (hand-over-connection!)
   (lock! (server-lock *server*))
   (let ((s (find (lambda (s) (and (eq? (serving-thread s) (current-thread))
@@ -260,9 +235,8 @@
     (unlock! (server-lock *server*))
     (if s (take-over! s))))
 
-;; Marks the start and the end of the reader's inline apply of call id;
-;; ending answers whether this thread is still the reader.  Until it ends,
-;; the thread is found by id when its caller gives up.
+;; Marks the reader's inline apply of call id, during which a caller giving
+;; up finds the thread; ending answers whether it is still the reader.
 (define (inline-apply-begins! s id)
   (lock! (server-lock *server*))
   (serving-applying-set! s (cons (cons id (current-thread))
@@ -282,16 +256,14 @@
   (if (abandoned?) (forget-abandoned! (current-thread)))
   still)
 
-;; The entries of applying but thread's; not remove (docs/speed.md).
+;; Not remove (docs/speed.md).
 (define (without-thread applying thread)
   (cond ((null? applying) '())
         ((eq? (cdar applying) thread) (without-thread (cdr applying) thread))
         (else (cons (car applying) (without-thread (cdr applying) thread)))))
 
-;;> Lets the call that \var{thread} runs here go from its caller: the
-;;> caller giving it up no longer stops it.  A detached task's component
-;;> that a new coordinator adopts (task/running.scm) is not stopped by the
-;;> old one's call, given up when it let the task go.
+;;> Lets the call that \var{thread} runs here go from its caller, whose
+;;> giving up no longer stops it: a component a new coordinator adopts.
 (define (release-call! thread)
   (with-lock (server-lock *server*)
     (lambda ()
@@ -299,8 +271,7 @@
                   (serving-applying-set! s (without-thread (serving-applying s) thread)))
                 (server-servings *server*)))))
 
-;; The caller of apply id gave up on it: its thread is marked, to stop
-;; where it next calls out (abandon.scm).  An apply already done is let be.
+;; The caller of apply id gave up: its thread is marked to stop (code/abandon.scm).
 (define (abandon-call! s id)
   (let ((a (with-lock (server-lock *server*) (lambda () (assv id (serving-applying s))))))
     (when a
@@ -323,9 +294,8 @@
               (refuse-connection! fd peer))))
     (accept-loop listener addr)))
 
-;; Whether a connection from host stays under the lab's caps, in all and
-;; from one host: past them, connections that never say hello could take
-;; every descriptor the process has.
+;; Whether a connection from host stays under the lab's caps, in all and a
+;; host: connections that never say hello could take every descriptor.
 (define (room-for? host)
   (with-lock (server-lock *server*)
     (lambda ()
@@ -343,9 +313,7 @@
     (log-warn "connection from " peer " refused: over max-connections"
               " or max-connections-per-host")))
 
-;;> Starts serving calls to the local address space, under the limits of
-;;> \var{lab}: listens on its port, or on a free one for port 0, and starts
-;;> the janitor.
+;;> Serves calls here under \var{lab}'s limits, and starts the janitor.
 (define (start-serving! lab)
   (set! *server*
         (make-server (lab-setting lab 'frame-timeout) (lab-setting lab 'max-connections)

@@ -1,6 +1,5 @@
-;;> The callee's side of the wire: accepting connections, reading calls,
-;;> running them, and the janitor that ends stalled connections and
-;;> relieves readers held by a long apply.
+;;> The callee's side of the wire: accepting connections, reading and
+;;> running calls, and the janitor.
 
 (define-library (murdoch remote serve)
   (export start-serving! hand-over-connection! release-call!

@@ -1,9 +1,6 @@
-;;;; Served calls, part of (murdoch remote serve): reading a connection's
-;;;; calls, running them and writing their answers.
+;;;; Served calls, part of (murdoch remote serve): reading, running, answering.
 
-;; A call that a reader has read, from a connection or the group: who
-;; sent it, its id, what it applies, and how it is answered, a procedure
-;; of the connection's or the group's (see reply!).
+;; A call read from a connection or the group, answered their way (reply!).
 (define-record-type served-call
   (make-served-call caller id kind proc-code args-code answer)
   served-call?
@@ -14,23 +11,19 @@
   (args-code served-call-args-code)
   (answer served-call-answer))          ; (answer C KIND VALUE)
 
-;;> Answers served call \var{c}: \var{kind} ack, value or error, and
-;;> \var{value}, the encoded value or the error's message.
+;;> Answers served call \var{c}: \var{kind} ack, value or error, and its \var{value}.
 (define (reply! c kind value) ((served-call-answer c) c kind value))
 
-;; A thread reading s's calls: the call it runs, until its answer is made,
-;; for read-calls to answer an error to.
+;; A thread reading s's calls, and the call it runs until answered.
 (define-record-type reading
   (make-reading serving call)
   reading?
   (serving reading-serving)
   (call reading-call reading-call-set!))
 
-;; Runs (read-on r) while this thread is s's reader, r its reading, under
-;; one handler for the thread's life (docs/speed.md, What Chibi charges).
-;; An error in the call r runs is answered by (answer-error call e), once
-;; what the call wrote is flushed (see call-in-sandbox); any other by
-;; (other-failure e), which may raise to end the reader.
+;; Runs (read-on r) while this thread is s's reader, under one handler
+;; (docs/speed.md).  An error in r's call is answered by (answer-error
+;; call e) once its output is flushed; any other goes to (other-failure e).
 (define (read-calls s read-on answer-error other-failure)
   (let ((r (make-reading s #f)))
     (let again ()
@@ -45,10 +38,8 @@
                     (if (reader? s) (again))))
         (read-on r)))))
 
-;; Runs call c, which reading r has read.  A run is acknowledged once its
-;; procedure is decoded, so that one that cannot be is reported to its
-;; caller, and runs in a worker; an apply runs here, until the janitor
-;; gives r's connection a new reader, and its value goes back.
+;; Runs call c: a run is acknowledged once decoded, and runs in a worker;
+;; an apply runs here until the janitor hands the connection on.
 (define (serve-call r c)
   (reading-call-set! r c)
   (if (eq? (served-call-kind c) 'run)
@@ -62,14 +53,12 @@
 
 (define (serve-apply r s c)
   (inline-apply-begins! s (served-call-id c))
-  ;; Answered while the call is r's: a value that cannot go back (too
-  ;; large, say) is answered with the error instead.
+  ;; Answered while the call is r's; a value too large gets the error.
   (reply! c 'value (encoded-result c))
   (reading-call-set! r #f)
   (inline-apply-ends! s))
 
-;; What a connection knows once its caller has said hello: who called,
-;; the nonces each side MACs with, and the count of frames each way.
+;; What a connection knows after hello: the caller, the nonces, the counts.
 (define-record-type greeting
   (make-greeting uid caller-nonce nonce text write-lock answer count sent flushed)
   greeting?
@@ -83,11 +72,9 @@
   (sent greeting-sent greeting-sent-set!)       ; frames written
   (flushed greeting-flushed greeting-flushed-set!)) ; sent when last flushed
 
-;; Welcomes the caller of hello, which the poller read on s.
 (define (greet! s hello)
   (match (check-message hello '(hello) "a hello")
     (('hello uid host port caller-nonce)
-     ;; Where the caller listens, learned from its hello.
      (learn-aspace! (make-aspace uid host port))
      (let ((g (make-greeting uid caller-nonce (random-hex 16) (open-output-string)
                              (make-mutex)
@@ -99,7 +86,6 @@
        (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
                     (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))))
 
-;; Serves s's frames while this thread is its reader; see read-calls.
 (define (serve-greeted s)
   (read-calls s (lambda (r) (read-on s r))
               (lambda (c e)
@@ -118,22 +104,16 @@
     (flush-if-idle! s (serving-greeting s))
     (if (reader? s) (read-on s r))))
 
-;; Answers served call c on s.
 (define (answer-call s c kind value)
   (if (eq? kind 'ack)
       (answer! s (serving-greeting s) (make-message 'ack (served-call-id c)) #f)
       (answer! s (serving-greeting s) (make-message kind (served-call-id c) value)
                #t)))
 
-;; The reader's own answers wait in the port's buffer until it has read
-;; every call that has arrived: a burst of calls is answered in one write.
-;; A value or an error, last? true, is flushed under the same lock when no
-;; call waits behind it; a run's ack waits for flush-if-idle!, after its
-;; worker has its procedure (docs/speed.md, Levers tried).  Answers from
-;; former readers go at once.  The write lock is taken by lock!, not
-;; with-lock (docs/speed.md, What Chibi charges): a raise under it, from a
-;; message too large or a caller that left, is let go of by the reader's
-;; handlers (let-go-of-writes!).
+;; The reader's answers wait in the buffer until it has read every call
+;; that arrived, for one write.  A value or error with no call behind it is
+;; flushed under the lock; an ack waits for flush-if-idle!.  The lock is
+;; taken by lock! (docs/speed.md); the reader's handlers let go after a raise.
 (define (answer! s g message last?)
   (lock! (greeting-write-lock g))
   (write-answer! s g (frame-text (greeting-text g) message))
@@ -151,10 +131,7 @@
   (flush-output-port (serving-out s))
   (greeting-flushed-set! g (greeting-sent g)))
 
-;; Nothing to flush after a frame that had no answer (the answers to our
-;; own datagram calls, which a requester gets from every peer): no lock
-;; taken for it.  Sent and flushed change under the write lock, and a
-;; writer flushes or comes here after its write.
+;; Nothing to flush after a frame that had no answer; under the write lock.
 (define (flush-if-idle! s g)
   (when (and (not (= (greeting-flushed g) (greeting-sent g)))
              (null? (serving-frames s)))
@@ -162,31 +139,24 @@
     (flush! s g)
     (unlock! (greeting-write-lock g))))
 
-;; The write lock of s, should this thread hold it: a raise under it
-;; (see answer!) leaves it held.
+;; Lets go of s's write lock, should a raise (see answer!) have left it held.
 (define (let-go-of-writes! s)
   (let ((g (serving-greeting s)))
     (if (and g (eq? (mutex-state (greeting-write-lock g)) (current-thread)))
         (unlock! (greeting-write-lock g)))))
 
-;; Serves one frame from the caller uid, read by r: a call, which answer
-;; answers, or one that needs no answer (serve-notice).
+;; Serves one frame from uid: a call, answered by answer, or a notice.
 (define (serve-frame r uid answer message)
   (if (memq (car message) '(run apply))
       (serve-call r (served-call-of message uid answer))
       (serve-notice (reading-serving r) uid message)))
 
-;; The served call that message, a run or an apply checked whole by
-;; open-served, asks for: its procedure and arguments taken by their
-;; places in the wire's table of messages (wire/frame.scm), not by match
-;; (docs/speed.md, What Chibi charges).
+;; The served call message asks for, by the places of wire/frame.scm's table.
 (define (served-call-of message uid answer)
   (make-served-call uid (message-id message) (car message) (list-ref message 2)
                     (list-ref message 3) answer))
 
-;; Serves a frame of s from uid that needs no answer: the answer to one
-;; of our datagram calls, or an abandon, checked whole by open-served.
-;; By cond, not match (docs/speed.md, What Chibi charges).
+;; Serves a frame that needs no answer: an answer or an abandon (by cond).
 (define (serve-notice s uid message)
   (if (eq? (car message) 'answer)
       (take-datagram-answer! uid message)
@@ -199,14 +169,11 @@
 (define (sandboxed-thunk proc args)
   (lambda () (call-in-sandbox proc args)))
 
-;; What the application call c asks for answers, encoded to go back.  No
-;; thunk made for it, as decode-call makes (docs/speed.md, What Chibi
-;; charges).
+;; What c's application answers, encoded (no thunk: docs/speed.md).
 (define (encoded-result c)
   (encode (call-in-sandbox (served-procedure c) (served-arguments c))
           (lab-environment) "the result"))
 
-;; The procedure and the arguments of served call c, decoded.
 (define (served-procedure c)
   (checked-procedure (decode-value (served-call-proc-code c))))
 

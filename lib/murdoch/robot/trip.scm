@@ -1,34 +1,20 @@
 ;;;; The MOVER robot primitives, spoken over trip (docs/trip-protocol.md).
 ;;;
-;;; One connection per robot, which the threads of the address space
-;;; share.  A thread sends its request under the connection's lock and
-;;; lets go at once; the connection's reader thread hands each reply to the
-;;; mailbox of the request with its tag (murdoch sys wait), and drops the rest
-;;; (tag 0, or a reply whose asker gave up).  So a request never holds the
-;;; connection while it waits, and a reply not back within (trip-timeout)
-;;; seconds raises a trip error naming robot and command.
-;;;
-;;; A motion (goto-xy, rotate, translate) ends with `base await', whose
-;;; reply the server holds back until the motion is over: the thread that
-;;; moves waits in its mailbox, up to (trip-motion-timeout), asking nothing
-;;; again and again, while other threads (the live view) read the robot on
-;;; the same connection.  A thread whose caller gives up (abandon.scm) is
-;;; woken in that wait and stops the robot.
-;;;
-;;; The primitives act on (current-robot), the connection of the address
-;;; space's own robot (#f on a workstation).  Devices are opened on first
-;;; use; (im) opens them all at once, as MOVER's did.
+;;; One connection a robot, shared by the address space's threads: a
+;;; request is sent under its lock, and the reader thread hands each reply
+;;; to its tag's mailbox, so no request holds the connection while it
+;;; waits.  A motion ends with `base await', answered when it is over; an
+;;; abandoned mover (code/abandon.scm) is woken and stops the robot.
+;;; Devices open on first use, or all with (im), as MOVER's did.
 
-;;> Seconds to wait for any reply.
+;;> Seconds to wait for any reply (the lab's trip-timeout, for the process's one robot).
 (define trip-timeout (make-parameter (lab-default 'trip-timeout)))
 
-;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is
-;;> stopped and an error raised.
+;;> Seconds a \scheme{goto-xy} or \scheme{rotate} may take before it is stopped (the lab's).
 (define trip-motion-timeout (make-parameter (lab-default 'trip-motion-timeout)))
 
-;;> The connection the primitives use: #f on a workstation.  Set it for
-;;> the whole address space with \scheme{set-current-robot!} (threads do
-;;> not inherit \scheme{parameterize}).
+;;> The connection the primitives use: #f on a workstation.  Global, as a
+;;> process drives one robot: set it with \scheme{set-current-robot!}.
 (define current-robot (make-parameter #f))
 
 (define (set-current-robot! c) (current-robot c))
@@ -45,8 +31,7 @@
   (and (exception? e) (eq? (exception-kind e) 'trip-error)))
 
 (define (trip-error-robot e) (car (exception-irritants e)))
-;;> The protocol's error code as a symbol: held, not-open, args, unknown,
-;;> timeout, closed, stalled ...
+;;> The protocol's error code as a symbol: held, not-open, args, timeout ...
 (define (trip-error-code e) (string->symbol (list-ref (exception-irritants e) 2)))
 (define (trip-error-text e) (list-ref (exception-irritants e) 3))
 
@@ -70,17 +55,13 @@
     (write-u8 etx out)
     (flush-output-port out)))
 
-;; The next byte or an eof object.  Waits for the socket (port-wait!), so
-;; that only this thread waits; the wait is long since the reader has no
-;; deadline: each request has its own.
+;; The next byte or an eof object, waiting on the socket (port-wait!).
 (define (next-byte in)
   (if (u8-ready? in)
       (read-u8 in)
       (begin (port-wait! in 3600) (next-byte in))))
 
-;; The next whole frame's payload as a string, or an eof object.  Bytes
-;; between frames and broken frames are skipped: the server never sends
-;; them.
+;; The next whole frame's payload as a string, or an eof object.
 (define (read-frame in)
   (let outside ()
     (let ((b (next-byte in)))
@@ -128,8 +109,7 @@
       (string-append (trip-connection-host c) ":"
                      (number->string (trip-connection-port c)))))
 
-;;> Connects to the trip server of one robot and returns the connection;
-;;> its name is the robot's, as the server says.
+;;> Connects to the trip server of one robot and returns the connection.
 (define (trip-connect host port)
   (let ((io (open-connection host port (trip-timeout))))
     (if (string? io)
@@ -152,17 +132,14 @@
 (define (trip-close c)
   (with-lock (trip-connection-lock c) (lambda () (shut! c))))
 
-;; Close the socket once; the caller holds the lock.  Closing both ports
-;; closes it; closing its number again could close a socket that has taken
-;; it.  The reader then finds the end of its input, and ends.
+;; Close the socket once, under the lock, lest its number be another's.
 (define (shut! c)
   (when (trip-connection-open? c)
     (trip-connection-open?-set! c #f)
     (guard (e (#t #f)) (close-input-port (trip-connection-in c)))
     (guard (e (#t #f)) (close-output-port (trip-connection-out c)))))
 
-;; The connection's reader: each reply to the mailbox of its request, until
-;; the connection ends (or is closed here, which makes the port fail).
+;; The connection's reader: each reply to its request's mailbox, until the end.
 (define (read-replies c)
   (let ((frame (guard (e (#t (eof-object))) (read-frame (trip-connection-in c)))))
     (if (eof-object? frame)
@@ -173,14 +150,12 @@
           (if mb (mailbox-put! mb reply))
           (read-replies c)))))
 
-;; The mailbox waiting for the reply tagged tag, which no longer waits, or
-;; #f if none does (tag 0, or a request that gave up).
+;; The mailbox waiting for tag's reply, taken, or #f (tag 0, or gave up).
 (define (take-waiting! c tag)
   (with-lock (trip-connection-lock c)
     (lambda () (take-mailbox! (trip-connection-waiting c) tag))))
 
-;; Close c at its end, and take the mailboxes of the requests that still
-;; wait: no reply will come to them.  The next request connects again.
+;; Close c and take the mailboxes still waiting; the next request connects again.
 (define (close-for-good! c)
   (with-lock (trip-connection-lock c)
     (lambda ()
@@ -188,10 +163,8 @@
       (shut! c)
       (take-all-mailboxes! (trip-connection-waiting c)))))
 
-;; A connection the server ended (a robot's trip server that died, and
-;; that its lab starts again) connects again, once, for the request about
-;; to be sent, and opens again the devices it had open; a server still
-;; away is the error closed, as a lost connection is.
+;; A connection the server ended (a restarted trip server) connects again,
+;; once, and reopens its devices; a server still away is the error closed.
 (define (reconnect! c command)
   (with-lock (trip-connection-relock c)
     (lambda ()
@@ -239,9 +212,8 @@
 
 (define (reply-value w) (or (string->number w) w))
 
-;; Send one request and return the values of its ok reply; raise a trip
-;; error for an err reply, a lost connection or no reply in time.  In a
-;; call whose caller gave up, raise instead of sending (abandon.scm).
+;; Sends one request and returns its ok reply's values, or raises a trip
+;; error (err reply, lost connection, timeout, abandoned call).
 (define (request c . words)
   (let ((command (join (map ->word words))))
     (exchange c command (+ (monotonic-seconds) (trip-timeout))
@@ -250,10 +222,8 @@
                             (string-append "no reply within "
                                            (number->string (trip-timeout)) " s"))))))
 
-;; Send command, and return the values of its ok reply once it comes, by
-;; deadline (on the monotonic clock); else call too-late, which raises.
-;; The thread waits in a mailbox, not holding the connection, and is woken
-;; there should its caller give up.
+;; Sends command and returns its reply's values by deadline, else
+;; (too-late); waits in a mailbox, woken should its caller give up.
 (define (exchange c command deadline too-late)
   (let ((mb (make-mailbox)))
     (define (fail code text) (trip-error (robot-name c) command code text))
@@ -264,7 +234,7 @@
        (if (trip-connection-lost? c) (reconnect! c command))
        (let* ((tag (send! c command mb fail))
               (reply (mailbox-take mb deadline (lambda () 'late))))
-         ;; A reply that comes after all finds no mailbox, and is dropped.
+         ;; A late reply finds no mailbox and is dropped.
          (when (symbol? reply)
            (take-waiting! c tag))
          (case reply
@@ -274,7 +244,7 @@
            ((lost) (fail "closed" "connection lost"))
            (else (reply-values reply fail))))))))
 
-;; Write command under a new tag, whose reply mailbox mb is to get; the tag.
+;; Writes command under a new tag, for mailbox mb; answers the tag.
 (define (send! c command mb fail)
   (with-lock (trip-connection-lock c)
     (lambda ()
@@ -295,9 +265,7 @@
       (fail (if (pair? (cddr reply)) (car (cddr reply)) "protocol")
             (join (if (pair? (cddr reply)) (cdr (cddr reply)) reply)))))
 
-;;> One raw request on connection \var{c}: words are joined with spaces
-;;> (numbers, symbols and strings); returns the values of the reply.  For
-;;> tools and tests, e.g. \scheme{(trip-request c 'buttons 'press 2)}.
+;;> One raw request on \var{c}, words joined with spaces: \scheme{(trip-request c 'buttons 'press 2)}.
 (define trip-request request)
 
 ;;; Devices
@@ -320,9 +288,7 @@
     (apply request c device words)))
 
 ;;> MOVER's initialisation: opens every device of the current robot, so
-;;> that a device held elsewhere shows up now rather than mid-task.  A
-;;> device the robot has not (\scheme{unknown}: a ROS 2 robot without
-;;> bumpers, say) stays closed, and its commands say so when used.
+;;> that one held elsewhere shows now, not mid-task.
 (define (im)
   (for-each (lambda (d)
               (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) #f))
@@ -332,9 +298,8 @@
 
 ;;; Motion
 
-;; Wait until the base's motion is over (base await); the final
-;; odometry pose.  A motion not over by (trip-motion-timeout) is stopped.
-;; In a call whose caller gave up, the robot is stopped where it is.
+;; Waits for the motion's end (base await): the final pose.  Stopped past
+;; (trip-motion-timeout), or when the caller gave up.
 (define (await-motion what)
   (let* ((c (robot))
          (end (guard (e ((abandoned-error? e)
@@ -349,8 +314,7 @@
         (trip-error (robot-name c) what "stalled" "the base is blocked"))
     (list (car end) (cadr end) (car (cddr end)) 0)))
 
-;;> Drives to \var{xy}, a list (x y) in millimetres of the odometry frame:
-;;> turns to face it, then goes.  Returns the pose reached, as reckon.
+;;> Drives to \var{xy}, (x y) in mm of the odometry frame, facing it first; the pose reached.
 (define (goto-xy xy)
   (let ((c (robot)))
     (dynamic-wind
@@ -360,15 +324,13 @@
        (await-motion "goto-xy"))
      (lambda () (trip-connection-goal-set! c #f)))))
 
-;;> Where the robot's goto-xy is driving it, (x y), or #f when it is not:
-;;> the live view draws it.
+;;> Where the robot's goto-xy is driving it, (x y), or #f (for the view).
 (define (goto-goal)
   (let ((c (current-robot)))
     (and c (trip-connection-goal c))))
 
-;;> \scheme{(rotate 'by degrees)} turns in place by an angle (counter-
-;;> clockwise positive); \scheme{(rotate 'to heading)} turns to a heading.
-;;> Returns the pose reached.
+;;> \scheme{(rotate 'by degrees)} turns in place (counter-clockwise positive);
+;;> \scheme{(rotate 'to heading)} turns to a heading.
 (define (rotate how degrees)
   (let ((by (case how
               ((by) degrees)
@@ -388,10 +350,8 @@
     (let ((w (- a (* 360 (round (/ a 360))))))
       (if (<= w -180) (+ w 360) w))))
 
-;;> The robot's own clock, seconds: the simulator's time (`T time`), which
-;;> runs at its speed against the wall clock and slips when the machine is
-;;> too slow to keep up, so that a robot counting time by it keeps pace
-;;> with the world it moves in.
+;;> The robot's own clock, seconds: the simulator's time, which slips when
+;;> the machine cannot keep up, so a robot timing by it keeps its world's pace.
 (define (robot-time) (/ (car (request (robot) "time")) 1000.))
 
 ;;> Translation (mm/s) and rotation (deg/s) velocities, until changed.
@@ -414,11 +374,10 @@
 (define (sonar-start) (device 'sonar "start") #t)
 ;;> Stops the sonar ring.
 (define (sonar-stop) (device 'sonar "stop") #t)
-;;> The 16 sonar ranges in mm, sonar 0 facing ahead, counter-clockwise;
-;;> the latest reading, which stays after \scheme{sonar-stop}.
+;;> The 16 sonar ranges in mm, sonar 0 ahead, counter-clockwise; the
+;;> latest, kept after \scheme{sonar-stop}.
 (define (sonar-read) (device 'sonar "read"))
-;;> The 16 infrared ranges in mm, as sonar-read's; the longest range
-;;> means nothing seen.
+;;> The 16 infrared ranges in mm; the longest means nothing seen.
 (define (ir-read) (device 'ir "read"))
 ;;> The 12 front bumpers: 1 for each one pressed, else 0.
 (define (bumpers-read) (device 'bumpers "read"))
@@ -427,8 +386,7 @@
 ;;> The buttons pressed since the last call, as four 0/1.
 (define (buttons-read) (device 'buttons "read"))
 
-;;> Sets the four LEDs from a list or four arguments of 0/1 or #f/#t;
-;;> with none, answers them.
+;;> Sets the four LEDs from a list or four 0/1 or #f/#t; with none, answers them.
 (define (lights . which)
   (let ((ls (if (and (pair? which) (list? (car which))) (car which) which)))
     (if (null? ls)
@@ -447,13 +405,8 @@
                      things)))
   #t)
 
-;;> The boxes the fiducial finder sees (docs/trip-protocol.md, Stage's
-;;> fiducial finder), nearest first, as (ID RANGE BEARING ORIENTATION)
-;;> each: ID the box's index among the lab's boxes, RANGE in mm to its
-;;> centre, BEARING in degrees from the heading (counter-clockwise), and
-;;> ORIENTATION the box's heading less the robot's, in degrees.  Only boxes
-;;> within range and the field of view, and in sight; () when none.
-;;> fiducial-id and the other fiducial- procedures read each.
+;;> The boxes the fiducial finder sees (docs/trip-protocol.md), nearest
+;;> first, as (ID RANGE BEARING ORIENTATION), in mm and degrees; () for none.
 (define (fiducials)
   (let loop ((words (cdr (device 'fiducial "read"))) (seen '()))
     (if (null? words)
@@ -463,21 +416,19 @@
                           (cadr (cddr words)))
                     seen)))))
 
-;;> The ID, the box's index among the lab's boxes, of \var{f}, one box
-;;> that fiducials answers.
+;;> The ID, the box's index among the lab's boxes, of \var{f}, one of fiducials'.
 (define (fiducial-id f) (car f))
 
-;;> The RANGE in mm of \var{f}, one box that fiducials answers.
+;;> The RANGE in mm of \var{f}, one of fiducials'.
 (define (fiducial-range f) (cadr f))
 
-;;> The BEARING in degrees of \var{f}, one box that fiducials answers.
+;;> The BEARING in degrees of \var{f}, one of fiducials'.
 (define (fiducial-bearing f) (car (cddr f)))
 
-;;> The ORIENTATION in degrees of \var{f}, one box that fiducials answers.
+;;> The ORIENTATION in degrees of \var{f}, one of fiducials'.
 (define (fiducial-orientation f) (cadr (cddr f)))
 
-;;> The battery in tenths of a volt, an integer (136 for 13.6 V): the unit
-;;> of the thesis's thresholds (130 charging, 100 low, 140 a workstation).
+;;> The battery in tenths of a volt, an integer (136 for 13.6 V), the thesis's unit.
 (define (battery-voltage)
   (exact (round (* 10 (car (device 'battery "read"))))))
 
@@ -492,23 +443,19 @@
 (define (safe-im)
   (if (current-robot) (im) #t))
 
-;;> The battery on a robot; on a workstation, or a robot that has no
-;;> battery reading (a ROS 2 robot without BatteryState), 140, high
-;;> enough to count as charging.
+;;> The battery on a robot; elsewhere, or with no reading, 140: enough to count as charging.
 (define (safe-battery-voltage)
   (if (current-robot)
       (guard (e ((and (trip-error? e) (eq? (trip-error-code e) 'unknown)) 140))
         (battery-voltage))
       140))
 
-;;> Where a workstation says it is, (x y heading) from its lab clause
-;;> \scheme{(position X Y HEADING)}; #f when it has none.  Set it once, as
-;;> \scheme{(workstation-position '(-1524 -2743.2 90))}.
+;;> Where a workstation says it is, (x y heading), or #f.  Global, as a
+;;> process is one machine: set it once, \scheme{(workstation-position '(-1524 -2743.2 90))}.
 (define workstation-position (make-parameter #f))
 
-;;> \scheme{reckon} on a robot; on a workstation its fixed \var{position},
-;;> by default \scheme{(workstation-position)}, as (x y heading 0); #f when
-;;> it has none.
+;;> \scheme{reckon} on a robot; on a workstation its fixed \var{position}
+;;> (default \scheme{(workstation-position)}) as (x y heading 0), or #f.
 (define (safe-reckon . position)
   (let ((p (if (pair? position) (car position) (workstation-position))))
     (cond ((current-robot) (reckon))

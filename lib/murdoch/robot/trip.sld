@@ -1,6 +1,5 @@
-;;> The MOVER robot primitives over trip (docs/trip-protocol.md): the
-;;> procedures the thesis's robot code calls, acting on the robot whose
-;;> trip connection is \scheme{(current-robot)}.
+;;> The MOVER robot primitives over trip (docs/trip-protocol.md), acting
+;;> on \scheme{(current-robot)}'s connection.
 (define-library (murdoch robot trip)
   (export trip-connect trip-close trip-request trip-connection? trip-timeout
           trip-motion-timeout

@@ -1,6 +1,4 @@
-;;;; One-line log messages on standard error.
-;;
-;; (chibi log) would do, but loads slowly (docs/speed.md).
+;;;; One-line log messages on standard error ((chibi log) loads slowly).
 
 ;; Global: every thread of the process logs under one name, set at start.
 (define *log-name* "murdoch")
@@ -8,22 +6,18 @@
 ;;> Names this process in log lines, e.g. "murdoch troy".
 (define (set-log-name! name) (set! *log-name* name))
 
+;; Global: the process writes one log, stamped or not.
 (define *stamped?* #f)
 
-;;> Starts each log line with the time, in UTC to the millisecond: for an
-;;> address space, whose log is a file; a person at a REPL sees its lines
-;;> as they come.
+;;> Starts each log line with the UTC time to the millisecond.
 (define (stamp-log-lines!) (set! *stamped?* #t))
 
-;;> Seconds since 1970 by the system's clock, UTC: what a person or a
-;;> file is shown.  (scheme time)'s current-second counts TAI seconds,
-;;> 37 ahead of the clock on the wall.
+;;> Seconds since 1970 by the system's clock, UTC (current-second is TAI's, 37 ahead).
 (define (utc-seconds)
   (let ((tv (car (get-time-of-day))))
     (+ (timeval-seconds tv) (/ (timeval-microseconds tv) 1000000.))))
 
-;; "2026-11-25T03:19:13.123Z " for seconds since 1970 (the civil date of
-;; a count of days, as in H. Hinnant's chrono algorithms).
+;; "2026-11-25T03:19:13.123Z " for seconds since 1970 (H. Hinnant's civil dates).
 (define (timestamp seconds)
   (let* ((ms (exact (floor (* 1000 seconds))))
          (days (floor-quotient ms 86400000))
@@ -51,10 +45,7 @@
         (string-append (make-string (- width (string-length s)) #\0) s)
         s)))
 
-;; The line is made whole, then written by one write-string: written in
-;; pieces, it was cut into by another thread's line (log-test), and the lab
-;; script, which waits for an address space's "listening on", stopped a
-;; lab whose line came out inside a warning.
+;; Written whole by one write-string, lest another thread's line cut in.
 (define (log-line level parts)
   (let ((err (current-error-port)))
     (write-string (line-text level parts) err)
@@ -76,9 +67,7 @@
 ;;> Logs a fault that was handled.
 (define (log-warn . parts) (log-line ": warning: " parts))
 
-;;> What \var{e}, any raised object, says, as one line for a log or an
-;;> answer: an error's message and irritants, or what else was raised.
-;;> (murdoch wire)'s error-message says a remote error its own way.
+;;> What \var{e}, any raised object, says, as one line.
 (define (condition-message e)
   (cond
    ((stack-guard-tripped? (current-thread))

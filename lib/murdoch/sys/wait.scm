@@ -1,15 +1,8 @@
-;;;; Waiting with a deadline: one clock, one way to wait.
-;;
-;; Every deadline in Murdoch is a moment on the monotonic clock
-;; (monotonic-seconds), and every wait for another thread is a mailbox or
-;; a mutex taken by a deadline: no loop sleeps and looks again.  (A wait
-;; for a socket is the scheduler's port-wait!.)
+;;;; Waiting with a deadline on the monotonic clock, by mailbox or mutex:
+;;;; no loop sleeps and looks again.
 
-;;> Chibi's dynamic-wind without its garbage (docs/speed.md, What Chibi
-;;> charges): \scheme{(in)}, then \scheme{(body)}'s value, with
-;;> \scheme{(out)} run however body leaves.  Its point is Chibi's (a vector
-;;> of depth, in, out and parent in %dk), so call/cc and raise wind
-;;> through it as through dynamic-wind's.
+;;> Chibi's dynamic-wind without its garbage (docs/speed.md): (in), then
+;;> (body)'s value, (out) however body leaves, on Chibi's own wind points.
 (define (wind in body out)
   (in)
   (wound (%dk) in body out))
@@ -30,10 +23,7 @@
   (vector-set! p 3 parent)
   p)
 
-;;> \scheme{(mutex-lock! m)} and \scheme{(mutex-unlock! m)} of srfi 18,
-;;> for a mutex taken with no timeout and freed with no condition
-;;> variable, without the garbage of their optional arguments
-;;> (docs/speed.md): the primitives that srfi 18's call.
+;;> srfi 18's mutex-lock! and mutex-unlock!, no timeout or condition variable, no garbage.
 (define (lock! m)
   (or (%mutex-lock! m #f #t)
       (begin (thread-yield!) (mutex-lock! m))))   ; as srfi 18's, once it failed
@@ -52,13 +42,11 @@
 (define %mutex-lock! (srfi-18-primitive '%mutex-lock!))
 (define %mutex-unlock! (srfi-18-primitive '%mutex-unlock!))
 
-;;> Applies \var{thunk} holding the mutex \var{m}, which it frees however
-;;> thunk leaves.
+;;> Applies \var{thunk} holding the mutex \var{m}, freed however thunk leaves.
 (define (with-lock m thunk)
   (wind (lambda () (lock! m)) thunk (lambda () (unlock! m))))
 
-;; As with-lock, giving up with (too-late) when m is not free by the
-;; deadline, on the monotonic clock.
+;; As with-lock, calling (too-late) when m is not free by the deadline.
 (define (with-lock-by m deadline too-late thunk)
   (if (mutex-lock! m (seconds-until deadline))
       (wind nothing thunk (lambda () (unlock! m)))
@@ -66,21 +54,17 @@
 
 (define (nothing) #f)
 
-;; Seconds from now to deadline, none if it has passed; inexact, never
-;; mixed with exact numbers (docs/speed.md).
+;; Seconds from now to deadline, none if past; inexact (docs/speed.md).
 (define (seconds-until deadline)
   (not-below-zero (- (inexact deadline) (monotonic-seconds))))
 
 (define (not-below-zero x) (if (< x 0.) 0. x))
 
-;; Frees m and waits on cv for left seconds, from seconds-until; #f when
-;; none were left, or they ran out.
+;; Frees m and waits on cv for left seconds; #f when none were left or they ran out.
 (define (waited? m cv left)
   (and (> left 0.) (mutex-unlock! m cv left)))
 
-;;> Calls thunk; when it leaves by raising, calls undo on the way out: a
-;;> wind point whose out is undo, taken off unrun when thunk returns, not
-;;> a guard (docs/speed.md).
+;;> Calls thunk; should it raise, calls undo on the way out (docs/speed.md).
 (define (undo-on-raise undo thunk)
   (undone-on-raise (%dk) undo thunk))
 
@@ -92,9 +76,7 @@
   (%dk here)
   value)
 
-;;> (map proc items), where an item whose (proc item) raises gives
-;;> (on-raise item e), under one handler, entered again only after a
-;;> raise (docs/speed.md, What Chibi charges).
+;;> (map proc items), a raising item giving (on-raise item e) (docs/speed.md).
 (define (map-guarded proc items on-raise)
   (let ((done '()) (rest items))
     (let run ()
@@ -108,9 +90,8 @@
             (loop)))))
     (reverse done)))
 
-;; A one-shot mailbox: the reader thread puts an answer, the caller takes
-;; it or gives up at its deadline.  Its taker may empty it for the next
-;; (mailbox-empty!), once no other thread can still put to it.
+;; A one-shot mailbox: the reader puts an answer, the caller takes it or
+;; gives up; emptied by its taker once no other thread can put to it.
 (define-record-type mailbox
   (%make-mailbox mutex condvar value full?)
   mailbox?
@@ -129,18 +110,14 @@
   (condition-variable-broadcast! (mailbox-condvar mb))
   (unlock! (mailbox-mutex mb)))
 
-;;> Empties mailbox \var{mb}, for its taker to wait on again: a worker's
-;;> for its next job, say, instead of a new mutex and condition variable
-;;> for each.
+;;> Empties mailbox \var{mb}, for its taker to wait on again.
 (define (mailbox-empty! mb)
   (lock! (mailbox-mutex mb))
   (mailbox-value-set! mb #f)
   (mailbox-full?-set! mb #f)
   (unlock! (mailbox-mutex mb)))
 
-;; The mailbox's value, or (timed-out) once the deadline, on the monotonic
-;; clock, has passed.  Chibi's SRFI-18 time objects count whole seconds, so
-;; each wait is given as the seconds left.  No named let (docs/speed.md).
+;; The value, or (timed-out) past the deadline; SRFI-18 waits count whole seconds.
 (define (mailbox-take mb deadline timed-out)
   (lock! (mailbox-mutex mb))
   (if (mailbox-full? mb)
@@ -155,9 +132,7 @@
 
 ;;; Mailboxes by id: a connection's calls waiting for their answers
 
-;;> The mailbox that \var{table} (id -> mailbox, an SRFI 69 table) holds
-;;> for \var{id}, taken out of it; #f when it holds none.  The caller
-;;> holds the lock that guards the table.
+;;> The mailbox \var{table} holds for \var{id}, taken out, or #f; under the table's lock.
 (define (take-mailbox! table id)
   (taken table id (hash-table-cell table id #f)))
 
@@ -167,12 +142,10 @@
        (begin (hash-table-delete! table id)
               (cdr cell))))
 
-;;> The value in \var{cell}, from srfi 69's \scheme{hash-table-cell}, or
-;;> \var{default} when it is #f, without hash-table-ref/default's closure.
+;;> The value in \var{cell} (from \scheme{hash-table-cell}), or \var{default} when it is #f.
 (define (cell-value cell default) (if cell (cdr cell) default))
 
-;;> Every mailbox of \var{table}, taken out of it: the connection ended,
-;;> and no answer will come to them.  The caller holds the table's lock.
+;;> Every mailbox of \var{table}, taken out of it, as the connection ended; under its lock.
 (define (take-all-mailboxes! table)
   (let ((mbs (hash-table-values table)))
     (for-each (lambda (id) (hash-table-delete! table id))
@@ -181,9 +154,8 @@
 
 ;;; Gatherings: one wake for the answers to many calls
 
-;;> A gathering: the poller hands in the answers to a caller's calls one
-;;> at a time, and the caller, waiting for n of them, wakes once, when the
-;;> nth has come or at its deadline; a mailbox each would wake it n times.
+;;> A gathering: the poller hands in the answers to a caller's calls, and
+;;> the caller wakes once, at the nth or its deadline, not n times.
 (define-record-type gathering
   (%make-gathering mutex condvar got wanted)
   gathering?
@@ -195,9 +167,7 @@
 (define (make-gathering)
   (%make-gathering (make-mutex) (make-condition-variable) 0 #f))
 
-;;> Gives \var{item} the answer \var{value}, by \scheme{(put item value)},
-;;> under the gathering's lock, and counts it, unless \scheme{(get item)}
-;;> shows it has one.  No wind, as put only sets a field (docs/speed.md).
+;;> Gives \var{item} \var{value} by \scheme{(put item value)} unless \scheme{(get item)} has one.
 (define (gathering-put! g item value get put)
   (lock! (gathering-mutex g))
   (when (not (get item))
@@ -207,8 +177,7 @@
         (condition-variable-signal! (gathering-condvar g))))
   (unlock! (gathering-mutex g)))
 
-;;> Waits until \var{n} answers have come, answering #t, or until the
-;;> deadline, answering #f.  No let (docs/speed.md).
+;;> Waits until \var{n} answers have come (#t), or the deadline (#f).
 (define (gathering-wait g n deadline)
   (lock! (gathering-mutex g))
   (gathering-wanted-set! g n)

@@ -1,19 +1,13 @@
-;;;; What the multi-process tests share: labs in temporary folders on free
-;;;; ports, and child processes that are always stopped.
+;;;; What the multi-process tests share: labs on free ports, children stopped.
 
-;; The repository: MURDOCH_TOP, as tests/run sets it, else the current
-;; folder, which is where tests/run and bench/run work.
+;; The repository: MURDOCH_TOP, as tests/run sets it, else the current folder.
 (define top
   (or (get-environment-variable "MURDOCH_TOP") (current-directory)))
 
-;; The lab file's port base rules in tests; an exported MURDOCH_PORT_BASE
-;; would move this process and not its children.
+;; The lab file's port base rules; an exported one would move only this process.
 (unsetenv "MURDOCH_PORT_BASE")
 
-;; A test writes to children that may have died: a REPL past its time
-;; limit, an address space it killed.  SIGPIPE's default action would end
-;; the test without its summary, so it is ignored and the write raises,
-;; which the test reports.
+;; A write to a dead child raises, rather than SIGPIPE ending the test unreported.
 (set-signal-action! signal/pipe #f)
 
 ;;> The path of a file of the repository.
@@ -26,13 +20,9 @@
   (directory test-lab-directory)
   (port-base test-lab-port-base))
 
-;; The first line \var{cmd} prints; an error when it prints none, which
-;; gives how it ended (its wait status: 9 for SIGKILL, 256 for exit 1).
-;; (chibi process)'s call-with-process-io will not do: it closes the
-;; parent's ends of its pipes with close-file-descriptor, which leaves
-;; their filenos marked open, and the collector later closes those
-;; numbers again -- by then another pipe's or a live socket's.  Closing
-;; through a port marks the fileno closed.
+;; The first line \var{cmd} prints, else an error with its wait status.
+;; Not call-with-process-io, whose close-file-descriptor leaves the
+;; collector to close the numbers again later, by then others'.
 (define (command-output cmd)
   (let* ((pipe (open-pipe))
          (pid (fork)))
@@ -53,9 +43,7 @@
                 (error "a command printed nothing; its wait status:" cmd status))
             line)))))))
 
-;;> A fresh folder of its own under $TMPDIR, readable by its owner alone,
-;;> as mktemp -d makes one but with no process to start: this process's
-;;> id and a count name it, and a name a process before took is passed.
+;;> A fresh folder under $TMPDIR for its owner alone, as mktemp -d makes.
 (define (temporary-directory)
   (let ((base (or (get-environment-variable "TMPDIR") "/tmp")))
     (let loop ((tries 0))
@@ -70,9 +58,8 @@
 
 (define folders-made 0)
 
-;;> A port base B such that nothing listens on B to B + 199, claimed for
-;;> as long as this process lives, or, given a \var{folder}, as long as
-;;> that folder exists (tools/free-port-base).
+;;> A port base B, free from B to B + 199, held while this process lives
+;;> or \var{folder} exists.
 (define (free-port-base . folder)
   (string->number (command-output (cons (tool-path "tools/free-port-base") folder))))
 
@@ -96,8 +83,7 @@
     (let ((line (read-line in)))
       (if (eof-object? line) (reverse acc) (loop (cons line acc))))))
 
-;;> The message of the error \var{thunk} raises -- of a remote-error, the
-;;> one it carries from the other address space -- or no-error.
+;;> The message of the error \var{thunk} raises, or no-error.
 (define (error-text thunk)
   (guard (e ((remote-error? e) (remote-error-message e))
             ((error-object? e) (error-object-message e)))
@@ -111,9 +97,7 @@
       (and (<= (+ i n) (string-length text))
            (or (string=? word (substring text i (+ i n))) (loop (+ i 1)))))))
 
-;;> Writes a lab file with \var{clauses} into a fresh temporary folder, on
-;;> a port base no other lab on this machine is using.  \var{files} is a
-;;> list of (name . text) written beside it (code files).
+;;> Writes a lab file of \var{clauses} and \var{files} in a fresh folder, on a free port base.
 (define (make-test-lab clauses . files)
   (let* ((dir (temporary-directory))
          (base (free-port-base dir))
@@ -128,9 +112,7 @@
               (if (pair? files) (car files) '()))
     (%make-test-lab file dir base)))
 
-;;> Removes the lab's folder.  When a test of this process has failed, the
-;;> last lines of each log in it go to standard error first: an address
-;;> space that died in a CI run leaves no other trace.
+;;> Removes the lab's folder, after a failure showing each log's last lines.
 (define (remove-test-lab! lab)
   (if (positive? (test-failure-count))
       (show-log-tails (test-lab-directory lab) 30))
@@ -149,11 +131,10 @@
                      (list-tail lines (max 0 (- (length lines) n))))))))
    (directory-files dir)))
 
+;; Global: the test process's children, all stopped at its end.
 (define *children* '())
 
-;;> Starts \var{args} (a command and its arguments) with its output going
-;;> to \var{log-file}; answers the pid.  The environment variable
-;;> MURDOCH_PORT_BASE is cleared for it, so the lab file rules.
+;;> Starts \var{args} logging to \var{log-file}; answers the pid.
 (define (start-process! args log-file)
   (let ((pid (fork)))
     (cond
@@ -183,8 +164,7 @@
   (cond ((null? ls) '()) ((= pid (car ls)) (cdr ls))
         (else (cons (car ls) (remove-pid pid (cdr ls))))))
 
-;;> Asks \var{pid} to stop (SIGTERM) and waits for it; answers its wait
-;;> status.
+;;> Asks \var{pid} to stop (SIGTERM) and waits; answers its wait status.
 (define (stop-process! pid)
   (kill pid signal/term)
   (reap! pid))
@@ -197,17 +177,14 @@
 (define (stop-all-processes!)
   (for-each stop-process! *children*))
 
-;;> Waits until \var{thunk} answers true, checking every 50 ms, for at most
-;;> \var{seconds}; answers its last value.
+;;> Waits until \var{thunk} answers true, for at most \var{seconds}; its last value.
 (define (wait-until seconds thunk)
   (let loop ((left (* seconds 20)))
     (or (thunk)
         (and (> left 0)
              (begin (thread-sleep! 0.05) (loop (- left 1)))))))
 
-;;> Starts address space \var{uid} of the test lab as a process of its own,
-;;> logging to UID.log in the lab's folder, and waits until it listens;
-;;> answers its pid.
+;;> Starts address space \var{uid} of the test lab; answers its pid once it listens.
 (define (start-lab-aspace! lab uid)
   (let* ((entry (lab-aspace-by-uid (read-lab (test-lab-file lab)) uid))
          (pid (start-process!
@@ -220,11 +197,8 @@
                (test-lab-directory lab)))
     pid))
 
-;;> Starts `bin/murdoch lab` with \var{args} (the lab file and options),
-;;> its output going to \var{out}, and answers its pid once it says it is
-;;> ready.  If it gives up instead, it is stopped and an error raised that
-;;> holds its output.  \var{port-base}, if given, is the MURDOCH_PORT_BASE
-;;> it runs with.
+;;> Starts `bin/murdoch lab` with \var{args}, output to \var{out}; its pid
+;;> once ready, else an error with its output.
 (define (start-murdoch-lab! args out . port-base)
   (let ((pid (start-process!
               (append (if (pair? port-base)
@@ -239,16 +213,13 @@
                        (or (text-contains? text "lab: ready")
                            (text-contains? text "stopping the lab")
                            (text-contains? text "ERROR")
-                           ;; A usage error, say, says no ERROR.
                            (reaped-if-ended! pid)))))
     (if (not (text-contains? (file-text out) "lab: ready"))
         (begin (if (memv pid *children*) (stop-process! pid))
                (error "the lab did not start" (file-text out))))
     pid))
 
-;;> The median time in seconds of \var{runs} calls of \var{thunk}: the
-;;> benches' measure, so that a few calls delayed by the machine's other
-;;> work do not move it.
+;;> The median seconds of \var{runs} calls of \var{thunk}, as the benches measure.
 (define (median-seconds runs thunk)
   (let loop ((i 0) (times '()))
     (if (= i runs)
@@ -267,17 +238,9 @@
                     (close-output-port (cadr io))
                     #t))))))
 
-;;> A loopback TCP listener on a port of its own, for a test or bench
-;;> that serves on one socket without a lab; answers (listener . port).
-;;> The listener is a fileno for \scheme{accept}, non-blocking as Chibi's
-;;> threads want (the \scheme{bind} and \scheme{listen} of (chibi net)
-;;> make it so).  Keep the listener itself, not only its port, for as
-;;> long as it is used: the collector closes a fileno nothing refers to.
-;;>
-;;> The port is drawn at random between the test labs' port bases and
-;;> the kernel's ephemeral range (see \scheme{spare-ports}); one that
-;;> another process holds is stepped over, so that runs at once each get
-;;> a port of their own.
+;;> A loopback TCP listener on a port of its own, (listener . port): keep
+;;> the listener while in use, as the collector closes a fileno nothing
+;;> refers to.  Drawn at random from spare-ports, so runs at once differ.
 (define (listen-on-free-port)
   (let-values (((low high) (spare-ports)))
     (let ((n (- high low)))
@@ -287,11 +250,7 @@
          ((listener-on port) => (lambda (sock) (cons sock port)))
          (else (try (+ tries 1) (+ low (modulo (- (+ port 1) low) n)))))))))
 
-;; The ports [low, high) that nothing else of ours, nor the kernel, hands
-;; out: tools/free-port-base puts lab port bases at 10000 + 200k, each
-;; taking 200 ports, for as many k as fit below the ephemeral range, where
-;; the kernel picks the local ports of outgoing connections.  From the top
-;; lab's end to the start of that range are 200 to 399 spare ports.
+;; The ports [low, high) that neither labs (tools/free-port-base) nor the kernel hand out.
 (define (spare-ports)
   (let* ((high (ephemeral-port-start))
          (low (+ 10000 (* 200 (quotient (- high 10200) 200)))))
@@ -314,13 +273,8 @@
 
 (define eaddrinuse 98)          ; Linux's EADDRINUSE, which Chibi does not name
 
-;; A listener on 127.0.0.1:port, or #f when another socket has the port.
-;; (chibi net)'s make-listener-socket will not do for trying ports: when
-;; bind fails it closes the socket with close-file-descriptor, which leaves
-;; the fileno marked open, and the collector later closes that number
-;; again -- by then the number of the next socket made, the listener that
-;; did bind, and accept on it answers #f.  Here a socket that fails is
-;; closed through a port, which marks its fileno closed.
+;; A listener on 127.0.0.1:port, or #f when taken; a failed socket is
+;; closed through a port (see command-output).
 (define (listener-on port)
   (let* ((addr (get-address-info "127.0.0.1" port))
          (sock (socket (address-info-family addr)

@@ -1,4 +1,4 @@
-;;;; A raw peer: the wire protocol of lib/murdoch/remote.scm's header,
+;;;; A raw peer: the wire protocol of lib/murdoch/wire/frame.scm's header,
 ;;;; written out by hand so that a test can break it on purpose.
 
 ;;> A TCP connection to \var{port} on loopback: (input . output).
@@ -24,8 +24,7 @@
     (write-netstring (string->utf8 (string-append mac text)) out)
     (get-output-bytevector out)))
 
-;;> The MAC of frame \var{count} of a connection whose receiver chose
-;;> \var{nonce}, under \var{key}.
+;;> The MAC of frame \var{count} under \var{key}, for the receiver's \var{nonce}.
 (define (frame-mac key nonce count text)
   (hmac-sha256 key (string->utf8 (string-append nonce ":"
                                                (number->string count) ":"
@@ -43,13 +42,11 @@
 (define (hello-frame key nonce)
   (framed (frame-mac key "hello" 0 (hello-text nonce)) (hello-text nonce)))
 
-;;> The count-th frame of a connection, \var{datum} MAC'd for the
-;;> receiver's \var{nonce}.
+;;> The count-th frame of a connection, \var{datum} MAC'd for \var{nonce}.
 (define (counted key nonce count datum)
   (framed (frame-mac key nonce count (text-of datum)) (text-of datum)))
 
-;;> The message of the next frame on \var{conn}, its MAC unchecked, or an
-;;> eof object when the other side closed.
+;;> The message of the next frame on \var{conn}, unchecked, or an eof object.
 (define (raw-answer conn)
   (let ((payload (guard (e (#t (eof-object)))
                    (read-netstring (car conn) 10000000))))
@@ -58,8 +55,7 @@
         (let ((text (utf8->string payload)))
           (read (open-input-string (substring text 64 (string-length text))))))))
 
-;;> A connection to \var{port} that has said hello as \var{nonce} under
-;;> \var{key} and been welcomed: (connection . the callee's nonce).
+;;> A connection to \var{port} welcomed after hello: (connection . callee's nonce).
 (define (welcomed-raw-connect key port nonce)
   (let ((conn (raw-connect port)))
     (raw-send! conn (hello-frame key nonce))

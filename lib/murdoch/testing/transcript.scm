@@ -21,10 +21,9 @@
           ((and (< i j) (char-whitespace? (string-ref s (- j 1)))) (loop i (- j 1)))
           (else (substring s i j)))))
 
-;;> Reads the transcript \var{file}.  Comments (";;") and blank lines are
-;;> dropped; "lab:" and "as:" lines are the header; "> " lines are input,
-;;> and the lines after each are what it should print; a "$ " line is a
-;;> shell command, run once the REPL has answered the inputs before it.
+;;> Reads transcript \var{file}: ";;" and blank lines dropped, "lab:" and
+;;> "as:" the header, "> " lines input followed by what they print, "$ "
+;;> a shell command run once the REPL answered the inputs before it.
 (define (read-transcript file)
   (let loop ((lines (read-lines file)) (lab #f) (as #f) (steps '()) (shell '()))
     (cond
@@ -52,13 +51,9 @@
           (loop rest lab as (cons (cons line (car steps)) (cdr steps))
                 shell))))))))
 
-;;> The REPL sessions a document shows, as one transcript: every code
-;;> block whose first line starts with a prompt ("guest-1234> ") is a step
-;;> of it, its prompt lines input and the lines after each what that
-;;> prints, in the order of the document, at one REPL of one lab: the lab
-;;> that the line "<!-- transcript lab: FILE -->" names.  The document
-;;> shows what a run printed, so a number in it stands for any number
-;;> ({number}) and "..." for any text ({any}).
+;;> A document's REPL sessions as one transcript: code blocks that start
+;;> with a prompt, at the lab "<!-- transcript lab: FILE -->" names; a
+;;> number matches any number, "..." any text.
 (define (read-doc-transcript file)
   (let ((lines (read-lines file)))
     (make-transcript
@@ -70,8 +65,7 @@
      (append-map block-steps (code-blocks lines))
      '())))
 
-;; The code blocks of a markdown text's lines, each a list of its lines:
-;; fenced by ``` or indented by four spaces.
+;; The code blocks of markdown lines: fenced by ``` or indented four spaces.
 (define (code-blocks lines)
   (let loop ((lines lines) (blocks '()))
     (cond
@@ -112,8 +106,6 @@
                           (cons (cons (loosen (car lines)) (car steps)) (cdr steps))))))
       '()))
 
-;; A line a run printed as a pattern for any run: numbers as {number},
-;; "..." as {any}.
 (define (loosen line)
   (let loop ((i 0) (acc '()))
     (cond
@@ -140,9 +132,7 @@
         (loop (+ j 1))
         j)))
 
-;;> What to do, in order: each input line as a string, typed at the REPL,
-;;> and each shell command as (shell COMMAND K), to run once the REPL has
-;;> answered its first K inputs.
+;;> What to do: input lines, and (shell COMMAND K) to run after K answers.
 (define (transcript-script t)
   (let loop ((k 0) (steps (transcript-steps t)) (shell (transcript-shell t)))
     (cond ((and (pair? shell) (= k (caar shell)))
@@ -151,9 +141,7 @@
            (cons (caar steps) (loop (+ k 1) (cdr steps) shell)))
           (else '()))))
 
-;;> Compares the REPL's \var{output} with transcript \var{t}; the REPL's
-;;> prompt is \var{prompt}.  Answers a list of readable mismatches, empty
-;;> when everything matched.
+;;> The mismatches between the REPL's \var{output} and \var{t}; empty when none.
 (define (transcript-mismatches t prompt output)
   (let ((answers (split-at-prompts output prompt))
         (steps (transcript-steps t)))
@@ -162,13 +150,11 @@
                     'prompts-seen (length answers)))
         (append-map step-mismatches steps (take answers (length steps))))))
 
-;;> How many times the REPL has printed \var{prompt} in \var{output}: one
-;;> more than the inputs it has answered.
+;;> How many times \var{prompt} is in \var{output}: one more than the inputs answered.
 (define (prompt-count prompt output)
   (length (split-at-prompts output prompt)))
 
-;; What the REPL printed after each prompt, as lists of lines; what came
-;; before the first prompt (the lab's start) is left out.
+;; What the REPL printed after each prompt, as lists of lines.
 (define (split-at-prompts output prompt)
   (let loop ((start (string-search prompt output 0)) (acc '()))
     (if (not start)
@@ -231,12 +217,9 @@
             (string->number (substring line l e)))
           (iota (- (string-length line) l) (+ l 1))))
 
-;;; Replaying: bin/murdoch lab on a free port base, then bin/murdoch repl
-;;; with the transcript's input typed through a pipe.
+;;; Replaying: bin/murdoch lab, then bin/murdoch repl fed through a pipe.
 
-;; The lab of transcript t, started in dir on a free port base without the
-;; address space the REPL will be, if it is one of the lab's; answers
-;; (pid . port-base) once it is ready.
+;; Starts t's lab in dir on a free port base; answers (pid . port-base).
 (define (start-lab! t dir)
   (let ((base (free-port-base dir)))
     (cons (start-murdoch-lab!
@@ -248,9 +231,7 @@
            base)
           (number->string base))))
 
-;; The REPL's whole output for t's input, stdout and stderr together.
-;; Its input is typed through a pipe, a line at a time, so that a shell
-;; command runs only once the REPL has answered every input before it.
+;; The REPL's whole output for t's input, typed a line at a time.
 (define (replay t dir base lab-pid)
   (let ((out (string-append dir "/output")))
     (call-with-process-io
@@ -267,8 +248,7 @@
        (waitpid pid 0)))
     (file-text out)))
 
-;; An input line is typed; a shell command waits for the REPL's answers
-;; (at most 60 s), then runs with LAB_PID and MURDOCH_PORT_BASE set.
+;; Types an input line; a shell command waits for the REPL (60 s at most).
 (define (perform! item t in out base lab-pid)
   (cond
    ((string? item)
@@ -300,8 +280,7 @@
                  (string-append (substring output i j) "> "))))
           (else (loop (+ i 1))))))
 
-;; A diff of each mismatch: the input, "-" before the lines expected and
-;; "+" before those the REPL printed.
+;; A diff of each mismatch: the input, "-" expected lines, "+" printed ones.
 (define (report file mismatches output)
   (if (pair? mismatches)
       (begin
@@ -320,10 +299,8 @@
           (for-each (lambda (l) (display (string-append "+ " l "\n"))) (field 'actual)))
         (begin (write m) (newline)))))
 
-;;> Replays transcript \var{t}, read from \var{file}, against a fresh lab
-;;> of its own, as one test named \var{file}: a mismatch is shown as a
-;;> diff.  A transcript whose lab does not start fails as a test (chibi
-;;> test reports the error) rather than ending the run.
+;;> Replays transcript \var{t} from \var{file} against a fresh lab, as one
+;;> test named \var{file}, showing a mismatch as a diff.
 (define (check-transcript file t)
   (let ((dir (temporary-directory)))
     (test file '() (mismatches-of file t dir))

@@ -1,6 +1,5 @@
-;;> Scripted REPL sessions (docs/transcripts.md): reading a transcript,
-;;> or a document's REPL sessions as one, replaying it against a fresh
-;;> lab, and comparing what the REPL printed with what it expects.
+;;> Scripted REPL sessions (docs/transcripts.md): reading transcripts or a
+;;> document's sessions, replaying them against a fresh lab, comparing.
 (define-library (murdoch testing transcript)
   (export read-transcript read-doc-transcript transcript-lab transcript-as
           transcript-steps

@@ -1,5 +1,5 @@
-;;;; Serving the live view, part of (murdoch view): the page, the trace
-;;;; so far and the snapshots as they come, and the loop that polls the lab.
+;;;; Serving the live view, part of (murdoch view): the page, the trace,
+;;;; the snapshots as they come, and the loop that polls the lab.
 
 (define content-types
   '(("html" . "text/html; charset=UTF-8")
@@ -23,8 +23,7 @@
                      (Connection . "close")))
   (write-string body (request-out request)))
 
-;; The servlet: the page and its files from web, /info, /trace, /state
-;; and /events.  feed is #f in a replay.
+;; The servlet: web's files, /info, /trace, /state and /events (no feed in a replay).
 (define (view-servlet web trace feed info)
   (lambda (cfg request next restart)
     (let ((path (request-path request)))
@@ -48,11 +47,9 @@
         (send-events request feed))
        (else (respond request 404 "text/plain" "not found\n"))))))
 
-;; Server-sent events: each snapshot from the one the page asks for
-;; (?from=N, or the one after its Last-Event-ID when it reconnects), as
-;; "id: N" and "data: JSON", until the page goes.  A comment after 10 s
-;; without a snapshot finds out a page that went quietly.  With ?once=1,
-;; only those there are now, and the stream ends: a page that polls.
+;; Server-sent events from snapshot ?from=N or after Last-Event-ID, until
+;; the page goes (a comment after 10 s quiet finds it gone); ?once=1 sends
+;; what there is and ends.
 (define (send-events request feed)
   (let ((out (request-out request))
         (once? (request-param request "once")))
@@ -80,7 +77,6 @@
         (and p (string->number p)))
       (feed-count feed)))
 
-;; A listening socket on 127.0.0.1:port, or an error that says so.
 (define (listen-on port)
   (let ((addr (get-address-info "127.0.0.1" port)))
     (guard (e (#t (error (string-append "the view cannot listen on 127.0.0.1:"
@@ -96,11 +92,9 @@
   (newline)
   (flush-output-port (current-output-port)))
 
-;;> `murdoch view LAB [PORT]`: joins the running lab at \var{lab-file} as
-;;> a peer listening on port-base + 147, polls it twice a second, appends
-;;> each snapshot to \var{trace} (a path, or #f for runs/LAB-SECONDS.jsonl),
-;;> and serves the page from the folder \var{web} on 127.0.0.1:\var{port} (#f for the
-;;> lab's port-base + 148), until killed.
+;;> `murdoch view LAB [PORT]`: joins the running lab, polls it twice a
+;;> second, appends each snapshot to \var{trace} (#f: runs/LAB-SECONDS.jsonl)
+;;> and serves the page from \var{web} on 127.0.0.1:\var{port}, until killed.
 (define (run-view web lab-file port trace)
   (set-process-name! "murdoch-view")
   (let* ((lab (read-lab lab-file))
@@ -109,9 +103,7 @@
          (trace (or trace (default-trace lab)))
          (uid (string->symbol
                (string-append "view-" (number->string (current-process-id)))))
-         ;; Not a guest's port, which is one of fifty by process id: the
-         ;; view stays as long as the lab, and a REPL or pose that drew
-         ;; the same would not start.
+         ;; Its own port, not a guest's: a REPL that drew the same would not start.
          (env (join-lab lab-file uid (lab-planned-port lab 'view-peer)))
          (proc (eval report-source (make-repl-environment lab env)))
          (aspaces (map (lambda (a) (uid->aspace (lab-aspace-uid a))) (lab-aspaces lab)))
@@ -125,8 +117,7 @@
      (make-logged-thread
       (lambda ()
         (let loop ()
-          ;; The trace counts wall-clock seconds from its start; the
-          ;; next look is due by the monotonic clock, as every deadline.
+          ;; The trace counts wall-clock seconds; looks are due by the monotonic clock.
           (let ((t0 (monotonic-seconds))
                 (at (- (utc-seconds) start)))
             (feed-add! feed (json-text
@@ -144,8 +135,7 @@
                             `((live . #t) (lab . ,(symbol->string (lab-name lab)))
                               (trace . ,trace)))))))
 
-;; The header of the trace already at path, or #f: the view started
-;; again by the lab carries on with the trace it was writing.
+;; The header of the trace at path, or #f: a restarted view carries on.
 (define (trace-header path)
   (and (file-exists? path)
        (let ((line (call-with-input-file path read-line)))
@@ -160,8 +150,7 @@
             (if (eof-object? (read-line in)) n (loop (+ n 1))))))
       0))
 
-;; The trace's port: a new file that starts with the header, or the end
-;; of the trace there is.
+;; The trace's port: a new file that starts with header, or the trace's end.
 (define (open-trace path header)
   (if (trace-header path)
       (open-output-file-descriptor
@@ -172,9 +161,7 @@
         (flush-output-port out)
         out)))
 
-;;> runs/LAB-SECONDS.jsonl, or LAB-SECONDS-2.jsonl and on when a view
-;;> started in the same second has that: a name is claimed by making the
-;;> file, which only one process can.
+;;> runs/LAB-SECONDS.jsonl, or -2 and on when taken: claimed by making the file.
 (define (default-trace lab)
   (let ((dir "runs")
         (stem (string-append "runs/" (symbol->string (lab-name lab)) "-"
@@ -189,9 +176,7 @@
               ((file-exists? name) (claim (+ n 1)))
               (else (error (string-append "cannot make the trace " name))))))))
 
-;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port}
-;;> (default: port-base + 148, MURDOCH_PORT_BASE's or else 7100's, as the
-;;> view's) to play the run that \var{trace} holds.
+;;> `murdoch replay TRACE [PORT]`: serves the page on 127.0.0.1:\var{port} to play \var{trace}.
 (define (run-replay web trace port)
   (if (not (file-exists? trace)) (error (string-append "no such trace " trace)))
   (let ((header (trace-header trace)))

@@ -1,39 +1,24 @@
 ;;;; The live view, (murdoch view): its snapshots.
 ;;
-;; One process, a guest of the lab, asks every address space at once,
-;; twice a second, how it is -- task/status.scm's aspace-report and, on a
-;; robot, its latest sonar ring and the boxes its fiducial finder sees --
-;; and makes of the answers a snapshot: one JSON object with the time,
-;; every address space, where the boxes are, and the tasks.  Snapshots
-;; are appended to the run's trace, one line each, after a line that
-;; describes the room.  The page (web/view.html, web/view.js) reads the
-;; trace so far from /trace and then each new snapshot from /events, as
-;; server-sent events; a replay serves a finished trace and no events, and
-;; the same page plays it.  The server is (chibi net http-server), on
-;; 127.0.0.1 only.
-;;
-;; The room is the lab file's world; a box is drawn where the lab file
-;; puts it until a robot's fiducial finder sees it, then where that robot
-;; saw it last.  A robot's pose is its odometry (safe-reckon), which the
-;; simulator starts at the lab file's pose.
+;; A guest of the lab asks every address space twice a second how it is
+;; (aspace-report, a robot's sonar and fiducials) and makes a snapshot: a
+;; JSON object appended to the run's trace after a line for the room.  The
+;; page (web/view.js) reads /trace, then /events; a replay serves a trace.
 
 (define poll-seconds 0.5)
 
-;; Snapshots kept in memory for the pages that are following along; one
-;; that falls further behind reads the trace again.
+;; Snapshots kept for pages following along; one further behind reads the trace.
 (define kept-snapshots 200)
 
 ;;; JSON
 
-;;> \var{x} written as JSON, to a string: objects are alists of symbols,
-;;> arrays vectors (chibi json).
+;;> \var{x} written as JSON, to a string ((chibi json): alists and vectors).
 (define (json-text x)
   (let ((out (open-output-string)))
     (json-write x out)
     (get-output-string out)))
 
-;; A number as JSON takes it: exact integers as they are, anything else
-;; to a tenth.
+;; A number as JSON takes it: exact integers as they are, else to a tenth.
 (define (num x)
   (cond ((exact-integer? x) x)
         ((and (real? x) (finite? x)) (/ (round (* 10. x)) 10.))
@@ -51,9 +36,8 @@
 
 ;;; The room: the first line of a trace
 
-;;> The first line of a trace, as JSON: the lab's name, the robots'
-;;> radius, its walls as (x1 y1 x2 y2 thickness), its boxes as (x y
-;;> width depth heading), and its address spaces, robots or not.
+;;> The first line of a trace, as JSON: the lab's name, robot radius,
+;;> walls, boxes, and address spaces.
 (define (lab-header lab)
   `((kind . "lab")
     (lab . ,(symbol->string (lab-name lab)))
@@ -78,10 +62,7 @@
 
 (define (degrees->radians d) (* d (/ (acos -1) 180)))
 
-;;> Where box \var{id} is, as (x y heading), from a robot at \var{pose}
-;;> (x y heading ...) that sees it at \var{range} mm and \var{bearing}
-;;> degrees, the box's heading being \var{orientation} degrees from the
-;;> robot's.
+;;> Where box \var{id} is, (x y heading), seen from a robot at \var{pose}.
 (define (box-seen pose range bearing orientation)
   (let ((a (degrees->radians (+ (list-ref pose 2) bearing))))
     (list (+ (car pose) (* range (cos a)))
@@ -90,10 +71,8 @@
 
 ;;; Snapshots
 
-;; What each address space is asked: its report, on a robot its sonar
-;; ring and fiducials (#f on a workstation, where they raise), and the
-;; tasks it posed lately, over or not: the report leaves out those over,
-;; and a task ends in the state its poser gives it.
+;; What each address space is asked: its report, a robot's sonar and
+;; fiducials, and the tasks it posed lately, over or not.
 (define report-source
   '(lambda ()
      (list (aspace-report)
@@ -102,14 +81,12 @@
            (let ((posed (filter listed-posed? (tasks))))
              (if (> (length posed) 12) (take posed 12) posed)))))
 
-;; The parts of what report-source answers, a look at one address space.
 (define (look-report look) (car look))
 (define (look-sonar look) (cadr look))
 (define (look-seen look) (car (cddr look)))
 ;; A peer older than POSED answers none.
 (define (look-posed look) (and (> (length look) 3) (list-ref look 3)))
 
-;; A robot's last sonar ring, and the pose it was first read at.
 (define-record-type ring
   (make-ring uid ranges pose)
   ring?
@@ -117,11 +94,8 @@
   (ranges ring-ranges)
   (pose ring-pose))
 
-;; What the view remembers from one poll to the next: where the boxes
-;; are, the task table, and for each robot its last sonar ring with the
-;; pose it was first seen at.  A ring stays readable after sonar-stop, so
-;; a robot that stopped its sonar and drove on still answers the ring it
-;; read back there, which is drawn from there.
+;; What the view remembers between polls: the boxes, the task table, and
+;; each robot's last sonar ring with the pose it was read at.
 (define-record-type view-state
   (make-view-state boxes table sonars)
   view-state?
@@ -129,17 +103,13 @@
   (table view-state-table)
   (sonars view-state-sonars view-state-sonars-set!))  ; rings
 
-;;> The view's memory, at the start, for the room \var{header} (see
-;;> lab-header).
+;;> The view's memory at the start, for the room \var{header}.
 (define (new-view-state header)
   (make-view-state (list->vector (vector->list (cdr (assq 'boxes header))))
                    (make-task-table) '()))
 
-;;> The snapshot at \var{t} seconds of the lab: \var{answers} are
-;;> remote-apply-all's, for the lab's address spaces, of report-source;
-;;> \var{state} what the view remembers (new-view-state), brought up to
-;;> date; \var{line}, when given, the lab's waiting tasks as lab-line has
-;;> them, a guest's too.
+;;> The snapshot at \var{t} seconds of the lab, from \var{answers} and
+;;> \var{state}, brought up to date; \var{line} the lab's waiting tasks.
 (define (view-snapshot lab t answers state . line)
   (let* ((answered (filter outcome-ok? answers))
          (boxes (view-state-boxes state)))
@@ -162,7 +132,6 @@
       (boxes . ,(vector-map (lambda (b) b) boxes))
       (tasks . ,(task-table->json (view-state-table state) 12)))))
 
-;; The ring the view remembers of uid, or #f.
 (define (ring-of state uid)
   (find (lambda (r) (eq? (ring-uid r) uid)) (view-state-sonars state)))
 
@@ -213,10 +182,9 @@
             (battery . ,(if (real? battery) (num (/ battery 10)) 'null))
             (held . ,(list->vector (map (lambda (h) (vector (car h) (cdr h)))
                                         (held-texts report))))
-            ;; The last sonar ring, and the pose it was read at.
             (sonar . ,(if ring (numbers (ring-ranges ring)) 'null))
             (sonar-at . ,(if ring (numbers (ring-pose ring)) 'null))
-            ;; Where the robot's goto-xy is going (aspace-report's GOAL).
+            ;; Where the robot's goto-xy is going.
             (goal . ,(let ((goal (report-goal report)))
                        (if (and (list? goal) (>= (length goal) 2)
                                 (every real? (take goal 2)))
@@ -225,9 +193,7 @@
 
 ;;; The feed: snapshots for the trace file and the pages that follow
 
-;; The trace is written as the run goes, a line at a time, so that a
-;; lab stopped any way leaves a trace to replay.  The pages that follow
-;; it wait on changed for the next snapshot.
+;; The trace is written a line at a time, so a lab stopped any way leaves one.
 (define-record-type feed
   (%make-feed trace out count recent lock changed)
   feed?
@@ -255,8 +221,7 @@
         (feed-count-set! feed (+ k 1))
         (condition-variable-broadcast! (feed-changed feed))))))
 
-;; The snapshots numbered next or later that the feed still keeps, oldest
-;; first, as soon as there is one, or none once seconds have passed.
+;; The feed's snapshots from next on, once there is one, or none after seconds.
 (define (feed-after feed next seconds)
   (let ((deadline (+ (monotonic-seconds) seconds)))
     (let loop ()

@@ -1,26 +1,9 @@
-;;;; The live view's table of tasks, part of (murdoch view): who holds
-;;;; what, for which task, from what the address spaces report.
-
-;;; The tasks: what the address spaces say they hold and run
-;;
-;; A robot tells the subjects it holds and for whom -- a reservation name,
-;; NAME@POSER/N (task/pose-task.scm) -- the components it runs, (running ID
-;; INDEX POSER) with ID NAME@POSER/N, a started task's id or a posed task's
-;; reservation name (task/running.scm), and the components that ended there
-;; lately, each with how it ended, which its poser was told.  The table
-;; remembers each component from when it is first seen on a robot to when
-;; it ended there, and how; one that ended between two looks is added
-;; whole.  A component of a started task seen on another robot than before
-;; was reassigned.  Subjects held for a task that its robot runs no
-;; component of are a reservation of its negotiation, shown without a
-;; number until a component of that task starts on that robot, or it is
-;; released.  A task's own state is what its poser says, when the poser is
-;; an address space of the lab; else what its components say: running while
-;; one runs, negotiating while only reservations are held, failed when one
-;; failed or was lost, not started when none started, else done.  A
-;; component is lost when its robot started again (its up-since moved) or
-;; has not answered for away-polls looks in a row: a robot that died does
-;; not say that it stopped, and its poser was told "connection lost".
+;;;; The live view's table of tasks, part of (murdoch view): who holds what
+;;;; for which task, from the robots' reports of subjects held (NAME@POSER/N),
+;;;; components running and ended.  A component seen on another robot was
+;;;; reassigned; subjects held with none are a negotiation's reservation.  A
+;;;; task's state is its poser's word, else its components'.  A component is
+;;;; lost when its robot restarted or missed away-polls looks.
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)
@@ -50,8 +33,7 @@
   (robots table-robots table-robots-set!)       ; seen-robots
   (tasks table-tasks table-tasks-set!))         ; task-entries, oldest first
 
-;; A robot the table has seen: when it last started, and how many looks
-;; in a row it has not answered.
+;; A robot the table has seen: when it last started, and looks missed in a row.
 (define-record-type seen-robot
   (make-seen-robot name since silent)
   seen-robot?
@@ -64,9 +46,7 @@
 
 (define away-polls 3)
 
-;;> The task name and poser that reservation name or task id \var{key}
-;;> (a string, NAME@POSER/N: task-key's) holds, as a list, or the key and
-;;> #f when it is not one.
+;;> The task name and poser of \var{key} (NAME@POSER/N) as a list, else (key #f).
 (define (reservation-task key)
   (or (task-key-parts key) (list key #f)))
 
@@ -75,8 +55,7 @@
   (let ((nt (reservation-task key)))
     (if (cadr nt) (string-append (car nt) "@" (cadr nt)) key)))
 
-;; A component one address space's report shows there: KEY its task's,
-;; INDEX #f when only held subjects show it.
+;; A component one report shows: KEY its task's, INDEX #f for held subjects only.
 (define-record-type shown
   (make-shown key index subjects)
   shown?
@@ -84,13 +63,11 @@
   (index shown-index)
   (subjects shown-subjects))
 
-;; The (subject . holder) of each subject a report says is held, as text.
 (define (held-texts report)
   (map (lambda (h) (cons (text (held-subject h)) (text (held-holder h))))
        (report-held report)))
 
-;; What one address space's report shows running there: a shown for
-;; each component.
+;; A shown for each component one report shows running there.
 (define (report-components report)
   (let* ((held (held-texts report))
          (running (filter-map (lambda (t)
@@ -115,8 +92,7 @@
             (make-shown holder #f (subjects-of (lambda (h) (equal? h holder)))))
           (delete-duplicates (remove covered? (map cdr held)))))))
 
-;; (KEY . STATE) for each task of tasks, entries as (tasks) answers, posed
-;; by the address space that answered them.
+;; (KEY . STATE) for each of tasks, as (tasks) answers, posed by the answerer.
 (define (posed-states tasks)
   (filter-map (lambda (t)
                 (and (pair? t) (listed-posed? t) (>= (length t) 3)
@@ -124,9 +100,7 @@
                            (posed-state-text t (and (= (length t) 8) (listed-place t))))))
               tasks))
 
-;; A posed task's state as the view shows it: its word, as task-state's,
-;; then for a failed one why, for a waiting one what it holds and waits
-;; for, and its place in the lab's line.
+;; A posed task's state as shown: its word, why it failed, or what it waits for.
 (define (posed-state-text t place)
   (let ((word (text (listed-state t))))
     (cond ((< (length t) 8) word)       ; a peer older than the word's details
@@ -135,18 +109,13 @@
           ((string? (listed-why t)) (string-append word ": " (listed-why t)))
           (else word))))
 
-;; Whether the table takes a posed task's (KEY . STATE): it goes on, or
-;; it is one the table has; a task over before the view saw it is left out.
+;; Whether the table takes a posed (KEY . STATE): a task over unseen is left out.
 (define (posed-news? table posed)
   (or (task-known table (car posed))
       (not (any (lambda (word) (string-prefix? word (cdr posed)))
                 '("done" "failed" "cancelled" "deadline")))))
 
-;;> Brings the tasks of \var{table} that wait their turn up to date with
-;;> \var{line}, the lab's waiting tasks as lab-line has them, whoever
-;;> posed them: their state, and their place in the one line.  A task a
-;;> guest posed that has left the line is over or running, as its
-;;> components say.
+;;> Brings \var{table}'s waiting tasks up to date with \var{line}, the lab's.
 (define (task-table-note-line! table line)
   (let ((keys (map (lambda (x) (text (listed-id (car (cddr x))))) line)))
     (for-each (lambda (x key)
@@ -166,7 +135,6 @@
   (and (>= (string-length s) (string-length prefix))
        (string=? prefix (substring s 0 (string-length prefix)))))
 
-;; The entries of components-ended that a report gives, those well made.
 (define (ended-entries report)
   (filter (lambda (e)
             (and (list? e) (= (length e) 6) (exact-integer? (ended-index e))
@@ -174,8 +142,7 @@
                  (pair? (ended-end e))))
           (report-ended report)))
 
-;; (done), (failed WHY) or (lost WHY), as "done", "failed: WHY" ...; a
-;; long WHY cut short.
+;; (done), (failed WHY) or (lost WHY) as "done", "failed: WHY" ..., WHY cut short.
 (define (end-text end)
   (if (pair? (cdr end))
       (let ((why (text (cadr end))))
@@ -198,7 +165,6 @@
 
 (define (open? c) (not (component-entry-until c)))
 
-;; Whether c ended lost or failed.
 (define (failed? c)
   (let ((end (component-entry-end c)))
     (and (string? end)
@@ -207,17 +173,14 @@
                      (string=? word (substring end 0 (string-length word)))))
               '("lost:" "failed:")))))
 
-;; Whether c of cs failed or was lost, and no later entry took its number:
-;; a started task's component may be lost on one robot and done on the
-;; next.
+;; Whether c failed or was lost, and no later entry took its number.
 (define (failed-for-good? c cs)
   (and (failed? c)
        (let ((k (component-entry-index c)))
          (not (and k (any (lambda (later) (eqv? (component-entry-index later) k))
                           (cdr (memq c cs))))))))
 
-;; A task's state, when its poser does not say it: what its components
-;; say.
+;; A task's state by its components, when its poser does not say.
 (define (components-state cs)
   (cond ((any (lambda (c) (and (open? c) (component-entry-index c))) cs) "running")
         ((any open? cs) "negotiating")
@@ -226,12 +189,8 @@
         ((any component-entry-index cs) "done")
         (else "not started")))
 
-;;> Brings \var{table} up to the time \var{t} (seconds since the view
-;;> started) with \var{reports}: (UID REPORT [POSED]) for each address
-;;> space that answered, REPORT as aspace-report makes it, POSED the tasks
-;;> it posed lately as (tasks) lists them, those over too (else REPORT's
-;;> TASKS).  A component that an address space that answered no longer
-;;> shows has ended: as it says, or else, a reservation, released.
+;;> Brings \var{table} up to time \var{t} with \var{reports}, (UID REPORT
+;;> [POSED]) each; a component no longer shown has ended or was released.
 (define (task-table-update! table t reports)
   (let ((seen '()))                     ; the component entries seen now
     (for-each
@@ -280,15 +239,12 @@
                    (task-entry-components task)))
        (table-tasks table)))))
 
-;; The parts of one of task-table-update!'s reports, a sighting: the
-;; (UID REPORT [POSED]) that the view makes of an outcome, and tests write.
+;; The parts of a sighting, (UID REPORT [POSED]), as the view and tests make it.
 (define (sighting-uid r) (car r))
 (define (sighting-report r) (cadr r))
 (define (sighting-posed r) (and (pair? (cddr r)) (car (cddr r))))
 
-;; Brings the table's robots up to date with reports, and answers
-;; ((ROBOT . WHY) ...) for those whose components seen before were lost:
-;; started again, or silent for away-polls looks.
+;; Brings the table's robots up to date: ((ROBOT . WHY) ...) for those lost.
 (define (note-robots! table t reports)
   (let ((gone '()))
     (for-each
@@ -351,11 +307,8 @@
                                                  (list c)))
         c)))))
 
-;; The reservations robot holds, unnumbered, for task -- under its own
-;; name, or under the name a started task negotiated with, which shares
-;; its NAME@POSER -- are the component of task that starts there now:
-;; they are taken out of the table, a task left with nothing with them,
-;; and answers when the first was seen, or #f when there was none.
+;; The unnumbered reservations robot holds for task become the component
+;; starting there; answers when the first was seen, or #f.
 (define (take-reservations! table task robot)
   (let ((base (key-base (task-entry-key task)))
         (since #f))
@@ -378,9 +331,7 @@
                               (table-tasks table)))
     since))
 
-;; Brings robot's component that e, an entry of ended-entries, tells of to
-;; its end: the open entry seen before, or a new one when it ended since
-;; the view started and the table has none.
+;; Ends robot's component that e tells of: the open entry, or a new one.
 (define (note-ended! table t robot e)
   (let* ((key (text (ended-id e)))
          (k (ended-index e))
@@ -400,16 +351,12 @@
   (component-entry-until-set! c until)
   (component-entry-end-set! c end))
 
-;; Whether component a goes before b: a smaller number, or a number
-;; before none.
+;; Whether a goes before b: a smaller number, or a number before none.
 (define (by-number a b)
   (let ((i (component-entry-index a)) (j (component-entry-index b)))
     (and i (or (not j) (< i j)))))
 
-;;> The table as JSON: the newest \var{most} tasks, each with its name,
-;;> poser, state, coordinator and standby when it is detached, and components (index, robot, subjects, since, until,
-;;> how it ended, and the robot it was reassigned from), by their number,
-;;> the reservations last.
+;;> The table as JSON: the newest \var{most} tasks and their components.
 (define (task-table->json table most)
   (list->vector
    (map (lambda (task)

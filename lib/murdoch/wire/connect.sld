@@ -1,12 +1,7 @@
-;;> A TCP connect that gives up at a timeout: \scheme{open-connection},
-;;> the non-blocking replacement of (chibi net)'s \scheme{open-net-io}.
-;;> The C is lib/murdoch/wire/connect.stub and nonblocking-connect.c, built into
-;;> lib/murdoch/wire/connect.so by \scheme{make native}; the waiting is
-;;> lib/murdoch/wire/connect.scm.
-;;>
-;;> \procedure{(socket-port socket)}
-;;> The local port \var{socket} is bound to: for a listener bound to port
-;;> 0, the free one the kernel chose.
+;;> \scheme{open-connection}, a TCP connect that gives up at a timeout, in
+;;> place of (chibi net)'s \scheme{open-net-io}.  C: connect.stub and
+;;> nonblocking-connect.c.
+;;> \procedure{(socket-port socket)} The local port \var{socket} is bound to.
 
 (define-library (murdoch wire connect)
   (export open-connection socket-port)

@@ -1,26 +1,15 @@
 ;;> \procedure{(hmac-sha256 key part ...)}
-;;> HMAC-SHA256 under \var{key} of the message made of the \var{part}s one
-;;> after the other, as a lowercase hex string.  The key and each part are
-;;> a bytevector or a string (its UTF-8 bytes); a part may also be a
-;;> fixnum, which stands for its decimal digits.
-;;>
-;;> \procedure{(hmac-sha256-sign key text parts)}
-;;> \var{text} signed: a string of the MAC under \var{key} of the list
-;;> \var{parts} followed by \var{text}, then \var{text}.
-;;>
-;;> \procedure{(hmac-sha256-write! key text parts port)}
-;;> Writes to the output \var{port} the netstring of \var{text} signed as
-;;> by hmac-sha256-sign, making no string of it.
-;;>
-;;> \procedure{(hmac-sha256-open key bytes end parts)}
-;;> The text of a signed message, the first \var{end} bytes of the
-;;> bytevector \var{bytes}, as a string, when its MAC is that of the list
-;;> \var{parts} followed by the text; #f when it is not.
-;;>
-;;> The body is lib/murdoch/wire/hmac.stub and hmac-sha256.c, built into
-;;> lib/murdoch/wire/hmac.so by \scheme{make native}: over Chibi's SHA-256 in
-;;> Scheme a frame's MAC cost 40 us.  A frame's parts come as a list, which
-;;> its caller builds once, where a rest argument would be built again.
+;;> HMAC-SHA256 under \var{key} of the \var{part}s one after another, as
+;;> lowercase hex.  Key and parts are bytevectors or strings (UTF-8); a
+;;> part may be a fixnum, standing for its decimal digits.
+;;> \procedure{(hmac-sha256-sign key text parts)} The MAC under \var{key}
+;;> of the list \var{parts} then \var{text}, followed by \var{text}.
+;;> \procedure{(hmac-sha256-write! key text parts port)} Writes the
+;;> netstring of \var{text} signed, making no string of it.
+;;> \procedure{(hmac-sha256-open key bytes end parts)} The text of the
+;;> signed message in the first \var{end} bytes of \var{bytes}, or #f when
+;;> its MAC is not that of \var{parts} then the text.
+;;> C: hmac.stub and hmac-sha256.c (docs/speed.md says why not Scheme).
 
 (define-library (murdoch wire hmac)
   (export hmac-sha256 hmac-sha256-sign hmac-sha256-write! hmac-sha256-open)

@@ -1,17 +1,12 @@
-;;;; Netstrings: the frames every Murdoch message travels in.
-;;
-;; A netstring is "LENGTH:PAYLOAD," with LENGTH in decimal (D. J. Bernstein).
-;; The reader is strict, because a frame comes from the network: digits
-;; only, no leading zero but for the empty payload, at most MAX bytes of
-;; payload, and the comma.
+;;;; Netstrings (D. J. Bernstein): "LENGTH:PAYLOAD,".  The reader is strict,
+;;;; as frames come from the network: digits only, no leading zero but for
+;;;; the empty payload, at most MAX bytes of payload, and the comma.
 
-;; What a peer sends that is not a netstring is a protocol error of the
-;; remote-error family, whose message says what was wrong, for the log.
+;; A peer's bad netstring is a protocol error of the remote-error family.
 (define (netstring-fail . parts)
   (apply protocol-fail "netstring" parts))
 
-;;> Whether \var{e} is the error for a bad netstring, or any other
-;;> protocol violation: the same family (remote-error.scm).
+;;> Whether \var{e} is a bad netstring's error, or another protocol error.
 (define netstring-error? remote-protocol-error?)
 
 ;;> What was wrong with the netstring.
@@ -19,9 +14,8 @@
 
 (define (digit-byte? b) (and (>= b 48) (<= b 57)))
 
-;; The length prefix, read one byte at a time: it is a few bytes long, and
-;; reading no further than the colon leaves the payload in the buffer.  A
-;; length already over max takes no more digits.
+;; The length, read a byte at a time to leave the payload in the buffer;
+;; a length already over max takes no more digits.
 (define (read-netstring-length in max)
   (let loop ((n 0) (digits 0))
     (let ((b (read-u8 in)))
@@ -39,9 +33,8 @@
         (netstring-fail "length over " (number->string max) " bytes"))
        (else (loop (+ (* n 10) (- b 48)) (+ digits 1)))))))
 
-;; What the port's buffer holds is copied at once (netstring-scan.c); when
-;; it is empty, read-u8 waits for more and refills it.  The end of the port
-;; before the last byte is a fault.
+;; The buffer's bytes are copied at once (netstring-scan.c); read-u8 waits
+;; to refill an empty one.  The port's end before the last byte is a fault.
 (define (read-payload in n)
   (let ((payload (make-bytevector n)))
     (let loop ((have 0))
@@ -55,9 +48,8 @@
                   (bytevector-u8-set! payload have b)
                   (loop (+ have 1)))))))))
 
-;;> Reads one netstring from the binary port \var{in} and returns its
-;;> payload as a bytevector, or an eof object when the port ends cleanly
-;;> between frames.  Raises a protocol remote-error on anything else.
+;;> Reads one netstring from binary port \var{in}: its payload, or an eof
+;;> object at a clean end; a protocol remote-error on anything else.
 (define (read-netstring in max)
   (or (take-buffered-netstring in max)  ; netstring-scan.c: a whole frame
       (read-netstring-bytewise in max)))
@@ -76,9 +68,8 @@
               (netstring-fail "missing comma after payload")))
         payload)))))
 
-;;> Writes \var{payload}, a bytevector or a string (its UTF-8 bytes), to
-;;> \var{out} as one netstring; a string is the faster (docs/speed.md).
-;;> Does not flush: the caller knows when a batch of frames is complete.
+;;> Writes \var{payload}, a bytevector or a string (faster: docs/speed.md),
+;;> to \var{out} as one netstring, unflushed.
 (define (write-netstring payload out)
   (if (string? payload)
       (begin

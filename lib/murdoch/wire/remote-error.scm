@@ -1,7 +1,7 @@
 ;;;; The remote errors: one family, a kind for each way a call fails.
 ;;
-;; Its irritants are the target's uid (#f for a frame from a peer not yet
-;; known), what was called or read, and the message:
+;; Its irritants: the target's uid (#f for a peer not yet known), what was
+;; called or read, and the message.  The kinds:
 ;;   timed-out     no answer within the timeout (connecting included)
 ;;   unreachable   no connection, or it was lost or refused
 ;;   raised        the procedure raised an error at the callee
@@ -17,8 +17,7 @@
                              (string-append "protocol violation: " message))
                          (list uid what message) #f #f)))
 
-;;> Raises the protocol error for a frame from an unnamed peer, the
-;;> message made of \var{parts}.
+;;> Raises the protocol error, of \var{parts}, for a frame from an unnamed peer.
 (define (protocol-fail what . parts)
   (remote-error 'protocol #f what (apply string-append parts)))
 
@@ -33,8 +32,7 @@
 ;;> A remote-error for a call that had no answer within its timeout.
 (define (remote-timeout-error? e) (remote-error-of-kind? 'timed-out e))
 
-;;> A remote-error for a target that could not be reached, or whose
-;;> connection was lost or refused.
+;;> A remote-error for a target that could not be reached, or was lost.
 (define (remote-unreachable-error? e) (remote-error-of-kind? 'unreachable e))
 
 ;;> A remote-error for a procedure that raised an error in the target.
@@ -49,18 +47,15 @@
 ;;> What went wrong, as a string.
 (define (remote-error-message e) (car (cddr (exception-irritants e))))
 
-;;> What \var{e}, any raised object, says, as one line for a log or an
-;;> answer: a remote error's own message (its uid and procedure are its
-;;> irritants, for whoever names them), else condition-message's.
+;;> What \var{e}, any raised object, says, as one line: a remote error's
+;;> own message, else condition-message's.
 (define (error-message e)
   (if (and (remote-error? e) (not (stack-guard-tripped? (current-thread))))
       (remote-error-message e)
       (condition-message e)))
 
-;;> As error-message, but a remote error's message follows the uid of the
-;;> address space it concerns, as \scheme{"praline: car: not a pair ()"}:
-;;> for an error that leaves the place that knows the uid, an answer to
-;;> another caller or the command line's ERROR line.
+;;> As error-message, a remote error's message after its uid, as
+;;> \scheme{"praline: car: not a pair ()"}, for an answer or an ERROR line.
 (define (error-message-naming e)
   (let ((uid (and (remote-error? e) (remote-error-uid e))))
     (if uid
