@@ -99,6 +99,21 @@
 (define (running-everywhere? id)
   (every (lambda (s) (eq? (car (status-state s)) 'running)) (task-status id)))
 
+;; Poses from the poser a detached task named tag, of one restartable
+;; component of rounds, and answers its id once it runs, with a standby.
+(define (running-detached tag rounds)
+  (let ((id (remote-apply
+             (uid->aspace 'poser)
+             (eval `(lambda ()
+                      (start-task ',tag 1 (list '((mobile) ())) (list #f)
+                                  (list (lambda () (work ',tag ,rounds))) '(1) '(#t)
+                                  'detach #t))
+                   (lab-environment)))))
+    (test-assert "it runs, with a standby"
+      (wait-until 10 (lambda () (and (running-everywhere? id)
+                                     (lab-task-standby (entry-of id))))))
+    id))
+
 ;; Kills uid's process, as a crash would; restart! starts it again.
 (define (kill! uid) (kill-process! (cdr (assq uid pids))))
 (define (restart! uid)
@@ -307,16 +322,7 @@
   ;; nobody coordinates it until the standby wakes and takes it over.  A
   ;; peer's task-wait meanwhile waits on; its task-status, bounded, says
   ;; the task is moving, not that it failed.
-  (let ((id (remote-apply
-             (uid->aspace 'poser)
-             (eval '(lambda ()
-                      (start-task 'stalled 1 (list '((mobile) ())) (list #f)
-                                  (list (lambda () (work 'stalled 60))) '(1) '(#t)
-                                  'detach #t))
-                   (lab-environment)))))
-    (test-assert "it runs, with a standby"
-      (wait-until 10 (lambda () (and (running-everywhere? id)
-                                     (lab-task-standby (entry-of id))))))
+  (let ((id (running-detached 'stalled 60)))
     (let* ((e (entry-of id)) (coordinator (lab-task-coordinator e))
            (standby (lab-task-standby e)) (pid (cdr (assq standby pids))))
       (kill pid signal/stop)
@@ -362,16 +368,7 @@
       (restart! standby))))
 
 (test-group "a robot lost while the standby is in charge"
-  (let ((id (remote-apply
-             (uid->aspace 'poser)
-             (eval '(lambda ()
-                      (start-task 'moved 1 (list '((mobile) ())) (list #f)
-                                  (list (lambda () (work 'moved 100))) '(1) '(#t)
-                                  'detach #t))
-                   (lab-environment)))))
-    (test-assert "it runs, with a standby"
-      (wait-until 10 (lambda () (and (running-everywhere? id)
-                                     (lab-task-standby (entry-of id))))))
+  (let ((id (running-detached 'moved 100)))
     (let ((old (coordinator-of id)))
       (kill! old)
       (test-assert "the standby takes over"
