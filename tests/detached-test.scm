@@ -99,6 +99,14 @@
 (define (running-everywhere? id)
   (every (lambda (s) (eq? (car (status-state s)) 'running)) (task-status id)))
 
+;; The coordinator of task id once one has taken it over, or #f.
+(define (second-coordinator id)
+  (wait-until 10 (lambda ()
+                   (let ((e (entry-of id)))
+                     (and (eq? (lab-task-role e) 'coordinator)
+                          (= 2 (lab-task-epoch e))
+                          (lab-task-coordinator e))))))
+
 ;; Poses from the poser a detached task named tag, of one restartable
 ;; component of rounds, and answers its id once it runs, with a standby.
 (define (running-detached tag rounds)
@@ -175,12 +183,7 @@
       (wait-until 10 (lambda () (lab-task-standby (entry-of id)))))
     (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
       (kill! old)
-      (test "the standby takes over" standby
-        (wait-until 10 (lambda ()
-                         (let ((e (entry-of id)))
-                           (and (eq? (lab-task-role e) 'coordinator)
-                                (= 2 (lab-task-epoch e))
-                                (lab-task-coordinator e))))))
+      (test "the standby takes over" standby (second-coordinator id))
       (test-assert "and chooses a new standby"
         (wait-until 10 (lambda ()
                          (let ((s (lab-task-standby (entry-of id))))
@@ -235,12 +238,7 @@
          (wait-until 15 (lambda () (and (in-step? id step) (lab-task-standby (entry-of id))))))
        (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
          (kill! old)
-         (test "the standby takes over" standby
-           (wait-until 10 (lambda ()
-                            (let ((e (entry-of id)))
-                              (and (eq? (lab-task-role e) 'coordinator)
-                                   (= 2 (lab-task-epoch e))
-                                   (lab-task-coordinator e))))))
+         (test "the standby takes over" standby (second-coordinator id))
          (let* ((waited (murdoch-status "wait" (test-lab-file lab) (symbol->string id)))
                 (results (task-wait id 30))
                 (one (car (car results)))
