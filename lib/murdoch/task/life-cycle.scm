@@ -125,8 +125,19 @@
 ;;> (detached.scm).
 (define task-id-maker (make-parameter task-key))
 
-;; Whether t's coordinator let it go (detached.scm): it acts no more.
+;;> Whether \var{t}'s coordinator let it go (detached.scm): it acts no
+;;> more.
 (define (let-go? t) (eq? (task-state t) 'let-go))
+
+;;> Stops acting for \var{t}, a detached task whose standby may be taking
+;;> it over: no heartbeat, start or negotiation more (let-go? checks),
+;;> and nothing cancelled; what it holds while it waits is given back.  A
+;;> task of steps lets its step go with it.
+(define (let-task-go! t)
+  (task-state-set! t 'let-go)
+  (if (task-waiter t) (tell-waiter! (task-waiter t) '(cancel)))
+  (if (pair? (task-steps t)) (let-task-go! (last (task-steps t))))
+  (mailbox-put! (task-done t) 'let-go))
 
 ;; Negotiates t, runs its components, each watched over by a thread of
 ;; its own, and puts their results in t's mailbox.
