@@ -15,7 +15,8 @@
 ;;;   bench: chaos-tasks N, with how they ended
 ;;;   bench: chaos-double-bookings N, chaos-leaked N, chaos-hung N
 ;;; Beside them, two more posers hand restartable tasks to the lab
-;;; ('detach #t), coordinated by three workstations k1..k3, and a second
+;;; ('detach #t), every other one a task of two steps, coordinated by
+;;; three workstations k1..k3, and a second
 ;;; killer kill -9s a running detached task's coordinator or standby every
 ;;; few seconds, starting it again a second later.  It prints
 ;;;   bench: takeover-p50 / -p95 S s   a coordinator's kill to its standby
@@ -25,6 +26,9 @@
 ;;;                                    where the task's components run
 ;;;   bench: detached-lost N           tasks whose result no peer could read
 ;;;   bench: detached-double-runs N    a component running twice at once
+;;; and tells each failed detached task, and each component begun again
+;;; after it completed; a task lost or a component run twice keeps the
+;;; lab's logs, and says where.
 ;;; MURDOCH_CHAOS_SECONDS sets how long the kills go on (default 90).
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme process-context) (scheme inexact) (scheme time)
@@ -93,13 +97,20 @@
 ;; when its robot is away or was started again since.
 (define copies '())
 (define double-runs 0)
+;; The tags of the components that completed, and how many began again
+;; after: a step of a task of steps run again after a takeover, say.
+(define completed '())
+(define reruns 0)
 (define (copy-enter! tag who)
   (under copies-lock
    (lambda ()
      (let ((others (filter (lambda (c) (and (equal? (car c) tag) (live-copy? c)))
                            copies)))
        (if (pair? others) (set! double-runs (+ double-runs 1)))
+       (if (member tag completed) (set! reruns (+ reruns 1)))
        (set! copies (cons (cons tag who) copies))))))
+(define (copy-completed! tag)
+  (under copies-lock (lambda () (set! completed (cons tag completed)))))
 (define (live-copy? c)
   (guard (e (#t #f))
     (equal? (caddr c)
@@ -113,7 +124,10 @@
     (remote-apply (uid->aspace 'quiet) (lambda () (copy-enter! tag who)))
     (dynamic-wind
      (lambda () #f)
-     chaos-component
+     (lambda ()
+       (let ((result (chaos-component)))
+         (tell-quiet (lambda () (copy-completed! tag)))
+         result))
      (lambda () (tell-quiet (lambda () (copy-leave! tag who)))))))
 (define (held subjects)
   (apply + (map (lambda (r) (length (filter (lambda (s) (pair? (cadr s))) (cadr r))))
@@ -267,18 +281,50 @@
 (define detached-outcomes '())          ; done, failed or lost, one a task
 (define tags 0)
 
+(define steps-tasks 0)
+
+;; A task of one component, or every other one of two steps, each of one;
+;; each component a copy of its own, (N) or (N STEP).
 (define (one-detached-task)
   (let* ((tag (locked (lambda () (set! tags (+ tags 1)) tags)))
-         (id (start-task 'handed 1 (list '((mobile) ())) (list #f)
-                         (list (eval `(lambda () (detached-component ,tag))
-                                     (lab-environment)))
-                         '(1) '(#t) 'detach #t))
+         (began (monotonic-seconds))
+         (steps? (even? tag))
+         (id (if steps?
+                 (apply start-steps 'handed-steps
+                        (append (map (lambda (i) (detached-step (list tag i))) '(1 2))
+                                '(detach #t)))
+                 (start-task 'handed 1 (list '((mobile) ())) (list #f)
+                             (list (eval `(lambda () (detached-component '(,tag)))
+                                         (lab-environment)))
+                             '(1) '(#t) 'detach #t)))
          (outcome (guard (e (#t (display (error-message e)) (newline) 'lost))
                     (let ((r (task-wait id 60)))
-                      (cond ((and (pair? r) (memq (car r) robots)) 'done)
-                            ((symbol? r) r)
-                            (else 'failed))))))
+                      (cond ((symbol? r) r)
+                            ((and steps? (find symbol? r)))  ; a step's not-enough-takers
+                            ((if steps? (every done-one? r) (done-one? r)) 'done)
+                            (else (tell-failed id (if steps? (apply append r) r) began) 'failed))))))
+    (if steps? (locked (lambda () (set! steps-tasks (+ steps-tasks 1)))))
     (locked (lambda () (set! detached-outcomes (cons outcome detached-outcomes))))))
+
+;; Why a detached task posed at began failed, from its components'
+;; results: each (error UID WHY), and whether the killer killed UID since.
+(define (tell-failed id results began)
+  (display (string-append "chaos: detached " (symbol->string id) " failed: "))
+  (for-each (lambda (x)
+              (when (and (pair? x) (eq? (car x) 'error))
+                (write x)
+                (display (if (killed-after (cadr x) began) " (its robot killed) "
+                             " (its robot not killed) "))))
+            results)
+  (newline))
+
+(define (detached-step tag)
+  (task-step (list '((mobile) ())) (list #f)
+             (list (eval `(lambda (previous) (detached-component ',tag)) (lab-environment)))
+             '(1) '(#t)))
+
+;; Whether r, a task's results, are a component's: its robot's uid.
+(define (done-one? r) (and (pair? r) (memq (car r) robots) #t))
 
 (define (detached-poser until)
   (when (< (monotonic-seconds) until)
@@ -352,6 +398,7 @@
            (string-append "bench: takeover-floor " (seconds-text (median takeover-floors))
                           " s")
            (string-append "chaos: detached tasks " (number->string (length detached-outcomes))
+                          " (" (number->string steps-tasks) " of two steps)"
                           ": done " (number->string (count (lambda (o) (eq? o 'done))
                                                            detached-outcomes))
                           ", not-enough-takers "
@@ -366,7 +413,19 @@
                           (number->string (count (lambda (o) (eq? o 'lost))
                                                  detached-outcomes)))
            (string-append "bench: detached-double-runs "
-                          (number->string (at-quiet 'double-runs)))))))
+                          (number->string (at-quiet 'double-runs)))
+           (string-append "chaos: detached components begun again after they completed "
+                          (number->string (at-quiet 'reruns))
+                          " (a robot killed before its result was read, or a step run"
+                          " again)")))))
 
+;; A detached task lost, or a component run twice, keeps the lab's logs.
+(define keep-logs?
+  (or (memq 'lost detached-outcomes)
+      (positive? (+ (at-quiet 'double-runs) (at-quiet 'reruns)))))
 (stop-all-processes!)
-(remove-test-lab! lab)
+(if keep-logs?
+    (begin (display (string-append "chaos: the lab's logs are kept in "
+                                   (test-lab-directory lab)))
+           (newline))
+    (remove-test-lab! lab))

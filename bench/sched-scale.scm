@@ -26,7 +26,7 @@
 ;;; 0.008); MURDOCH_SCHED_SEED (30).
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme time) (scheme process-context) (scheme inexact)
-        (srfi 1) (srfi 18) (srfi 27) (srfi 132)
+        (srfi 1) (srfi 18) (srfi 132)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness)
         (bench clock) (bench schedule))
@@ -101,18 +101,12 @@
    `(("code.scm" . ,lab-code))))
 
 (define uids (append posers (map car robots)))
-(define pids (map (lambda (uid) (start-lab-aspace! lab uid)) uids))
-(join-lab (test-lab-file lab) 'bench)
-(wait-until 60 (lambda () (every (lambda (u) (memq u (live-uids))) uids)))
-(define (lab-proc name) (eval name (lab-environment)))
-(eval (list 'set! 'clock current-second) (lab-environment))
+(define pids (start-bench-lab! lab uids 60))
 
 ;;; The tasks
 
-(define random-source (make-random-source))
-(random-source-pseudo-randomize! random-source seed 0)
-(define random-real (random-source-make-reals random-source))
-(define (random-below n) (exact (floor (* n (random-real)))))
+(define random-real (seeded-reals seed))
+(define (random-below n) (below random-real n))
 
 ;; A component's subject: a kind, or a pair of kinds.
 (define (random-subject)

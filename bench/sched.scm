@@ -40,7 +40,7 @@
 ;;; MURDOCH_SCHED_SEED sets the seed (default 30).
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme time) (scheme process-context) (scheme inexact)
-        (srfi 1) (srfi 18) (srfi 27) (srfi 132)
+        (srfi 1) (srfi 18) (srfi 132)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness) (bench schedule))
 
@@ -87,20 +87,12 @@
      ,@(map (lambda (uid) `(aspace ,uid (capabilities arm))) robots))
    `(("code.scm" . ,lab-code))))
 
-(define pids (map (lambda (uid) (cons uid (start-lab-aspace! lab uid)))
-                  (append posers robots)))
-(join-lab (test-lab-file lab) 'bench)
-(wait-until 20 (lambda () (every (lambda (u) (memq u (live-uids)))
-                                 (append posers robots))))
-(define (lab-proc name) (eval name (lab-environment)))
-(eval (list 'set! 'clock current-second) (lab-environment))
+(start-bench-lab! lab (append posers robots) 20)
 
 ;;; The tasks
 
-(define random-source (make-random-source))
-(random-source-pseudo-randomize! random-source seed 0)
-(define random-real (random-source-make-reals random-source))
-(define (random-below n) (exact (floor (* n (random-real)))))
+(define random-real (seeded-reals seed))
+(define (random-below n) (below random-real n))
 
 ;; (id kinds seconds priority gap), as (bench schedule) reads it: a list
 ;; (arm) a robot; gap, seconds after the task before.

@@ -10,11 +10,36 @@
 ;;> robot UID, in time order.  Robots are ((UID . KIND) ...).
 
 (define-library (bench schedule)
-  (export make-schedule-run schedule-completed! print-schedule-figures
+  (export start-bench-lab! lab-proc seeded-reals below
+          make-schedule-run schedule-completed! print-schedule-figures
           schedule-spans schedule-makespan percentile round-to bench)
-  (import (scheme base) (scheme write) (scheme inexact)
-          (srfi 1) (srfi 132))
+  (import (scheme base) (scheme write) (scheme inexact) (scheme eval) (scheme time)
+          (srfi 1) (srfi 27) (srfi 132)
+          (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+          (murdoch cli command) (murdoch testing harness))
   (begin
+    ;;> Starts the address spaces \var{uids} of test lab \var{lab}, joins
+    ;;> it as bench, waits up to \var{seconds} for them all to be live, and
+    ;;> sets the lab code's clock to this one's: answers their pids.
+    (define (start-bench-lab! lab uids seconds)
+      (let ((pids (map (lambda (uid) (start-lab-aspace! lab uid)) uids)))
+        (join-lab (test-lab-file lab) 'bench)
+        (wait-until seconds (lambda () (every (lambda (u) (memq u (live-uids))) uids)))
+        (eval (list 'set! 'clock current-second) (lab-environment))
+        pids))
+
+    ;;> The lab code's procedure \var{name}, to send to a poser.
+    (define (lab-proc name) (eval name (lab-environment)))
+
+    ;;> Reals in [0, 1) drawn from \var{seed}, the same in every run.
+    (define (seeded-reals seed)
+      (let ((source (make-random-source)))
+        (random-source-pseudo-randomize! source seed 0)
+        (random-source-make-reals source)))
+
+    ;;> An integer below \var{n}, drawn by \var{reals}.
+    (define (below reals n) (exact (floor (* n (reals)))))
+
     (define-record-type schedule-run
       (%make-schedule-run tasks posed-at posed-by events robots aging
                           spans ready starts completed)
@@ -96,7 +121,9 @@
                    (k (cond ((assq uid inside) => cdr) (else 0)))
                    (rest (remove (lambda (x) (eq? (car x) uid)) inside)))
               (if (eq? (cadr e) 'start)
-                  (loop (cdr es) (cons (cons uid (+ k 1)) rest) (if (> k 0) (+ n 1) n))
+                  (begin
+                    (if (> k 0) (tell-double-booking! run e))
+                    (loop (cdr es) (cons (cons uid (+ k 1)) rest) (if (> k 0) (+ n 1) n)))
                   (loop (cdr es) (cons (cons uid (- k 1)) rest) n))))))
 
     (define (rank-key run t)
@@ -156,6 +183,23 @@
          (run-tasks run))))
 
     ;; Each inversion, on standard error, so that a run's can be looked into.
+    ;; Names on standard error the start e, (TIME start ID K UID), and
+    ;; the last start on its robot before it.
+    (define (tell-double-booking! run e)
+      (let ((before (find (lambda (b) (and (eq? (cadr b) 'start) (eq? (list-ref b 4) (list-ref e 4))
+                                           (< (car b) (car e))))
+                          (reverse (run-events run)))))
+        (write-string (string-append "sched: double booking: " (event-line e)
+                                     "\n  while on it: "
+                                     (if before (event-line before) "?") "\n")
+                      (current-error-port))))
+
+    (define (event-line e)
+      (string-append "component " (number->string (list-ref e 3)) " of task "
+                     (number->string (list-ref e 2)) " on "
+                     (symbol->string (list-ref e 4)) " at "
+                     (number->string (round-to (car e) 3)) " s"))
+
     (define (tell-inversion! run xy)
       (let ((out (current-error-port)) (x (car xy)) (y (cadr xy)))
         (define (task-line t)

@@ -43,7 +43,7 @@
           listed-priority listed-held listed-wants listed-index listed-poser run-component run-posed-component components-ended
           ended-id ended-index ended-started ended-ended ended-end
           component-heartbeat! stop-component!
-          waiting-ranks waiting-entries waiting-for receive-offer receive-give-way note-waiters!
+          waiting-ranks waiting-entries waiting-for takers-here receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
           team-send! team-receive step-team
           ;; tasks handed to the lab (lib/murdoch/task/detached.scm)

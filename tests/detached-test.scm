@@ -2,15 +2,17 @@
 ;;; at once, a coordinator killed mid-task, while its task waits holding
 ;;; a robot, or together with its standby, and a robot lost while the
 ;;; standby is in charge.  Workstations stand in for robots, as in
-;;; task-test; each component writes (begin TAG UID) and (end TAG UID) to
-;;; its own address space's log, which the tests read.
-(import (except (scheme base) lambda define) (scheme write) (scheme eval)
-        (srfi 1) (srfi 18) (chibi test)
+;;; task-test; each component writes (begin TAG UID SECOND) and (end TAG
+;;; UID SECOND) to its own address space's log, which the tests read.
+(import (except (scheme base) lambda define) (scheme write) (scheme read) (scheme eval)
+        (srfi 1) (srfi 18) (srfi 132) (chibi test)
+        (only (chibi process) kill signal/stop signal/continue)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
-(define (tell . xs) (write xs) (newline) (flush-output-port))
+(define (tell . xs) (write (append xs (list (time->seconds (current-time))))) (newline)
+  (flush-output-port))
 ;; A component that runs rounds of 50 ms, calling out each round, as a
 ;; robot command would go to its robot, so that it stops as an orphan.
 (define (work tag rounds)
@@ -22,12 +24,6 @@
        (thread-sleep! 0.05)
        (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
    (lambda () (tell 'end tag (local-aspace-uid)))))
-;; What the tester hears: each (begin TAG) as it comes.
-(define heard '())
-(define (note-begin tag) (set! heard (append heard (list tag))) #t)
-(define (work-told tag rounds)
-  (remote-apply (uid->aspace 'tester) (lambda () (note-begin tag)))
-  (work tag rounds))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
          (request 'all (lambda ()
@@ -84,6 +80,14 @@
             (text-contains? line (string-append "(" word " " (symbol->string tag) " ")))
           (read-lines (in-dir (string-append (symbol->string uid) ".log")))))
 
+;; The second at which each component tagged tag began, from the robots'
+;; own logs, earliest first.
+(define (begin-seconds tag)
+  (list-sort < (append-map (lambda (r)
+                             (map (lambda (line) (list-ref (read (open-input-string line)) 3))
+                                  (log-lines r "begin" tag)))
+                           robots)))
+
 ;; Task id's entry of lab-tasks; one that no address space answers for
 ;; now is (ID #f 0 #f #f #f #f #f).
 (define (entry-of id)
@@ -94,6 +98,29 @@
 
 (define (running-everywhere? id)
   (every (lambda (s) (eq? (car (status-state s)) 'running)) (task-status id)))
+
+;; The coordinator of task id once one has taken it over, or #f.
+(define (second-coordinator id)
+  (wait-until 10 (lambda ()
+                   (let ((e (entry-of id)))
+                     (and (eq? (lab-task-role e) 'coordinator)
+                          (= 2 (lab-task-epoch e))
+                          (lab-task-coordinator e))))))
+
+;; Poses from the poser a detached task named tag, of one restartable
+;; component of rounds, and answers its id once it runs, with a standby.
+(define (running-detached tag rounds)
+  (let ((id (remote-apply
+             (uid->aspace 'poser)
+             (eval `(lambda ()
+                      (start-task ',tag 1 (list '((mobile) ())) (list #f)
+                                  (list (lambda () (work ',tag ,rounds))) '(1) '(#t)
+                                  'detach #t))
+                   (lab-environment)))))
+    (test-assert "it runs, with a standby"
+      (wait-until 10 (lambda () (and (running-everywhere? id)
+                                     (lab-task-standby (entry-of id))))))
+    id))
 
 ;; Kills uid's process, as a crash would; restart! starts it again.
 (define (kill! uid) (kill-process! (cdr (assq uid pids))))
@@ -156,12 +183,7 @@
       (wait-until 10 (lambda () (lab-task-standby (entry-of id)))))
     (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
       (kill! old)
-      (test "the standby takes over" standby
-        (wait-until 10 (lambda ()
-                         (let ((e (entry-of id)))
-                           (and (eq? (lab-task-role e) 'coordinator)
-                                (= 2 (lab-task-epoch e))
-                                (lab-task-coordinator e))))))
+      (test "the standby takes over" standby (second-coordinator id))
       (test-assert "and chooses a new standby"
         (wait-until 10 (lambda ()
                          (let ((s (lab-task-standby (entry-of id))))
@@ -178,47 +200,146 @@
                (task-status id))))
       (restart! old))))
 
+(test-group "the coordinator killed mid-step: its standby takes the steps over"
+  ;; Step 1 has one component, step 2 two, each handed step 1's results;
+  ;; the coordinator of one task is killed in its step 1, of another in
+  ;; its step 2.
+  (define (tagged tag part)
+    (string->symbol (string-append (symbol->string tag) part)))
+  (define (steps-task tag)
+    (remote-apply
+     (uid->aspace 'poser)
+     (eval `(lambda ()
+              (start-steps ',tag
+                           (task-step (list '((mobile) ())) (list #f)
+                                      (list (lambda (previous)
+                                              (work ',(tagged tag "-one") 60))))
+                           (task-step (list '((mobile) ()) '((mobile) ())) (list #f #f)
+                                      (list (lambda (previous)
+                                              (list previous
+                                                    (work ',(tagged tag "-two") 60)))
+                                            (lambda (previous)
+                                              (list previous
+                                                    (work ',(tagged tag "-two") 60)))))
+                           'detach #t))
+           (lab-environment))))
+  (define (in-step? id i)
+    (let ((steps (task-status id)))
+      (and (= i (length steps))
+           (every (lambda (s) (eq? (car (status-state s)) 'running))
+                  (step-status-entries (list-ref steps (- i 1)))))))
+  (define (begins-and-ends tag)
+    (map (lambda (r) (list r (length (log-lines r "begin" tag)) (length (log-lines r "end" tag))))
+         robots))
+  (for-each
+   (lambda (tag step)
+     (let ((id (steps-task tag)))
+       (test-assert (string-append "step " (number->string step) " runs, with a standby")
+         (wait-until 15 (lambda () (and (in-step? id step) (lab-task-standby (entry-of id))))))
+       (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
+         (kill! old)
+         (test "the standby takes over" standby (second-coordinator id))
+         (let* ((waited (murdoch-status "wait" (test-lab-file lab) (symbol->string id)))
+                (results (task-wait id 30))
+                (one (car (car results)))
+                (two (map cadr (cadr results))))
+           (test-assert "the task completes, read by a new peer, murdoch wait"
+             (text-contains? waited "exit 0"))
+           (test "step 1's result, and step 2's, each handed step 1's"
+             (list (list one) (map (lambda (u) (list (list one) u)) two))
+             (task-wait id 5))
+           (test "step 1 ran once: one begin and one end, in its robot's own log"
+             (list (list one 1 1))
+             (filter (lambda (x) (> (+ (cadr x) (car (cddr x))) 0))
+                     (begins-and-ends (tagged tag "-one"))))
+           (test "step 2's two ran once each, on robots of their own"
+             (filter-map (lambda (r) (and (memq r two) (list r 1 1))) robots)
+             (filter (lambda (x) (> (+ (cadr x) (car (cddr x))) 0))
+                     (begins-and-ends (tagged tag "-two"))))
+           (test "murdoch wait prints both steps' results" #t
+             (every (lambda (u) (text-contains? waited (symbol->string u)))
+                    (cons one two))))
+         (restart! old))))
+   '(stepped-a stepped-b) '(1 2)))
+
 (test-group "the coordinator killed while its task waits, holding"
-  ;; r2 and r3 are busy; the detached task needs two robots and holds
-  ;; r1; a task posed after it also waits for two.
-  (let* ((busy (map (lambda (tag)
+  ;; r2 and r3 are busy, r3 for longer; the detached task needs two
+  ;; robots and holds r1; a task posed after it, at its priority, waits
+  ;; for one.  Its coordinator killed, the lab frees r1 at the lease, and
+  ;; the standby's negotiation must take it again in the task's rank:
+  ;; were the rank lost, the later task would start on r1 at once, not
+  ;; on r3 once r2 has gone to the task.
+  (let* ((busy (map (lambda (tag rounds)
                       (start-task 'busy 1 (list '((mobile) ()))
                                   (list (location-metric-maker '(2000 0 0 0)))
-                                  (list (eval `(lambda () (work ',tag 140))
+                                  (list (eval `(lambda () (work ',tag ,rounds))
                                               (lab-environment)))))
-                    '(busy-a busy-b)))
+                    '(busy-a busy-b) '(200 300)))
          (_ (wait-until 10 (lambda () (every (lambda (t) (running-everywhere? t)) busy))))
          (id (remote-apply
               (uid->aspace 'poser)
               (eval '(lambda ()
                        (start-task 'holder 2 (list '((mobile) ()) '((mobile) ()))
                                    (list #f #f)
-                                   (list (lambda () (work-told 'holder 10))
-                                         (lambda () (work-told 'holder 10)))
+                                   (list (lambda () (work 'holder 10))
+                                         (lambda () (work 'holder 10)))
                                    'hold #t 'detach #t))
                     (lab-environment)))))
-    (test-assert "it waits, with a standby"
+    (test-assert "it holds a robot and waits for another, with a standby"
       (wait-until 10 (lambda () (let ((e (entry-of id)))
-                                  (and (memq (lab-task-state e) '(waiting holding))
+                                  (and (eq? (lab-task-state e) 'holding)
                                        (lab-task-standby e))))))
-    (let ((later (start-task 'later 2 (list '((mobile) ()) '((mobile) ()))
-                             (list #f #f)
-                             (list (eval '(lambda () (work-told 'later 10)) (lab-environment))
-                                   (eval '(lambda () (work-told 'later 10)) (lab-environment)))
+    (let ((later (start-task 'later 1 (list '((mobile) ())) (list #f)
+                             (list (eval '(lambda () (work 'later 10)) (lab-environment)))
                              'wait #t))
           (old (coordinator-of id)))
+      (test-assert "the task posed after it waits"
+        (wait-until 10 (lambda () (eq? 'waiting (task-state later)))))
       (kill! old)
       (test-assert "its standby takes over"
         (wait-until 10 (lambda () (let ((c (coordinator-of id))) (and c (not (eq? c old)))))))
+      (test-assert "and holds a robot again, the first given back at the lease"
+        (wait-until 10 (lambda () (let ((e (entry-of id)))
+                                    (and (= 2 (lab-task-epoch e))
+                                         (eq? (lab-task-state e) 'holding))))))
       (let ((results (task-wait id 60)))
         (test "it completes on two robots" 2
           (length (delete-duplicates (filter (lambda (r) (memq r robots)) results)))))
       (task-wait later 60)
-      (test "in its rank: before the task posed after it" '(holder holder later later)
-        (remote-apply (uid->aspace 'tester) (eval '(lambda () heard) (lab-environment))))
+      (let ((holder (begin-seconds 'holder)) (after (begin-seconds 'later)))
+        (test "each began once, in the robots' logs" '(2 1)
+          (list (length holder) (length after)))
+        (test "in its rank: no begin of the later task's before its components'" '()
+          (filter (lambda (s) (< s (last holder))) after)))
       (for-each task-wait busy)
       (test-assert "nothing is held after" (wait-until 10 all-free?))
       (restart! old))))
+
+(test-group "the standby stalled: a peer's wait follows the task as it moves"
+  ;; The standby frozen (SIGSTOP), its coordinator lets the task go and
+  ;; nobody coordinates it until the standby wakes and takes it over.  A
+  ;; peer's task-wait meanwhile waits on; its task-status, bounded, says
+  ;; the task is moving, not that it failed.
+  (let ((id (running-detached 'stalled 60)))
+    (let* ((e (entry-of id)) (coordinator (lab-task-coordinator e))
+           (standby (lab-task-standby e)) (pid (cdr (assq standby pids))))
+      (kill pid signal/stop)
+      (test-assert "its standby frozen, the coordinator lets the task go"
+        (wait-until 10 (lambda () (eq? 'let-go (remote-apply (uid->aspace coordinator)
+                                                             handed-role-of id)))))
+      (let* ((asking (lambda (thunk)
+                       (thread-start!
+                        (make-thread (lambda () (guard (e ((error-object? e) (error-object-message e)))
+                                                   (thunk)))))))
+             (waited (asking (lambda () (task-wait id 60))))
+             (status (asking (lambda () (task-status id)))))
+        (thread-sleep! 7)
+        (kill pid signal/continue)
+        (test-assert "task-status says it is moving"
+          (let ((s (thread-join! status))) (and (string? s) (text-contains? s "is moving"))))
+        (test-assert "task-wait waits on, and answers once the standby has it"
+          (pair? (thread-join! waited)))
+        (test "the standby took it over" standby (coordinator-of id))))))
 
 (test-group "coordinator and standby killed at once: the task fails clearly"
   (let ((id (remote-apply
@@ -245,16 +366,7 @@
       (restart! standby))))
 
 (test-group "a robot lost while the standby is in charge"
-  (let ((id (remote-apply
-             (uid->aspace 'poser)
-             (eval '(lambda ()
-                      (start-task 'moved 1 (list '((mobile) ())) (list #f)
-                                  (list (lambda () (work 'moved 100))) '(1) '(#t)
-                                  'detach #t))
-                   (lab-environment)))))
-    (test-assert "it runs, with a standby"
-      (wait-until 10 (lambda () (and (running-everywhere? id)
-                                     (lab-task-standby (entry-of id))))))
+  (let ((id (running-detached 'moved 100)))
     (let ((old (coordinator-of id)))
       (kill! old)
       (test-assert "the standby takes over"

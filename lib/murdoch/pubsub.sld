@@ -8,7 +8,7 @@
           capability-layout check-subjects request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive receive-components
-          offer-subjects! get-system-load load-monitor battery-monitor
+          offer-subjects! addressed-here? get-system-load load-monitor battery-monitor
           *battery-charging* *battery-low* *load-threshold*
           set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)

@@ -14,7 +14,7 @@
           listed-id listed-state listed-place listed-why listed-priority
           listed-held listed-wants listed-index listed-poser waiting-entries
           offer-on-joining! task-step start-steps pose-steps waiting-ranks
-          waiting-for receive-offer receive-give-way note-waiters! robot-freed!
+          waiting-for receive-offer receive-give-way note-waiters! robot-freed! takers-here
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between pose-task negotiate pose-task-progress

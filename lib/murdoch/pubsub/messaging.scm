@@ -118,9 +118,9 @@
          (levels-match? (cdr p) (cdr t)))
         (else #f)))
 
-;; Whether every subject of the address is subscribed (the thesis's
-;; "proper subset" means subset), without the lock; an exact subject needs
-;; no matcher, the common case (docs/speed.md).
+;;> Whether every subject of the address is subscribed (the thesis's
+;;> "proper subset" means subset), without the lock; an exact subject needs
+;;> no matcher, the common case (docs/speed.md).
 (define (addressed-here? topic)
   (if (list? topic)
       (subjects-here? *subscriptions* topic)

@@ -200,7 +200,10 @@
 ;; the components that ended, by id.
 (define (fresh-id name)
   (let ((id (task-key name)))
-    (if (or (holder-of id) (pair? (components-of id))) (fresh-id name) id)))
+    (if (or (holder-of id) (pair? (components-of id))
+            (pair? (components-of (step-task-id id 1))))
+        (fresh-id name)
+        id)))
 
 ;; Starts the threads of h's coordinator: one keeps its standby's copy,
 ;; one waits for the task's end.
@@ -245,7 +248,16 @@
   (let ((t (handed-task h)) (old (handed-copy h)))
     (if (or (not t) (copy-results old))
         old
-        (list (task-state t) (task-status t) #f (task-turn-copy t) #f))))
+        (list (state-now t) (task-status t) #f (task-turn-copy t) #f))))
+
+;; t's state; a task of steps that is not over is in its step's, and
+;; running between two steps.
+(define (state-now t)
+  (let ((steps (task-steps t)))
+    (if (and (pair? steps) (eq? (task-state t) 'negotiating))
+        (let ((state (task-state (last steps))))
+          (if (memq state '(negotiating waiting holding running)) state 'running))
+        (task-state t))))
 
 ;; Whether a finished task's copy has been kept for keep-results.
 (define (kept-enough? copy)
@@ -412,37 +424,68 @@
   (let ((copy (handed-copy h)))
     (cond
      ((copy-results copy) #f)
-     ((eq? (handed-kind h) 'steps)
-      (let ((why "its coordinator was lost, and a task of steps is not taken over"))
-        (handed-copy-set! h (list 'failed (copy-status copy) (list 'error #f why)
-                                  (copy-turn copy) (utc-seconds)))))
      (else
       (handed-task-set!
        h (parameterize ((heartbeat-patience detached-patience))
-           (adopt-task (handed-id h) (copy-turn copy) (adoption-plan h copy)
-                       (handed-args h)))))))
+           (if (eq? (handed-kind h) 'steps)
+               (adopt-steps h copy)
+               (adopt-task (handed-id h) (copy-turn copy)
+                           (adoption-plan (handed-id h) (copy-status copy))
+                           (handed-args h))))))))
   (coordinate! h))
 
-;; For each component of the copy, (STATE ATTEMPTS UID): UID the robot
-;; where it runs, or ended lately, that is to be adopted, else #f.  A
-;; component found running anywhere is adopted there, whatever the copy
-;; says: its start may have come after the copy was sent.
-(define (adoption-plan h copy)
-  (let ((seen (components-of (handed-id h))))
+;; For each component of task id, whose status entries are statuses,
+;; (STATE ATTEMPTS UID): UID the robot where it runs, or ended lately,
+;; that is to be adopted, else #f.  A component found running anywhere
+;; is adopted there, whatever the copy says: its start may have come
+;; after the copy was sent; so is one found ended that the copy has
+;; running there, or not yet started.
+(define (adoption-plan id statuses)
+  (let ((seen (if (every (lambda (s) (memq (car (status-state s)) '(done failed))) statuses)
+                  '()                   ; a finished step's: none to look for
+                  (components-of id))))
     (map (lambda (s)
            (let* ((k (status-index s)) (state (status-state s))
                   (running (find (lambda (x) (and (= (cadr x) k) (eq? (car (cddr x)) 'running)))
                                  seen))
-                  (ended (find (lambda (x) (and (= (cadr x) k)
-                                                (eq? (car state) 'running)
-                                                (eq? (car x) (cadr state))))
+                  (ended (find (lambda (x)
+                                 (and (= (cadr x) k)
+                                      (if (eq? (car state) 'running)
+                                          (eq? (car x) (cadr state))
+                                          (and (memq (car state) '(negotiating waiting holding))
+                                               (null? (status-attempts s))))))
                                seen)))
              (list state (status-attempts s)
                    (cond (running (car running))
                          ((memq (car state) '(done failed)) #f)
                          (ended (car ended))
                          (else #f)))))
-         (copy-status copy))))
+         statuses)))
+
+;; The task record of the detached task of steps of h, taken over here
+;; with copy: each step the copy has, or whose components are found in
+;; the lab, is adopted as adopt-task adopts a task, the one the copy was
+;; running at its rank; a finished one so ends at once, with its
+;; results, and the step after it starts.  So no step starts twice, and
+;; no finished step's results are lost.
+(define (adopt-steps h copy)
+  (let* ((args (handed-args h)) (copied (copy-status copy)))
+    (resume-steps
+     (handed-id h) (car args) (map (lambda (parts) (apply task-step parts)) (cadr args))
+     (car (cddr args))
+     (lambda (i id step-args)
+       ;; Only the step after the copy's last may have begun unseen.
+       (let ((entry (find (lambda (e) (= (step-status-index e) i)) copied)))
+         (and (<= i (+ 1 (length copied)))
+              (let ((plan (adoption-plan
+                           id
+                           (if entry
+                               (step-status-entries entry)
+                               (map (lambda (k) (list k '(negotiating) '()))
+                                    (iota (cadr step-args) 1))))))
+                (and (or entry (any plan-uid plan))
+                     (adopt-task id (and entry (= i (length copied)) (copy-turn copy))
+                                 plan step-args)))))))))
 
 ;; (UID INDEX running) or (UID INDEX ended) for each component of task id
 ;; that runs, or ended lately, anywhere in the lab.
@@ -463,19 +506,11 @@
 
 ;;; Letting a task go, and adopting it
 
-;; Stops acting for t, a detached task whose standby may be taking it
-;; over: no heartbeat, start or negotiation more (life-cycle.scm's let-go?
-;; checks), and nothing cancelled; what it holds while it waits is given
-;; back.
-(define (let-task-go! t)
-  (task-state-set! t 'let-go)
-  (if (task-waiter t) (tell-waiter! (task-waiter t) '(cancel)))
-  (mailbox-put! (task-done t) 'let-go))
-
 ;; What t's rank and deadline are made of, as data that travels: (WAIT
-;; HOLD PRIORITY DEADLINE POSED), DEADLINE a utc-seconds or #f.
+;; HOLD PRIORITY DEADLINE POSED), DEADLINE a utc-seconds or #f.  A task
+;; of steps waits in its step's turn, the last begun.
 (define (task-turn-copy t)
-  (let ((turn (task-turn t)))
+  (let ((turn (task-turn (if (pair? (task-steps t)) (last (task-steps t)) t))))
     (and turn
          (list (turn-wait? turn) (turn-hold? turn) (turn-priority turn)
                (and (turn-deadline turn)
@@ -515,8 +550,7 @@
            (run-task t priorities))
           (else
            (task-state-set! t 'running)
-           (task-team-set! t (map (lambda (p) (or (plan-uid p) (state-uid (plan-state p))))
-                                  plan))
+           (task-team-set! t (map plan-robot plan))
            (supervise-all t (map (lambda (c p) (lambda () (go-on t c p)))
                                  (task-components t) plan))))))
       id))
@@ -526,6 +560,12 @@
 (define (plan-state p) (car p))
 (define (plan-attempts p) (cadr p))
 (define (plan-uid p) (car (cddr p)))
+
+;; The robot of an entry of adopt-task's plan: where it runs, or last
+;; ran.
+(define (plan-robot p)
+  (or (plan-uid p) (state-uid (plan-state p))
+      (and (pair? (plan-attempts p)) (car (last (plan-attempts p))))))
 
 ;; The robot a component's state names, or #f.
 (define (state-uid state)
@@ -602,31 +642,53 @@
                            (remove (lambda (e) (eq? (lab-task-role e) 'let-go)) entries))))
     (and (pair? ranked) (car ranked))))
 
-;; The uid that answers for task id now, or #f.
+;; The uid that answers for task id now; moving while the only member
+;; that holds it has let it go, its standby silent (it takes the task
+;; back, or the standby takes it over, within take-over-periods); or #f.
 (define (holder-of id)
-  (let ((e (best-entry (append-map cadr
-                                   (guard (e (#t '()))
-                                     (request 'lab-tasks
-                                              (sendable-lambda ()
-                                                (filter (lambda (e) (eq? (lab-task-id e) id))
-                                                        (handed-entries)))))))))
-    (and e (if (eq? (lab-task-role e) 'standby)
-               (lab-task-standby e)
-               (lab-task-coordinator e)))))
+  (let* ((entries (append-map cadr
+                              (guard (e (#t '()))
+                                (parameterize ((remote-timeout (max 1 (* 2 (period)))))
+                                  (request 'lab-tasks
+                                           (sendable-lambda ()
+                                             (filter (lambda (e) (eq? (lab-task-id e) id))
+                                                     (handed-entries))))))))
+         (e (best-entry entries)))
+    (cond (e (if (eq? (lab-task-role e) 'standby)
+                 (lab-task-standby e)
+                 (lab-task-coordinator e)))
+          ((pair? entries) 'moving)
+          (else #f))))
 
 ;; Applies proc to id's record where it is held, trying for a few periods
-;; while a takeover is under way; raises a clear error when nobody holds it.
-(define (at-holder who id proc . args)
-  (let try ((left 2))
-    (let ((uid (holder-of id)))
-      (cond
-       ((and (not uid) (> left 0)) (thread-sleep! (period)) (try (- left 1)))
-       ((not uid) (error (string-append who ": " (not-held-text id))))
-       (else
-        (guard (e ((and (remote-error? e) (not (remote-raised-error? e)) (> left 0))
-                   (thread-sleep! (period))
-                   (try (- left 1))))
-          (apply remote-apply (uid->aspace uid) proc id args)))))))
+;; while a takeover is under way, and for up to moving seconds while the
+;; task is moving; raises a clear error when nobody holds it.
+(define (at-holder who id moving proc . args)
+  (let ((moving-until (+ (monotonic-seconds) moving)))
+    (let try ((left 2))
+      (let ((uid (holder-of id)))
+        (cond
+         ((and (eq? uid 'moving) (< (monotonic-seconds) moving-until))
+          (thread-sleep! (period))
+          (try left))
+         ((and (memq uid '(#f moving)) (> left 0)) (thread-sleep! (period)) (try (- left 1)))
+         ((eq? uid 'moving) (error (string-append who ": " (moving-text id))))
+         ((not uid) (error (string-append who ": " (not-held-text id))))
+         (else
+          (guard (e ((and (remote-error? e) (not (remote-raised-error? e)) (> left 0))
+                     (thread-sleep! (period))
+                     (try (- left 1))))
+            (apply remote-apply (uid->aspace uid) proc id args))))))))
+
+;; How long task-status and cancel-task wait for a task that moves: its
+;; standby takes over, or its coordinator takes it back, within
+;; take-over-periods, unless a partition parts them.
+(define (moving-seconds) (* (+ take-over-periods 4) (period)))
+
+(define (moving-text id)
+  (string-append "the task " (symbol->string id) " is moving: the member that"
+                 " coordinated it let it go, its standby silent (stalled, or cut off"
+                 " from it); one of them takes it, or it fails; ask again in a moment"))
 
 ;; Why nobody holds task id.
 (define (not-held-text id)
@@ -682,7 +744,7 @@
 ;;> detached task's id: see task-status in (murdoch task life-cycle).
 (define (task-status task)
   (if (symbol? task)
-      (at-holder "task-status" task handed-status)
+      (at-holder "task-status" task (moving-seconds) handed-status)
       (status-here task)))
 
 ;;> Waits for \var{task}, a record or a detached task's id, as task-wait
@@ -693,8 +755,10 @@
       (let ((until (and (pair? seconds) (+ (monotonic-seconds) (car seconds)))))
         (let loop ()
           (let* ((left (if until (- until (monotonic-seconds)) 10))
+                 ;; A task that moves is waited for as one that runs.
                  (answer (parameterize ((remote-timeout (+ (min left 10) 5)))
-                           (at-holder "task-wait" task handed-wait (max 0 (min left 10))))))
+                           (at-holder "task-wait" task (if until (max 0 left) 3600)
+                                      handed-wait (max 0 (min left 10))))))
             (cond ((eq? (car answer) 'done) (cadr answer))
                   ((and until (<= (- until (monotonic-seconds)) 0))
                    (error (string-append "task-wait: " (symbol->string task)
@@ -707,5 +771,5 @@
 ;;> in (murdoch task life-cycle).
 (define (cancel-task task)
   (if (symbol? task)
-      (at-holder "cancel-task" task handed-cancel)
+      (at-holder "cancel-task" task (moving-seconds) handed-cancel)
       (cancel-here task)))

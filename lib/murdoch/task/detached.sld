@@ -17,11 +17,12 @@
                 ended-index)
           (murdoch task record)
           (only (murdoch task rank) make-turn turn-wait? turn-hold? turn-priority
-                turn-deadline turn-posed tell-waiter!)
+                turn-deadline turn-posed)
           (rename (murdoch task life-cycle)
                   (start-task start-here) (task-status status-here)
                   (task-wait wait-here) (cancel-task cancel-here))
-          (rename (only (murdoch task steps) start-steps step? step-parts task-step)
+          (rename (only (murdoch task steps) start-steps step? step-parts task-step
+                        resume-steps step-task-id)
                   (start-steps start-steps-here))
           (only (murdoch pubsub) subscribe unsubscribe request get-system-load))
   (include "detached.scm"))

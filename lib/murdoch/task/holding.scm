@@ -22,24 +22,38 @@
   (let ((t (waiter-task w)) (cs (waiter-components w)))
     (for-each
      (lambda (c)
-       (if (not (assv (component-index c) (waiter-held w)))
-           (let ((team (parameterize ((pose-task-excluded
-                                       (append (held-uids w) (waiter-yielded w)
-                                               (pose-task-excluded))))
-                         (negotiate (task-name t) 1 (list (component-capabilities c))
-                                    (list (component-metric c))
-                                    (list (component-proc c))))))
-             (if (pair? team)
-                 (waiter-held-set! w (cons (list (component-index c)
-                                                 (car (negotiated-winners team))
-                                                 (car (negotiated-types team)))
-                                           (waiter-held w)))))))
+       (let ((excluded (append (held-uids w) (waiter-yielded w) (pose-task-excluded))))
+         (if (and (not (assv (component-index c) (waiter-held w)))
+                  (may-win? w c excluded))
+             (let ((team (parameterize ((pose-task-excluded excluded))
+                           (negotiate (task-name t) 1 (list (component-capabilities c))
+                                      (list (component-metric c))
+                                      (list (component-proc c))))))
+               (if (pair? team)
+                   (waiter-held-set! w (cons (list (component-index c)
+                                                   (car (negotiated-winners team))
+                                                   (car (negotiated-types team)))
+                                             (waiter-held w))))))))
      (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
       (cond ((every pair? held)
              (waiter-held-set! w '())
              (list (map held-winner held) (map held-type held)))
             (else 'not-enough-takers)))))
+
+;; Whether a negotiation of c, with the robots excluded left out, may
+;; find a robot: one of those its last look found capable of it, or one
+;; offered that the look did not know (a robot that joined since).  A
+;; robot offers itself to a task of four components, and negotiating the
+;; three it cannot take cost a round of the lab each, with the poser's
+;; other tries waiting.
+(define (may-win? w c excluded)
+  (let ((capable (assq c (waiter-capables w)))
+        (free? (lambda (uid) (not (memq uid excluded)))))
+    (or (not capable)
+        (any free? (cdr capable))
+        (any (lambda (uid) (and (free? uid) (not (memq uid (waiter-capable w)))))
+             (waiter-offered w)))))
 
 ;; Frees what w holds on robot uid, or on every robot.
 (define (let-go-held! w . uid)

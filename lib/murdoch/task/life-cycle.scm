@@ -125,8 +125,19 @@
 ;;> (detached.scm).
 (define task-id-maker (make-parameter task-key))
 
-;; Whether t's coordinator let it go (detached.scm): it acts no more.
+;;> Whether \var{t}'s coordinator let it go (detached.scm): it acts no
+;;> more.
 (define (let-go? t) (eq? (task-state t) 'let-go))
+
+;;> Stops acting for \var{t}, a detached task whose standby may be taking
+;;> it over: no heartbeat, start or negotiation more (let-go? checks),
+;;> and nothing cancelled; what it holds while it waits is given back.  A
+;;> task of steps lets its step go with it.
+(define (let-task-go! t)
+  (task-state-set! t 'let-go)
+  (if (task-waiter t) (tell-waiter! (task-waiter t) '(cancel)))
+  (if (pair? (task-steps t)) (let-task-go! (last (task-steps t))))
+  (mailbox-put! (task-done t) 'let-go))
 
 ;; Negotiates t, runs its components, each watched over by a thread of
 ;; its own, and puts their results in t's mailbox.
@@ -436,16 +447,16 @@
 ;;> listed- procedures read them.
 (define (tasks)
   (let* ((posed (with-lock *tasks-lock* posed-tasks))
-         (others (and (any task-waiter posed)
-                      (guard (e (#t '())) (lab-waiting)))))
-    (append (map (lambda (t) (posed-entry t others)) posed)
+         (line (and (any task-waiter posed)
+                    (line-of (guard (e (#t '())) (lab-waiting))))))
+    (append (map (lambda (t) (posed-entry t line)) posed)
             (map (lambda (r) (cons 'running r)) (components-running)))))
 
 ;; t as (tasks) lists it; a waiting task as waiting-entry has it, with
-;; its place in the lab's line of others, the lab's waiting tasks.
-(define (posed-entry t others)
+;; its place in line, the ranks of the lab's waiting tasks (line-of).
+(define (posed-entry t line)
   (let ((w (task-waiter t)))
     (if w
-        (begin (move-up! w others) (waiting-entry w))
+        (begin (move-up! w line) (waiting-entry w))
         (list 'posed (task-id t) (task-state t) (task-why t) #f
               (and (task-turn t) (turn-priority (task-turn t))) '() '()))))

@@ -6,7 +6,8 @@
 (define-library (murdoch task life-cycle)
   (export start-task task-status task-wait cancel-task tasks task-state-text
           new-task inheriting finish! task-of-args run-task supervise-all supervise
-          after-attempt heartbeat-patience task-id-maker)
+          after-attempt heartbeat-patience task-id-maker let-go?
+          let-task-go!)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
           (murdoch wire) (murdoch lab) (murdoch remote) (murdoch task progress)

@@ -125,18 +125,31 @@
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
 (define *waiters-seen* #f)
 
+;; Each poser answers its best offer-depth tasks that may use the robot,
+;; and the robot asks for twice as many when every one declined it, in
+;; this round or the next, until it is taken: the best-ranked of the lab
+;; are among them, and a round costs the same with 20 tasks waiting or
+;; 2,000 (docs/allocation.md).
+(define offer-depth 4)
+(define *depth* offer-depth)
+
 (define (offer-round)
-  (let ((me (local-aspace-uid)))
+  (let ((me (local-aspace-uid))
+        (depth *depth*))
     (set! *waiters-here?* #f)       ; before asking: a note after it stands
     (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
-    (let ((waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
-                              (guard (e (#t '()))
-                                (append-map cadr (request 'waiting-tasks waiting-for me
-                                                          (subjects-here)))))))
+    (let* ((answers (guard (e (#t '()))
+                      (request 'waiting-tasks waiting-for me (subjects-here) depth)))
+           (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
+                               (append-map cadr answers))))
       (set! *waiters-seen* (pair? waiting))
       (if (pair? waiting) (set! *waiters-here?* #t))
-      (offer-to me waiting))))
+      (offer-to me waiting)
+      (cond ((not (free-here?)) (set! *depth* offer-depth))
+            ((any (lambda (a) (>= (length (cadr a)) depth)) answers)
+             (set! *depth* (* 2 depth))
+             (if (not *new-waiters*) (offer-round)))))))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))

@@ -87,16 +87,23 @@
   (kept waiter-kept waiter-kept-set!)            ; monotonic-seconds
   (yielded waiter-yielded waiter-yielded-set!)   ; robots it gave way on
   (capable waiter-capable waiter-capable-set!)   ; uids of its capable robots, or #t
+  (capables waiter-capables waiter-capables-set!) ; ((COMPONENT UID ...) ...), or ()
+  (offered waiter-offered waiter-offered-set!)   ; the uids offered to its try
   (position waiter-position waiter-position-set!)
   (why waiter-why waiter-why-set!)               ; a line a component
+  (never waiter-never waiter-never-set!)         ; why it never can start, or #f
+  (excluded waiter-excluded waiter-excluded-set!) ; its pose-task-excluded
   (news waiter-news waiter-news-set!)
   (bell waiter-bell waiter-bell-set!))
 
-;; The tasks waiting here, under *tasks-lock*.
+;; The tasks waiting here, best rank first, under *tasks-lock*.
 (define *waiters* '())
 
 (define (waiters) *waiters*)
-(define (add-waiter! w) (set! *waiters* (cons w *waiters*)))
+(define (add-waiter! w)
+  (let-values (((before after)
+                (break (lambda (x) (rank<? (waiter-rank w) (waiter-rank x))) *waiters*)))
+    (set! *waiters* (append before (cons w after)))))
 (define (drop-waiter! w) (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*)))
 
 ;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
@@ -134,39 +141,40 @@
 
 (define (held-uids w) (map held-uid (waiter-held w)))
 
-;; w's place in the lab's line, others being every task of the lab that
-;; waits: 1 + how many of them rank before it.  One order for the whole
-;; lab, 1 to n, whatever robots each may use.
-(define (place-in-line w others)
-  (+ 1 (count (lambda (other) (rank<? (waiting-there-rank other) (waiter-rank w)))
-              others)))
+;; w's place in the lab's line, line being the ranks of every task of
+;; the lab that waits, as line-of orders them: 1 + how many rank before
+;; it.  One order for the whole lab, 1 to n, whatever robots each may
+;; use; found by halving, as a look numbers all of its poser's tasks.
+(define (place-in-line w line)
+  (let loop ((lo 0) (hi (vector-length line)))
+    (if (= lo hi)
+        (+ lo 1)
+        (let ((mid (quotient (+ lo hi) 2)))
+          (if (rank<? (vector-ref line mid) (waiter-rank w))
+              (loop (+ mid 1) hi)
+              (loop lo mid))))))
 
-;; Whether one of others that ranks before w may use a robot w may use.
-(define (ahead-for-its-robots? w others)
-  (any (lambda (other)
-         (and (rank<? (waiting-there-rank other) (waiter-rank w))
-              (may-use? other (waiter-capable w))))
-       others))
+;; The ranks of others, waiting-theres, best first.
+(define (line-of others)
+  (list->vector (list-sort rank<? (map waiting-there-rank others))))
 
-;; Whether other, a waiting-there, may use one of uids.
-(define (may-use? other uids)
-  (or (eq? (waiting-there-capable other) #t) (eq? uids #t)
-      (any (lambda (uid) (memq uid (waiting-there-capable other))) uids)))
-
-;;> The (RANK CAPABLE HELD) of each task waiting here: its rank, the uids
-;;> of the robots it may use (#t before it has looked), and of those it
-;;> holds.
-(define (waiting-ranks)
-  (map (lambda (w) (list (waiter-rank w) (waiter-capable w) (held-uids w)))
-       (with-lock *tasks-lock* waiters)))
+;;> The (RANK HELD) of each task waiting here: its rank, and the uids of
+;;> the robots it holds; only of those that hold one if \var{holding} is
+;;> given and true.  The robots each may use stay here: a line of 2,000
+;;> tasks that carried them was megabytes a second.
+(define (waiting-ranks . holding)
+  (filter-map (lambda (w)
+                (let ((held (held-uids w)))
+                  (and (or (null? holding) (not (car holding)) (pair? held))
+                       (list (waiter-rank w) held))))
+              (with-lock *tasks-lock* waiters)))
 
 ;; A task that waits at poser, as its entry of waiting-ranks says.
 (define-record-type waiting-there
-  (make-waiting-there poser rank capable held)
+  (make-waiting-there poser rank held)
   waiting-there?
   (poser waiting-there-poser)
   (rank waiting-there-rank)
-  (capable waiting-there-capable)
   (held waiting-there-held))
 
 ;; Every task of the lab that waits, each a waiting-there; request
@@ -181,37 +189,79 @@
 ;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*.
 (define *lab-waiting* #f)
 
-;; Every task of the lab that waits, as waiting-elsewhere answers, asked
-;; of the lab at most once a heartbeat for all the tasks waiting here,
-;; this poser's own as they are now.  Each waiting task's look numbers
-;; its place in the line: with W tasks waiting, a look that asked every
-;; poser each time cost W squared a period lab-wide.  A place may so be a
-;; heartbeat old; who is offered a robot is decided by the robot's own
-;; round, never by this list.
-(define (lab-waiting)
+;; The waiting tasks of the other posers, as waiting-elsewhere answers,
+;; asked of the lab at most once a heartbeat for every 100 tasks it
+;; waited last time, for all the tasks waiting here.  Each look numbers
+;; its tasks' places in the line: with W tasks waiting, a look that asked
+;; every poser each time cost W squared a period lab-wide, and one a
+;; heartbeat, 2,500 tasks' entries twice a second a poser.  A place may
+;; so be W/100 heartbeats old for tasks posed elsewhere; who is offered a
+;; robot is decided by the robot's own round, never by this list, and who
+;; holds what is asked afresh (lab-holders).
+(define (waiting-at-others)
   (let* ((now (monotonic-seconds))
          (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
          (all (if (and cached
-                       (< (- now (car cached)) (lab-setting (current-lab) 'heartbeat)))
+                       (< (- now (car cached))
+                          (* (lab-setting (current-lab) 'heartbeat)
+                             (max 1 (/ (length (cdr cached)) 100)))))
                   (cdr cached)
                   (let ((fresh (waiting-elsewhere)))
                     (with-lock *tasks-lock*
                       (lambda () (set! *lab-waiting* (cons now fresh))))
                     fresh)))
          (me (local-aspace-uid)))
-    (append (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)
-            (map (lambda (e) (apply make-waiting-there me e)) (waiting-ranks)))))
+    (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)))
+
+;; Every task of the lab that waits: the other posers' as
+;; waiting-at-others has them, this poser's as they are now.
+(define (lab-waiting)
+  (append (waiting-at-others)
+          (map (lambda (e) (apply make-waiting-there (local-aspace-uid) e))
+               (waiting-ranks))))
+
+;; Every task of the lab that waits holding robots, asked afresh: no more
+;; of them than robots.
+(define (lab-holders)
+  (append-map (lambda (answer)
+                (map (lambda (e) (apply make-waiting-there (car answer) e))
+                     (cadr answer)))
+              (request 'waiting-tasks waiting-ranks #t)))
 
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
 ;;> when it last looked, or that has a component those subjects serve (a
-;;> robot that joined since).
-(define (waiting-for uid . subjects)
-  (filter-map (lambda (w)
-                (and (or (eq? (waiter-capable w) #t) (memq uid (waiter-capable w))
-                         (and (pair? subjects) (serves? (car subjects) w)))
-                     (list (waiter-rank w) (local-aspace-uid) (task-id (waiter-task w)))))
-              (with-lock *tasks-lock* waiters)))
+;;> robot that joined since).  Best rank first, and only the first
+;;> \var{limit} if given: a robot offers itself to the best first, and
+;;> asks for more only when those all decline it, so that an offer round
+;;> does not carry every waiting task of the lab.
+(define (waiting-for uid . subjects+limit)
+  (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
+        (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
+                    (cadr subjects+limit))))
+    (let loop ((ws (with-lock *tasks-lock* waiters)) (n 0) (out '()))
+      (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
+            ((wants? (car ws) uid subjects)
+             (loop (cdr ws) (+ n 1)
+                   (cons (list (waiter-rank (car ws)) (local-aspace-uid)
+                               (task-id (waiter-task (car ws))))
+                         out)))
+            (else (loop (cdr ws) n out))))))
+
+;; Whether w may use robot uid, subscribed to subjects (or #f): for a
+;; component it does not hold, when it has looked; a robot its look did
+;; not know, if subjects serve a component.  Offered to a task that held
+;; the one component it could take, a robot went down its round to no
+;; avail, and sat free while tasks waited for it further down.
+(define (wants? w uid subjects)
+  (let ((capable (waiter-capable w)))
+    (cond ((eq? capable #t) #t)
+          ((memq uid capable)
+           (any (lambda (cc)
+                  (and (not (assv (component-index (car cc)) (waiter-held w)))
+                       (memq uid (cdr cc))))
+                (waiter-capables w)))
+          (else (and subjects (serves? subjects w))))))
 
 ;; Whether a robot subscribed to subjects could take a component of w.
 (define (serves? subjects w)

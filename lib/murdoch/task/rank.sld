@@ -8,17 +8,19 @@
           make-waiter waiter? waiter-task waiter-components waiter-rank
           waiter-held waiter-held-set! waiter-looked waiter-looked-set!
           waiter-kept waiter-kept-set! waiter-yielded waiter-yielded-set!
-          waiter-capable waiter-capable-set! waiter-position waiter-position-set!
-          waiter-why waiter-why-set! waiter-news waiter-news-set!
+          waiter-capable waiter-capable-set! waiter-capables
+          waiter-capables-set! waiter-offered waiter-offered-set! waiter-position waiter-position-set!
+          waiter-why waiter-why-set! waiter-never waiter-never-set!
+          waiter-excluded waiter-excluded-set! waiter-news waiter-news-set!
           waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter!
           news-kind offer? offer-reply offer-uid give-way-uid tell-waiter!
           take-news! answer-offers! held-index held-winner held-type held-uid
-          held-uids place-in-line ahead-for-its-robots? may-use? waiting-ranks waiting-there?
-          waiting-there-poser waiting-there-rank waiting-there-capable
-          waiting-there-held waiting-elsewhere lab-waiting waiting-for waiting-entries waiting-entry
+          held-uids place-in-line line-of waiting-ranks waiting-there?
+          waiting-there-poser waiting-there-rank
+          waiting-there-held waiting-elsewhere waiting-at-others lab-waiting lab-holders waiting-for waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id)
-  (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (murdoch sys)
+  (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132) (murdoch sys)
           (murdoch lab) (murdoch remote) (murdoch task pose-task)
           (only (murdoch pubsub) request capability-layout) (murdoch task record))
   (include "rank.scm"))

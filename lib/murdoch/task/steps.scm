@@ -48,11 +48,26 @@
     (read-turn "start-steps" options)
     (for-each check-same steps (iota (length steps) 1))
     (let ((t (new-task ((task-id-maker) task-name) task-name '() '() '() '() #f)))
-      (task-steps-set! t '())
-      (thread-start!
-       (make-logged-thread (inheriting (lambda () (run-steps t steps options)))
-                           (task-id t)))
+      (go-steps! t steps options (lambda (i id args) #f))
       t)))
+
+;;> Goes on with the task of steps \var{id}, a detached one taken over
+;;> (detached.scm), as start-steps started it with \var{task-name},
+;;> \var{steps} and \var{options}; answers its new task record at once.
+;;> Each step is first offered to \var{adopt-step}, applied to its
+;;> number, its id (step-task-id) and the arguments start-task would
+;;> start it with: it answers the step's task record, for a step that
+;;> started or ended before, or #f for one to start.
+(define (resume-steps id task-name steps options adopt-step)
+  (let ((t (new-task id task-name '() '() '() '() #f)))
+    (go-steps! t steps options adopt-step)
+    t))
+
+(define (go-steps! t steps options adopt-step)
+  (task-steps-set! t '())
+  (thread-start!
+   (make-logged-thread (inheriting (lambda () (run-steps t steps options adopt-step)))
+                       (task-id t))))
 
 ;;> Runs a task of steps and answers, as task-wait, each step's results.
 (define (pose-steps task-name . steps)
@@ -72,9 +87,10 @@
                          c)))
             (step-capabilities s)))
 
-(define (run-steps t steps options)
+(define (run-steps t steps options adopt-step)
   (let loop ((i 1) (steps steps) (previous '()) (results '()))
     (cond
+     ((let-go? t) #f)
      ((or (null? steps) (eq? (task-state t) 'cancelled))
       (finish! t (reverse results)))
      (else
@@ -82,35 +98,53 @@
              (coordinator (make-coordinator (lambda () (if sub (task-team sub) '()))))
              (step-results
               (begin
-                (set! sub (start-step t (car steps) i previous coordinator options))
+                (set! sub (begin-step t (car steps) i previous coordinator options
+                                      adopt-step))
                 (task-steps-set! t (append (task-steps t) (list sub)))
+                ;; Let go while the step began: it lets the step go too.
+                (if (let-go? t) (let-task-go! sub))
                 (task-wait sub))))
         (release-proxy! coordinator)
-        (progress (task-id t) ": step " i " done: " step-results)
-        (if (step-failed? step-results)
-            (begin (when (not (eq? (task-state t) 'cancelled))
-                     (task-state-set! t (if (memq (task-state sub) '(cancelled deadline))
-                                            (task-state sub)
-                                            'failed))
-                     (task-why-set! t (task-why sub)))
-                   (finish! t (reverse (cons step-results results))))
-            (loop (+ i 1) (cdr steps) step-results (cons step-results results))))))))
+        (if (not (let-go? t)) (progress (task-id t) ": step " i " done: " step-results))
+        (cond
+         ((let-go? t) #f)
+         ((step-failed? step-results)
+          (when (not (eq? (task-state t) 'cancelled))
+            (task-state-set! t (if (memq (task-state sub) '(cancelled deadline))
+                                   (task-state sub)
+                                   'failed))
+            (task-why-set! t (task-why sub)))
+          (finish! t (reverse (cons step-results results))))
+         (else
+          (loop (+ i 1) (cdr steps) step-results (cons step-results results)))))))))
 
 (define (step-failed? results)
   (or (symbol? results)
       (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
 
-;; Starts step number i of t as a task of its own.
-(define (start-step t s i previous coordinator options)
-  (apply start-task (task-name t) (length (step-procs s))
-         (map (lambda (c) (if (same? c) (same-robot t c) c)) (step-capabilities s))
-         (map (lambda (c m) (if (same? c) #f m))
-              (step-capabilities s) (step-metrics s))
-         (map (lambda (p)
-                (sendable-lambda ()
-                  (with-coordinator coordinator (lambda () (p previous)))))
-              (step-procs s))
-         (append (step-options s) options)))
+;; Starts step number i of t as a task of its own, whose id is
+;; step-task-id's, or has adopt-step adopt it.
+(define (begin-step t s i previous coordinator options adopt-step)
+  (let ((id (step-task-id (task-id t) i))
+        (args (cons* (task-name t) (length (step-procs s))
+                     (map (lambda (c) (if (same? c) (same-robot t c) c))
+                          (step-capabilities s))
+                     (map (lambda (c m) (if (same? c) #f m))
+                          (step-capabilities s) (step-metrics s))
+                     (map (lambda (p)
+                            (sendable-lambda ()
+                              (with-coordinator coordinator (lambda () (p previous)))))
+                          (step-procs s))
+                     (append (step-options s) options))))
+    (or (adopt-step i id args)
+        (parameterize ((task-id-maker (lambda (name) id)))
+          (apply start-task args)))))
+
+;;> The id of step \var{i} of the task of steps \var{id}: ID.I, so that
+;;> a coordinator that takes a detached task of steps over finds the
+;;> step's components by it.
+(define (step-task-id id i)
+  (string->symbol (string-append (symbol->string id) "." (number->string i))))
 
 ;; The capabilities of the robot that (same J K) names: its uid, to
 ;; itself.

@@ -31,18 +31,35 @@
   (free explanation-free)
   (capable explanation-capable))
 
-;;> An explanation for each of \var{layouts}, in order.
+;;> An explanation for each of \var{layouts}, in order: one request of
+;;> the whole lab, each address space answering for every layout at once
+;;> (takers-here), so that a look of many components, or of a poser's
+;;> many waiting tasks, costs one round of the lab, not one a component.
 (define (explain-components layouts)
-  (let ((live (map car (request 'all (sendable-lambda () #t)))))
-    (map (lambda (i layout) (explain-component i layout live))
+  (let* ((answers (request 'all takers-here layouts))
+         (live (map car answers)))
+    (map (lambda (i layout)
+           (explain-component
+            i layout live
+            (filter-map (lambda (a)
+                          (let ((statuses (list-ref (cadr a) (- i 1))))
+                            (and statuses (list (car a) statuses))))
+                        answers)))
          (iota (length layouts) 1) layouts)))
 
-;; A line on component i, the robots free for it, and those capable.
-(define (explain-component i layout live)
+;;> What an address space answers explain-components: for each of
+;;> \var{layouts}, the statuses of its exclusive subjects when it has
+;;> every subject of the layout, else #f.
+(define (takers-here layouts)
+  (map (lambda (layout)
+         (and (addressed-here? (apply append layout)) (map topic-status (car layout))))
+       layouts))
+
+;; A line on component i, the robots free for it, and those capable;
+;; answers, (UID STATUSES) of each address space that has its subjects.
+(define (explain-component i layout live answers)
   (let* ((exclusive (car layout))
-         (answers (in-lab-order
-                   (request (apply append layout)
-                            (sendable-lambda () (map topic-status exclusive)))))
+         (answers (in-lab-order answers))
          (silent (remove (lambda (uid) (assq uid answers))
                          (file-capable (apply append layout)))))
     (make-explanation

@@ -13,9 +13,11 @@
 ;; address space, and aging does not reorder the tasks that wait: it
 ;; raises all their priorities alike, and only a task posed later starts
 ;; from lower down.  A task no live robot of the lab is capable of fails
-;; at once; one whose capable robots all die while it waits fails when
-;; it next looks at the lab, every ten heartbeats or a third of the
-;; lease, whichever is sooner.
+;; at once; one whose capable robots all die while it waits fails at its
+;; poser's next look at the lab, every ten heartbeats or a third of the
+;; lease, whichever is sooner.  A poser looks once for all its waiting
+;; tasks (look-all!): a task that waits sends nothing to the lab by
+;; itself, so that W tasks waiting do not cost W looks a period.
 
 (define (enlist! w)
   (waiter-held-set! w '())
@@ -23,17 +25,44 @@
   (waiter-kept-set! w (monotonic-seconds))
   (waiter-yielded-set! w '())
   (waiter-capable-set! w #t)            ; any robot, until it has looked
+  (waiter-capables-set! w '())
+  (waiter-offered-set! w '())
   (waiter-position-set! w #f)
   (waiter-why-set! w '())
+  (waiter-never-set! w #f)
+  (waiter-excluded-set! w (pose-task-excluded))
   (waiter-news-set! w '())
   (waiter-bell-set! w (make-mailbox))
   (with-lock *tasks-lock*
     (lambda ()
       (task-waiter-set! (waiter-task w) w)
       (add-waiter! w)
+      (start-looker!)
       (subscribe 'waiting-tasks)))
-  (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
-    (publish 'all note-waiters!)))
+  (note-lab!))
+
+;; Tells the lab that a task waits here: once for all the tasks that
+;; start to wait while the publication goes (500 posed at once were 500
+;; publications, each to every address space).
+(define *noting* #f)                    ; a publication goes
+(define *note-again* #f)                ; and another task waited meanwhile
+
+(define (note-lab!)
+  (when (with-lock *tasks-lock*
+          (lambda ()
+            (if *noting*
+                (begin (set! *note-again* #t) #f)
+                (begin (set! *noting* #t) #t))))
+    (let loop ()
+      (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
+        (publish 'all note-waiters!))
+      (if (with-lock *tasks-lock*
+            (lambda ()
+              (let ((again *note-again*))
+                (set! *note-again* #f)
+                (if (not again) (set! *noting* #f))
+                again)))
+          (loop)))))
 
 ;; The offers w had not answered are declined: a robot waits for no task
 ;; that no longer waits.
@@ -62,11 +91,11 @@
 
 ;; Tries, answers the offers that woke it, and waits for the next.  It
 ;; tries only when a robot offered itself, or when it was posed with no
-;; better-ranked task waiting for a robot it may use: a robot's offers
+;; better-ranked task waiting in the lab: a robot's offers
 ;; come in rank order, and a try out of turn could take a robot freed for
-;; a better-ranked task.  It looks at the lab again when what it holds
-;; changed, or a second after its last look: an offer is answered by one
-;; try.
+;; a better-ranked task.  It asks its poser to look at the lab again when
+;; what it holds changed, or a second after its last look: an offer is
+;; answered by one try.
 (define (wait-turn w try news)
   (let ((t (waiter-task w))
         (offers (filter offer? news))
@@ -84,12 +113,13 @@
         (answer-offers! offers (pair? team))
         (cond
          ((pair? team) team)
-         ((and (or (not (equal? held (held-uids w))) (look-due? w)) (look! w))
+         ((waiter-never w)
           => (lambda (never)
                (for-each (lambda (c) (component-state-set! c (list 'failed never)))
                          (waiter-components w))
                'not-enough-takers))
          (else
+          (if (or (not (equal? held (held-uids w))) (look-due? w)) (want-look!))
           (if (> (- (monotonic-seconds) (waiter-kept w))
                  (/ (lab-setting (current-lab) 'lease) 4))
               (keep-held! w))
@@ -109,6 +139,7 @@
 (define (try-in-turn w try offered)
   (with-lock *try-lock*
     (lambda ()
+      (waiter-offered-set! w offered)
       (quiet-try (lambda ()
                    (parameterize ((pose-task-excluded (append (offered-to-others w)
                                                               (not-offered w offered)
@@ -139,54 +170,113 @@
   (parameterize ((pose-task-retries 0) (current-error-port (open-output-string)))
     (try)))
 
-;; Looks at the lab for w after a try that failed: why it waits, and its
-;; place in line, in its components' states; answers why it never can be
-;; served, or #f.
-(define (look! w)
+;;; The poser's look, for all its waiting tasks at once
+
+(define *looker* #f)                    ; the poser's looking thread runs
+(define *look-bell* (make-mailbox))     ; rung by a task that wants a look
+
+;; Under *tasks-lock*, as a task starts to wait.
+(define (start-looker!)
+  (when (not *looker*)
+    (set! *looker* #t)
+    (thread-start! (make-logged-thread looker 'looks))))
+
+(define (want-look!) (mailbox-put! *look-bell* #t))
+
+;; Looks when a waiting task asks, a second after the last look at the
+;; soonest, and every ten heartbeats or a third of the lease in any case,
+;; until no task waits here.
+(define (looker)
+  (mailbox-take *look-bell* (next-look #f) (lambda () #f))
+  (mailbox-empty! *look-bell*)
+  (let ((ws (with-lock *tasks-lock*
+              (lambda ()
+                (if (null? (waiters)) (set! *looker* #f))
+                (waiters))))
+        (start (monotonic-seconds)))
+    (when (pair? ws)
+      (guard (e (#t (log-warn "looking at the lab: " (error-message e))))
+        (look-all! ws))
+      (thread-sleep! (max 0 (- (+ start 1) (monotonic-seconds))))
+      (looker))))
+
+;; Looks at the lab for the waiting tasks ws: one request for the takers
+;; of all their components, one for the tasks that hold robots, and the
+;; lab's line as lab-waiting has it, whatever the number of tasks.
+(define (look-all! ws)
+  (let* ((layouts (delete-duplicates (append-map waiter-layouts ws)))
+         (lines (map cons layouts (explain-components layouts)))
+         (line (line-of (guard (e (#t '())) (lab-waiting))))
+         ;; Those that hold robots, no more than the robots: each task
+         ;; asks those of them that rank after it to give way.
+         (holders (guard (e (#t '())) (lab-holders))))
+    (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines))))
+    (for-each (lambda (w)
+                (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
+                       holders line))
+              ws)))
+
+(define (waiter-layouts w)
+  (map (lambda (c) (capability-layout (component-capabilities c))) (waiter-components w)))
+
+;; What a look tells w, from lines, the explanations of its components,
+;; holders, the lab's waiting tasks that hold robots, and line, the ranks
+;; of all its waiting tasks in order: why it waits, and its place in line,
+;; in its components' states; or why it never can be served, its waiting
+;; task told.
+(define (look! w lines holders line)
   (waiter-looked-set! w (monotonic-seconds))
   (let* ((cs (waiter-components w))
-         (lines (explain-components
-                 (map (lambda (c) (capability-layout (component-capabilities c))) cs)))
          (capable (map (lambda (line)
-                         (remove (lambda (uid) (memq uid (pose-task-excluded)))
+                         (remove (lambda (uid) (memq uid (waiter-excluded w)))
                                  (explanation-capable line)))
                        lines))
-         (others (guard (e (#t '())) (lab-waiting)))
          (exclusive (filter-map (lambda (c caps)
                                   (and (pair? (car (capability-layout
                                                     (component-capabilities c))))
                                        caps))
-                                cs capable)))
+                                cs capable))
+         (never (cond
+                 ((any null? capable)
+                  (string-append "no live robot of the lab is capable of it:"
+                                 (apply string-append (map explanation-line lines))))
+                 ((< (length (delete-duplicates (apply append exclusive)))
+                     (length exclusive))
+                  "fewer live robots of the lab are capable of it than it has components")
+                 (else #f))))
     (cond
-     ((any null? capable)
-      (string-append "no live robot of the lab is capable of it:"
-                     (apply string-append (map explanation-line lines))))
-     ((< (length (delete-duplicates (apply append exclusive))) (length exclusive))
-      "fewer live robots of the lab are capable of it than it has components")
+     (never
+      (waiter-never-set! w never)
+      (tell-waiter! w '(looked)))
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
-      (remind-free! (delete-duplicates (append-map explanation-free lines)))
+      (waiter-capables-set! w (map cons cs capable))
       (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
-      (ask-way! w lines others)
-      (move-up! w others)
+      (ask-way! w lines holders)
+      (move-up! w line)
       (progress (task-id (waiter-task w)) ": " (task-state (waiter-task w))
                 (if (pair? (waiter-held w))
                     (apply string-append
                            (map (lambda (uid) (string-append " " (symbol->string uid)))
                                 (held-uids w)))
                     "")
-                ", " (waiter-position w) " in line")
-      #f))))
+                ", " (waiter-position w) " in line")))))
 
-;; Robots that a look finds free may have made their offers before this
-;; task waited, or be making them: each is asked to offer itself (again),
-;; best rank first, rather than taken by a try out of turn.
-(define (remind-free! uids)
+;; Robots that a look finds free may have made their offers before these
+;; tasks waited, or be making them: each found free by the last look too
+;; is asked to offer itself (again), best rank first, rather than taken by
+;; a try out of turn.  A robot just freed is offering itself already: a
+;; look that reminded every robot it found free, with hundreds of tasks
+;; waiting, kept them all answering reminders.
+(define *free-seen* '())                ; the free robots of the last look
+
+(define (remind-free! free)
   (for-each (lambda (uid)
               (guard (e (#t (log-warn "reminding " uid ": " (error-message e))))
                 (parameterize ((remote-timeout 1))
                   (remote-apply (uid->aspace uid) note-waiters!))))
-            uids))
+            (filter (lambda (uid) (memq uid *free-seen*)) free))
+  (set! *free-seen* free))
 
 (define (trimmed line)
   (let loop ((s line))
@@ -200,10 +290,11 @@
 ;; Brings w's place in the lab's line, its state and its components'
 ;; states up to date: holding while it holds a robot, each component it
 ;; holds a robot for (holding UID), the others (waiting PLACE WHY).
-;; others are the lab's waiting tasks, asked for when not given.
-(define (move-up! w . others)
+;; line is the ranks of the lab's waiting tasks (line-of), asked for when
+;; not given.
+(define (move-up! w . line)
   (let ((place (guard (e (#t (waiter-position w)))
-                 (place-in-line w (if (pair? others) (car others) (lab-waiting)))))
+                 (place-in-line w (if (pair? line) (car line) (line-of (lab-waiting))))))
         (t (waiter-task w)))
     (with-lock *tasks-lock*
       (lambda ()
@@ -222,6 +313,9 @@
                       (waiter-why w)
                       (map (lambda (c) "") (waiter-components w))))))))
 
-;; Whether a better-ranked task of the lab waits for a robot w may use.
+;; Whether a better-ranked task of the lab waits: w, just posed, has not
+;; looked at which robots it may use.
 (define (behind-others? w)
-  (ahead-for-its-robots? w (guard (e (#t '())) (waiting-elsewhere))))
+  (or (rank<? (waiter-rank (car (with-lock *tasks-lock* waiters))) (waiter-rank w))
+      (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
+           (guard (e (#t '())) (waiting-at-others)))))

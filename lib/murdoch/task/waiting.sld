@@ -5,7 +5,7 @@
 (define-library (murdoch task waiting)
   (export negotiate-turn move-up!)
   (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
-          (murdoch sys) (murdoch wire) (murdoch lab) (murdoch remote)
+          (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (murdoch task progress) (murdoch task pose-task)
           (only (murdoch pubsub) subscribe unsubscribe publish capability-layout)
           (only (murdoch task takers) explain-components explanation-line
