@@ -80,7 +80,7 @@
 ;; No ghosts: a component stops once its poser is silent for
 ;; orphan-periods (looked at every quarter period, so by 2.25 periods),
 ;; well before the poser declares the robot lost after lost-periods
-;; (life-cycle.scm) and may start another.
+;; (life-cycle.scm) and may start another: docs/tasks.md.
 (define orphan-periods 2)
 (define lost-periods 4)
 
