@@ -28,16 +28,13 @@
 ;;     which the members holding a task subscribe to.  A finished task's
 ;;     results are kept for the lab's keep-results seconds.
 ;;
-;; A detached task's components wait longer for their coordinator than a
-;; poser's: detached-patience times the periods, so that a takeover comes
-;; before they stop as orphans.
+;; Its components wait detached-patience times longer for their
+;; coordinator than a poser's, so a takeover comes before they stop.
 
 (define detached-patience 4)
 
-;; The coordinator lets a task go when its standby's pings have not come
-;; for let-go-periods; the standby takes over when its pings have not
-;; been answered for take-over-periods (docs/tasks.md, never two
-;; coordinators).
+;; Let go after let-go-periods without the standby's pings; take over
+;; after take-over-periods unanswered (docs/tasks.md).
 (define let-go-periods 2)
 (define take-over-periods 4)
 
@@ -129,9 +126,7 @@
           ((eq? (car kv) 'detach) (cddr kv))
           (else (cons (car kv) (cons (cadr kv) (loop (cddr kv))))))))
 
-;; Starts, here, the task of kind (task or steps) that args describe, as
-;; hand-to-lab sends them: start-task's arguments, or the name, each
-;; step's parts and the keywords.
+;; Starts here the task of kind (task or steps) that args describe.
 (define (start-kind kind args)
   (if (eq? kind 'steps)
       (apply start-steps-here (car args)
@@ -139,8 +134,6 @@
                      (car (cddr args))))
       (apply start-here args)))
 
-;; Hands the task to the least loaded member that will coordinate it,
-;; and answers its id.
 (define (hand-to-lab kind args)
   (let ((poser (local-aspace-uid)))
     (let try ((candidates (coordinator-candidates (list poser))))
@@ -156,9 +149,8 @@
               (remote-apply (uid->aspace uid) coordinate-task! kind args poser))
             (try (cdr candidates)))))))
 
-;; The uids of the address spaces that may coordinate a detached task,
-;; those in excluded left out, least loaded first: the negotiation of a
-;; component whose capability is coordinator, by the load metric.
+;; The uids that may coordinate a detached task, those in excluded left
+;; out, least loaded first (the load metric).
 (define (coordinator-candidates excluded)
   (map car
        (list-sort (lambda (a b)
@@ -205,8 +197,7 @@
         (fresh-id name)
         id)))
 
-;; Starts the threads of h's coordinator: one keeps its standby's copy,
-;; one waits for the task's end.
+;; Starts h's coordinator threads: the standby's copy, the task's end.
 (define (coordinate! h)
   (let ((t (handed-task h)) (epoch (handed-epoch h)))
     (if t
@@ -222,9 +213,8 @@
           'coordinator)))
     (thread-start! (make-logged-thread (lambda () (keep-watch h epoch)) 'coordinator))))
 
-;; The coordinator's watch, every quarter period: it lets the task go
-;; when its standby's pings stop, and sends the standby a copy when the
-;; record changes, and every period.
+;; Every quarter period: let go when the standby's pings stop; send it a
+;; copy when the record changes, and every period.
 (define (keep-watch h epoch)
   (let loop ((sent-at 0) (sent #f))
     (thread-sleep! (/ (period) 4))
@@ -259,12 +249,10 @@
           (if (memq state '(negotiating waiting holding running)) state 'running))
         (task-state t))))
 
-;; Whether a finished task's copy has been kept for keep-results.
 (define (kept-enough? copy)
   (and (copy-ended copy)
        (> (- (utc-seconds) (copy-ended copy)) (lab-setting (current-lab) 'keep-results))))
 
-;; Sends copy to h's standby; answers whether it has it.
 (define (send-copy! h copy)
   (let ((uid (handed-partner h)))
     (guard (e ((and (remote-error? e) (not (remote-raised-error? e)))
@@ -280,9 +268,8 @@
   (handed-partner-set! h #f)
   (choose-standby! h))
 
-;; Asks the least loaded other member to stand by, as the coordinator
-;; was chosen, the poser left out while another will do; answers whether
-;; one does, and has the copy.
+;; Asks the least loaded other member to stand by, the poser left out
+;; while another will do.
 (define (choose-standby! h)
   (let* ((me (local-aspace-uid))
          (all (coordinator-candidates (list me)))
@@ -348,7 +335,6 @@
 (define (gone-by? e uid)
   (and (remote-unreachable-error? e) (process-gone? uid)))
 
-;; Whether uid's process is gone: its port refuses a connection.
 (define (process-gone? uid)
   (let* ((a (uid->aspace uid))
          (io (open-connection (aspace-host a) (aspace-port a) (period))))
@@ -382,9 +368,8 @@
     (and h (eq? (handed-role h) 'standby) (= (handed-epoch h) epoch)
          (begin (handed-copy-set! h copy) #t))))
 
-;; Pings the coordinator every period; takes over when no ping has been
-;; answered for take-over-periods, or a period after the coordinator's process
-;; is found gone.
+;; Takes over when no ping has been answered for take-over-periods, or a
+;; period after the coordinator's process is found gone.
 (define (stand-by h)
   (let loop ((last (monotonic-seconds)))
     (thread-sleep! (max 0 (- (+ last (period)) (monotonic-seconds))))
@@ -411,9 +396,7 @@
           (take-over! h (list uid)))
          (else (loop started)))))))
 
-;; This address space becomes h's coordinator, at a new epoch: it adopts
-;; the task's components where they run, and chooses a new standby, not
-;; one of excluded.
+;; This address space becomes h's coordinator, at a new epoch.
 (define (take-over! h excluded)
   (handed-role-set! h 'coordinator)
   (handed-epoch-set! h (+ 1 (handed-epoch h)))
@@ -434,12 +417,10 @@
                            (handed-args h))))))))
   (coordinate! h))
 
-;; For each component of task id, whose status entries are statuses,
-;; (STATE ATTEMPTS UID): UID the robot where it runs, or ended lately,
-;; that is to be adopted, else #f.  A component found running anywhere
-;; is adopted there, whatever the copy says: its start may have come
-;; after the copy was sent; so is one found ended that the copy has
-;; running there, or not yet started.
+;; (STATE ATTEMPTS UID) for each component of task id: UID where it is to
+;; be adopted, else #f.  One found running anywhere is adopted there,
+;; whatever the copy says (its start may have come after the copy), as is
+;; one found ended that the copy has running there, or not yet started.
 (define (adoption-plan id statuses)
   (let ((seen (if (every (lambda (s) (memq (car (status-state s)) '(done failed))) statuses)
                   '()                   ; a finished step's: none to look for
@@ -462,12 +443,9 @@
                          (else #f)))))
          statuses)))
 
-;; The task record of the detached task of steps of h, taken over here
-;; with copy: each step the copy has, or whose components are found in
-;; the lab, is adopted as adopt-task adopts a task, the one the copy was
-;; running at its rank; a finished one so ends at once, with its
-;; results, and the step after it starts.  So no step starts twice, and
-;; no finished step's results are lost.
+;; The task record of h's task of steps, taken over with copy: each step
+;; known is adopted as adopt-task adopts a task, so that no step starts
+;; twice, and no finished step's results are lost.
 (define (adopt-steps h copy)
   (let* ((args (handed-args h)) (copied (copy-status copy)))
     (resume-steps
@@ -487,8 +465,7 @@
                      (adopt-task id (and entry (= i (length copied)) (copy-turn copy))
                                  plan step-args)))))))))
 
-;; (UID INDEX running) or (UID INDEX ended) for each component of task id
-;; that runs, or ended lately, anywhere in the lab.
+;; (UID INDEX running|ended) for each component of task id in the lab.
 (define (components-of id)
   (append-map (lambda (answer)
                 (map (lambda (x) (cons (car answer) x)) (cadr answer)))
@@ -525,12 +502,9 @@
                            posed))
               copy)))
 
-;; The task record of a detached task taken over here: id and turn-copy
-;; are the task's, args start-task's, and plan has (STATE ATTEMPTS UID)
-;; for each component, UID the robot where it runs or ended lately, or
-;; #f.  A task none of whose components started is negotiated again, at
-;; its rank; otherwise each component is adopted where it runs, kept as
-;; it ended, or, found nowhere, moved on as a lost robot's.
+;; The record of a detached task taken over here.  A task none of whose
+;; components started is negotiated again, at its rank; otherwise each is
+;; adopted where it runs, kept as it ended, or moved on as a lost robot's.
 (define (adopt-task id turn-copy plan args)
   (let-values (((t priorities) (task-of-args id (turn-of-copy turn-copy) args)))
     (for-each (lambda (c p)
@@ -556,25 +530,21 @@
       id))
     t))
 
-;; The parts of an entry of adopt-task's plan.
 (define (plan-state p) (car p))
 (define (plan-attempts p) (cadr p))
 (define (plan-uid p) (car (cddr p)))
 
-;; The robot of an entry of adopt-task's plan: where it runs, or last
-;; ran.
+;; Where the component of plan entry p runs, or last ran.
 (define (plan-robot p)
   (or (plan-uid p) (state-uid (plan-state p))
       (and (pair? (plan-attempts p)) (car (last (plan-attempts p))))))
 
-;; The robot a component's state names, or #f.
 (define (state-uid state)
   (case (car state)
     ((running) (cadr state))
     ((reassigned) (car (cddr state)))
     (else #f)))
 
-;; Component c of an adopted task goes on from its entry p of the plan.
 (define (go-on t c p)
   (let ((state (plan-state p)) (uid (plan-uid p)))
     (cond (uid
@@ -605,23 +575,17 @@
 ;;> The role of the address space that gave \var{e}, an entry of
 ;;> lab-tasks: coordinator, standby or let-go.
 (define (lab-task-role e) (cadr e))
-;;> How many coordinators the task of \var{e}, an entry of lab-tasks,
-;;> has had: 1, and 1 more a takeover.
+;;> How many coordinators the task of \var{e} has had.
 (define (lab-task-epoch e) (list-ref e 2))
-;;> The state of the task of \var{e}, an entry of lab-tasks:
-;;> negotiating, waiting, holding, running, done, failed, cancelled or
-;;> deadline.
+;;> The state of the task of \var{e}, an entry of lab-tasks.
 (define (lab-task-state e) (list-ref e 3))
 ;;> The coordinator's uid in \var{e}, an entry of lab-tasks.
 (define (lab-task-coordinator e) (list-ref e 4))
-;;> The standby's uid in \var{e}, an entry of lab-tasks, or #f while
-;;> there is none.
+;;> The standby's uid in \var{e}, or #f while there is none.
 (define (lab-task-standby e) (list-ref e 5))
-;;> The uid of the address space that posed the task of \var{e}, an
-;;> entry of lab-tasks.
+;;> The uid that posed the task of \var{e}.
 (define (lab-task-poser e) (list-ref e 6))
-;;> The utc-seconds at which the coordinator of \var{e}, an entry of
-;;> lab-tasks, took the task over from another, or #f.
+;;> When the coordinator of \var{e} took the task over, or #f.
 (define (lab-task-took-over e) (list-ref e 7))
 
 ;;> The lab's detached tasks, one entry each, as its coordinator (or, in
@@ -660,9 +624,8 @@
           ((pair? entries) 'moving)
           (else #f))))
 
-;; Applies proc to id's record where it is held, trying for a few periods
-;; while a takeover is under way, and for up to moving seconds while the
-;; task is moving; raises a clear error when nobody holds it.
+;; Applies proc to id's record where it is held, waiting while it moves;
+;; raises a clear error when nobody holds it.
 (define (at-holder who id moving proc . args)
   (let ((moving-until (+ (monotonic-seconds) moving)))
     (let try ((left 2))
@@ -680,9 +643,7 @@
                      (try (- left 1))))
             (apply remote-apply (uid->aspace uid) proc id args))))))))
 
-;; How long task-status and cancel-task wait for a task that moves: its
-;; standby takes over, or its coordinator takes it back, within
-;; take-over-periods, unless a partition parts them.
+;; How long to wait for a task that moves (take-over-periods).
 (define (moving-seconds) (* (+ take-over-periods 4) (period)))
 
 (define (moving-text id)
@@ -690,7 +651,6 @@
                  " coordinated it let it go, its standby silent (stalled, or cut off"
                  " from it); one of them takes it, or it fails; ask again in a moment"))
 
-;; Why nobody holds task id.
 (define (not-held-text id)
   (let ((seen (components-of id)))
     (string-append

@@ -1,15 +1,11 @@
 ;;;; Metrics (thesis §4.2, appendix A.7): how a component ranks its
 ;;;; candidates.
 
-;; A metric compares two candidates, (uid promise-or-result) entries, and
-;; answers #t when the first is better, as in the thesis.  Those made here
-;; also carry their keys, what they compare by, in order: a measure with
-;; the tolerance within which two candidates tie, or a comparator.  So
-;; pose-task can ask each candidate once per measure, not once per
-;; comparison: the same choice, fewer messages; and optimal assignment
-;; has the numbers it adds up.  A measure is a procedure of a uid, or an
-;; asking: what a candidate answers to one procedure, scored here, which
-;; pose-task sends to every candidate at once.
+;; A metric answers #t when its first candidate, a (uid promise-or-result)
+;; entry, is better, as in the thesis.  Those made here also carry their
+;; keys (a measure with its tolerance, or a comparator), so pose-task asks
+;; each candidate once per measure, not once per comparison, and optimal
+;; assignment has numbers to add up.
 (define-record-type asking
   (make-asking proc score)
   asking?
@@ -22,7 +18,6 @@
   (measure measure-key-measure)
   (tolerance measure-key-tolerance))
 
-;; A metric of keys that compares as the thesis's metrics do.
 (define (keyed-metric keys)
   (lambda (entry1 entry2)
     (keys-better? keys (key-values keys entry1) (key-values keys entry2))))
@@ -30,7 +25,7 @@
 (define keyed-metric-code (procedure-code (keyed-metric '())))
 
 ;; The keys of metric: its own when made here; any other procedure is its
-;; one comparator; #f, no metric, has none.
+;; one comparator.
 (define (metric-keys metric)
   (cond ((not (procedure? metric)) '())
         ((and (not (opcode? metric))
@@ -38,13 +33,11 @@
          (vector-ref (procedure-vars metric) 0))
         (else (list metric))))
 
-;; The measure of a metric by one measure, else #f.
 (define (metric-measure metric)
   (let ((keys (metric-keys metric)))
     (and (= (length keys) 1) (measure-key? (car keys))
          (measure-key-measure (car keys)))))
 
-;; What a key compares of one candidate: its measure, or the entry itself.
 (define (key-values keys entry)
   (map (lambda (key)
          (if (measure-key? key)
@@ -53,8 +46,7 @@
        keys))
 
 ;; Whether values as are better than bs by the first key that does not
-;; tie them.  Ties within a tolerance are judged pair by pair, so three
-;; candidates may tie two by two and still not all three.
+;; tie them.  Ties are judged pair by pair, so not transitive.
 (define (keys-better? keys as bs)
   (and (pair? keys)
        (cond ((key-better? (car keys) (car as) (car bs)) #t)
@@ -110,7 +102,6 @@
   (let ((dx (- (car p) (car q))) (dy (- (cadr p) (cadr q))))
     (sqrt (+ (* dx dx) (* dy dy)))))
 
-;; What candidate uid answers to proc, asked point to point.
 (define (ask uid proc)
   (remote-apply (uid->aspace uid) proc))
 
@@ -152,10 +143,8 @@
   (let ((keys (metric-keys metric)))
     (map cdr (sort-measured (measured-response response keys) keys))))
 
-;; Each candidate as (values . entry), its values by keys: each measure
-;; asked of every candidate at once, once.  asked, when given, holds the
-;; candidates' answers to the keys' askings, ((uid answer ...) ...) as
-;; request-components answers them, so that none is asked again.
+;; Each candidate as (values . entry), each measure asked of every
+;; candidate once; asked holds answers already had (request-components).
 (define (measured-response response keys . asked)
   (apply map
          (lambda (entry . values) (cons values entry))
@@ -179,8 +168,7 @@
                                       (measure-all measure (map car response)))
                        (loop (cdr keys) k))))))))
 
-;; Candidate entry's score by an asking measure from its k-th answer;
-;; asked is request-components's ((uid answer ...) ...).
+;; Candidate entry's score by an asking measure from its k-th answer.
 (define (asked-score measure asked entry k)
   (let ((answers (assq (car entry) asked)))
     (if (and answers (> (length answers) (+ k 1)) (list? (list-ref answers (+ k 1))))
@@ -193,9 +181,7 @@
   (progress "  measured " (map list uids measures))
   measures)
 
-;; The procedures that a candidate is asked for the measures among keys,
-;; in order (metric-by-asking's): what pose-task sends with its request,
-;; for measured-response to score.
+;; The procedures a candidate is asked for the measures among keys.
 (define (asking-procs keys)
   (filter-map (lambda (key)
                 (and (measure-key? key) (asking? (measure-key-measure key))
@@ -207,9 +193,8 @@
       (shuffle measured)
       (list-sort (lambda (a b) (keys-better? keys (car a) (car b))) measured)))
 
-;; Measures every candidate at once: the answers' round trips overlap.  A
-;; candidate that cannot be measured (it died, did not answer in time, or
-;; its answer does not score) measures +inf.0, and so comes last.
+;; Measures every candidate at once; one that cannot be measured scores
+;; +inf.0, and so comes last.
 (define (measure-all measure uids)
   (if (asking? measure)
       (map-guarded (lambda (o)
@@ -222,9 +207,8 @@
                    (make-thread (lambda () (guard (e (#t +inf.0)) (measure uid))))))
                 uids))))
 
-;; An asking measure's score of a candidate's answer, when ok?; +inf.0
-;; when it gave none, or one that is not a number.  The score is the
-;; user's code: it may raise, for map-guarded to score unscored.
+;; An asking measure's score of an answer, or +inf.0; the score is user
+;; code and may raise.
 (define (score measure ok? answer)
   (let ((score (and ok? ((asking-score measure) answer))))
     (if (real? score) score +inf.0)))

@@ -1,26 +1,17 @@
 ;;;; pose-task (thesis §4.2, appendix A.7 new-task.scm).
 ;;
-;; The user poses a task as components, each with the capabilities it
-;; needs, a metric to rank candidates and the procedure to run.  pose-task
-;; asks the lab who is capable (request-exclusive for components that need
-;; a resource to themselves, request otherwise), ranks each component's
-;; candidates by its metric, gives each component the best candidate not
-;; already chosen for a more important one (the components come in
-;; priority order), frees every promise it will not use, and runs the
-;; components as a team.  Beyond the thesis (docs/allocation.md): explicit
-;; priorities, composed metrics, optimal assignment, and a rule by which
-;; tasks posed at once that want the same robots take turns.  Its metrics
-;; are metric.scm's, and its team runs by team.scm's on-list.
+;; pose-task asks the lab who is capable (request-exclusive for a
+;; component that needs a resource to itself, request otherwise), ranks
+;; each component's candidates by its metric, gives each, in priority
+;; order, the best not already chosen, frees every unused promise, and
+;; runs the team.  Beyond the thesis: docs/allocation.md.
 
 ;;; pose-task
 
 ;;> How pose-task gives components their robots: \scheme{greedy}, the
-;;> thesis's rule (resolve-conflicts: each component in priority order
-;;> takes its best robot not yet taken), or \scheme{optimal}, the least
-;;> total of the components' measures (the Hungarian method, (murdoch
-;;> assign)).  Under optimal, a component whose metric is not one measure
-;;> (a comparator, a composition, none) keeps the greedy rule and picks
-;;> first, and the progress output says so.
+;;> thesis's rule (resolve-conflicts), or \scheme{optimal}, the least
+;;> total of the components' measures ((murdoch assign)); a component
+;;> whose metric is not one measure keeps the greedy rule.
 (define pose-task-assignment (make-parameter 'greedy))
 
 ;;> The priority of the tasks posed here, a real: when tasks posed at
@@ -40,11 +31,9 @@
 (define pose-task-excluded (make-parameter '()))
 
 ;; The reservation name a negotiation holds its robots under, or #f for
-;; a new one: a started task's id, so that its reservations, holdings
-;; and components name the task as start-task answered it.
+;; a new one: a started task's id, so its reservations name the task.
 (define pose-task-reservation (make-parameter #f))
 
-;; Whether a component's result is pose-task's (error UID WHY).
 (define (failed-result? r)
   (and (list? r) (= (length r) 3) (eq? (car r) 'error) (string? (caddr r))))
 
@@ -52,18 +41,15 @@
           (list pose-task-assignment pose-task-priority pose-task-retries
                 pose-task-backoff pose-task-excluded))
 
-;; Whether a component needs resources to itself, from its layout.
 (define (component-type layout)
   (if (null? (car layout)) 'non-exclusive 'exclusive))
 
-;; The poses made here, counted, and those negotiating, each a
-;; negotiation.  Threads and received calls pose at once.  Global: a
+;; The poses made here, counted, and those negotiating.  Global: a
 ;; rival's call (receive-rival) finds them by name.
 (define *poses* 0)
 (define *negotiating* '())
 
-;; A pose negotiating here: its name, its rank, and the ranks of the other
-;; tasks that said they want robots it holds.
+;; A pose negotiating here: its name, rank, and its rivals' ranks.
 (define-record-type negotiation
   (make-negotiation name rank rivals)
   negotiation?
@@ -75,10 +61,8 @@
 (define (with-poses thunk) (with-lock *poses-lock* thunk))
 
 ;;> A key of this address space's own for a task named \var{task-name},
-;;> NAME@UID/N, the one form of a started task's id and of the name a
-;;> pose's reservations are made under: the same task posed twice at once,
-;;> from here or elsewhere, never shares a robot, and the key says where it
-;;> was posed.
+;;> NAME@UID/N: a started task's id and its reservations' name, so the
+;;> same task posed twice at once never shares a robot.
 (define (task-key task-name)
   (let ((n (with-poses (lambda () (set! *poses* (+ *poses* 1)) *poses*))))
     (string->symbol (string-append (symbol->string task-name) "@"
@@ -94,7 +78,6 @@
          (at (and slash (last-index s #\@ slash))))
     (and at (list (substring s 0 at) (substring s (+ at 1) slash)))))
 
-;; The uid of the address space that made reservation name, or #f.
 (define (reservation-aspace-uid name)
   (let ((parts (task-key-parts name)))
     (and parts (string->symbol (cadr parts)))))
@@ -142,16 +125,8 @@
 ;;> type-list name), where winners are the chosen (uid promise-or-#t)
 ;;> entries and name the reservation name they were won under, or
 ;;> \scheme{not-enough-takers}.  Every promise not among the winners is
-;;> freed.
-;;>
-;;> Tasks posed at once may want the same robots.  One that fails while
-;;> robots it could use are reserved by other poses frees everything it
-;;> holds, tells those poses its rank, waits a random while and tries
-;;> again, at most (pose-task-retries) times.  A rank is the task's
-;;> (pose-task-priority), ties broken by reservation name.  A pose told of
-;;> a higher rank before it starts its components gives way: it frees
-;;> everything and does not try again until that pose is done
-;;> negotiating.  A pose whose components have started is never stopped.
+;;> freed.  Tasks that want the same robots take turns by rank
+;;> (pose-task-priority, then reservation name): docs/allocation.md.
 (define (negotiate task-name num-robots capability-list metrics procs . priorities)
   (let ((priorities (if (pair? priorities)
                         (car priorities)
@@ -174,7 +149,6 @@
 (define (winner-uid winner) (car winner))
 (define (winner-promise winner) (cadr winner))
 
-;; A task being negotiated, as negotiate has checked it.
 (define-record-type pose
   (make-pose name layouts type-list keys-list procs priorities)
   pose?
@@ -186,7 +160,6 @@
   (priorities pose-priorities)
   (tried pose-tried pose-tried-set!))    ; the last try's candidates' uids
 
-;; The task's tries, from try number n on.
 (define (negotiate-by-tries task n)
   (let ((outcome (if (outranking-rivals-negotiating? (pose-name task))
                      'waiting
@@ -200,9 +173,8 @@
            (explain-no-takers (pose-name task) (pose-layouts task) (current-error-port))
            'not-enough-takers))))
 
-;; One round of negotiation: (winners type-list name), or not-enough-takers, or
-;; outranked when a rival outranks this pose; on failure everything is
-;; freed.
+;; One round: (winners type-list name), not-enough-takers, or outranked;
+;; on failure everything is freed.
 (define (try task)
   (let* ((type-list (pose-type-list task))
          (round (request-components (pose-name task) (round-components task)))
@@ -225,17 +197,15 @@
                   (iota (length winners) 1) winners)
         (list winners type-list (pose-name task)))))))
 
-;; What runs component k, proc, of the task won under name, on its robot:
-;; proc, listed there as that component (run-posed-component), so that the
-;; live view finds each component, by its number, and how it ended.
+;; What runs component k, proc, on its robot: listed there
+;; (run-posed-component), so the live view finds how it ended.
 (define (posed-component name)
   (let ((poser (local-aspace-uid)))
     (lambda (k proc)
       (sendable-lambda () (run-posed-component name k poser proc)))))
 
-;; What request-components asks the lab for each component: the thesis's
-;; request-exclusive, or request of t for a non-exclusive component, with
-;; the askings of its metric.
+;; What request-components asks the lab for each component, with the
+;; askings of its metric.
 (define (round-components task)
   (map (lambda (type layout proc keys)
          (list type layout (if (eq? type 'exclusive) proc t) (asking-procs keys)))
@@ -286,7 +256,6 @@
           (release-runners-up (list out) (list type) '())
           (remove (lambda (e) (memq e out)) response)))))
 
-;; Frees every promise but the winners' and answers outcome.
 (define (give-up responses type-list outcome)
   (release-runners-up responses type-list '())
   (progress "  " outcome "; every reservation freed")

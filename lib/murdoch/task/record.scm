@@ -39,11 +39,9 @@
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
-;; The tasks started here, newest first: those not over, and the newest
-;; of those over, at most the lab's tasks-kept.  Global, as the waiting
-;; tasks (rank.scm) and the offers (offers.scm) are: peers' calls find
-;; them by name.  The lock guards these lists and the tasks' and
-;; waiters' fields.
+;; The tasks started here, newest first: those not over, and at most
+;; tasks-kept of those over.  Global: peers' calls find them by name.  The
+;; lock guards these lists and the tasks' and waiters' fields.
 (define *posed* '())
 (define *tasks-lock* (make-mutex 'tasks))
 
@@ -62,7 +60,6 @@
           ((< n kept) (loop (cdr ts) (+ n 1) (cons (car ts) out)))
           (else (loop (cdr ts) n out)))))
 
-;; Marks c failed for why, and t with it if it is its first failure.
 (define (fail-component! t c why)
   (component-state-set! c (list 'failed why))
   (if (not (task-why t)) (task-why-set! t why)))
@@ -86,8 +83,7 @@
 ;;> SINCE), (done VALUE), (failed WHY) ...
 (define (status-state s) (cadr s))
 
-;;> The (UID . OUTCOME) of each robot done with the component in \var{s},
-;;> an entry of task-status.
+;;> The (UID . OUTCOME) of each robot done with the component in \var{s}.
 (define (status-attempts s) (car (cddr s)))
 
 ;;> Whether \var{s}, an entry of task-status, is a step's (step I
@@ -98,7 +94,7 @@
 (define (step-status-index s) (cadr s))
 
 ;;> The STATUS in \var{s}, a step's entry of task-status: the step's own
-;;> task-status, an entry for each of its components.
+;;> task-status.
 (define (step-status-entries s) (car (cddr s)))
 
 (define (check-task-record who x)
@@ -120,8 +116,7 @@
 (define (listed-why e) (list-ref e 3))
 
 ;;> The place in line of \var{e}, a posed entry of (tasks), when it
-;;> waits or holds, else #f: 1 for the lab's best-ranked waiting task, and
-;;> so on, one order for the whole lab.
+;;> waits or holds, else #f: 1 for the lab's best-ranked waiting task.
 (define (listed-place e) (list-ref e 4))
 
 ;;> The priority of \var{e}, a posed entry of (tasks).
@@ -131,7 +126,7 @@
 (define (listed-held e) (list-ref e 6))
 
 ;;> What \var{e}, a posed entry of (tasks) that waits or holds, still
-;;> waits for: the capabilities of each component it holds no robot for.
+;;> waits for.
 (define (listed-wants e) (list-ref e 7))
 
 ;;> The component's number in \var{e}, a running entry of (tasks).

@@ -1,12 +1,9 @@
-;;;; The robot's side of the task life cycle (life-cycle.scm): the components
-;;;; of started tasks that run here, each watched for its poser's
-;;;; heartbeats; and pose-task's components, which have no heartbeats.
-;;;; Each is listed while it runs, and remembered for a while once it has
-;;;; ended, with how, so that the live view sees every component and how
-;;;; it ended, though its poser be a guest that has gone.
+;;;; The robot's side of the task life cycle (life-cycle.scm): components
+;;;; running here, watched for their poser's heartbeats, and pose-task's,
+;;;; which have none.  Each is listed, and remembered a while once ended,
+;;;; so the live view sees how it ended though its poser be gone.
 
 
-;; A component running here.
 (define-record-type running
   (make-running id index poser thread started heard)
   running?
@@ -43,8 +40,7 @@
   (run-listed id k poser (list thunk) (lambda (e) #f) (lambda (r) #f)))
 
 ;; Runs work listed as component k of id, watched as watch! sets it
-;; going; a condition for which lost? is true comes back as
-;; (robot-failure WHY).
+;; going.
 (define (run-listed id k poser work lost? watch!)
   (let* ((now (monotonic-seconds))
          (r (make-running id k poser (current-thread) now now))
@@ -71,7 +67,6 @@
 ;; is left with no answer, by a continuation or thread-terminate!.
 (define unfinished (list 'unfinished))
 
-;; A condition that a component raised, held until it is outside.
 (define-record-type raised
   (make-raised condition)
   raised?
@@ -82,18 +77,13 @@
 (define (robot-failure? e)
   (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
 
-;; No ghosts, with a margin: a component stops on its robot once its
-;; poser has been silent for orphan-periods heartbeat periods, looked at
-;; every quarter period, so by 2.25 periods after the last heartbeat the
-;; robot heard; its poser declares the robot lost only when no heartbeat
-;; was answered for lost-periods (life-cycle.scm), and the robot heard that
-;; heartbeat before its answer reached the poser.  The stale copy has
-;; stopped 1.75 periods before the poser can start another: one full
-;; period, and more, for a loaded robot that is late to look.
+;; No ghosts: a component stops once its poser is silent for
+;; orphan-periods (looked at every quarter period, so by 2.25 periods),
+;; well before the poser declares the robot lost after lost-periods
+;; (life-cycle.scm) and may start another: docs/tasks.md.
 (define orphan-periods 2)
 (define lost-periods 4)
 
-;; Stops r when its poser is silent for orphan-periods.
 (define (watch-poser r period)
   (thread-sleep! (/ period 4))
   (cond ((running-over? r) #t)
@@ -174,7 +164,6 @@
 (define kept-ended 16)
 (define *ended* '())
 
-;; Running r over, at a time on the monotonic clock, as end-of says.
 (define-record-type ending
   (make-ending running at end outcome)
   ending?
@@ -183,7 +172,6 @@
   (end ending-end)
   (outcome ending-outcome))             ; what run-listed caught, for await-component
 
-;; r is over, with outcome, as run-listed catches it.
 (define (note-ended! r outcome)
   (let ((entry (make-ending r (monotonic-seconds)
                             (if (and (running-cancelled? r)
@@ -197,9 +185,8 @@
         (set! *ended* (let ((all (cons entry *ended*)))
                         (if (> (length all) kept-ended) (take all kept-ended) all)))))))
 
-;; How a component ended, from what it answered or raised: (done), (lost
-;; WHY) for a robot failure, or (failed WHY), WHY the message its poser
-;; is given; note-ended! makes it (cancelled) when its poser cancelled it.
+;; How a component ended: (done), (lost WHY), (failed WHY); note-ended!
+;; makes it (cancelled) when its poser cancelled it.
 (define (end-of outcome)
   (cond ((eq? outcome unfinished) '(failed "it stopped with no answer"))
         ((raised? outcome) (list 'failed (error-message (raised-condition outcome))))
@@ -208,10 +195,7 @@
         (else '(done))))
 
 ;;> The components that ended here, the last sixteen, newest first, each
-;;> as (ID INDEX POSER STARTED ENDED END): STARTED and ENDED are seconds
-;;> before now, END is (done), (failed WHY), (lost WHY) or (cancelled).  They travel
-;;> as lists, to the status and the view; ended-id and the other ended-
-;;> procedures read them.
+;;> as (ID INDEX POSER STARTED ENDED END), read by the ended- procedures.
 (define (components-ended)
   (let ((now (monotonic-seconds)))
     (map (lambda (e)
@@ -226,14 +210,12 @@
 ;;> The component's number in \var{e}, an entry of components-ended.
 (define (ended-index e) (cadr e))
 
-;;> The seconds since the component of \var{e}, an entry of
-;;> components-ended, started.
+;;> The seconds since the component of \var{e} started.
 (define (ended-started e) (list-ref e 3))
 
-;;> The seconds since the component of \var{e}, an entry of
-;;> components-ended, ended.
+;;> The seconds since the component of \var{e} ended.
 (define (ended-ended e) (list-ref e 4))
 
-;;> How the component of \var{e}, an entry of components-ended, ended:
-;;> (done), (failed WHY), (lost WHY) or (cancelled).
+;;> How the component of \var{e} ended: (done), (failed WHY), (lost WHY)
+;;> or (cancelled).
 (define (ended-end e) (list-ref e 5))

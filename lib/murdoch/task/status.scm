@@ -2,14 +2,10 @@
 ;;;; what they all say, asked at once.
 
 ;;> What this address space says of itself: (UID UP-SINCE POSE BATTERY
-;;> HELD TASKS GOAL ENDED), UP-SINCE the wall-clock second it joined the
-;;> lab, POSE what safe-reckon answers, BATTERY safe-battery-voltage in
-;;> tenths of a volt, HELD the (subject holder) of each subject held here,
-;;> TASKS what (tasks) answers: the tasks it started that are not over and
-;;> the newest few over, and the components it runs; GOAL where goto-xy
-;;> is driving its robot, or #f; ENDED what (components-ended) answers,
-;;> the components that ended here lately; HANDED what (handed-entries)
-;;> answers, the detached tasks it coordinates or stands by for.
+;;> HELD TASKS GOAL ENDED HANDED), read by the report- procedures: POSE
+;;> as safe-reckon, BATTERY in tenths of a volt, HELD (subject holder)
+;;> entries, TASKS, ENDED and HANDED as (tasks), (components-ended) and
+;;> (handed-entries) answer, GOAL goto-xy's or #f.
 (define (aspace-report)
   ;; The components running are read before those ended: one that ends
   ;; in between is then in both lists, never in neither.
@@ -46,7 +42,6 @@
 (define (held-subject h) (car h))
 (define (held-holder h) (cadr h))
 
-;; lab-status's entry for an address space that did not answer.
 (define (make-away uid why) (list uid 'away why))
 (define (away? r) (eq? (cadr r) 'away))
 (define (away-why r) (car (cddr r)))
@@ -92,7 +87,6 @@
          (list-sort (lambda (a b) (rank<? (cadr a) (cadr b))) all)
          (iota (length all) 1))))
 
-;; The line's entry of task id, or #f.
 (define (in-line line id)
   (find (lambda (x) (eq? (listed-id (car (cddr x))) id)) line))
 
@@ -133,7 +127,6 @@
       (for-each (lambda (e) (write-line out "    " (handed-text e)))
                 (report-handed r))))))
 
-;; An entry of handed-entries, as a line.
 (define (handed-text e)
   (string-append
    (case (lab-task-role e)
@@ -155,7 +148,6 @@
                  "  posed by " (held-text (lab-task-poser e))
                  (if (lab-task-took-over e) "  (taken over)" "")))
 
-;; An entry of (tasks), as a line; place its place in the lab's line.
 (define (task-text t place)
   (if (listed-posed? t)
       (string-append "task " (held-text (listed-id t)) " " (held-text (listed-state t))
@@ -203,7 +195,6 @@
                        ((= (modulo n 10) 3) "rd")
                        (else "th"))))
 
-;; Strings, joined by "; ".
 (define (join-text strings) (join-with "; " strings))
 
 (define (write-line out . parts)

@@ -1,14 +1,10 @@
 ;;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
 ;;;; synchronization)
 ;;
-;; A task of steps runs its steps in order, each a task as start-task runs
-;; one: a step starts when every component of the step before is done (a
-;; barrier), and its procedures are applied to that step's results.  Its
-;; components may ask for a robot that had a component of an earlier step,
-;; so that a team keeps its members, and run as a team: team-barrier,
-;; team-send! and team-receive (team.scm) reach the other members.  A step
-;; with a failed component stops the task; everything is freed as each
-;; step's components end.
+;; A step starts when every component of the step before is done (a
+;; barrier), its procedures applied to that step's results.  A component
+;; may ask for a robot of an earlier step, so a team keeps its members
+;; (team.scm).  A step with a failed component stops the task.
 
 (define-record-type step
   (make-step capabilities metrics procs options)
@@ -36,10 +32,8 @@
 
 ;;> Starts a task of \var{steps} (made by task-step) and answers its task
 ;;> record at once; start-task's keywords may follow the steps, and each
-;;> step is started with them.  task-status gives (step I STATUS) for each
-;;> step started (read by step-status? and the other step-status-
-;;> procedures), task-wait the list of each step's results, and
-;;> cancel-task stops the step running and those after it.
+;;> step is started with them.  task-status gives (step I STATUS) per step
+;;> started, task-wait each step's results.
 (define (start-steps task-name . steps+options)
   (let ((steps (take-while step? steps+options))
         (options (drop-while step? steps+options)))
@@ -52,12 +46,9 @@
       t)))
 
 ;;> Goes on with the task of steps \var{id}, a detached one taken over
-;;> (detached.scm), as start-steps started it with \var{task-name},
-;;> \var{steps} and \var{options}; answers its new task record at once.
-;;> Each step is first offered to \var{adopt-step}, applied to its
-;;> number, its id (step-task-id) and the arguments start-task would
-;;> start it with: it answers the step's task record, for a step that
-;;> started or ended before, or #f for one to start.
+;;> (detached.scm), as start-steps started it; answers its new task
+;;> record at once.  \var{adopt-step} answers a step's record for one
+;;> that started or ended before, or #f for one to start.
 (define (resume-steps id task-name steps options adopt-step)
   (let ((t (new-task id task-name '() '() '() '() #f)))
     (go-steps! t steps options adopt-step)
@@ -122,8 +113,8 @@
   (or (symbol? results)
       (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
 
-;; Starts step number i of t as a task of its own, whose id is
-;; step-task-id's, or has adopt-step adopt it.
+;; Starts step number i of t as a task of its own, or has adopt-step
+;; adopt it.
 (define (begin-step t s i previous coordinator options adopt-step)
   (let ((id (step-task-id (task-id t) i))
         (args (cons* (task-name t) (length (step-procs s))

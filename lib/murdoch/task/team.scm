@@ -32,10 +32,7 @@
 
 ;; Macros are defined before their first use, which Chibi requires.
 ;;> A thunk that runs the task's components on its chosen robots, as a
-;;> team: an exclusive component by applying its winner's promise to #t, a
-;;> non-exclusive one by running its procedure on the winner.  With
-;;> \var{listed}, a procedure of a component's number and the procedure
-;;> that runs it, each component runs as the procedure listed answers.
+;;> team; with \var{listed}, each runs as the procedure listed answers.
 (define (with-team-proc-maker task-uids type-list procs . listed)
   (let* ((as (if (pair? listed) (car listed) (lambda (k proc) proc)))
          (proclist (map (lambda (k task-uid proc type)
@@ -50,10 +47,8 @@
         (on-list ((fixed uids)) proclist)))))
 
 ;;> Seconds a component may run before its caller gives up on it, when
-;;> on-list is not given a timeout: pose-task's components, for one.  The
-;;> component is told as failed (see on-error), and stops on its robot at
-;;> its next robot command or remote call (abandon.scm); until then an
-;;> exclusive one holds its subjects.
+;;> on-list is not given a timeout; it stops on its robot at its next
+;;> command (abandon.scm).
 (define task-timeout (make-parameter (lab-default 'task-timeout)))
 (sandbox-parameter! task-timeout)
 
@@ -88,14 +83,12 @@
                          (run-on uid proc seconds on-error debug?))))))
                  uids procs)))))
 
-;; The threads' results, in order.  Left before they are all done (Ctrl-C
-;; at the REPL interrupts the join), the threads are interrupted too: each
-;; gives up its component, which stops on its robot (abandon.scm).
+;; The threads' results, in order; left early (Ctrl-C), the threads are
+;; interrupted too and each gives up its component (abandon.scm).
 (define (join-or-interrupt threads)
   (undo-on-raise (lambda () (for-each thread-interrupt! threads))
                  (lambda () (map thread-join! threads))))
 
-;; Runs one component on its robot; an error or a timeout goes to on-error.
 (define (run-on uid proc seconds on-error debug?)
   (if debug? (progress "  " uid " starts"))
   (let ((result (guard (e (#t (on-error uid e)))
@@ -106,10 +99,8 @@
     (if debug? (progress "  " uid " done: " result))
     result))
 
-;; A component that this address space won runs here, in a thread of its
-;; own, so that seconds bound it as they bound one elsewhere: the wait
-;; ends, by timeout or interrupt, and the component is given up
-;; (abandon.scm).
+;; A component this address space won runs in a thread of its own, so
+;; seconds bound it as they bound one elsewhere (abandon.scm).
 (define (apply-here-by proc seconds)
   (let* ((outcome #f)
          (runner (make-logged-thread
@@ -135,12 +126,9 @@
 
 ;;; Synchronization inside a team, MOVER's way
 ;;
-;; The members of a team running one step of a task wait for each other at
-;; named barriers and pass values to each other by uid, through the team's
-;; coordinator: a proxy (encap) made where the task was posed, which every
-;; member calls.  The poser runs the step's procedures inside
-;; with-coordinator, so a member finds its team and coordinator where it
-;; runs, whichever robot that is.
+;; Members wait at named barriers and pass values by uid through the
+;; team's coordinator, a proxy (encap) made where the task was posed;
+;; with-coordinator lets a member find it wherever it runs.
 
 ;; The coordinator of the team being run here, or #f.
 (define current-coordinator (make-parameter #f))
@@ -154,10 +142,8 @@
                  (current-team (coordinator 'team)))
     (thunk)))
 
-;;> The step's robots as they are now, in component order: a member lost
-;;> and replaced (a restartable component given to another robot) is
-;;> replaced here, where (current-team) keeps the robots the member started
-;;> with.
+;;> The step's robots as they are now, in component order, a lost member
+;;> replaced; (current-team) keeps those it started with.
 (define (step-team) ((team-coordinator "step-team") 'team))
 
 (define (team-coordinator who)
@@ -193,7 +179,6 @@
       (or (c 'receive (local-aspace-uid) s)
           (error "team-receive: nothing came within" s)))))
 
-;; A value sent by team-send!, waiting at the coordinator for its member.
 (define-record-type letter
   (make-letter to from value)
   letter?
