@@ -15,21 +15,26 @@
   (let ((lines (explain-components layouts)))
     (write-string (string-append "pose-task: not enough takers for "
                                  (name task-name) ":\n"
-                                 (apply string-append (map explanation-line lines))
+                                 (apply string-append (map explanation-line lines (iota (length lines) 1)))
                                  (too-few-line layouts (map explanation-free lines)))
                   port)
     (flush-output-port port)))
 
-;;> What is known of one component's takers: its line says who could take
-;;> it and why none did, as explain-no-takers writes it; free and capable
-;;> are the uids of the live address spaces capable of it that are free,
-;;> and all of them.
+;;> What is known of one layout's takers: who could take it and why none
+;;> did (its line, as explain-no-takers writes it for the component
+;;> numbered i: \scheme{(explanation-line e i)}); free and capable are the
+;;> uids of the live address spaces capable of it that are free, and all
+;;> of them.  The number is the caller's, for a poser's look explains each
+;;> layout once for all its waiting tasks' components.
 (define-record-type explanation
-  (make-explanation line free capable)
+  (make-explanation needs free capable)
   explanation?
-  (line explanation-line)
+  (needs explanation-needs)
   (free explanation-free)
   (capable explanation-capable))
+
+(define (explanation-line e i)
+  (string-append "  component " (number->string i) " " (explanation-needs e) "\n"))
 
 ;;> An explanation for each of \var{layouts}, in order: one request of
 ;;> the whole lab, each address space answering for every layout at once
@@ -40,7 +45,7 @@
          (live (map car answers)))
     (map (lambda (i layout)
            (explain-component
-            i layout live
+            layout live
             (filter-map (lambda (a)
                           (let ((statuses (list-ref (cadr a) (- i 1))))
                             (and statuses (list (car a) statuses))))
@@ -55,21 +60,21 @@
          (and (addressed-here? (apply append layout)) (map topic-status (car layout))))
        layouts))
 
-;; A line on component i, the robots free for it, and those capable;
-;; answers, (UID STATUSES) of each address space that has its subjects.
-(define (explain-component i layout live answers)
+;; What a layout needs and who could take it, the robots free for it,
+;; and those capable; answers, (UID STATUSES) of each address space that
+;; has its subjects.
+(define (explain-component layout live answers)
   (let* ((exclusive (car layout))
          (answers (in-lab-order answers))
          (silent (remove (lambda (uid) (assq uid answers))
                          (file-capable (apply append layout)))))
     (make-explanation
      (string-append
-      "  component " (number->string i) " needs " (name layout) ": "
+      "needs " (name layout) ": "
       (if (and (null? answers) (null? silent))
           "no address space of the lab is capable of it"
           (join (append (map robot-state answers)
-                        (map (lambda (uid) (silent-state uid live)) silent))))
-      "\n")
+                        (map (lambda (uid) (silent-state uid live)) silent)))))
      (filter-map (lambda (a) (and (free? a) (car a))) answers)
      (map car answers))))
 

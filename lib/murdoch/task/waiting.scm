@@ -239,7 +239,7 @@
          (never (cond
                  ((any null? capable)
                   (string-append "no live robot of the lab is capable of it:"
-                                 (apply string-append (map explanation-line lines))))
+                                 (apply string-append (map explanation-line lines (iota (length lines) 1)))))
                  ((< (length (delete-duplicates (apply append exclusive)))
                      (length exclusive))
                   "fewer live robots of the lab are capable of it than it has components")
@@ -251,7 +251,8 @@
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
       (waiter-capables-set! w (map cons cs capable))
-      (waiter-why-set! w (map (lambda (line) (trimmed (explanation-line line))) lines))
+      (waiter-why-set! w (map (lambda (line i) (trimmed (explanation-line line i)))
+                                   lines (iota (length lines) 1)))
       (ask-way! w lines holders)
       (move-up! w line)
       (progress (task-id (waiter-task w)) ": " (task-state (waiter-task w))
