@@ -65,15 +65,23 @@
     ;; runs stop within a millimetre and a tenth of a degree of it (the
     ;; face's arrive-mm and arrive-deg), so the rings differ by the sonar's
     ;; noise (10 mm, a fresh draw in each run): 80 mm, or 3 % of a far
-    ;; echo's range.  A ring read elsewhere, or mid-turn, differs by metres.
+    ;; echo's range.  But the other robot may still be on its way when one
+    ;; reads, and ROS 2 times the two robots differently: a clean-clone run
+    ;; saw each robot one sector over, a metre off, where the direct run
+    ;; saw it too.  So up to two sectors a ring may read nearer than the
+    ;; direct run's; a ring read elsewhere, or mid-turn, differs in many.
     (test "each sonar ring is sixteen ranges" '(#t #t)
           (map (lambda (ring) (and (list? ring) (= 16 (length ring)) (every real? ring)))
                (take b 2)))
     (test "each sonar near the direct run's, at the same target" '()
           (filter-map (lambda (ring-a ring-b i)
-                        (and (not (every (lambda (x y) (< (abs (- x y)) (max 80 (* 0.03 x))))
-                                         ring-a ring-b))
-                             (list i ring-a ring-b)))
+                        (let ((near (lambda (x y) (< (abs (- x y)) (max 80 (* 0.03 x))))))
+                          (and (not (and (every (lambda (x y) (or (near x y) (< y x)))
+                                                ring-a ring-b)
+                                         (<= (count (lambda (x y) (not (near x y)))
+                                                    ring-a ring-b)
+                                             2)))
+                               (list i ring-a ring-b))))
                       (take a 2) (take b 2) '(1 2)))))
 
 (test-end)
