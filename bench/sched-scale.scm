@@ -55,21 +55,7 @@
                     (numbered "r" n-robots) (iota n-robots)))
 (define posers (numbered "p" n-posers))
 
-(define lab-code "
-;; Run here, on the bench's address space, with clock set to its clock.
-(define clock #f)
-(define events '())                     ; (time kind id k uid), newest first
-(define started 0)                      ; tasks whose first component started
-(define (note! kind id k uid)
-  (if (and (eq? kind 'start) (= k 1)) (set! started (+ started 1)))
-  (set! events (cons (list (clock) kind id k uid) events)))
-;; A component: a timed wait on its robot, told to bench as it starts and ends.
-(define (bench-work id k seconds)
-  (let ((me (local-aspace-uid)))
-    (remote-apply (uid->aspace 'bench) (lambda () (note! 'start id k me)))
-    (thread-sleep! seconds)
-    (remote-apply (uid->aspace 'bench) (lambda () (note! 'end id k me)))
-    me))
+(define lab-code (string-append bench-lab-code "
 ;; Run on the posers: subjects, one a component.
 (define posed '())                      ; (id . task)
 (define (pose-bench! id subjects seconds priority)
@@ -85,7 +71,7 @@
   #t)
 (define (bench-results)
   (map (lambda (p) (list (car p) (task-wait (cdr p) 1200))) posed))
-")
+"))
 
 (define lab
   (make-test-lab

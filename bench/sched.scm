@@ -51,19 +51,7 @@
 (define posers '(p1 p2 p3))
 (define aging 0.1)
 
-(define lab-code "
-;; Run here, on the bench's address space, with clock set to its clock.
-(define clock #f)
-(define events '())                     ; (time kind id k uid), newest first
-(define (note! kind id k uid)
-  (set! events (cons (list (clock) kind id k uid) events)))
-;; A component: a timed wait on its robot, told to bench as it starts and ends.
-(define (bench-work id k seconds)
-  (let ((me (local-aspace-uid)))
-    (remote-apply (uid->aspace 'bench) (lambda () (note! 'start id k me)))
-    (thread-sleep! seconds)
-    (remote-apply (uid->aspace 'bench) (lambda () (note! 'end id k me)))
-    me))
+(define lab-code (string-append bench-lab-code "
 ;; Run on the posers.
 (define posed '())                      ; (id . task)
 (define (pose-bench! id n seconds priority)
@@ -77,7 +65,7 @@
   #t)
 (define (bench-results)
   (map (lambda (p) (list (car p) (task-wait (cdr p) 600))) posed))
-")
+"))
 
 (define lab
   (make-test-lab

@@ -10,7 +10,7 @@
 ;;> robot UID, in time order.  Robots are ((UID . KIND) ...).
 
 (define-library (bench schedule)
-  (export start-bench-lab! lab-proc seeded-reals below
+  (export bench-lab-code start-bench-lab! lab-proc seeded-reals below
           make-schedule-run schedule-completed! print-schedule-figures
           schedule-spans schedule-makespan percentile round-to bench)
   (import (scheme base) (scheme write) (scheme inexact) (scheme eval) (scheme time)
@@ -18,6 +18,25 @@
           (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
           (murdoch cli command) (murdoch testing harness))
   (begin
+    ;;> The lab code both benches share, before each one's pose-bench!: the
+    ;;> bench's clock and the events its components tell it (started counts
+    ;;> the tasks whose first component started), and bench-work, a
+    ;;> component: a timed wait on its robot, told as it starts and ends.
+    (define bench-lab-code "
+(define clock #f)
+(define events '())                     ; (time kind id k uid), newest first
+(define started 0)
+(define (note! kind id k uid)
+  (if (and (eq? kind 'start) (= k 1)) (set! started (+ started 1)))
+  (set! events (cons (list (clock) kind id k uid) events)))
+(define (bench-work id k seconds)
+  (let ((me (local-aspace-uid)))
+    (remote-apply (uid->aspace 'bench) (lambda () (note! 'start id k me)))
+    (thread-sleep! seconds)
+    (remote-apply (uid->aspace 'bench) (lambda () (note! 'end id k me)))
+    me))
+")
+
     ;;> Starts the address spaces \var{uids} of test lab \var{lab}, joins
     ;;> it as bench, waits up to \var{seconds} for them all to be live, and
     ;;> sets the lab code's clock to this one's: answers their pids.
