@@ -101,6 +101,7 @@
         (offers (filter offer? news))
         (held (held-uids w)))
     (give-way! w news)
+    (unblock! w)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((eq? (task-state t) 'let-go) (answer-offers! offers #f) 'let-go)
@@ -254,6 +255,7 @@
       (waiter-why-set! w (map (lambda (line i) (trimmed (explanation-line line i)))
                                    lines (iota (length lines) 1)))
       (ask-way! w lines holders)
+      (if (blocked-on-itself? w) (tell-waiter! w '(looked)))
       (move-up! w line)
       (progress (task-id (waiter-task w)) ": " (task-state (waiter-task w))
                 (if (pair? (waiter-held w))
