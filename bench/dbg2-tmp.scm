@@ -1,0 +1,222 @@
+;;; make bench-sched-scale: Murdoch as a scheduler of a queue of thousands
+;;; (issue 43; docs/allocation.md, "What an offer round costs").
+;;;
+;;; A lab of 64 robots (workstations, no motion) of 4 kinds, a to d, and 8
+;;; posers.  A robot of kind a subscribes to a and to the pairs ab and da,
+;;; and so on round the ring, so that a component needing (a) accepts
+;;; kind a only and one needing (ab) accepts a or b; those are shared, and
+;;; each robot's one exclusive subject is station: a component needs
+;;; ((station) (KIND)).  Each subject is a resource of its own in pubsub,
+;;; so kinds that were exclusive would let one robot run a component
+;;; needing a beside one needing ab.  From a seed, 2,500
+;;; tasks of 1 to 4 components, each component a timed wait of 0.2 to 2 s
+;;; (the same for all of a task's), accepting one kind or two, priorities
+;;; 0 to 3, every one with 'wait #t 'hold #t; 500 posed at once, then the
+;;; rest at random arrivals faster than the lab serves them, so that the
+;;; queue grows to about 2,000.  The posers pose in parallel, each its own
+;;; tasks.  Each component tells this address space when it starts and
+;;; ends, as in make bench-sched, and bench/schedule.sld judges the run
+;;; beside its ideal schedule: the same lines as make bench-sched's,
+;;; named sched-scale-.  Besides, once a second, the lab's CPU (the posers'
+;;; and robots' processes) and how many tasks have started and are
+;;; queued (posed, not started):
+;;;   bench: sched-scale-cpu-per-start-us-at-Q X us, the lab's CPU over
+;;;          the seconds when the queue held Q/sqrt(2) to Q*sqrt(2) tasks,
+;;;          over the tasks started then, for Q 500 and 2000;
+;;;   bench: sched-scale-cpu-per-start-growth X x, the second over the
+;;;          first, beside sched-scale-log-growth, log 2000 / log 500.
+;;; Sizes: MURDOCH_SCHED_SCALE_ROBOTS (64, a multiple of 4), _POSERS (8),
+;;; _TASKS (2500), _BURST (500), _GAP (mean seconds between arrivals,
+;;; 0.008); MURDOCH_SCHED_SEED (30).
+(import (except (scheme base) lambda define) (scheme write) (scheme eval)
+        (scheme time) (scheme process-context) (scheme inexact)
+        (srfi 1) (srfi 18) (srfi 132)
+        (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
+        (murdoch cli command) (murdoch testing harness)
+        (bench clock) (bench schedule))
+
+(define (setting name default)
+  (cond ((get-environment-variable name) => string->number)
+        (else default)))
+(define seed (setting "MURDOCH_SCHED_SEED" 30))
+(define n-robots (setting "MURDOCH_SCHED_SCALE_ROBOTS" 64))
+(define n-posers (setting "MURDOCH_SCHED_SCALE_POSERS" 8))
+(define n-tasks (setting "MURDOCH_SCHED_SCALE_TASKS" 2500))
+(define burst (setting "MURDOCH_SCHED_SCALE_BURST" 500))
+(define gap (setting "MURDOCH_SCHED_SCALE_GAP" 0.008))
+(define aging 0.1)
+
+(define kinds '(a b c d))
+;; Each kind's subjects: its own, and the pairs it is in round the ring.
+(define pairs '((ab a b) (bc b c) (cd c d) (da d a)))
+(define (subjects-of kind)
+  (cons* 'station kind (filter-map (lambda (p) (and (memq kind (cdr p)) (car p))) pairs)))
+
+(define (numbered prefix n)
+  (map (lambda (i) (string->symbol (string-append prefix (number->string i))))
+       (iota n 1)))
+(define robots (map (lambda (uid i) (cons uid (list-ref kinds (modulo i 4))))
+                    (numbered "r" n-robots) (iota n-robots)))
+(define posers (numbered "p" n-posers))
+
+(define lab-code (string-append bench-lab-code "
+;; Run on the posers: subjects, one a component.
+(define posed '())                      ; (id . task)
+(define (pose-bench! id subjects seconds priority)
+  (set! posed
+        (cons (cons id
+                    (start-task 'bench (length subjects)
+                                (map (lambda (s) (list '(station) (list s))) subjects)
+                                (map (lambda (s) #f) subjects)
+                                (map (lambda (k) (lambda () (bench-work id k seconds)))
+                                     (iota (length subjects) 1))
+                                'wait #t 'hold #t 'priority priority))
+              posed))
+  #t)
+(define (bench-results)
+  (map (lambda (p) (list (car p) (task-wait (cdr p) 1200))) posed))
+"))
+
+(define lab
+  (make-test-lab
+   ;; Every address space is on this host: the bench's and each poser's
+   ;; hear from every robot, more than the 64 a host that the lab allows
+   ;; by default (they refused the robots' calls, and the lab stalled).
+   `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 0.5)
+     (max-connections-per-host ,(* 2 (+ n-robots n-posers 1)))
+     (aspace bench)
+     ,@(map (lambda (uid) `(aspace ,uid)) posers)
+     ,@(map (lambda (r) `(aspace ,(car r) (capabilities ,@(subjects-of (cdr r)))))
+            robots))
+   `(("code.scm" . ,lab-code))))
+
+(define uids (append posers (map car robots)))
+(define pids (start-bench-lab! lab uids 60))
+
+;;; The tasks
+
+(define random-real (seeded-reals seed))
+(define (random-below n) (below random-real n))
+
+;; A component's subject: a kind, or a pair of kinds.
+(define (random-subject)
+  (if (< (random-real) 0.5)
+      (list-ref kinds (random-below 4))
+      (car (list-ref pairs (random-below 4)))))
+(define (accepted subject)
+  (cond ((assq subject pairs) => cdr) (else (list subject))))
+
+;; (id subjects seconds priority at): at, the second it is posed.
+(define plan
+  (let loop ((id 0) (at 0) (out '()))
+    (if (= id n-tasks)
+        (reverse out)
+        (let ((at (if (< id burst) 0 (+ at (* (- gap) (log (- 1 (random-real))))))))
+          (loop (+ id 1) at
+                (cons (list id (list-tabulate (+ 1 (random-below 4))
+                                              (lambda (k) (random-subject)))
+                            (+ 0.2 (* 1.8 (random-real))) (random-below 4) at)
+                      out))))))
+
+;;; The run
+
+;; A task's rank is read from its poser's clock, between the two seconds
+;; noted here as it is posed: before the call that poses it, and after.
+(define posed-at (make-vector n-tasks #f))
+(define posed-by (make-vector n-tasks #f))
+(define n-posed 0)
+(define t0 (current-second))
+
+;; Each poser poses its own tasks, at their seconds, in a thread of its own.
+(define (pose-all! poser mine)
+  (for-each (lambda (t)
+              (let ((wait (- (list-ref t 4) (- (current-second) t0))))
+                (if (> wait 0) (thread-sleep! wait)))
+              (vector-set! posed-at (car t) (- (current-second) t0))
+              (parameterize ((remote-timeout 60))
+                (remote-apply (uid->aspace poser) (lab-proc 'pose-bench!) (car t)
+                              (cadr t) (list-ref t 2) (list-ref t 3)))
+              (vector-set! posed-by (car t) (- (current-second) t0))
+              (set! n-posed (+ n-posed 1)))
+            mine))
+
+;; Once a second: (second lab-cpu-us started queued).
+(define samples '())
+(define (started-count) (eval 'started (lab-environment)))
+(define (sample!)
+  (let* ((started (started-count))
+         (s (list (- (current-second) t0) (processes-cpu-us pids) started
+                  (- n-posed started))))
+    (set! samples (cons s samples))
+    ;; As it goes, so that a run cut short still tells how far it got.
+    (write-string (string-append "sched-scale: at " (number->string (round (car s)))
+                                 " s: lab cpu " (number->string (round (/ (cadr s) 1e6)))
+                                 " s, started " (number->string started)
+                                 ", queued " (number->string (list-ref s 3)) "\n")
+                  (current-error-port))))
+(define sampling #t)
+(define sampler
+  (thread-start! (make-thread (lambda ()
+                                (let loop ()
+                                  (sample!)
+                                  (thread-sleep! 1)
+                                  (if sampling (loop)))))))
+
+(for-each thread-join!
+          (map (lambda (poser i)
+                 (thread-start!
+                  (make-thread (lambda ()
+                                 (pose-all! poser (filter (lambda (t) (= (modulo (car t) n-posers) i))
+                                                          plan))))))
+               posers (iota n-posers)))
+
+(define results
+  (append-map (lambda (p)
+                (parameterize ((remote-timeout 1300))
+                  (remote-apply (uid->aspace p) (lab-proc 'bench-results))))
+              posers))
+(set! sampling #f)
+(thread-join! sampler)
+
+(define events
+  (map (lambda (e) (cons (- (car e) t0) (cdr e)))
+       (reverse (remote-apply (uid->aspace 'bench)
+                              (eval '(lambda () events) (lab-environment))))))
+
+(stop-all-processes!)
+(write-string (string-append "LABDIR " (test-lab-directory lab) "\n") (current-error-port))
+
+;;; The figures
+
+(define (ok? result) (and (list? result) (every symbol? result)))
+(define tasks (map (lambda (t) (list (car t) (map accepted (cadr t)) (list-ref t 2)
+                                     (list-ref t 3) 0))
+                   plan))
+(define run (make-schedule-run tasks posed-at posed-by events robots aging))
+(schedule-completed! run (count (lambda (r) (ok? (cadr r))) results))
+(for-each (lambda (r) (if (not (ok? (cadr r))) (begin (write (list 'FAILED r) (current-error-port)) (newline (current-error-port))))) results)
+(bench "sched-scale-robots" n-robots "")
+(bench "sched-scale-posers" n-posers "")
+(print-schedule-figures run "sched-scale")
+
+;; The lab's CPU per task started over the seconds whose queue, at their
+;; start and end, was within a factor sqrt 2 of q; #f if none was.
+(define (cpu-per-start q)
+  (let loop ((ss (reverse samples)) (cpu 0) (starts 0))
+    (if (or (null? ss) (null? (cdr ss)))
+        (and (> starts 0) (/ cpu starts))
+        (let* ((a (car ss)) (b (cadr ss))
+               (within? (lambda (s) (<= (/ q (sqrt 2)) (list-ref s 3) (* q (sqrt 2))))))
+          (if (and (within? a) (within? b))
+              (loop (cdr ss) (+ cpu (- (cadr b) (cadr a)))
+                    (+ starts (- (list-ref b 2) (list-ref a 2))))
+              (loop (cdr ss) cpu starts))))))
+
+(define at-500 (cpu-per-start 500))
+(define at-2000 (cpu-per-start 2000))
+(bench "sched-scale-queue-max" (apply max 0 (map (lambda (s) (list-ref s 3)) samples)) "")
+(bench "sched-scale-cpu-per-start-us-at-500" (if at-500 (round at-500) "none") "us")
+(bench "sched-scale-cpu-per-start-us-at-2000" (if at-2000 (round at-2000) "none") "us")
+(if (and at-500 at-2000)
+    (bench "sched-scale-cpu-per-start-growth" (round-to (/ at-2000 at-500) 3) "x"))
+(bench "sched-scale-log-growth" (round-to (/ (log 2000) (log 500)) 3) "x")
