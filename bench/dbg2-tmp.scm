@@ -82,7 +82,11 @@
    ;; Every address space is on this host: the bench's and each poser's
    ;; hear from every robot, more than the 64 a host that the lab allows
    ;; by default (they refused the robots' calls, and the lab stalled).
-   `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 0.5)
+   ;; A heartbeat of 1 s: with 73 address spaces on two cores (load
+   ;; averages of 30), a poser's heartbeats to its components' robots fell
+   ;; more than the two periods of 0.5 s behind, and the robots stopped
+   ;; them as orphans (docs/allocation.md).
+   `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 1)
      (max-connections-per-host ,(* 2 (+ n-robots n-posers 1)))
      (aspace bench)
      ,@(map (lambda (uid) `(aspace ,uid)) posers)
