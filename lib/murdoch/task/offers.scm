@@ -68,12 +68,15 @@
 (define *waiters-here?* #f)
 
 ;;> What a poser, \var{poser}, publishes to the lab when one of its tasks
-;;> starts to wait: the robots offer themselves when freed, and a free
-;;> robot at once, since a task posed behind others waits for the offers.
-(define (note-waiters! . poser)
+;;> starts to wait, \var{rank} the best rank of those that did since its
+;;> last note: the robots offer themselves when freed, and a free robot
+;;> at once, since a task posed behind others waits for the offers.
+(define (note-waiters! . poser+rank)
   (set! *waiters-here?* #t)
-  (set! *new-waiters* #t)
-  (if (pair? poser) (know-poser! (car poser)))
+  (set! *new-waiters* (if (and (= 2 (length poser+rank)) (not (eq? *new-waiters* #t)))
+                          (better-rank (cadr poser+rank) *new-waiters*)
+                          #t))
+  (if (pair? poser+rank) (know-poser! (car poser+rank)))
   (if (and (robot-here?) (free-here?)) (robot-freed!))
   #t)
 
@@ -110,8 +113,18 @@
 ;; offer round asked who waits: the round's list may lack a better-ranked
 ;; task, and it asks again before its next offer (forty tasks posed at
 ;; once: a round that had asked before the best of them waited went on
-;; down its list to a worse one).
+;; down its list to a worse one).  The best rank of those noted, or #t
+;; for one not known (a reminder): a round asks again only if that rank
+;; goes before its next offer's.  While posers posed thousands, a note
+;; came between any two offers, and every robot asked who waits again
+;; after each offer, never getting past the best task of the lab, which
+;; declined all but one robot a component (docs/allocation.md).
 (define *new-waiters* #f)
+
+(define (ask-again-before? waiting)
+  (and *new-waiters*
+       (or (eq? *new-waiters* #t) (null? waiting)
+           (rank<? *new-waiters* (wanting-rank (car waiting))))))
 
 (define (robot-here?)
   (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
@@ -189,7 +202,7 @@
         (parameterize ((remote-timeout (+ (offer-seconds) 1)))
           (remote-apply (uid->aspace poser) receive-offer
                         (wanting-id (car waiting)) me)))
-      (if (and *new-waiters* (free-here?))
+      (if (and (ask-again-before? (cdr waiting)) (free-here?))
           (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
           (offer-to me (cdr waiting))))))
 

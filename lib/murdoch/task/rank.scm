@@ -74,6 +74,10 @@
                (and (= (rank-posed a) (rank-posed b))
                     (string<? (rank-id a) (rank-id b)))))))
 
+;; The better of ranks a and b, either #f for none.
+(define (better-rank a b)
+  (cond ((not a) b) ((not b) a) ((rank<? a b) a) (else b)))
+
 ;; A task waiting here: news is what came for it, offers and cancels, and
 ;; bell rings when news comes.
 (define-record-type waiter

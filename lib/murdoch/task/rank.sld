@@ -4,7 +4,7 @@
 
 (define-library (murdoch task rank)
   (export make-turn turn? turn-wait? turn-hold? turn-priority turn-deadline
-          turn-posed read-turn check-waiting-room turn-rank rank<?
+          turn-posed read-turn check-waiting-room turn-rank rank<? better-rank
           make-waiter waiter? waiter-task waiter-components waiter-rank
           waiter-held waiter-held-set! waiter-looked waiter-looked-set!
           waiter-kept waiter-kept-set! waiter-yielded waiter-yielded-set!

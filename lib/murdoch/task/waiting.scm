@@ -39,30 +39,31 @@
       (add-waiter! w)
       (start-looker!)
       (subscribe 'waiting-tasks)))
-  (note-lab!))
+  (note-lab! (waiter-rank w)))
 
-;; Tells the lab that a task waits here: once for all the tasks that
-;; start to wait while the publication goes (500 posed at once were 500
-;; publications, each to every address space).
+;; Tells the lab that a task of rank rank waits here: once for all the
+;; tasks that start to wait while the publication goes (500 posed at once
+;; were 500 publications, each to every address space), with the best of
+;; their ranks.
 (define *noting* #f)                    ; a publication goes
-(define *note-again* #f)                ; and another task waited meanwhile
+(define *note-again* #f)                ; the best rank waiting since, or #f
 
-(define (note-lab!)
+(define (note-lab! rank)
   (when (with-lock *tasks-lock*
           (lambda ()
             (if *noting*
-                (begin (set! *note-again* #t) #f)
+                (begin (set! *note-again* (better-rank rank *note-again*)) #f)
                 (begin (set! *noting* #t) #t))))
-    (let loop ()
+    (let loop ((rank rank))
       (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
-        (publish 'all note-waiters! (local-aspace-uid)))
-      (if (with-lock *tasks-lock*
-            (lambda ()
-              (let ((again *note-again*))
-                (set! *note-again* #f)
-                (if (not again) (set! *noting* #f))
-                again)))
-          (loop)))))
+        (publish 'all note-waiters! (local-aspace-uid) rank))
+      (let ((again (with-lock *tasks-lock*
+                     (lambda ()
+                       (let ((again *note-again*))
+                         (set! *note-again* #f)
+                         (if (not again) (set! *noting* #f))
+                         again)))))
+        (if again (loop again))))))
 
 ;; The offers w had not answered are declined: a robot waits for no task
 ;; that no longer waits.
