@@ -86,7 +86,7 @@
 ;;> The id of \var{message} (all kinds but hello, welcome, datagram, beacon).
 (define (message-id message) (cadr message))
 
-;; No or: it costs a let (docs/speed.md).
+;; No or, whose let makes a closure (docs/speed.md).
 (define (fields-pass? values checks)
   (cond ((null? checks) (null? values))
         ((pair? values) (and ((car checks) (car values))
