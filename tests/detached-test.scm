@@ -18,12 +18,39 @@
 (define (work tag rounds)
   (dynamic-wind
    (lambda () (tell 'begin tag (local-aspace-uid)))
-   (lambda ()
-     (let loop ((n rounds))
-       (remote-apply (local-aspace) (lambda () #t))
-       (thread-sleep! 0.05)
-       (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
+   (lambda () (rounds! rounds) (local-aspace-uid))
    (lambda () (tell 'end tag (local-aspace-uid)))))
+(define (rounds! n)
+  (remote-apply (local-aspace) (lambda () #t))
+  (thread-sleep! 0.05)
+  (if (> n 0) (rounds! (- n 1))))
+;; A member of a team of two: both meet; the first sends before to the
+;; second and waits at mid while the second works rounds; past mid, the
+;; first sends after-1 and after-2, the second takes all three; both meet
+;; again at done.  Each tells (team TAG UID WHAT) of each call it made.
+(define (teamwork tag rounds)
+  (let* ((team (current-team)) (me (local-aspace-uid)) (first? (eq? me (car team)))
+         (other (if first? (cadr team) (car team))))
+    (define (told what) (tell 'team tag me what))
+    (tell 'begin tag me)
+    (team-barrier 'meet 60)
+    (told 'met)
+    (cond (first?
+           (team-send! other 'before)
+           (told 'sent)
+           (team-barrier 'mid 60)
+           (told 'mid)
+           (team-send! other 'after-1)
+           (team-send! other 'after-2))
+          (else
+           (rounds! rounds)
+           (team-barrier 'mid 60)
+           (told 'mid)
+           (for-each (lambda (i) (told (list 'got (team-receive 60)))) '(1 2 3))))
+    (team-barrier 'done 60)
+    (told 'done)
+    (tell 'end tag me)
+    me))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
          (request 'all (lambda ()
@@ -313,6 +340,54 @@
           (filter (lambda (s) (< s (last holder))) after)))
       (for-each task-wait busy)
       (test-assert "nothing is held after" (wait-until 10 all-free?))
+      (restart! old))))
+
+(test-group "the coordinator killed between team calls: the team goes on with the new one"
+  ;; Killed while the first member waits at the barrier mid and a letter
+  ;; to the second waits for it: the barrier, that letter and those sent
+  ;; after reach the standby that took over, each once.
+  (let* ((id (remote-apply
+              (uid->aspace 'poser)
+              (eval '(lambda ()
+                       (start-steps 'teamed
+                                    (task-step (list '((mobile) ()) '((mobile) ()))
+                                               (list #f #f)
+                                               (list (lambda (previous) (teamwork 'teamed 60))
+                                                     (lambda (previous) (teamwork 'teamed 60))))
+                                    'detach #t))
+                    (lab-environment))))
+         (told (lambda (what)
+                 (filter-map (lambda (r)
+                               (and (any (lambda (line)
+                                           (equal? what (list-ref (read (open-input-string line))
+                                                                  3)))
+                                         (log-lines r "team" 'teamed))
+                                    r))
+                             robots))))
+    (test-assert "the first member has sent, and waits at mid; the second works"
+      (wait-until 15 (lambda () (and (= 2 (length (told 'met))) (= 1 (length (told 'sent)))
+                                     (lab-task-standby (entry-of id))))))
+    (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
+      (kill! old)
+      (test "the standby takes over" standby (second-coordinator id))
+      (let* ((results (car (task-wait id 60)))
+             (first (car (told 'sent)))
+             (second (find (lambda (r) (and (memq r results) (not (eq? r first)))) robots)))
+        (test "the task completes, its two members on robots of their own" 2
+          (length (delete-duplicates results)))
+        (test "each member's own log: one begin and one end" '((1 1) (1 1))
+          (map (lambda (r) (list (length (log-lines r "begin" 'teamed))
+                                 (length (log-lines r "end" 'teamed))))
+               results))
+        (test "the first member's team calls, each once, in order"
+          '(met sent mid done)
+          (map (lambda (line) (list-ref (read (open-input-string line)) 3))
+               (log-lines first "team" 'teamed)))
+        (test "the second took the letter sent before the kill and those after, each once"
+          (list 'met 'mid (list 'got (cons first 'before)) (list 'got (cons first 'after-1))
+                (list 'got (cons first 'after-2)) 'done)
+          (map (lambda (line) (list-ref (read (open-input-string line)) 3))
+               (log-lines second "team" 'teamed))))
       (restart! old))))
 
 (test-group "the standby stalled: a peer's wait follows the task as it moves"

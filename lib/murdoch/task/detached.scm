@@ -52,6 +52,7 @@
   (task handed-task handed-task-set!)            ; the coordinator's record
   (copy handed-copy handed-copy-set!)            ; as last sent or received
   (heard handed-heard handed-heard-set!)         ; monotonic: the partner, last
+  (teams handed-teams handed-teams-set!)         ; ((TEAM-ID STATE) ...), its steps'
   (took-over handed-took-over handed-took-over-set!)) ; utc-seconds, or #f
 
 ;; The copy of a task's record that travels to the standby: (STATE STATUS
@@ -172,20 +173,26 @@
 ;;> chose: starts the task of \var{kind} that \var{args} describe here
 ;;> (see start-kind); answers its id.
 (define (coordinate-task! kind args poser)
-  (let* ((t (parameterize ((heartbeat-patience detached-patience)
-                            (task-id-maker fresh-id))
-              (start-kind kind args)))
-         (h (make-handed (task-id t) kind args poser)))
+  (let* ((id (fresh-id (car args)))
+         (h (make-handed id kind args poser)))
     (handed-role-set! h 'coordinator)
     (handed-partner-set! h #f)
     (handed-epoch-set! h 1)
-    (handed-task-set! h t)
-    (handed-copy-set! h (list 'negotiating '() #f (task-turn-copy t) #f))
+    (handed-task-set! h #f)
+    (handed-copy-set! h (list 'negotiating '() #f #f #f))
     (handed-heard-set! h (monotonic-seconds))
+    (handed-teams-set! h '())
     (handed-took-over-set! h #f)
+    ;; Held before it starts, so that its steps' teams are kept from the first.
     (hold-handed! h)
-    (coordinate! h)
-    (task-id t)))
+    (let ((t (parameterize ((heartbeat-patience detached-patience)
+                            (task-id-maker (lambda (name) id))
+                            (team-keeper keep-team))
+               (start-kind kind args))))
+      (handed-task-set! h t)
+      (handed-copy-set! h (list 'negotiating '() #f (task-turn-copy t) #f))
+      (coordinate! h)
+      id)))
 
 ;; A task id no peer of the lab knows: a coordinator started again counts
 ;; its ids from 1 again, and the lab keeps results, and robots remember
@@ -281,7 +288,7 @@
                 (parameterize ((remote-timeout (period)))
                   (remote-apply (uid->aspace uid) become-standby! (handed-id h)
                                 (handed-kind h) (handed-args h) (handed-poser h)
-                                (handed-epoch h) (handed-copy h) me)))
+                                (handed-epoch h) (handed-copy h) (handed-teams h) me)))
               (begin
                 (handed-heard-set! h (monotonic-seconds))
                 (handed-partner-set! h uid)
@@ -345,7 +352,7 @@
 
 ;;> What a coordinator calls at the member it chose to stand by for task
 ;;> \var{id}: answers #t when it does.
-(define (become-standby! id kind args poser epoch copy coordinator)
+(define (become-standby! id kind args poser epoch copy teams coordinator)
   (let ((old (handed-by-id id)))
     (and (not (and old (eq? (handed-role old) 'coordinator)))
          (let ((h (make-handed id kind args poser)))
@@ -355,6 +362,7 @@
            (handed-task-set! h #f)
            (handed-copy-set! h copy)
            (handed-heard-set! h (monotonic-seconds))
+           (handed-teams-set! h teams)
            (handed-took-over-set! h #f)
            (hold-handed! h)
            (thread-start! (make-logged-thread (lambda () (stand-by h)) 'standby))
@@ -367,6 +375,43 @@
   (let ((h (handed-by-id id)))
     (and h (eq? (handed-role h) 'standby) (= (handed-epoch h) epoch)
          (begin (handed-copy-set! h copy) #t))))
+
+;;> What the coordinator of task \var{id} calls at its standby when a
+;;> member of a step's team, \var{team-id}, arrives at a barrier or sends
+;;> a letter, before the member hears back: answers whether this address
+;;> space stands by for it at \var{epoch}.
+(define (receive-team-copy id epoch team-id state)
+  (let ((h (handed-by-id id)))
+    (and h (eq? (handed-role h) 'standby) (= (handed-epoch h) epoch)
+         (begin (set-team! h team-id state) #t))))
+
+(define (set-team! h team-id state)
+  (with-lock *handed-lock*
+    (lambda ()
+      (handed-teams-set! h (cons (list team-id state)
+                                 (remove (lambda (x) (eq? (car x) team-id))
+                                         (handed-teams h)))))))
+
+;; The team-keeper of a detached task's steps: (keep-team ID TEAM-ID) the
+;; state its coordinator, or the standby that took over, holds of the
+;; team, or #f; (keep-team ID TEAM-ID STATE) holds it, and gives it to
+;; the standby.  A standby that does not answer is found lost by
+;; keep-watch, and the next is given every team as it is then.
+(define (keep-team id team-id . state)
+  (let ((h (handed-by-id id)))
+    (cond ((not h) #f)
+          ((null? state)
+           (cond ((assq team-id (handed-teams h)) => cadr) (else #f)))
+          (else
+           (set-team! h team-id (car state))
+           (let ((uid (handed-partner h)))
+             (if (and uid (eq? (handed-role h) 'coordinator))
+                 (guard (e ((remote-error? e)
+                            (log-warn "task " id ": the standby " uid " took no copy of "
+                                      team-id ": " (error-message e))))
+                   (parameterize ((remote-timeout (period)))
+                     (remote-apply (uid->aspace uid) receive-team-copy id
+                                   (handed-epoch h) team-id (car state))))))))))
 
 ;; Takes over when no ping has been answered for take-over-periods, or a
 ;; period after the coordinator's process is found gone.
@@ -409,7 +454,7 @@
      ((copy-results copy) #f)
      (else
       (handed-task-set!
-       h (parameterize ((heartbeat-patience detached-patience))
+       h (parameterize ((heartbeat-patience detached-patience) (team-keeper keep-team))
            (if (eq? (handed-kind h) 'steps)
                (adopt-steps h copy)
                (adopt-task (handed-id h) (copy-turn copy)
