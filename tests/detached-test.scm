@@ -390,6 +390,47 @@
           (calls second)))
       (restart! old))))
 
+(test-group "after a takeover, its first coordinator back: the id still finds the task"
+  ;; The id names the member that first coordinated the task; killed and
+  ;; started again, that member counts its own poses from 1 again.
+  (let* ((id (running-detached 'renamed 2000))
+         (old (coordinator-of id))
+         (standby (lab-task-standby (entry-of id))))
+    (test-assert "the id is the lab's kind, naming its first coordinator"
+      (text-contains? (symbol->string id) (string-append "@" (symbol->string old) "/lab-")))
+    (kill! old)
+    (test "the standby takes over" standby (second-coordinator id))
+    (restart! old)
+    (let ((plain (remote-apply
+                  (uid->aspace old)
+                  (eval '(lambda ()
+                           (task-id (start-task 'renamed 1 (list '((mobile) ())) (list #f)
+                                                (list (lambda () (work 'plain 0))))))
+                        (lab-environment)))))
+      (test-assert "a task posed at the first coordinator, started again, has an id of its own"
+        (and (symbol? plain) (not (eq? plain id)))))
+    (test-assert "task-status by the id, from a peer: its component runs on"
+      (running-everywhere? id))
+    (let ((tasks (murdoch-status "tasks" (test-lab-file lab))))
+      (test "murdoch tasks lists it under its id, with its new coordinator" #t
+        (and (text-contains? tasks (symbol->string id))
+             (text-contains? tasks (string-append "coordinator " (symbol->string standby))))))
+    (test "murdoch cancel with the id cancels it" #t
+      (text-contains? (murdoch-status "cancel" (test-lab-file lab) (symbol->string id))
+                      "exit 0"))
+    (test "its component ends on its robot, begun once" '(1 1)
+      (let ((robot (wait-until 10 (lambda ()
+                                    (find (lambda (r) (pair? (log-lines r "end" 'renamed)))
+                                          robots)))))
+        (if robot
+            (list (length (log-lines robot "begin" 'renamed))
+                  (length (log-lines robot "end" 'renamed)))
+            '())))
+    (test "murdoch wait with the id says it was cancelled" #t
+      (let ((waited (murdoch-status "wait" (test-lab-file lab) (symbol->string id))))
+        (and (text-contains? waited "cancelled") (text-contains? waited "exit 1"))))
+    (test-assert "nothing is held after" (wait-until 10 all-free?))))
+
 (test-group "the standby stalled: a peer's wait follows the task as it moves"
   ;; The standby frozen (SIGSTOP), its coordinator lets the task go and
   ;; nobody coordinates it until the standby wakes and takes it over.  A

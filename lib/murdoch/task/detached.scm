@@ -194,11 +194,11 @@
       (coordinate! h)
       id)))
 
-;; A task id no peer of the lab knows: a coordinator started again counts
-;; its ids from 1 again, and the lab keeps results, and robots remember
-;; the components that ended, by id.
+;; A task id no peer of the lab knows, lab-task-key's: a coordinator
+;; started again counts its ids from 1 again, and the lab keeps results,
+;; and robots remember the components that ended, by id.
 (define (fresh-id name)
-  (let ((id (task-key name)))
+  (let ((id (lab-task-key name)))
     (if (or (holder-of id) (pair? (components-of id))
             (pair? (components-of (step-task-id id 1))))
         (fresh-id name)

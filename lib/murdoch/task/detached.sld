@@ -13,7 +13,7 @@
   (import (scheme base) (scheme cxr) (scheme write) (srfi 1) (srfi 18) (srfi 132)
           (only (chibi string) string-contains)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
-          (murdoch task progress) (only (murdoch task pose-task) task-key)
+          (murdoch task progress) (only (murdoch task pose-task) lab-task-key)
           (only (murdoch task running) components-running components-ended ended-id
                 ended-index)
           (murdoch task record)
