@@ -185,10 +185,13 @@
     (handed-took-over-set! h #f)
     ;; Held before it starts, so that its steps' teams are kept from the first.
     (hold-handed! h)
-    (let ((t (parameterize ((heartbeat-patience detached-patience)
-                            (task-id-maker (lambda (name) id))
-                            (team-keeper keep-team))
-               (start-kind kind args))))
+    (let ((t (undo-on-raise
+              (lambda () (drop-handed! h))
+              (lambda ()
+                (parameterize ((heartbeat-patience detached-patience)
+                               (task-id-maker (lambda (name) id))
+                               (team-keeper keep-team))
+                  (start-kind kind args))))))
       (handed-task-set! h t)
       (handed-copy-set! h (list 'negotiating '() #f (task-turn-copy t) #f))
       (coordinate! h)

@@ -128,9 +128,9 @@
 ;;
 ;; Members wait at named barriers and pass values by uid through the
 ;; team's coordinator, held where the task is coordinated, under the
-;; team's id.  A member reaches it by its address, (ID UID); when UID is
-;; lost, or holds the team no more (a detached task taken over), the
-;; member asks the lab who holds ID now (the lab-tasks subject, which the
+;; team's id.  A member reaches it by its address, (ID UID KEPT?); when
+;; UID is lost, or holds the team no more, the member of a team that is
+;; kept (a detached task's, taken over) asks the lab who holds ID now (the lab-tasks subject, which the
 ;; members holding a detached task subscribe to), and calls again there.
 ;; So any call may count twice: an arrival counts once however often it
 ;; comes, a letter carries its sender's key and is kept once, a member
@@ -141,10 +141,11 @@
 
 ;; What a member of a team keeps, in the thread running its procedure.
 (define-record-type teammate
-  (make-teammate id uid nonce sent taken seen)
+  (make-teammate id uid kept? nonce sent taken seen)
   teammate?
   (id teammate-id)
   (uid teammate-uid teammate-uid-set!)       ; where its coordinator is held
+  (kept? teammate-kept?)                     ; whether it may be held elsewhere later
   (nonce teammate-nonce)                     ; its letters' keys: (UID NONCE N)
   (sent teammate-sent teammate-sent-set!)    ; letters sent so far
   (taken teammate-taken teammate-taken-set!) ; the last letter's key, or #f
@@ -158,7 +159,7 @@
 ;;> \var{coordinator}, what make-coordinator answered: team-barrier,
 ;;> team-send! and team-receive reach it, and current-team is its robots.
 (define (with-coordinator coordinator thunk)
-  (let ((m (make-teammate (car coordinator) (cadr coordinator)
+  (let ((m (make-teammate (car coordinator) (cadr coordinator) (car (cddr coordinator))
                           (random-integer 1000000000) 0 #f '())))
     (parameterize ((current-teammate m)
                    (current-team (ask-team m "with-coordinator" 'team
@@ -220,27 +221,39 @@
                       (cons (letter-from letter) (letter-value letter))))))))))
 
 ;; What m's team coordinator answers to OP, applied to what args-of
-;; makes of the seconds left, found again wherever the lab holds it
-;; until seconds run out.
+;; makes of the seconds left; a kept one is found again wherever the lab
+;; holds it, until seconds run out.
 (define (ask-team m who op args-of seconds)
   (let ((deadline (+ (monotonic-seconds) seconds)))
     (let loop ()
       (let* ((uid (teammate-uid m))
+             (left (max 0 (seconds-until deadline)))
              (answer (guard (e ((and (remote-error? e) (not (remote-raised-error? e))) #f))
-                       (parameterize ((remote-timeout (+ (max 0 (seconds-until deadline)) 1)))
+                       (parameterize ((remote-timeout (call-seconds m op left)))
                          (remote-apply (uid->aspace uid) team-answer (teammate-id m) op
-                                       (args-of (max 0 (seconds-until deadline))))))))
+                                       (args-of left))))))
         (cond ((pair? answer) (car answer))
-              ((<= (seconds-until deadline) 0)
-               (error (string-append who ": the team's coordinator is lost, and no"
-                                     " address space of the lab holds the team "
-                                     (symbol->string (teammate-id m)))))
+              ((or (not (teammate-kept? m)) (<= (seconds-until deadline) 0))
+               (error (string-append who ": the coordinator of the team "
+                                     (symbol->string (teammate-id m)) " is lost"
+                                     (if (teammate-kept? m)
+                                         ", and no address space of the lab holds it"
+                                         ""))))
               (else
                (let ((holder (team-holder (teammate-id m))))
                  (if (or (not holder) (eq? holder uid))
                      (thread-sleep! (min (team-period) (max 0 (seconds-until deadline)))))
                  (if holder (teammate-uid-set! m holder))
                  (loop))))))))
+
+;; How long m's call of op waits for its answer: only arrive and receive
+;; wait there.  A kept team's call made again counts once, so it is made
+;; again after two periods, in case the coordinator it reached is cut off.
+(define (call-seconds m op left)
+  (let ((waits (if (memq op '(arrive receive)) left 0)))
+    (if (teammate-kept? m)
+        (+ waits (max 1 (* 2 (team-period))))
+        (if (> waits 0) (+ waits 1) (remote-timeout)))))
 
 (define (team-period) (lab-setting (current-lab) 'heartbeat))
 
@@ -275,16 +288,14 @@
   (with-lock *teams-lock*
     (lambda () (find (lambda (c) (eq? (car (held-team-address c)) id)) *teams*))))
 
-;;> Whether this address space holds team \var{id} and acts for it, its
-;;> robots chosen.
+;;> Whether this address space holds team \var{id} and acts for it.
 (define (team-held? id)
   (let ((c (find-held-team id)))
-    (and c ((held-team-live? c)) (pair? ((held-team-proc c) 'team)) #t)))
+    (and c ((held-team-live? c)) #t)))
 
 ;;> What a member's call runs where its team is: (RESULT) of applying the
 ;;> coordinator of team \var{id} to \var{op} and \var{args}, or #f when
-;;> this address space does not hold it, acts for it no more, or has not
-;;> its robots yet.
+;;> this address space does not hold it, or acts for it no more.
 (define (team-answer id op args)
   (let ((c (find-held-team id)))
     (and c (team-held? id)
@@ -298,7 +309,7 @@
 ;;> space: (KEEP) answers the state kept for it, or #f; (KEEP STATE) keeps
 ;;> STATE.  Release it with release-coordinator! when the team is done.
 (define (make-coordinator id team-of live? keep)
-  (let ((c (make-held-team (list id (local-aspace-uid)) live?
+  (let ((c (make-held-team (list id (local-aspace-uid) (and keep #t)) live?
                            (coordinator-proc team-of live? keep
                                              (or (and keep (keep)) '(() ()))))))
     (with-lock *teams-lock*
@@ -345,7 +356,8 @@
       (change! (lambda ()
                  (if (not (member (cons name uid) arrived))
                      (set! arrived (cons (cons name uid) arrived)))))
-      (if (wait-until (lambda () (null? (missing name))) seconds)
+      ;; A team taken over may not have its robots yet.
+      (if (wait-until (lambda () (and (pair? (team-of)) (null? (missing name)))) seconds)
           '()
           (with-lock lock (lambda () (missing name)))))
     (define (send key to from value)
