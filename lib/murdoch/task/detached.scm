@@ -10,7 +10,9 @@
 ;;  2. The coordinator starts the task as start-task would, and does for
 ;;     it all a poser does: heartbeats, reassignments, its place in line.
 ;;     It chooses a standby the same way, on another member, and sends it
-;;     a copy of the task's record whenever it changes, and every period.
+;;     a copy of the task's record whenever it changes, and every period,
+;;     and of a step's team at each arrival or letter, before the member
+;;     that made the call hears back (team.scm).
 ;;  3. Never two coordinators.  The standby pings the coordinator every
 ;;     heartbeat period.  The coordinator acts for the task (heartbeats,
 ;;     starts, negotiations) only while the pings arrive: silent for two
@@ -21,9 +23,11 @@
 ;;  4. Taking over, the standby asks the lab which of the task's
 ;;     components run or ended where, adopts each where it is, re-runs the
 ;;     negotiation of a task that had not started, with its rank, and
-;;     chooses a new standby.  A coordinator that let the task go because
-;;     its standby fell silent takes it back the same way once it finds
-;;     the standby's process gone, and drops it if the standby took over.
+;;     chooses a new standby.  The members of a step's team find its
+;;     coordinator there by the step's id.  A coordinator that let the
+;;     task go because its standby fell silent takes it back the same way
+;;     once it finds the standby's process gone, and drops it if the
+;;     standby took over.
 ;;  5. Any peer finds the task by its id through the lab-tasks subject,
 ;;     which the members holding a task subscribe to.  A finished task's
 ;;     results are kept for the lab's keep-results seconds.
