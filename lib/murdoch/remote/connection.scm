@@ -75,7 +75,7 @@
   (with-lock *connections-lock*
     (lambda ()
       (or (hash-table-ref/default *connecting* uid #f)
-          (let ((m (make-mutex uid)))
+          (let ((m (make-mutex 'connecting)))
             (hash-table-set! *connecting* uid m)
             m)))))
 
@@ -91,7 +91,7 @@
                                      (number->string (aspace-port a)) ": " io)))
     (let* ((nonce (random-hex 16))
            (c (make-connection (aspace-uid a) (car io) (cadr io)
-                               (open-output-string) (make-mutex)
+                               (open-output-string) (make-mutex 'connection-write)
                                (make-hash-table eq?) nonce (make-mailbox))))
       (connection-fd-set! c #f)
       (connection-received-set! c 0)

@@ -199,7 +199,7 @@
                                  +inf.0))
            (server-janitor-resting?-set! *server* #f)
            (unlock! m))
-          (else (mutex-unlock! m (server-janitor-wake *server*))))))
+          (else (unlock-waiting! m (server-janitor-wake *server*))))))
 
 (define (janitor-wanted!)
   (when (server-janitor-resting? *server*)

@@ -77,7 +77,7 @@
     (('hello uid host port caller-nonce)
      (learn-aspace! (make-aspace uid host port))
      (let ((g (make-greeting uid caller-nonce (random-hex 16) (open-output-string)
-                             (make-mutex)
+                             (make-mutex 'served-write)
                              (lambda (c kind value) (answer-call s c kind value))
                              0 0 0)))
        (serving-greeting-set! s g)

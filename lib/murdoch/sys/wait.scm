@@ -25,10 +25,14 @@
 
 ;;> srfi 18's mutex-lock! and mutex-unlock!, no timeout or condition variable, no garbage.
 (define (lock! m)
+  (if lock-order-checked? (taking! m))
   (or (%mutex-lock! m #f #t)
-      (begin (thread-yield!) (mutex-lock! m))))   ; as srfi 18's, once it failed
+      (begin (thread-yield!) (mutex-lock! m)))   ; as srfi 18's, once it failed
+  (if lock-order-checked? (took! m)))
 
-(define (unlock! m) (%mutex-unlock! m #f #f))
+(define (unlock! m)
+  (if lock-order-checked? (released! m))
+  (%mutex-unlock! m #f #f))
 
 ;;> \var{value}, once \var{m} is unlocked: no let (docs/speed.md).
 (define (unlocked m value)
@@ -48,8 +52,10 @@
 
 ;; As with-lock, calling (too-late) when m is not free by the deadline.
 (define (with-lock-by m deadline too-late thunk)
+  (if lock-order-checked? (taking! m))
   (if (mutex-lock! m (seconds-until deadline))
-      (wind nothing thunk (lambda () (unlock! m)))
+      (begin (if lock-order-checked? (took! m))
+             (wind nothing thunk (lambda () (unlock! m))))
       (too-late)))
 
 (define (nothing) #f)
@@ -62,7 +68,79 @@
 
 ;; Frees m and waits on cv for left seconds; #f when none were left or they ran out.
 (define (waited? m cv left)
-  (and (> left 0.) (mutex-unlock! m cv left)))
+  (and (> left 0.) (unlock-waiting! m cv left)))
+
+;;> srfi 18's (mutex-unlock! m cv [timeout]): frees \var{m} and waits on \var{cv}.
+(define (unlock-waiting! m cv . timeout)
+  (if lock-order-checked? (released! m))
+  (apply mutex-unlock! m cv timeout))
+
+;;; The lock order (docs/architecture.md), checked in a process started
+;;; with MURDOCH_LOCK_ORDER naming a folder (tests/run does): a thread
+;;; holding a lock takes another only of a higher rank, and a process that
+;;; breaks the order writes what it took, and what it held, to standard
+;;; error and to a file of that folder named by its process id.
+
+;; A mutex's rank, by the name it was made with; a name of no rank is a
+;; break of the order wherever it is taken under another.
+(define lock-ranks
+  '((tries . 1)
+    (tasks . 2) (offers . 2)
+    (handed . 2.5)
+    (poses . 3) (running . 3) (subscriptions . 3)
+    (connecting . 4.1) (connection-write . 4.2) (connections . 4.3) (peers . 4.4)
+    (janitor . 4.5) (served-write . 4.55) (serving . 4.6)
+    (trip-reconnect . 5) (trip . 5.1) (sequence . 5.1) (last-heard . 5.1)
+    (datagram-calls . 5.1) (workers . 5.1) (proxies . 5.1) (abandoned . 5.1)
+    (protected . 5.1) (fields-text . 5.1) (team . 5.1) (feed . 5.1)
+    (mailbox . 6) (gathering . 6)))
+
+(define lock-order-folder (get-environment-variable "MURDOCH_LOCK_ORDER"))
+(define lock-order-checked? (and lock-order-folder #t))
+
+(define held-locks (make-hash-table eq?))   ; thread -> its locks, innermost first
+
+(define (lock-rank m)
+  (cond ((assq (mutex-name m) lock-ranks) => cdr)
+        (else #f)))
+
+(define (taking! m)
+  (for-each (lambda (h)
+              (if (not (and (lock-rank h) (lock-rank m) (< (lock-rank h) (lock-rank m))))
+                  (lock-order-broken m h)))
+            (hash-table-ref/default held-locks (current-thread) '())))
+
+(define lock-order-report #f)               ; this process's file, once it broke the order
+
+(define (lock-order-broken m h)
+  (let ((line (call-with-output-string
+               (lambda (out)
+                 (write-string "lock order: took " out)
+                 (write (mutex-name m) out)
+                 (write-string " holding " out)
+                 (write (mutex-name h) out)
+                 (newline out)))))
+    (write-string line (current-error-port))
+    (if (not lock-order-report)
+        (set! lock-order-report
+              (open-output-file (string-append lock-order-folder "/"
+                                               (number->string (current-process-id))))))
+    (write-string line lock-order-report)
+    (flush-output-port lock-order-report)))
+
+(define (took! m)
+  (hash-table-update!/default held-locks (current-thread) (lambda (ms) (cons m ms)) '()))
+
+(define (released! m)
+  (let ((ms (remove-first m (hash-table-ref/default held-locks (current-thread) '()))))
+    (if (null? ms)
+        (hash-table-delete! held-locks (current-thread))
+        (hash-table-set! held-locks (current-thread) ms))))
+
+(define (remove-first x xs)
+  (cond ((null? xs) xs)
+        ((eq? x (car xs)) (cdr xs))
+        (else (cons (car xs) (remove-first x (cdr xs))))))
 
 ;;> Calls thunk; should it raise, calls undo on the way out (docs/speed.md).
 (define (undo-on-raise undo thunk)
@@ -101,7 +179,7 @@
   (full? mailbox-full? mailbox-full?-set!))
 
 (define (make-mailbox)
-  (%make-mailbox (make-mutex) (make-condition-variable) #f #f))
+  (%make-mailbox (make-mutex 'mailbox) (make-condition-variable) #f #f))
 
 (define (mailbox-put! mb value)
   (lock! (mailbox-mutex mb))
@@ -165,7 +243,7 @@
   (wanted gathering-wanted gathering-wanted-set!))
 
 (define (make-gathering)
-  (%make-gathering (make-mutex) (make-condition-variable) 0 #f))
+  (%make-gathering (make-mutex 'gathering) (make-condition-variable) 0 #f))
 
 ;;> Gives \var{item} \var{value} by \scheme{(put item value)} unless \scheme{(get item)} has one.
 (define (gathering-put! g item value get put)

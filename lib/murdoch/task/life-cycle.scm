@@ -338,10 +338,10 @@
          ((begin (task-acted-set! t (utc-seconds))
                  (heartbeat a (task-id t) (component-index c) period))
           (watch (monotonic-seconds)))
-         ((>= (- (monotonic-seconds) heard) (* lost-periods patience period))
+         ((>= (- (monotonic-seconds) heard) (* (lost-periods) patience period))
           (thread-interrupt! runner)    ; its call is given up
           (list 'lost (string-append (symbol->string uid) " silent for "
-                                     (number->string (* lost-periods patience))
+                                     (number->string (* (lost-periods) patience))
                                      " heartbeats")))
          (else (watch heard)))))))
 

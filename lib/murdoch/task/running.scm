@@ -77,17 +77,19 @@
 (define (robot-failure? e)
   (and (trip-error? e) (memq (trip-error-code e) '(closed stalled)) #t))
 
-;; No ghosts: a component stops once its poser is silent for
-;; orphan-periods (looked at every quarter period, so by 2.25 periods),
-;; well before the poser declares the robot lost after lost-periods
-;; (life-cycle.scm) and may start another: docs/tasks.md.
-(define orphan-periods 2)
-(define lost-periods 4)
+;; No ghosts: a component stops once its poser is silent for the lab's
+;; orphan-periods (looked at every quarter period), well before the poser
+;; declares the robot lost after lost-periods (life-cycle.scm) and may
+;; start another: docs/tasks.md.
+;;> How many silent heartbeat periods a poser waits before it declares a
+;;> robot lost: the lab's lost-periods.
+(define (lost-periods) (lab-setting (current-lab) 'lost-periods))
 
 (define (watch-poser r period)
   (thread-sleep! (/ period 4))
   (cond ((running-over? r) #t)
-        ((> (- (monotonic-seconds) (running-heard r)) (* orphan-periods period))
+        ((> (- (monotonic-seconds) (running-heard r))
+            (* (lab-setting (current-lab) 'orphan-periods) period))
          (log-warn "the poser " (running-poser r) " of " (running-id r)
                    " is silent: component " (running-index r) " stops")
          (stop-running! r))

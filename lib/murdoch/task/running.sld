@@ -1,8 +1,8 @@
 ;;> The robot's side of the task life cycle: run-component runs a started
 ;;> task's component here and stops it when its poser falls silent;
 ;;> component-heartbeat! and stop-component! are what the poser calls, and
-;;> lost-periods how many silent heartbeat periods it waits before it
-;;> declares a robot lost (running.scm says why).  run-posed-component
+;;> (lost-periods) the lab's silent heartbeat periods before it declares a
+;;> robot lost (running.scm says why).  run-posed-component
 ;;> runs a component of pose-task's; components-running and
 ;;> components-ended list them all, for the status and the live view.
 
@@ -12,5 +12,6 @@
           components-running components-ended ended-id ended-index ended-started
           ended-ended ended-end lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
-          (murdoch robot) (only (murdoch remote) hand-over-connection! release-call!))
+          (murdoch robot) (only (murdoch lab) lab-setting)
+          (only (murdoch remote) hand-over-connection! release-call! current-lab))
   (include "running.scm"))

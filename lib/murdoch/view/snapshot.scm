@@ -225,12 +225,12 @@
 (define (feed-after feed next seconds)
   (let ((deadline (+ (monotonic-seconds) seconds)))
     (let loop ()
-      (mutex-lock! (feed-lock feed))
+      (lock! (feed-lock feed))
       (let ((new (filter (lambda (r) (>= (car r) next)) (feed-recent feed)))
             (left (seconds-until deadline)))
         (cond ((or (pair? new) (= left 0.))   ; inexact: see seconds-until
-               (mutex-unlock! (feed-lock feed))
+               (unlock! (feed-lock feed))
                (reverse new))
               (else
-               (mutex-unlock! (feed-lock feed) (feed-changed feed) left)
+               (unlock-waiting! (feed-lock feed) (feed-changed feed) left)
                (loop)))))))
