@@ -330,7 +330,7 @@
 (define (coordinator-proc team-of live? keep state)
   (let ((arrived (car state)) (letters (cadr state))
         (lock (make-mutex 'team)) (changed (make-condition-variable 'team))
-        (keeping (make-mutex 'keeping)))
+        (keeping (make-mutex 'team-keeping)))
     ;; Wakes every period at least, to leave a team it acts for no more.
     (define (wait-until done? seconds)
       (let ((deadline (+ (monotonic-seconds) seconds)))
