@@ -4,7 +4,11 @@
 ;;; A lab of 64 robots (workstations, no motion) of 4 kinds, a to d, and 8
 ;;; posers.  A robot of kind a subscribes to a and to the pairs ab and da,
 ;;; and so on round the ring, so that a component needing (a) accepts
-;;; kind a only and one needing (ab) accepts a or b.  From a seed, 2,500
+;;; kind a only and one needing (ab) accepts a or b; those are shared, and
+;;; each robot's one exclusive subject is station: a component needs
+;;; ((station) (KIND)).  Each subject is a resource of its own in pubsub,
+;;; so kinds that were exclusive would let one robot run a component
+;;; needing a beside one needing ab.  From a seed, 2,500
 ;;; tasks of 1 to 4 components, each component a timed wait of 0.2 to 2 s
 ;;; (the same for all of a task's), accepting one kind or two, priorities
 ;;; 0 to 3, every one with 'wait #t 'hold #t; 500 posed at once, then the
@@ -46,7 +50,7 @@
 ;; Each kind's subjects: its own, and the pairs it is in round the ring.
 (define pairs '((ab a b) (bc b c) (cd c d) (da d a)))
 (define (subjects-of kind)
-  (cons kind (filter-map (lambda (p) (and (memq kind (cdr p)) (car p))) pairs)))
+  (cons* 'station kind (filter-map (lambda (p) (and (memq kind (cdr p)) (car p))) pairs)))
 
 (define (numbered prefix n)
   (map (lambda (i) (string->symbol (string-append prefix (number->string i))))
@@ -62,7 +66,7 @@
   (set! posed
         (cons (cons id
                     (start-task 'bench (length subjects)
-                                (map (lambda (s) (list (list s) '())) subjects)
+                                (map (lambda (s) (list '(station) (list s))) subjects)
                                 (map (lambda (s) #f) subjects)
                                 (map (lambda (k) (lambda () (bench-work id k seconds)))
                                      (iota (length subjects) 1))
@@ -78,7 +82,11 @@
    ;; Every address space is on this host: the bench's and each poser's
    ;; hear from every robot, more than the 64 a host that the lab allows
    ;; by default (they refused the robots' calls, and the lab stalled).
-   `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 0.5)
+   ;; A heartbeat of 1 s: with 73 address spaces on two cores (load
+   ;; averages of 30), a poser's heartbeats to its components' robots fell
+   ;; more than the two periods of 0.5 s behind, and the robots stopped
+   ;; them as orphans (docs/allocation.md).
+   `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 1)
      (max-connections-per-host ,(* 2 (+ n-robots n-posers 1)))
      (aspace bench)
      ,@(map (lambda (uid) `(aspace ,uid)) posers)

@@ -391,6 +391,26 @@
     (open-gate! 'r2 'burst2)
     (for-each (lambda (t) (task-wait t 10)) blocks)))
 
+(test-group "a holding task that holds the one robot another of its components needs gives it up"
+  ;; pair's first component, a lift, is negotiated first and takes r3
+  ;; while r4 is busy; its second needs an arm and a lift, r3 alone.
+  ;; Held for the first, r3 is what the second waits for: no robot that
+  ;; frees could serve it, and the task waited on itself for ever.
+  (let* ((block (start-task 'block 1 (list '((lift r4) ())) (list #f)
+                            (list (job 'self4 'self4))))
+         (running (wait-until 10 (lambda () (eq? (car (state-of block 1)) 'running))))
+         (pair (start-task 'pair 2 (list '((lift) ()) '((arm lift) ())) (list #f #f)
+                           (list (job 'self-lift #f) (job 'self-both #f))
+                           'wait #t 'hold #t)))
+    (test "it holds r3 for its second component, and waits for r4" '(holding r3)
+      (and (wait-until 20 (lambda () (equal? (state-of pair 2) '(holding r3))))
+           (state-of pair 2)))
+    (open-gate! 'r4 'self4)
+    (test "both run once r4 frees" '(self-lift self-both) (task-wait pair 20))
+    (test "the lift on r4, the arm and lift on r3" '(r4 r3)
+      (map (lambda (s) (car (car (status-attempts s)))) (task-status pair)))
+    (task-wait block 10)))
+
 (test-group "a robot that joins the lab again offers itself to the tasks that wait for it"
   (kill-process! (cdr (assq 'r4 pids)))
   (wait-until 20 (lambda () (not (memq 'r4 (live-uids)))))

@@ -4,7 +4,7 @@
 (define-library (murdoch pubsub)
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote publish request request-exclusive
-          request-non-exclusive request-components asked-ok? asked-value
+          request-non-exclusive request-components request-audience asked-ok? asked-value
           capability-layout check-subjects request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive receive-components

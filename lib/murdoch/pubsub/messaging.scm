@@ -215,14 +215,27 @@
 ;;> asked ((uid answer ...) ...), each answer (#t value) or (#f message).
 (define (request-components task-name components)
   (let* ((n (length components))
-         (rows (checked-rows (broadcast-apply receive-components components task-name
-                                              (local-aspace-uid))
+         (rows (checked-rows (audience-apply receive-components components task-name
+                                             (local-aspace-uid))
                              n)))
     (map (lambda (c i)
            (list (column-answers (if (eq? (car c) 'exclusive) 'request-exclusive 'request)
                                  rows i)
                  (column-asked rows i)))
          components (iota n))))
+
+;;> The uids that request-components asks, or #f, the thesis's whole
+;;> lab.  Only an address space subscribed to a component's subjects
+;;> answers it, and a task that waits knows, from its poser's look, which
+;;> are: asked alone, a start of a waiting task costs messages to its
+;;> robots, not to every address space of the lab (docs/allocation.md).
+(define request-audience (make-parameter #f))
+
+(define (audience-apply proc . args)
+  (let ((uids (request-audience)))
+    (if uids
+        (call-all (filter-map live-aspace (delete-duplicates uids)) 'apply proc args)
+        (apply broadcast-apply proc args))))
 
 ;; rows with one not of n entries made a failure, checked once (docs/speed.md).
 (define (checked-rows rows n)

@@ -5,7 +5,7 @@
   (export subscribe unsubscribe subscriptions topic-status set-topic-status!
           subscribe-remote unsubscribe-remote
           publish request request-exclusive request-non-exclusive
-          request-components asked-ok? asked-value
+          request-components request-audience asked-ok? asked-value
           capability-layout check-subjects
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive

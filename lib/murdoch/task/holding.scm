@@ -16,8 +16,11 @@
       (guard (e (#t #f)) ((winner-promise winner) #f))))
 
 ;; A try that keeps what it wins: each component of w not yet held is
-;; negotiated alone, in priority order, without the robots held or given
-;; way on.  Answers (winners type-list) once every component has a robot.
+;; negotiated alone, without the robots held or given way on, those with
+;; the fewest capable robots first (a component that accepts two kinds
+;; took the one robot of the kind its neighbour alone accepts), then in
+;; priority order.  Answers (winners type-list) once every component has
+;; a robot.
 (define (hold-try w priorities)
   (let ((t (waiter-task w)) (cs (waiter-components w)))
     (for-each
@@ -34,12 +37,62 @@
                                                    (car (negotiated-winners team))
                                                    (car (negotiated-types team)))
                                              (waiter-held w))))))))
-     (map cdr (list-sort (lambda (a b) (> (car a) (car b))) (map cons priorities cs))))
+     (map cdr (list-sort (lambda (a b)
+                           (let ((na (capable-count w (cdr a))) (nb (capable-count w (cdr b))))
+                             (or (< na nb) (and (= na nb) (> (car a) (car b))))))
+                         (map cons priorities cs))))
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
       (cond ((every pair? held)
              (waiter-held-set! w '())
              (list (map held-winner held) (map held-type held)))
             (else 'not-enough-takers)))))
+
+;; How many robots w's last look found capable of c; before it, as many
+;; as the lab has.
+(define (capable-count w c)
+  (cond ((assq c (waiter-capables w)) => (lambda (cc) (length (cdr cc))))
+        (else (length (lab-aspaces (current-lab))))))
+
+;; Frees a robot that w holds for one component and that another, which
+;; no other capable robot serves, needs: that one waits on w itself, and
+;; with every robot of the lab held no robot is freed to offer itself
+;; (tasks of components (ab ab b), holding both b robots for the two ab,
+;; stalled a lab).  The robot given up is that of the component with the
+;; most capable robots, among those with one w does not hold; freed, it
+;; offers itself, and hold-try gives it to the fewer first.
+(define (unblock! w)
+  (let ((movable (movable-for-blocked w)))
+    (when (pair? movable)
+      (let* ((c (fold (lambda (c best)
+                        (if (> (capable-count w c) (capable-count w best)) c best))
+                      (car movable) (cdr movable)))
+             (uid (held-uid (assv (component-index c) (waiter-held w)))))
+        (progress (task-id (waiter-task w)) ": gives up " uid " of component "
+                  (component-index c) " for another that only it serves")
+        (let-go-held! w uid)))))
+
+;;> Whether waiting task \var{w} waits on itself, unblock! freeing one of
+;;> its robots.
+(define (blocked-on-itself? w) (pair? (movable-for-blocked w)))
+
+;; The components of w holding a robot that a component of w not held
+;; needs, every robot capable of that one being w's, and that have a
+;; capable robot w does not hold.
+(define (movable-for-blocked w)
+  (let* ((held-by (lambda (c) (assv (component-index c) (waiter-held w))))
+         (capable (lambda (c) (cond ((assq c (waiter-capables w)) => cdr) (else '()))))
+         (own (held-uids w))
+         (blocked (find (lambda (c)
+                          (and (not (held-by c)) (pair? (capable c))
+                               (every (lambda (uid) (memq uid own)) (capable c))))
+                        (waiter-components w))))
+    (if blocked
+        (filter (lambda (c)
+                  (let ((h (held-by c)))
+                    (and h (memq (held-uid h) (capable blocked))
+                         (any (lambda (uid) (not (memq uid own))) (capable c)))))
+                (waiter-components w))
+        '())))
 
 ;; Whether a negotiation of c, with the robots excluded left out, may
 ;; find a robot: one of those its last look found capable of it, or one

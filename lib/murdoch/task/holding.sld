@@ -4,7 +4,8 @@
 
 (define-library (murdoch task holding)
   (export free-winner! hold-try let-go-held! keep-held! give-way!
-          receive-give-way ask-way!)
+          receive-give-way ask-way! unblock!
+          blocked-on-itself?)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132)
           (murdoch sys) (murdoch lab) (murdoch remote) (murdoch task progress)
           (murdoch task pose-task) (murdoch task record) (murdoch task rank)

@@ -67,14 +67,44 @@
 ;; where no task waits sends nothing more when a robot is freed.
 (define *waiters-here?* #f)
 
-;;> What a poser publishes to the lab when one of its tasks starts to
-;;> wait: the robots offer themselves when freed, and a free robot at
-;;> once, since a task posed behind others waits for the offers.
-(define (note-waiters!)
+;;> What a poser, \var{poser}, publishes to the lab when one of its tasks
+;;> starts to wait: the robots offer themselves when freed, and a free
+;;> robot at once, since a task posed behind others waits for the offers.
+(define (note-waiters! . poser)
   (set! *waiters-here?* #t)
   (set! *new-waiters* #t)
+  (if (pair? poser) (know-poser! (car poser)))
   (if (and (robot-here?) (free-here?)) (robot-freed!))
   #t)
+
+;; The posers that may have tasks waiting: those that said so, and those
+;; subscribed to waiting-tasks when this robot last asked the whole lab.
+;; A round asks them alone, 8 posers where the lab has 73 address spaces,
+;; and the whole lab again every ten heartbeats or a third of the lease,
+;; as a poser looks: a poser this robot missed (it joined later) is then
+;; found.  #f until it has asked the lab.
+(define *posers* #f)
+(define *posers-asked* #f)              ; when the lab was last asked
+
+(define (know-poser! uid)
+  (if (and *posers* (not (memq uid *posers*))) (set! *posers* (cons uid *posers*))))
+
+(define (ask-lab-due?)
+  (or (not *posers*)
+      (> (- (monotonic-seconds) *posers-asked*)
+         (min (* 10 (lab-setting (current-lab) 'heartbeat))
+              (/ (lab-setting (current-lab) 'lease) 3)))))
+
+;; Each poser's (UID (WANTING ...)) for this robot, best offer-depth first.
+(define (who-waits me depth)
+  (if (ask-lab-due?)
+      (let ((answers (request 'waiting-tasks waiting-for me (subjects-here) depth)))
+        (set! *posers* (delete-duplicates (append (map car answers) (or *posers* '()))))
+        (set! *posers-asked* (monotonic-seconds))
+        answers)
+      (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
+                  (remote-apply-all (filter-map live-aspace *posers*)
+                                    waiting-for me (subjects-here) depth))))
 
 ;; Whether a task started to wait, or was reminded of, since this robot's
 ;; offer round asked who waits: the round's list may lack a better-ranked
@@ -140,7 +170,7 @@
     (set! *new-waiters* #f)
     (offer-subjects! (and *waiters-seen* 'nobody) 3)
     (let* ((answers (guard (e (#t '()))
-                      (request 'waiting-tasks waiting-for me (subjects-here) depth)))
+                      (who-waits me depth)))
            (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                                (append-map cadr answers))))
       (set! *waiters-seen* (pair? waiting))

@@ -55,7 +55,7 @@
                 (begin (set! *noting* #t) #t))))
     (let loop ()
       (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
-        (publish 'all note-waiters!))
+        (publish 'all note-waiters! (local-aspace-uid)))
       (if (with-lock *tasks-lock*
             (lambda ()
               (let ((again *note-again*))
@@ -101,6 +101,7 @@
         (offers (filter offer? news))
         (held (held-uids w)))
     (give-way! w news)
+    (unblock! w)
     (cond
      ((eq? (task-state t) 'cancelled) (answer-offers! offers #f) 'cancelled)
      ((eq? (task-state t) 'let-go) (answer-offers! offers #f) 'let-go)
@@ -140,11 +141,19 @@
   (with-lock *try-lock*
     (lambda ()
       (waiter-offered-set! w offered)
-      (quiet-try (lambda ()
-                   (parameterize ((pose-task-excluded (append (offered-to-others w)
-                                                              (not-offered w offered)
-                                                              (pose-task-excluded))))
-                     (try w)))))))
+      (let ((excluded (append (offered-to-others w) (not-offered w offered)
+                              (pose-task-excluded))))
+        (quiet-try (lambda ()
+                     (parameterize ((pose-task-excluded excluded)
+                                    (request-audience (audience w offered excluded)))
+                       (try w))))))))
+
+;; Whom w's negotiations ask: the robots its last look found capable and
+;; those offered, but those excluded; the whole lab before it has looked.
+(define (audience w offered excluded)
+  (and (list? (waiter-capable w))
+       (remove (lambda (uid) (memq uid excluded))
+               (append offered (waiter-capable w)))))
 
 (define (not-offered w offered)
   (let ((t (waiter-task w)))
@@ -254,6 +263,7 @@
       (waiter-why-set! w (map (lambda (line i) (trimmed (explanation-line line i)))
                                    lines (iota (length lines) 1)))
       (ask-way! w lines holders)
+      (if (blocked-on-itself? w) (tell-waiter! w '(looked)))
       (move-up! w line)
       (progress (task-id (waiter-task w)) ": " (task-state (waiter-task w))
                 (if (pair? (waiter-held w))
@@ -275,7 +285,7 @@
   (for-each (lambda (uid)
               (guard (e (#t (log-warn "reminding " uid ": " (error-message e))))
                 (parameterize ((remote-timeout 1))
-                  (remote-apply (uid->aspace uid) note-waiters!))))
+                  (remote-apply (uid->aspace uid) note-waiters! (local-aspace-uid)))))
             (filter (lambda (uid) (memq uid *free-seen*)) free))
   (set! *free-seen* free))
 

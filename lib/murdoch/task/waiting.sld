@@ -7,7 +7,8 @@
   (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (murdoch task progress) (murdoch task pose-task)
-          (only (murdoch pubsub) subscribe unsubscribe publish capability-layout)
+          (only (murdoch pubsub) subscribe unsubscribe publish capability-layout
+                request-audience)
           (only (murdoch task takers) explain-components explanation-line
                 explanation-free explanation-capable)
           (murdoch task record) (murdoch task rank) (murdoch task offers)
