@@ -38,9 +38,10 @@
 (define detached-patience 4)
 
 ;; Let go after let-go-periods without the standby's pings; take over
-;; after take-over-periods unanswered (docs/tasks.md).
-(define let-go-periods 2)
-(define take-over-periods 4)
+;; after take-over-periods unanswered: the no-ghost rule's settings, with
+;; the coordinator in the robot's place (docs/tasks.md).
+(define (let-go-periods) (lab-setting (current-lab) 'orphan-periods))
+(define (take-over-periods) (lost-periods))
 
 ;; What a coordinator and its standby each keep of a detached task.
 (define-record-type handed
@@ -240,7 +241,7 @@
          ;; Ended, and the standby has the copy: nothing more to say.
          ((and (copy-results copy) (equal? copy sent)) (loop sent-at sent))
          ((and (handed-partner h)
-               (> (- (monotonic-seconds) (handed-heard h)) (* let-go-periods (period))))
+               (> (- (monotonic-seconds) (handed-heard h)) (* (let-go-periods) (period))))
           (let-go! h))
          ((or (not (equal? copy sent)) (> (- (monotonic-seconds) sent-at) (period)))
           (loop (monotonic-seconds)
@@ -442,9 +443,9 @@
           (log-warn "task " (handed-id h) ": its coordinator " uid " is gone")
           (thread-sleep! (period))  ; it stopped acting a period ago at least
           (take-over! h (list uid)))
-         ((>= (- (monotonic-seconds) (handed-heard h)) (* take-over-periods (period)))
+         ((>= (- (monotonic-seconds) (handed-heard h)) (* (take-over-periods) (period)))
           (log-warn "task " (handed-id h) ": its coordinator " uid " is silent for "
-                    take-over-periods " periods")
+                    (take-over-periods) " periods")
           (take-over! h (list uid)))
          (else (loop started)))))))
 
@@ -696,7 +697,7 @@
             (apply remote-apply (uid->aspace uid) proc id args))))))))
 
 ;; How long to wait for a task that moves (take-over-periods).
-(define (moving-seconds) (* (+ take-over-periods 4) (period)))
+(define (moving-seconds) (* (+ (take-over-periods) 4) (period)))
 
 (define (moving-text id)
   (string-append "the task " (symbol->string id) " is moving: the member that"
