@@ -45,12 +45,12 @@
           component-heartbeat! stop-component!
           waiting-ranks waiting-entries waiting-for takers-here receive-offer receive-give-way note-waiters!
           task-step start-steps pose-steps with-coordinator team-barrier
-          team-send! team-receive step-team
+          team-send! team-receive step-team team-answer team-held?
           ;; tasks handed to the lab (lib/murdoch/task/detached.scm)
           lab-tasks lab-task-id lab-task-role lab-task-epoch lab-task-state
           lab-task-coordinator lab-task-standby lab-task-poser lab-task-took-over
           await-component components-running coordinate-task! coordinator-ping
-          become-standby! receive-copy handed-role-of handed-entries handed-status
+          become-standby! receive-copy receive-team-copy handed-role-of handed-entries handed-status
           handed-wait handed-cancel
                     ;; what the lab is doing (lib/murdoch/task/status.scm)
           aspace-report lab-status show-status aspace-started-at

@@ -18,12 +18,39 @@
 (define (work tag rounds)
   (dynamic-wind
    (lambda () (tell 'begin tag (local-aspace-uid)))
-   (lambda ()
-     (let loop ((n rounds))
-       (remote-apply (local-aspace) (lambda () #t))
-       (thread-sleep! 0.05)
-       (if (> n 0) (loop (- n 1)) (local-aspace-uid))))
+   (lambda () (rounds! rounds) (local-aspace-uid))
    (lambda () (tell 'end tag (local-aspace-uid)))))
+(define (rounds! n)
+  (remote-apply (local-aspace) (lambda () #t))
+  (thread-sleep! 0.05)
+  (if (> n 0) (rounds! (- n 1))))
+;; A member of a team of two: both meet; the first sends before to the
+;; second and waits at mid while the second works rounds; past mid, the
+;; first sends after-1 and after-2, the second takes all three; both meet
+;; again at done.  Each tells (team TAG UID WHAT) of each call it made.
+(define (teamwork tag rounds)
+  (let* ((team (current-team)) (me (local-aspace-uid)) (first? (eq? me (car team)))
+         (other (if first? (cadr team) (car team))))
+    (define (told what) (tell 'team tag me what))
+    (tell 'begin tag me)
+    (team-barrier 'meet 60)
+    (told 'met)
+    (cond (first?
+           (team-send! other 'before)
+           (told 'sent)
+           (team-barrier 'mid 60)
+           (told 'mid)
+           (team-send! other 'after-1)
+           (team-send! other 'after-2))
+          (else
+           (rounds! rounds)
+           (team-barrier 'mid 60)
+           (told 'mid)
+           (for-each (lambda (i) (told (list 'got (team-receive 60)))) '(1 2 3))))
+    (team-barrier 'done 60)
+    (told 'done)
+    (tell 'end tag me)
+    me))
 (define (free-everywhere? subjects)
   (every (lambda (r) (every (lambda (s) (null? (cadr s))) (cadr r)))
          (request 'all (lambda ()
@@ -314,6 +341,95 @@
       (for-each task-wait busy)
       (test-assert "nothing is held after" (wait-until 10 all-free?))
       (restart! old))))
+
+(test-group "the coordinator killed between team calls: the team goes on with the new one"
+  ;; Killed while the first member waits at the barrier mid and a letter
+  ;; to the second waits for it: the barrier, that letter and those sent
+  ;; after reach the standby that took over, each once.
+  (let* ((id (remote-apply
+              (uid->aspace 'poser)
+              (eval '(lambda ()
+                       (start-steps 'teamed
+                                    (task-step (list '((mobile) ()) '((mobile) ()))
+                                               (list #f #f)
+                                               (list (lambda (previous) (teamwork 'teamed 60))
+                                                     (lambda (previous) (teamwork 'teamed 60))))
+                                    'detach #t))
+                    (lab-environment))))
+         (told (lambda (what)
+                 (filter-map (lambda (r)
+                               (and (any (lambda (line)
+                                           (equal? what (list-ref (read (open-input-string line))
+                                                                  3)))
+                                         (log-lines r "team" 'teamed))
+                                    r))
+                             robots))))
+    (test-assert "the first member has sent, and waits at mid; the second works"
+      (wait-until 15 (lambda () (and (= 2 (length (told 'met))) (= 1 (length (told 'sent)))
+                                     (lab-task-standby (entry-of id))))))
+    (let ((old (coordinator-of id)) (standby (lab-task-standby (entry-of id))))
+      (kill! old)
+      (test "the standby takes over" standby (second-coordinator id))
+      (let* ((results (car (task-wait id 60)))
+             (first (car (told 'sent)))
+             (second (find (lambda (r) (and (memq r results) (not (eq? r first)))) robots))
+         (calls (lambda (r)
+                  (map (lambda (line) (list-ref (read (open-input-string line)) 3))
+                       (if r (log-lines r "team" 'teamed) '())))))
+        (test "the task completes, its two members on robots of their own" 2
+          (length (delete-duplicates (filter (lambda (r) (memq r robots)) results))))
+        (test "each member's own log: one begin and one end" '((1 1) (1 1))
+          (map (lambda (r) (list (length (log-lines r "begin" 'teamed))
+                                 (length (log-lines r "end" 'teamed))))
+               (list first second)))
+        (test "the first member's team calls, each once, in order"
+          '(met sent mid done) (calls first))
+        (test "the second took the letter sent before the kill and those after, each once"
+          (list 'met 'mid (list 'got (cons first 'before)) (list 'got (cons first 'after-1))
+                (list 'got (cons first 'after-2)) 'done)
+          (calls second)))
+      (restart! old))))
+
+(test-group "after a takeover, its first coordinator back: the id still finds the task"
+  ;; The id names the member that first coordinated the task; killed and
+  ;; started again, that member counts its own poses from 1 again.
+  (let* ((id (running-detached 'renamed 2000))
+         (old (coordinator-of id))
+         (standby (lab-task-standby (entry-of id))))
+    (test-assert "the id is the lab's kind, naming its first coordinator"
+      (text-contains? (symbol->string id) (string-append "@" (symbol->string old) "/lab-")))
+    (kill! old)
+    (test "the standby takes over" standby (second-coordinator id))
+    (restart! old)
+    (let ((plain (remote-apply
+                  (uid->aspace old)
+                  (eval '(lambda ()
+                           (task-id (start-task 'renamed 1 (list '((mobile) ())) (list #f)
+                                                (list (lambda () (work 'plain 0))))))
+                        (lab-environment)))))
+      (test-assert "a task posed at the first coordinator, started again, has an id of its own"
+        (and (symbol? plain) (not (eq? plain id)))))
+    (test-assert "task-status by the id, from a peer: its component runs on"
+      (running-everywhere? id))
+    (let ((tasks (murdoch-status "tasks" (test-lab-file lab))))
+      (test "murdoch tasks lists it under its id, with its new coordinator" #t
+        (and (text-contains? tasks (symbol->string id))
+             (text-contains? tasks (string-append "coordinator " (symbol->string standby))))))
+    (test "murdoch cancel with the id cancels it" #t
+      (text-contains? (murdoch-status "cancel" (test-lab-file lab) (symbol->string id))
+                      "exit 0"))
+    (test "its component ends on its robot, begun once" '(1 1)
+      (let ((robot (wait-until 10 (lambda ()
+                                    (find (lambda (r) (pair? (log-lines r "end" 'renamed)))
+                                          robots)))))
+        (if robot
+            (list (length (log-lines robot "begin" 'renamed))
+                  (length (log-lines robot "end" 'renamed)))
+            '())))
+    (test "murdoch wait with the id says it was cancelled" #t
+      (let ((waited (murdoch-status "wait" (test-lab-file lab) (symbol->string id))))
+        (and (text-contains? waited "cancelled") (text-contains? waited "exit 1"))))
+    (test-assert "nothing is held after" (wait-until 10 all-free?))))
 
 (test-group "the standby stalled: a peer's wait follows the task as it moves"
   ;; The standby frozen (SIGSTOP), its coordinator lets the task go and

@@ -22,13 +22,13 @@
           pose-task-backoff pose-task-excluded receive-rival pose-negotiations
           resolve-conflicts with-team-proc-maker with-team on-list current-team
           t sort-list make-maxrandom with-coordinator team-barrier team-send!
-          team-receive step-team aspace-report lab-status show-status
+          team-receive step-team team-answer team-held? aspace-report lab-status show-status
           write-lab-status lab-line waiting-text report-since report-pose report-battery
           report-held report-tasks report-goal report-ended held-subject held-holder
           report-handed lab-task-line await-component components-running lab-tasks
           lab-task-id lab-task-role lab-task-epoch lab-task-state
           lab-task-coordinator lab-task-standby lab-task-poser lab-task-took-over
-          coordinate-task! coordinator-ping become-standby! receive-copy
+          coordinate-task! coordinator-ping become-standby! receive-copy receive-team-copy
           handed-role-of handed-entries handed-status handed-wait handed-cancel)
   (import (murdoch task assign) (murdoch task running) (murdoch task metric)
           (murdoch task pose-task) (murdoch task progress) (murdoch task takers)

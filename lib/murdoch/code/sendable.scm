@@ -275,8 +275,11 @@
 
 ;; hash-table-cell, and no let (docs/speed.md).
 (define (known-encoding p env)
-  (or (known-code (hash-table-cell *known* p #f) p env)
-      (known-source-code (capture-free-source p) env)))
+  (known-else-source (known-code (hash-table-cell *known* p #f) p env) p env))
+
+;; No or, whose let makes a closure: one an encoding.
+(define (known-else-source code p env)
+  (if code code (known-source-code (capture-free-source p) env)))
 
 (define (known-source-code source env)
   (and source (known-code (hash-table-cell *known* source #f) #f env)))
@@ -285,7 +288,7 @@
 (define (known-code entry p env)
   (and entry
        (eq? (cadr entry) env)
-       (or (not (car (cddr entry))) (eq? (cdr (car (cddr entry))) p))
+       (if (car (cddr entry)) (eq? (cdr (car (cddr entry))) p) #t)
        (cdr (cddr entry))))
 
 ;; The source and names of p, a closure that captures no variable, or #f.
@@ -336,6 +339,12 @@
 ;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
 
+;; The procedure in cell, the env-cell of global name (no let: see known-encoding).
+(define (procedure-in cell name)
+  (if (and cell (procedure? (cdr cell)))
+      (cdr cell)
+      (error "no procedure of this name here" name)))
+
 (define (make-closure-compiler env)
   (let ((makers (make-hash-table chibi-equal?)))
     ;; See known-encoding.
@@ -347,9 +356,8 @@
             (set! makers (make-hash-table chibi-equal?)))
         (hash-table-set! makers key maker)
         maker))
-    (lambda (source names)
-      (let ((key (cons source names)))
-        (maker (hash-table-cell makers key #f) key)))))
+    (define (maker-of key) (maker (hash-table-cell makers key #f) key))
+    (lambda (source names) (maker-of (cons source names)))))
 
 ;;> Returns a procedure that rebuilds values encoded by \scheme{encode},
 ;;> resolving globals and sources in \var{env} and proxies by \var{proxy};
@@ -363,10 +371,11 @@
                   x)
        ((not (vector? x)) x)
        (else (dec-tagged x depth))))
-    ;; By iteration down the cdrs; no let (see known-encoding).
+    ;; By iteration down the cdrs; no let or or (see known-encoding).
     (define (dec-elements! p depth)
-      (if (or (pair? (car p)) (vector? (car p)))
-          (set-car! p (dec (car p) depth)))
+      (if (pair? (car p))
+          (set-car! p (dec (car p) depth))
+          (if (vector? (car p)) (set-car! p (dec (car p) depth))))
       (cond ((pair? (cdr p)) (dec-elements! (cdr p) depth))
             ((vector? (cdr p)) (set-cdr! p (dec (cdr p) depth)))))
     (define (dec-tagged v depth)
@@ -390,9 +399,5 @@
        ((eq? tag 'murdoch:void) void-value)
        ((eq? tag 'murdoch:eof) (eof-object))
        (else (error "unknown tag in a received value" v))))
-    (define (global-ref name)
-      (let ((cell (env-cell env name)))
-        (if (and cell (procedure? (cdr cell)))
-            (cdr cell)
-            (error "no procedure of this name here" name))))
+    (define (global-ref name) (procedure-in (env-cell env name) name))
     (lambda (x) (if (plain? x) x (dec x 0)))))

@@ -32,7 +32,7 @@
 (define *membership* #f)
 
 (define (joined)
-  (or *membership* (error "this process has not joined a lab")))
+  (if *membership* *membership* (error "this process has not joined a lab")))
 
 (define (with-peers thunk)
   (with-lock (membership-peers-lock (joined)) thunk))

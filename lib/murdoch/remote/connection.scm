@@ -45,23 +45,29 @@
 (define *connecting* (make-hash-table eq?))   ; uid -> mutex
 (define *connections-lock* (make-mutex 'connections))
 
-;; The open connection to uid, made and greeted by the deadline if there is none.
+;; The open connection to a, made and greeted by the deadline if there is
+;; none.  No let or or, whose closures every call to every peer would make
+;; (docs/speed.md).
 (define (connection-to a deadline)
-  (let ((uid (aspace-uid a)))
-    (or (live-connection-to uid)
-        (undo-on-raise
-         (lambda () (note-unreachable! uid))
-         (lambda ()
-           (with-lock-by (connecting-lock uid) deadline
-             (lambda ()
-               (remote-error 'timed-out uid 'connect
-                             "another call's connect did not end in time"))
-             (lambda ()
-               (or (live-connection-to uid)
-                   (let ((c (connect! a deadline)))
-                     (with-lock *connections-lock*
-                       (lambda () (hash-table-set! *connections* uid c)))
-                     c)))))))))
+  (live-or-new (live-connection-to (aspace-uid a)) a deadline))
+
+(define (live-or-new live a deadline)
+  (if live live (new-connection-to a (aspace-uid a) deadline)))
+
+(define (new-connection-to a uid deadline)
+  (undo-on-raise
+   (lambda () (note-unreachable! uid))
+   (lambda ()
+     (with-lock-by (connecting-lock uid) deadline
+       (lambda ()
+         (remote-error 'timed-out uid 'connect
+                       "another call's connect did not end in time"))
+       (lambda ()
+         (or (live-connection-to uid)
+             (let ((c (connect! a deadline)))
+               (with-lock *connections-lock*
+                 (lambda () (hash-table-set! *connections* uid c)))
+               c)))))))
 
 ;; No wind around the lock: nothing under it raises, and every call comes here.
 (define (live-connection-to uid)

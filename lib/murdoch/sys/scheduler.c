@@ -168,14 +168,18 @@ static int time_until (const struct timeval *deadline, struct timespec *ts) {
 static enum wait_result wait_once (sexp ctx, const sigset_t *mask) {
   sexp ls;
   nfds_t n = 0;
+  int paused = 0;
   struct timeval *deadline = NULL;
   struct timespec timeout;
   for (ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED); sexp_pairp(ls);
-       ls = sexp_cdr(ls))
+       ls = sexp_cdr(ls)) {
+    paused |= sexp_car(ls) == ctx;
     if (!note_waiter(sexp_car(ls), &n, &deadline))
       return WAIT_DONE;
-  /* Chibi's nap takes the current thread off the paused list. */
-  if (sexp_context_waitp(ctx) && !note_waiter(ctx, &n, &deadline))
+  }
+  /* Chibi's nap takes the current thread off the paused list; a thread
+   * that blocks is on it already, and its descriptor is polled once. */
+  if (sexp_context_waitp(ctx) && !paused && !note_waiter(ctx, &n, &deadline))
     return WAIT_DONE;
   if (n == 0 && !deadline)
     return WAIT_DONE;

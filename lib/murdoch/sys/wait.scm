@@ -26,7 +26,7 @@
 ;;> srfi 18's mutex-lock! and mutex-unlock!, no timeout or condition variable, no garbage.
 (define (lock! m)
   (if lock-order-checked? (taking! m))
-  (or (%mutex-lock! m #f #t)
+  (if (not (%mutex-lock! m #f #t))      ; no or: a closure a lock (docs/speed.md)
       (begin (thread-yield!) (mutex-lock! m)))   ; as srfi 18's, once it failed
   (if lock-order-checked? (took! m)))
 
@@ -86,13 +86,13 @@
 (define lock-ranks
   '((tries . 1)
     (tasks . 2) (offers . 2)
-    (handed . 2.5)
+    (team-keeping . 2.2) (handed . 2.5)
     (poses . 3) (running . 3) (subscriptions . 3)
     (connecting . 4.1) (connection-write . 4.2) (connections . 4.3) (peers . 4.4)
     (janitor . 4.5) (served-write . 4.55) (serving . 4.6)
     (trip-reconnect . 5) (trip . 5.1) (sequence . 5.1) (last-heard . 5.1)
     (datagram-calls . 5.1) (workers . 5.1) (proxies . 5.1) (abandoned . 5.1)
-    (protected . 5.1) (fields-text . 5.1) (team . 5.1) (feed . 5.1)
+    (protected . 5.1) (fields-text . 5.1) (team . 5.1) (teams . 5.1) (feed . 5.1)
     (mailbox . 6) (gathering . 6)))
 
 (define lock-order-folder (get-environment-variable "MURDOCH_LOCK_ORDER"))

@@ -10,7 +10,9 @@
 ;;  2. The coordinator starts the task as start-task would, and does for
 ;;     it all a poser does: heartbeats, reassignments, its place in line.
 ;;     It chooses a standby the same way, on another member, and sends it
-;;     a copy of the task's record whenever it changes, and every period.
+;;     a copy of the task's record whenever it changes, and every period,
+;;     and of a step's team at each arrival or letter, before the member
+;;     that made the call hears back (team.scm).
 ;;  3. Never two coordinators.  The standby pings the coordinator every
 ;;     heartbeat period.  The coordinator acts for the task (heartbeats,
 ;;     starts, negotiations) only while the pings arrive: silent for two
@@ -21,9 +23,11 @@
 ;;  4. Taking over, the standby asks the lab which of the task's
 ;;     components run or ended where, adopts each where it is, re-runs the
 ;;     negotiation of a task that had not started, with its rank, and
-;;     chooses a new standby.  A coordinator that let the task go because
-;;     its standby fell silent takes it back the same way once it finds
-;;     the standby's process gone, and drops it if the standby took over.
+;;     chooses a new standby.  The members of a step's team find its
+;;     coordinator there by the step's id.  A coordinator that let the
+;;     task go because its standby fell silent takes it back the same way
+;;     once it finds the standby's process gone, and drops it if the
+;;     standby took over.
 ;;  5. Any peer finds the task by its id through the lab-tasks subject,
 ;;     which the members holding a task subscribe to.  A finished task's
 ;;     results are kept for the lab's keep-results seconds.
@@ -34,9 +38,10 @@
 (define detached-patience 4)
 
 ;; Let go after let-go-periods without the standby's pings; take over
-;; after take-over-periods unanswered (docs/tasks.md).
-(define let-go-periods 2)
-(define take-over-periods 4)
+;; after take-over-periods unanswered: the no-ghost rule's settings, with
+;; the coordinator in the robot's place (docs/tasks.md).
+(define (let-go-periods) (lab-setting (current-lab) 'orphan-periods))
+(define (take-over-periods) (lost-periods))
 
 ;; What a coordinator and its standby each keep of a detached task.
 (define-record-type handed
@@ -52,6 +57,7 @@
   (task handed-task handed-task-set!)            ; the coordinator's record
   (copy handed-copy handed-copy-set!)            ; as last sent or received
   (heard handed-heard handed-heard-set!)         ; monotonic: the partner, last
+  (teams handed-teams handed-teams-set!)         ; ((TEAM-ID STATE) ...), its steps'
   (took-over handed-took-over handed-took-over-set!)) ; utc-seconds, or #f
 
 ;; The copy of a task's record that travels to the standby: (STATE STATUS
@@ -172,26 +178,35 @@
 ;;> chose: starts the task of \var{kind} that \var{args} describe here
 ;;> (see start-kind); answers its id.
 (define (coordinate-task! kind args poser)
-  (let* ((t (parameterize ((heartbeat-patience detached-patience)
-                            (task-id-maker fresh-id))
-              (start-kind kind args)))
-         (h (make-handed (task-id t) kind args poser)))
+  (let* ((id (fresh-id (car args)))
+         (h (make-handed id kind args poser)))
     (handed-role-set! h 'coordinator)
     (handed-partner-set! h #f)
     (handed-epoch-set! h 1)
-    (handed-task-set! h t)
-    (handed-copy-set! h (list 'negotiating '() #f (task-turn-copy t) #f))
+    (handed-task-set! h #f)
+    (handed-copy-set! h (list 'negotiating '() #f #f #f))
     (handed-heard-set! h (monotonic-seconds))
+    (handed-teams-set! h '())
     (handed-took-over-set! h #f)
+    ;; Held before it starts, so that its steps' teams are kept from the first.
     (hold-handed! h)
-    (coordinate! h)
-    (task-id t)))
+    (let ((t (undo-on-raise
+              (lambda () (drop-handed! h))
+              (lambda ()
+                (parameterize ((heartbeat-patience detached-patience)
+                               (task-id-maker (lambda (name) id))
+                               (team-keeper keep-team))
+                  (start-kind kind args))))))
+      (handed-task-set! h t)
+      (handed-copy-set! h (list 'negotiating '() #f (task-turn-copy t) #f))
+      (coordinate! h)
+      id)))
 
-;; A task id no peer of the lab knows: a coordinator started again counts
-;; its ids from 1 again, and the lab keeps results, and robots remember
-;; the components that ended, by id.
+;; A task id no peer of the lab knows, lab-task-key's: a coordinator
+;; started again counts its ids from 1 again, and the lab keeps results,
+;; and robots remember the components that ended, by id.
 (define (fresh-id name)
-  (let ((id (task-key name)))
+  (let ((id (lab-task-key name)))
     (if (or (holder-of id) (pair? (components-of id))
             (pair? (components-of (step-task-id id 1))))
         (fresh-id name)
@@ -226,7 +241,7 @@
          ;; Ended, and the standby has the copy: nothing more to say.
          ((and (copy-results copy) (equal? copy sent)) (loop sent-at sent))
          ((and (handed-partner h)
-               (> (- (monotonic-seconds) (handed-heard h)) (* let-go-periods (period))))
+               (> (- (monotonic-seconds) (handed-heard h)) (* (let-go-periods) (period))))
           (let-go! h))
          ((or (not (equal? copy sent)) (> (- (monotonic-seconds) sent-at) (period)))
           (loop (monotonic-seconds)
@@ -281,7 +296,7 @@
                 (parameterize ((remote-timeout (period)))
                   (remote-apply (uid->aspace uid) become-standby! (handed-id h)
                                 (handed-kind h) (handed-args h) (handed-poser h)
-                                (handed-epoch h) (handed-copy h) me)))
+                                (handed-epoch h) (handed-copy h) (handed-teams h) me)))
               (begin
                 (handed-heard-set! h (monotonic-seconds))
                 (handed-partner-set! h uid)
@@ -345,7 +360,7 @@
 
 ;;> What a coordinator calls at the member it chose to stand by for task
 ;;> \var{id}: answers #t when it does.
-(define (become-standby! id kind args poser epoch copy coordinator)
+(define (become-standby! id kind args poser epoch copy teams coordinator)
   (let ((old (handed-by-id id)))
     (and (not (and old (eq? (handed-role old) 'coordinator)))
          (let ((h (make-handed id kind args poser)))
@@ -355,6 +370,7 @@
            (handed-task-set! h #f)
            (handed-copy-set! h copy)
            (handed-heard-set! h (monotonic-seconds))
+           (handed-teams-set! h teams)
            (handed-took-over-set! h #f)
            (hold-handed! h)
            (thread-start! (make-logged-thread (lambda () (stand-by h)) 'standby))
@@ -367,6 +383,43 @@
   (let ((h (handed-by-id id)))
     (and h (eq? (handed-role h) 'standby) (= (handed-epoch h) epoch)
          (begin (handed-copy-set! h copy) #t))))
+
+;;> What the coordinator of task \var{id} calls at its standby when a
+;;> member of a step's team, \var{team-id}, arrives at a barrier or sends
+;;> a letter, before the member hears back: answers whether this address
+;;> space stands by for it at \var{epoch}.
+(define (receive-team-copy id epoch team-id state)
+  (let ((h (handed-by-id id)))
+    (and h (eq? (handed-role h) 'standby) (= (handed-epoch h) epoch)
+         (begin (set-team! h team-id state) #t))))
+
+(define (set-team! h team-id state)
+  (with-lock *handed-lock*
+    (lambda ()
+      (handed-teams-set! h (cons (list team-id state)
+                                 (remove (lambda (x) (eq? (car x) team-id))
+                                         (handed-teams h)))))))
+
+;; The team-keeper of a detached task's steps: (keep-team ID TEAM-ID) the
+;; state its coordinator, or the standby that took over, holds of the
+;; team, or #f; (keep-team ID TEAM-ID STATE) holds it, and gives it to
+;; the standby.  A standby that does not answer is found lost by
+;; keep-watch, and the next is given every team as it is then.
+(define (keep-team id team-id . state)
+  (let ((h (handed-by-id id)))
+    (cond ((not h) #f)
+          ((null? state)
+           (cond ((assq team-id (handed-teams h)) => cadr) (else #f)))
+          (else
+           (set-team! h team-id (car state))
+           (let ((uid (handed-partner h)))
+             (if (and uid (eq? (handed-role h) 'coordinator))
+                 (guard (e ((remote-error? e)
+                            (log-warn "task " id ": the standby " uid " took no copy of "
+                                      team-id ": " (error-message e))))
+                   (parameterize ((remote-timeout (period)))
+                     (remote-apply (uid->aspace uid) receive-team-copy id
+                                   (handed-epoch h) team-id (car state))))))))))
 
 ;; Takes over when no ping has been answered for take-over-periods, or a
 ;; period after the coordinator's process is found gone.
@@ -390,9 +443,9 @@
           (log-warn "task " (handed-id h) ": its coordinator " uid " is gone")
           (thread-sleep! (period))  ; it stopped acting a period ago at least
           (take-over! h (list uid)))
-         ((>= (- (monotonic-seconds) (handed-heard h)) (* take-over-periods (period)))
+         ((>= (- (monotonic-seconds) (handed-heard h)) (* (take-over-periods) (period)))
           (log-warn "task " (handed-id h) ": its coordinator " uid " is silent for "
-                    take-over-periods " periods")
+                    (take-over-periods) " periods")
           (take-over! h (list uid)))
          (else (loop started)))))))
 
@@ -409,7 +462,7 @@
      ((copy-results copy) #f)
      (else
       (handed-task-set!
-       h (parameterize ((heartbeat-patience detached-patience))
+       h (parameterize ((heartbeat-patience detached-patience) (team-keeper keep-team))
            (if (eq? (handed-kind h) 'steps)
                (adopt-steps h copy)
                (adopt-task (handed-id h) (copy-turn copy)
@@ -644,7 +697,7 @@
             (apply remote-apply (uid->aspace uid) proc id args))))))))
 
 ;; How long to wait for a task that moves (take-over-periods).
-(define (moving-seconds) (* (+ take-over-periods 4) (period)))
+(define (moving-seconds) (* (+ (take-over-periods) 4) (period)))
 
 (define (moving-text id)
   (string-append "the task " (symbol->string id) " is moving: the member that"

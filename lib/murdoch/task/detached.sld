@@ -7,14 +7,15 @@
   (export start-task start-steps task-status task-wait cancel-task lab-tasks
           lab-task-id lab-task-role lab-task-epoch lab-task-state lab-task-coordinator
           lab-task-standby lab-task-poser lab-task-took-over
-          coordinate-task! coordinator-ping become-standby! receive-copy handed-role-of
+          coordinate-task! coordinator-ping become-standby! receive-copy
+          receive-team-copy handed-role-of
           handed-entries handed-status handed-wait handed-cancel)
   (import (scheme base) (scheme cxr) (scheme write) (srfi 1) (srfi 18) (srfi 132)
           (only (chibi string) string-contains)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
-          (murdoch task progress) (only (murdoch task pose-task) task-key)
+          (murdoch task progress) (only (murdoch task pose-task) lab-task-key)
           (only (murdoch task running) components-running components-ended ended-id
-                ended-index)
+                ended-index lost-periods)
           (murdoch task record)
           (only (murdoch task rank) make-turn turn-wait? turn-hold? turn-priority
                 turn-deadline turn-posed)
@@ -22,7 +23,7 @@
                   (start-task start-here) (task-status status-here)
                   (task-wait wait-here) (cancel-task cancel-here))
           (rename (only (murdoch task steps) start-steps step? step-parts task-step
-                        resume-steps step-task-id)
+                        resume-steps step-task-id team-keeper)
                   (start-steps start-steps-here))
           (only (murdoch pubsub) subscribe unsubscribe request get-system-load))
   (include "detached.scm"))

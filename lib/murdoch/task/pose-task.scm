@@ -64,9 +64,29 @@
 ;;> NAME@UID/N: a started task's id and its reservations' name, so the
 ;;> same task posed twice at once never shares a robot.
 (define (task-key task-name)
+  (numbered-key task-name ""))
+
+;;> A key as task-key makes, NAME@UID/lab-N, for a task handed to the lab
+;;> (detached.scm): UID the member that first coordinated it, the key its
+;;> name wherever it is coordinated later, and never one of task-key's,
+;;> which a member started again counts from 1 again.
+(define (lab-task-key task-name)
+  (numbered-key task-name lab-key-mark))
+
+(define lab-key-mark "lab-")
+
+;;> Whether \var{key} was made by lab-task-key: the pose that holds it
+;;> may be coordinated elsewhere than UID.
+(define (lab-task-key? key)
+  (let* ((s (symbol->string key))
+         (from (+ 1 (or (last-index s #\/ (string-length s)) (string-length s))))
+         (to (+ from (string-length lab-key-mark))))
+    (and (<= to (string-length s)) (string=? lab-key-mark (substring s from to)))))
+
+(define (numbered-key task-name mark)
   (let ((n (with-poses (lambda () (set! *poses* (+ *poses* 1)) *poses*))))
     (string->symbol (string-append (symbol->string task-name) "@"
-                                   (symbol->string (local-aspace-uid)) "/"
+                                   (symbol->string (local-aspace-uid)) "/" mark
                                    (number->string n)))))
 
 ;;> The task name and the poser's uid of \var{key} (a symbol or string

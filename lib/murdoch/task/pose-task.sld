@@ -8,7 +8,7 @@
           winner-uid winner-promise check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
           pose-task-backoff pose-task-excluded pose-task-reservation receive-rival pose-negotiations
-          reservation-aspace-uid task-key task-key-parts
+          reservation-aspace-uid task-key task-key-parts lab-task-key lab-task-key?
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
           reckon-distance-between sort-response resolve-conflicts

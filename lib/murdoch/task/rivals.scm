@@ -87,11 +87,21 @@
     (pair? (outranking-rivals name))))
 
 (define (rival-negotiating? rank)
-  (guard (e (#t #f))
-    (and (assq (rank-name rank)
-               (remote-apply (uid->aspace (reservation-aspace-uid (rank-name rank)))
-                             pose-negotiations))
-         #t)))
+  (let ((name (rank-name rank)))
+    (or (guard (e (#t #f))
+          (and (assq name (remote-apply (uid->aspace (reservation-aspace-uid name))
+                                        pose-negotiations))
+               #t))
+        (and (lab-task-key? name)
+             (pair? (at-lab-task-holders (sendable-lambda ()
+                                           (and (assq name (pose-negotiations)) #t))))))))
+
+;; The uids of the members holding detached tasks at which thunk answers
+;; #t: where a pose of a task handed to the lab negotiates once another
+;; member took it over, its key naming the first.
+(define (at-lab-task-holders thunk)
+  (filter-map (lambda (answer) (and (eq? (cadr answer) #t) (car answer)))
+              (guard (e (#t '())) (request 'lab-tasks thunk))))
 
 ;; After a try that found too few robots: whether another may do better.
 ;; It may when other poses hold robots it could use, and those poses are
@@ -134,9 +144,13 @@
 
 (define (tell-rival! holder rank)
   (let ((uid (reservation-aspace-uid holder)))
-    (if uid
-        (guard (e (#t (log-warn "telling " holder " of " rank ": " (error-message e))))
-          (remote-apply (uid->aspace uid) receive-rival holder rank)))))
+    (if (and uid
+             (not (guard (e (#t (log-warn "telling " holder " of " rank ": "
+                                          (error-message e))
+                                #f))
+                    (remote-apply (uid->aspace uid) receive-rival holder rank)))
+             (lab-task-key? holder))
+        (at-lab-task-holders (sendable-lambda () (receive-rival holder rank))))))
 
 ;; Waits a random while, below (pose-task-backoff) doubled for each try
 ;; before try n.  Each process draws from its own seed: Chibi starts every

@@ -56,9 +56,17 @@
 
 (define (go-steps! t steps options adopt-step)
   (task-steps-set! t '())
-  (thread-start!
-   (make-logged-thread (inheriting (lambda () (run-steps t steps options adopt-step)))
-                       (task-id t))))
+  (let ((keeper (team-keeper)))
+    (thread-start!
+     (make-logged-thread
+      (inheriting (lambda () (run-steps t steps options adopt-step keeper)))
+      (task-id t)))))
+
+;;> How the teams of the tasks of steps started under it outlive the
+;;> address space that coordinates them: #f, or a procedure that (KEEPER
+;;> TASK-ID TEAM-ID) answers the state kept for a step's team, or #f, and
+;;> (KEEPER TASK-ID TEAM-ID STATE) keeps it (detached.scm's keep-team).
+(define team-keeper (make-parameter #f))
 
 ;;> Runs a task of steps and answers, as task-wait, each step's results.
 (define (pose-steps task-name . steps)
@@ -78,7 +86,7 @@
                          c)))
             (step-capabilities s)))
 
-(define (run-steps t steps options adopt-step)
+(define (run-steps t steps options adopt-step keeper)
   (let loop ((i 1) (steps steps) (previous '()) (results '()))
     (cond
      ((let-go? t) #f)
@@ -86,7 +94,7 @@
       (finish! t (reverse results)))
      (else
       (let* ((sub #f)
-             (coordinator (make-coordinator (lambda () (if sub (task-team sub) '()))))
+             (coordinator (step-coordinator t i (lambda () sub) keeper))
              (step-results
               (begin
                 (set! sub (begin-step t (car steps) i previous coordinator options
@@ -95,7 +103,7 @@
                 ;; Let go while the step began: it lets the step go too.
                 (if (let-go? t) (let-task-go! sub))
                 (task-wait sub))))
-        (release-proxy! coordinator)
+        (release-coordinator! coordinator)
         (if (not (let-go? t)) (progress (task-id t) ": step " i " done: " step-results))
         (cond
          ((let-go? t) #f)
@@ -112,6 +120,16 @@
 (define (step-failed? results)
   (or (symbol? results)
       (any (lambda (r) (and (pair? r) (eq? (car r) 'error))) results)))
+
+;; The coordinator of step i's team, under the step's id, acted for while
+;; t is not let go, kept by keeper.
+(define (step-coordinator t i sub keeper)
+  (let ((id (step-task-id (task-id t) i)))
+    (make-coordinator id
+                      (lambda () (if (sub) (task-team (sub)) '()))
+                      (lambda () (not (let-go? t)))
+                      (and keeper
+                           (lambda state (apply keeper (task-id t) id state))))))
 
 ;; Starts step number i of t as a task of its own, or has adopt-step
 ;; adopt it.

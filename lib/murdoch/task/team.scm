@@ -127,107 +127,257 @@
 ;;; Synchronization inside a team, MOVER's way
 ;;
 ;; Members wait at named barriers and pass values by uid through the
-;; team's coordinator, a proxy (encap) made where the task was posed;
-;; with-coordinator lets a member find it wherever it runs.
+;; team's coordinator, held where the task is coordinated, under the
+;; team's id.  A member reaches it by its address, (ID UID KEPT?); when
+;; UID is lost, or holds the team no more, the member of a team that is
+;; kept (a detached task's, taken over) asks the lab who holds ID now (the lab-tasks subject, which the
+;; members holding a detached task subscribe to), and calls again there.
+;; So any call may count twice: an arrival counts once however often it
+;; comes, a letter carries its sender's key and is kept once, a member
+;; takes each key once, and a letter stays with the coordinator until the
+;; member's next receive says that it came.  A coordinator that is kept
+;; (make-coordinator's keep) keeps an arrival or a letter before its
+;; member hears that it counted.
 
-;; The coordinator of the team being run here, or #f.
-(define current-coordinator (make-parameter #f))
-(sandbox-parameter! current-coordinator)
+;; What a member of a team keeps, in the thread running its procedure.
+(define-record-type teammate
+  (make-teammate id uid kept? nonce sent taken seen)
+  teammate?
+  (id teammate-id)
+  (uid teammate-uid teammate-uid-set!)       ; where its coordinator is held
+  (kept? teammate-kept?)                     ; whether it may be held elsewhere later
+  (nonce teammate-nonce)                     ; its letters' keys: (UID NONCE N)
+  (sent teammate-sent teammate-sent-set!)    ; letters sent so far
+  (taken teammate-taken teammate-taken-set!) ; the last letter's key, or #f
+  (seen teammate-seen teammate-seen-set!))   ; the keys of the letters taken
 
-;;> Runs \var{thunk} as a member of the team whose coordinator is
-;;> \var{coordinator}: team-barrier, team-send! and team-receive reach it,
-;;> and current-team is its robots.
+;; The member of the team being run here, or #f.
+(define current-teammate (make-parameter #f))
+(sandbox-parameter! current-teammate)
+
+;;> Runs \var{thunk} as a member of the team whose coordinator is at
+;;> \var{coordinator}, what make-coordinator answered: team-barrier,
+;;> team-send! and team-receive reach it, and current-team is its robots.
 (define (with-coordinator coordinator thunk)
-  (parameterize ((current-coordinator coordinator)
-                 (current-team (coordinator 'team)))
-    (thunk)))
+  (let ((m (make-teammate (car coordinator) (cadr coordinator) (car (cddr coordinator))
+                          (random-integer 1000000000) 0 #f '())))
+    (parameterize ((current-teammate m)
+                   (current-team (ask-team m "with-coordinator" 'team
+                                           (lambda (left) '()) (task-timeout))))
+      (thunk))))
 
 ;;> The step's robots as they are now, in component order, a lost member
 ;;> replaced; (current-team) keeps those it started with.
-(define (step-team) ((team-coordinator "step-team") 'team))
+(define (step-team)
+  (ask-team (teammate-of "step-team") "step-team" 'team (lambda (left) '())
+            (task-timeout)))
 
-(define (team-coordinator who)
-  (or (current-coordinator)
+(define (teammate-of who)
+  (or (current-teammate)
       (error (string-append who ": not inside a team's step"))))
 
 ;;> Waits until every member of the current team has come to the barrier
 ;;> \var{name}, at most \var{seconds} (default: (task-timeout)); raises an
 ;;> error naming the members that did not come, when they run out.
 (define (team-barrier name . seconds)
-  (let ((s (if (pair? seconds) (car seconds) (task-timeout)))
-        (c (team-coordinator "team-barrier")))
-    (parameterize ((remote-timeout (+ s 1)))
-      (let ((missing (c 'arrive name (local-aspace-uid) s)))
-        (if (pair? missing)
-            (error (string-append "team-barrier " (symbol->string name)
-                                  ": timed out waiting for")
-                   missing))
-        #t))))
+  (let* ((s (if (pair? seconds) (car seconds) (task-timeout)))
+         (missing (ask-team (teammate-of "team-barrier") "team-barrier" 'arrive
+                            (lambda (left) (list name (local-aspace-uid) left)) s)))
+    (if (pair? missing)
+        (error (string-append "team-barrier " (symbol->string name)
+                              ": timed out waiting for")
+               missing))
+    #t))
 
 ;;> Sends \var{value} to the member \var{uid} of the current team.
 (define (team-send! uid value)
-  ((team-coordinator "team-send!") 'send uid (local-aspace-uid) value)
-  #t)
+  (let* ((m (teammate-of "team-send!"))
+         (n (+ 1 (teammate-sent m))))
+    (teammate-sent-set! m n)
+    (ask-team m "team-send!" 'send
+              (lambda (left)
+                (list (list (local-aspace-uid) (teammate-nonce m) n) uid (local-aspace-uid)
+                      value))
+              (task-timeout))
+    #t))
 
 ;;> The next value a member sent to this one, as (FROM . VALUE), waiting at
 ;;> most \var{seconds} (default: (task-timeout)); raises an error when none
 ;;> comes in time.
 (define (team-receive . seconds)
-  (let ((s (if (pair? seconds) (car seconds) (task-timeout)))
-        (c (team-coordinator "team-receive")))
-    (parameterize ((remote-timeout (+ s 1)))
-      (or (c 'receive (local-aspace-uid) s)
-          (error "team-receive: nothing came within" s)))))
+  (let* ((s (if (pair? seconds) (car seconds) (task-timeout)))
+         (m (teammate-of "team-receive"))
+         (deadline (+ (monotonic-seconds) s)))
+    (let loop ()
+      (let ((letter (ask-team m "team-receive" 'receive
+                              (lambda (left) (list (local-aspace-uid) (teammate-taken m) left))
+                              (max 0 (seconds-until deadline)))))
+        (cond ((not letter) (error "team-receive: nothing came within" s))
+              (else
+               (teammate-taken-set! m (letter-key letter))
+               (cond ((member (letter-key letter) (teammate-seen m)) (loop))
+                     (else
+                      (teammate-seen-set! m (cons (letter-key letter) (teammate-seen m)))
+                      (cons (letter-from letter) (letter-value letter))))))))))
 
-(define-record-type letter
-  (make-letter to from value)
-  letter?
-  (to letter-to)
-  (from letter-from)
-  (value letter-value))
+;; What m's team coordinator answers to OP, applied to what args-of
+;; makes of the seconds left; a kept one is found again wherever the lab
+;; holds it, until seconds run out.
+(define (ask-team m who op args-of seconds)
+  (let ((deadline (+ (monotonic-seconds) seconds)))
+    (let loop ()
+      (let* ((uid (teammate-uid m))
+             (left (max 0 (seconds-until deadline)))
+             (answer (guard (e ((and (remote-error? e) (not (remote-raised-error? e))) #f))
+                       (parameterize ((remote-timeout (call-seconds m op left)))
+                         (remote-apply (uid->aspace uid) team-answer (teammate-id m) op
+                                       (args-of left))))))
+        (cond ((pair? answer) (car answer))
+              ((or (not (teammate-kept? m)) (<= (seconds-until deadline) 0))
+               (error (string-append who ": the coordinator of the team "
+                                     (symbol->string (teammate-id m)) " is lost"
+                                     (if (teammate-kept? m)
+                                         ", and no address space of the lab holds it"
+                                         ""))))
+              (else
+               (let ((holder (team-holder (teammate-id m))))
+                 (if (or (not holder) (eq? holder uid))
+                     (thread-sleep! (min (team-period) (max 0 (seconds-until deadline)))))
+                 (if holder (teammate-uid-set! m holder))
+                 (loop))))))))
 
-;;> A coordinator for a team, as a proxy: (COORDINATOR 'team) is its
-;;> robots, which \var{team-of} answers, once they are chosen.  Release it
-;;> with release-proxy! when the team is done.
-(define (make-coordinator team-of)
-  (let ((arrived '()) (inboxes '())
-        (lock (make-mutex 'team)) (changed (make-condition-variable 'team)))
+;; How long m's call of op waits for its answer: only arrive and receive
+;; wait there.  A kept team's call made again counts once, so it is made
+;; again after two periods, in case the coordinator it reached is cut off.
+(define (call-seconds m op left)
+  (let ((waits (if (memq op '(arrive receive)) left 0)))
+    (if (teammate-kept? m)
+        (+ waits (max 1 (* 2 (team-period))))
+        (if (> waits 0) (+ waits 1) (remote-timeout)))))
+
+(define (team-period) (lab-setting (current-lab) 'heartbeat))
+
+;; The uid of the address space that holds team id now, or #f.
+(define (team-holder id)
+  (let ((answers (guard (e (#t '()))
+                   (parameterize ((remote-timeout (max 1 (* 2 (team-period)))))
+                     (request 'lab-tasks (sendable-lambda () (team-held? id)))))))
+    (cond ((find cadr answers) => car)
+          (else #f))))
+
+;; A letter as it travels and is kept: (KEY TO FROM VALUE).
+(define (letter-key l) (car l))
+(define (letter-to l) (cadr l))
+(define (letter-from l) (list-ref l 2))
+(define (letter-value l) (list-ref l 3))
+
+;; A team's coordinator held here: its address, whether it is acted for,
+;; and the procedure its members' calls apply.
+(define-record-type held-team
+  (make-held-team address live? proc)
+  held-team?
+  (address held-team-address)
+  (live? held-team-live?)
+  (proc held-team-proc))
+
+;; Global: the teams held here, found by id from members' calls.
+(define *teams* '())
+(define *teams-lock* (make-mutex 'teams))
+
+(define (find-held-team id)
+  (with-lock *teams-lock*
+    (lambda () (find (lambda (c) (eq? (car (held-team-address c)) id)) *teams*))))
+
+;;> Whether this address space holds team \var{id} and acts for it.
+(define (team-held? id)
+  (let ((c (find-held-team id)))
+    (and c ((held-team-live? c)) #t)))
+
+;;> What a member's call runs where its team is: (RESULT) of applying the
+;;> coordinator of team \var{id} to \var{op} and \var{args}, or #f when
+;;> this address space does not hold it, or acts for it no more.
+(define (team-answer id op args)
+  (let ((c (find-held-team id)))
+    (and c (team-held? id)
+         (let ((result (apply (held-team-proc c) op args)))
+           (and ((held-team-live? c)) (list result))))))
+
+;;> Makes the coordinator of the team \var{id} here, and answers its
+;;> address for with-coordinator.  \var{team-of} answers its robots once
+;;> they are chosen; \var{live?} whether this address space still acts for
+;;> it.  \var{keep}, unless #f, is how the team outlives this address
+;;> space: (KEEP) answers the state kept for it, or #f; (KEEP STATE) keeps
+;;> STATE.  Release it with release-coordinator! when the team is done.
+(define (make-coordinator id team-of live? keep)
+  (let ((c (make-held-team (list id (local-aspace-uid) (and keep #t)) live?
+                           (coordinator-proc team-of live? keep
+                                             (or (and keep (keep)) '(() ()))))))
+    (with-lock *teams-lock*
+      (lambda ()
+        (set! *teams* (cons c (remove (lambda (x) (eq? (car (held-team-address x)) id))
+                                      *teams*)))))
+    (held-team-address c)))
+
+;;> Forgets the coordinator at \var{address}, made here by make-coordinator.
+(define (release-coordinator! address)
+  (with-lock *teams-lock*
+    (lambda ()
+      (set! *teams* (remove (lambda (c) (eq? (held-team-address c) address)) *teams*)))))
+
+;; The coordinator's calls, its state (ARRIVED LETTERS) to begin with:
+;; ARRIVED the (NAME . UID) come to a barrier, LETTERS those not known
+;; taken, in the order they came.
+(define (coordinator-proc team-of live? keep state)
+  (let ((arrived (car state)) (letters (cadr state))
+        (lock (make-mutex 'team)) (changed (make-condition-variable 'team))
+        (keeping (make-mutex 'team-keeping)))
+    ;; Wakes every period at least, to leave a team it acts for no more.
     (define (wait-until done? seconds)
       (let ((deadline (+ (monotonic-seconds) seconds)))
         (let loop ()
-          (mutex-lock! lock)
-          (cond ((done?) => (lambda (x) (mutex-unlock! lock) x))
-                ((and (< (monotonic-seconds) deadline)
-                      (mutex-unlock! lock changed (seconds-until deadline)))
+          (lock! lock)
+          (cond ((done?) => (lambda (x) (unlock! lock) x))
+                ((and (< (monotonic-seconds) deadline) (live?)
+                      (or (unlock-waiting! lock changed (min (team-period)
+                                                             (seconds-until deadline)))
+                          #t))
                  (loop))
-                (else (mutex-unlock! lock) #f)))))
+                (else (unlock! lock) #f)))))
+    ;; Keeps the state as it is now, a state kept before never after a later.
     (define (change! thunk)
       (with-lock lock thunk)
-      (condition-variable-broadcast! changed))
+      (condition-variable-broadcast! changed)
+      (if keep
+          (with-lock keeping
+            (lambda () (keep (with-lock lock (lambda () (list arrived letters))))))))
+    (define (missing name)
+      (remove (lambda (u) (member (cons name u) arrived)) (team-of)))
     (define (arrive name uid seconds)
-      (let ((missing (lambda ()
-                       (remove (lambda (u) (member (cons name u) arrived))
-                               (team-of)))))
-        (change! (lambda () (set! arrived (cons (cons name uid) arrived))))
-        (if (wait-until (lambda () (null? (missing))) seconds)
-            '()
-            (with-lock lock missing))))
-    (define (send to from value)
       (change! (lambda ()
-                 (set! inboxes (append inboxes (list (make-letter to from value)))))))
-    (define (receive uid seconds)
-      (wait-until (lambda ()
-                    (let ((m (find (lambda (m) (eq? (letter-to m) uid)) inboxes)))
-                      (and m (begin (set! inboxes (remove (lambda (x) (eq? x m)) inboxes))
-                                    (cons (letter-from m) (letter-value m))))))
+                 (if (not (member (cons name uid) arrived))
+                     (set! arrived (cons (cons name uid) arrived)))))
+      ;; A team taken over may not have its robots yet.
+      (if (wait-until (lambda () (and (pair? (team-of)) (null? (missing name)))) seconds)
+          '()
+          (with-lock lock (lambda () (missing name)))))
+    (define (send key to from value)
+      (change! (lambda ()
+                 (if (not (find (lambda (l) (equal? (letter-key l) key)) letters))
+                     (set! letters (append letters (list (list key to from value))))))))
+    (define (receive uid taken seconds)
+      (if taken
+          (with-lock lock
+            (lambda ()
+              (set! letters (remove (lambda (l) (equal? (letter-key l) taken)) letters)))))
+      (wait-until (lambda () (find (lambda (l) (eq? (letter-to l) uid)) letters))
                   seconds))
-    (encap (lambda (op . args)
-             (case op
-               ((team) (team-of))
-               ((arrive) (apply arrive args))
-               ((send) (apply send args))
-               ((receive) (apply receive args))
-               (else (error "a coordinator does not know" op)))))))
+    (lambda (op . args)
+      (case op
+        ((team) (team-of))
+        ((arrive) (apply arrive args))
+        ((send) (apply send args) #t)
+        ((receive) (apply receive args))
+        (else (error "a coordinator does not know" op))))))
 
 ;;; What the thesis's task procedures call
 

@@ -5,10 +5,10 @@
   (export with-team on-list current-team with-team-proc-maker exec-on
           task-timeout t sort-list make-maxrandom
           with-coordinator team-barrier team-send! team-receive step-team
-          make-coordinator)
+          make-coordinator release-coordinator! team-answer team-held?)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
-          (only (murdoch wire) error-message) (only (murdoch lab) lab-default)
-          (murdoch remote) (murdoch task progress)
+          (only (murdoch wire) error-message) (only (murdoch lab) lab-default lab-setting)
+          (murdoch remote) (only (murdoch pubsub) request) (murdoch task progress)
           (murdoch task metric))
   (include "team.scm"))
