@@ -15,7 +15,7 @@
   (let ((lines (explain-components layouts)))
     (write-string (string-append "pose-task: not enough takers for "
                                  (name task-name) ":\n"
-                                 (apply string-append (map explanation-line lines (iota (length lines) 1)))
+                                 (apply string-append (explanation-lines lines))
                                  (too-few-line layouts (map explanation-free lines)))
                   port)
     (flush-output-port port)))
@@ -35,6 +35,10 @@
 
 (define (explanation-line e i)
   (string-append "  component " (number->string i) " " (explanation-needs e) "\n"))
+
+;;> The lines of \var{explanations}, one a component, numbered from 1.
+(define (explanation-lines explanations)
+  (map explanation-line explanations (iota (length explanations) 1)))
 
 ;;> An explanation for each of \var{layouts}, in order: one request of
 ;;> the whole lab, each address space answering for every layout at once

@@ -249,7 +249,7 @@
          (never (cond
                  ((any null? capable)
                   (string-append "no live robot of the lab is capable of it:"
-                                 (apply string-append (map explanation-line lines (iota (length lines) 1)))))
+                                 (apply string-append (explanation-lines lines))))
                  ((< (length (delete-duplicates (apply append exclusive)))
                      (length exclusive))
                   "fewer live robots of the lab are capable of it than it has components")
@@ -261,8 +261,7 @@
      (else
       (waiter-capable-set! w (delete-duplicates (apply append capable)))
       (waiter-capables-set! w (map cons cs capable))
-      (waiter-why-set! w (map (lambda (line i) (trimmed (explanation-line line i)))
-                                   lines (iota (length lines) 1)))
+      (waiter-why-set! w (map trimmed (explanation-lines lines)))
       (ask-way! w lines holders)
       (if (blocked-on-itself? w) (tell-waiter! w '(looked)))
       (move-up! w line)

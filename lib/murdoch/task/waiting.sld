@@ -9,7 +9,7 @@
           (murdoch task progress) (murdoch task pose-task)
           (only (murdoch pubsub) subscribe unsubscribe publish capability-layout
                 request-audience)
-          (only (murdoch task takers) explain-components explanation-line
+          (only (murdoch task takers) explain-components explanation-lines
                 explanation-free explanation-capable)
           (murdoch task record) (murdoch task rank) (murdoch task offers)
           (murdoch task holding))
