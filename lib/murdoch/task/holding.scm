@@ -50,8 +50,7 @@
 ;; How many robots w's last look found capable of c; before it, as many
 ;; as the lab has.
 (define (capable-count w c)
-  (cond ((assq c (waiter-capables w)) => (lambda (cc) (length (cdr cc))))
-        (else (length (lab-aspaces (current-lab))))))
+  (length (or (looked-capable w c) (lab-aspaces (current-lab)))))
 
 ;; Frees a robot that w holds for one component and that another, which
 ;; no other capable robot serves, needs: that one waits on w itself, and
@@ -80,7 +79,7 @@
 ;; capable robot w does not hold.
 (define (movable-for-blocked w)
   (let* ((held-by (lambda (c) (assv (component-index c) (waiter-held w))))
-         (capable (lambda (c) (cond ((assq c (waiter-capables w)) => cdr) (else '()))))
+         (capable (lambda (c) (or (looked-capable w c) '())))
          (own (held-uids w))
          (blocked (find (lambda (c)
                           (and (not (held-by c)) (pair? (capable c))
@@ -101,10 +100,10 @@
 ;; three it cannot take cost a round of the lab each, with the poser's
 ;; other tries waiting.
 (define (may-win? w c excluded)
-  (let ((capable (assq c (waiter-capables w)))
+  (let ((capable (looked-capable w c))
         (free? (lambda (uid) (not (memq uid excluded)))))
     (or (not capable)
-        (any free? (cdr capable))
+        (any free? capable)
         (any (lambda (uid) (and (free? uid) (not (memq uid (waiter-capable w)))))
              (waiter-offered w)))))
 

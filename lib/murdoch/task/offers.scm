@@ -94,9 +94,7 @@
 
 (define (ask-lab-due?)
   (or (not *posers*)
-      (> (- (monotonic-seconds) *posers-asked*)
-         (min (* 10 (lab-setting (current-lab) 'heartbeat))
-              (/ (lab-setting (current-lab) 'lease) 3)))))
+      (> (- (monotonic-seconds) *posers-asked*) (look-period))))
 
 ;; Each poser's (UID (WANTING ...)) for this robot, best offer-depth first.
 (define (who-waits me depth)

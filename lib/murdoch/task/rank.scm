@@ -74,6 +74,14 @@
                (and (= (rank-posed a) (rank-posed b))
                     (string<? (rank-id a) (rank-id b)))))))
 
+;; Seconds between a poser's looks at its waiting tasks, and between a
+;; robot's asks of the whole lab who waits: ten heartbeats, or a third of
+;; the lease if that is sooner, so a look comes before a held robot's
+;; lease runs out.
+(define (look-period)
+  (min (* 10 (lab-setting (current-lab) 'heartbeat))
+       (/ (lab-setting (current-lab) 'lease) 3)))
+
 ;; The better of ranks a and b, either #f for none.
 (define (better-rank a b)
   (cond ((not a) b) ((not b) a) ((rank<? a b) a) (else b)))
@@ -99,6 +107,12 @@
   (excluded waiter-excluded waiter-excluded-set!) ; its pose-task-excluded
   (news waiter-news waiter-news-set!)
   (bell waiter-bell waiter-bell-set!))
+
+;; The uids w's last look found capable of its component c, or #f before
+;; one.
+(define (looked-capable w c)
+  (let ((cc (assq c (waiter-capables w))))
+    (and cc (cdr cc))))
 
 ;; The tasks waiting here, best rank first, under *tasks-lock*.
 (define *waiters* '())

@@ -5,10 +5,11 @@
 (define-library (murdoch task rank)
   (export make-turn turn? turn-wait? turn-hold? turn-priority turn-deadline
           turn-posed read-turn check-waiting-room turn-rank rank<? better-rank
+          look-period
           make-waiter waiter? waiter-task waiter-components waiter-rank
           waiter-held waiter-held-set! waiter-looked waiter-looked-set!
           waiter-kept waiter-kept-set! waiter-yielded waiter-yielded-set!
-          waiter-capable waiter-capable-set! waiter-capables
+          waiter-capable waiter-capable-set! waiter-capables looked-capable
           waiter-capables-set! waiter-offered waiter-offered-set! waiter-position waiter-position-set!
           waiter-why waiter-why-set! waiter-never waiter-never-set!
           waiter-excluded waiter-excluded-set! waiter-news waiter-news-set!

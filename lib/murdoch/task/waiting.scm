@@ -169,9 +169,7 @@
 (define (past? deadline) (and deadline (>= (monotonic-seconds) deadline)))
 
 (define (next-look deadline)
-  (let ((look (+ (monotonic-seconds)
-                 (min (* 10 (lab-setting (current-lab) 'heartbeat))
-                      (/ (lab-setting (current-lab) 'lease) 3)))))
+  (let ((look (+ (monotonic-seconds) (look-period))))
     (if deadline (min deadline look) look)))
 
 ;; A try that answers at once and writes no explanation: the waiter
