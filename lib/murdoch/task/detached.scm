@@ -40,7 +40,7 @@
 ;; Let go after let-go-periods without the standby's pings; take over
 ;; after take-over-periods unanswered: the no-ghost rule's settings, with
 ;; the coordinator in the robot's place (docs/tasks.md).
-(define (let-go-periods) (lab-setting (current-lab) 'orphan-periods))
+(define (let-go-periods) (orphan-periods))
 (define (take-over-periods) (lost-periods))
 
 ;; What a coordinator and its standby each keep of a detached task.

@@ -15,7 +15,7 @@
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (murdoch task progress) (only (murdoch task pose-task) lab-task-key)
           (only (murdoch task running) components-running components-ended ended-id
-                ended-index lost-periods)
+                ended-index orphan-periods lost-periods)
           (murdoch task record)
           (only (murdoch task rank) make-turn turn-wait? turn-hold? turn-priority
                 turn-deadline turn-posed)

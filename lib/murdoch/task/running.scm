@@ -81,6 +81,11 @@
 ;; orphan-periods (looked at every quarter period), well before the poser
 ;; declares the robot lost after lost-periods (life-cycle.scm) and may
 ;; start another: docs/tasks.md.
+
+;;> How many silent heartbeat periods a component waits for its poser
+;;> before it stops: the lab's orphan-periods.
+(define (orphan-periods) (lab-setting (current-lab) 'orphan-periods))
+
 ;;> How many silent heartbeat periods a poser waits before it declares a
 ;;> robot lost: the lab's lost-periods.
 (define (lost-periods) (lab-setting (current-lab) 'lost-periods))
@@ -88,8 +93,7 @@
 (define (watch-poser r period)
   (thread-sleep! (/ period 4))
   (cond ((running-over? r) #t)
-        ((> (- (monotonic-seconds) (running-heard r))
-            (* (lab-setting (current-lab) 'orphan-periods) period))
+        ((> (- (monotonic-seconds) (running-heard r)) (* (orphan-periods) period))
          (log-warn "the poser " (running-poser r) " of " (running-id r)
                    " is silent: component " (running-index r) " stops")
          (stop-running! r))

@@ -1,8 +1,9 @@
 ;;> The robot's side of the task life cycle: run-component runs a started
 ;;> task's component here and stops it when its poser falls silent;
 ;;> component-heartbeat! and stop-component! are what the poser calls, and
-;;> (lost-periods) the lab's silent heartbeat periods before it declares a
-;;> robot lost (running.scm says why).  run-posed-component
+;;> (orphan-periods) and (lost-periods) the lab's silent heartbeat periods
+;;> before a component stops and a poser declares its robot lost
+;;> (running.scm says why).  run-posed-component
 ;;> runs a component of pose-task's; components-running and
 ;;> components-ended list them all, for the status and the live view.
 
@@ -10,7 +11,7 @@
   (export run-component run-posed-component component-heartbeat! stop-component!
           await-component
           components-running components-ended ended-id ended-index ended-started
-          ended-ended ended-end lost-periods)
+          ended-ended ended-end orphan-periods lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
           (murdoch robot) (only (murdoch lab) lab-setting)
           (only (murdoch remote) hand-over-connection! release-call! current-lab))
