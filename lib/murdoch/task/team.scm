@@ -130,8 +130,9 @@
 ;; team's coordinator, held where the task is coordinated, under the
 ;; team's id.  A member reaches it by its address, (ID UID KEPT?); when
 ;; UID is lost, or holds the team no more, the member of a team that is
-;; kept (a detached task's, taken over) asks the lab who holds ID now (the lab-tasks subject, which the
-;; members holding a detached task subscribe to), and calls again there.
+;; kept (a detached task's, taken over) asks the lab who holds ID now
+;; (the lab-tasks subject, which the members holding a detached task
+;; subscribe to), and calls again there.
 ;; So any call may count twice: an arrival counts once however often it
 ;; comes, a letter carries its sender's key and is kept once, a member
 ;; takes each key once, and a letter stays with the coordinator until the
@@ -159,7 +160,8 @@
 ;;> \var{coordinator}, what make-coordinator answered: team-barrier,
 ;;> team-send! and team-receive reach it, and current-team is its robots.
 (define (with-coordinator coordinator thunk)
-  (let ((m (make-teammate (car coordinator) (cadr coordinator) (car (cddr coordinator))
+  (let ((m (make-teammate (address-id coordinator) (address-uid coordinator)
+                          (address-kept? coordinator)
                           (random-integer 1000000000) 0 #f '())))
     (parameterize ((current-teammate m)
                    (current-team (ask-team m "with-coordinator" 'team
@@ -271,6 +273,12 @@
 (define (letter-from l) (list-ref l 2))
 (define (letter-value l) (list-ref l 3))
 
+;; A coordinator's address as it travels to its members: (ID UID KEPT?),
+;; the team's id, the uid holding it, and whether it outlives that uid.
+(define (address-id a) (car a))
+(define (address-uid a) (cadr a))
+(define (address-kept? a) (car (cddr a)))
+
 ;; A team's coordinator held here: its address, whether it is acted for,
 ;; and the procedure its members' calls apply.
 (define-record-type held-team
@@ -286,7 +294,7 @@
 
 (define (find-held-team id)
   (with-lock *teams-lock*
-    (lambda () (find (lambda (c) (eq? (car (held-team-address c)) id)) *teams*))))
+    (lambda () (find (lambda (c) (eq? (address-id (held-team-address c)) id)) *teams*))))
 
 ;;> Whether this address space holds team \var{id} and acts for it.
 (define (team-held? id)
@@ -314,7 +322,7 @@
                                              (or (and keep (keep)) '(() ()))))))
     (with-lock *teams-lock*
       (lambda ()
-        (set! *teams* (cons c (remove (lambda (x) (eq? (car (held-team-address x)) id))
+        (set! *teams* (cons c (remove (lambda (x) (eq? (address-id (held-team-address x)) id))
                                       *teams*)))))
     (held-team-address c)))
 
