@@ -1,7 +1,7 @@
 ;;; (murdoch sys wait): wind as Chibi's dynamic-wind, the locks the remote
 ;;; layer takes on every call, undoing on a raise, and mailboxes by id.
 (import (scheme base) (scheme write) (srfi 18) (srfi 69) (chibi test)
-        (only (chibi ast) gc) (murdoch sys))
+        (only (chibi ast) gc) (murdoch sys) (only (murdoch sys wait) wind))
 
 ;; What ran, in order, through (note! x).
 (define trail '())
@@ -81,6 +81,16 @@
     (trail-of (lambda ()
                 (undo-on-raise (lambda () (note! 'undone)) (lambda () 1))
                 (raise 'later)))))
+
+(test-group "undo-on-raise in halves"
+  ;; The point is taken before the thunk runs: an argument of a call that runs it.
+  (define (halves thunk)
+    (trail-of (lambda () (ended (undo-begun! (lambda () (note! 'undone))) thunk))))
+  (define (ended here thunk) (undo-ended here (thunk)))
+  (test "undo does not run when what ran between returns" '((value 3))
+    (halves (lambda () 3)))
+  (test "undo runs when it raises" '(undone (raised boom))
+    (halves (lambda () (raise 'boom)))))
 
 (test-group "gatherings"
   (define (answer! item value) (set-car! item value))

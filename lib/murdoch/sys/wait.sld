@@ -5,7 +5,7 @@
 (define-library (murdoch sys wait)
   (export lock! unlock! unlocked unlock-waiting! cell-value wind with-lock with-lock-by
           lock-ranks
-          seconds-until undo-on-raise map-guarded
+          seconds-until undo-on-raise undo-begun! undo-ended map-guarded
           make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)
