@@ -11,6 +11,7 @@
           poller-frames! lock! unlock! unlocked unlock-waiting! cell-value with-lock
           with-lock-by seconds-until undo-on-raise undo-begun! undo-ended map-guarded make-mailbox
           mailbox-put! mailbox-take mailbox-empty! take-mailbox!
-          take-all-mailboxes! make-gathering gathering-put! gathering-wait)
+          take-all-mailboxes! make-gathering gathering-put! gathering-wait
+          define-lean-record-type)
   (import (murdoch sys guard) (murdoch sys log) (murdoch sys process)
-          (murdoch sys scheduler) (murdoch sys wait)))
+          (murdoch sys scheduler) (murdoch sys wait) (murdoch sys record)))

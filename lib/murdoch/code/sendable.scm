@@ -14,7 +14,7 @@
 ;;   #(murdoch:void) #(murdoch:eof)
 ;; Anything else (a port, a record) stops at the sender, naming what held it.
 
-(define-record-type sendable-info
+(define-lean-record-type sendable-info
   (make-sendable-info source+names values)
   sendable-info?
   (source+names sendable-info-source+names)

@@ -1,7 +1,7 @@
 ;;;; remote-run! and remote-apply (thesis §3.3.2), and their -all forms.
 
 ;; A call leaving this address space, encoded once for all its targets.
-(define-record-type call
+(define-lean-record-type call
   (make-call kind proc args proc-code args-code seconds)
   call?
   (kind call-kind)                      ; run or apply

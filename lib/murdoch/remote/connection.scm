@@ -24,7 +24,7 @@
 
 ;;> A call on its way to uid, or uid's answer to a datagram call; its
 ;;> answer, #f until it comes, is handed in through its gathering.
-(define-record-type pending-call
+(define-lean-record-type pending-call
   (make-pending-call uid connection id gathering answer)
   pending-call?
   (uid pending-call-uid)

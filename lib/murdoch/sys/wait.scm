@@ -189,7 +189,7 @@
 
 ;; A one-shot mailbox: the reader puts an answer, the caller takes it or
 ;; gives up; emptied by its taker once no other thread can put to it.
-(define-record-type mailbox
+(define-lean-record-type mailbox
   (%make-mailbox mutex condvar value full?)
   mailbox?
   (mutex mailbox-mutex)
@@ -253,7 +253,7 @@
 
 ;;> A gathering: the poller hands in the answers to a caller's calls, and
 ;;> the caller wakes once, at the nth or its deadline, not n times.
-(define-record-type gathering
+(define-lean-record-type gathering
   (%make-gathering mutex condvar got wanted)
   gathering?
   (mutex gathering-mutex)
