@@ -5,7 +5,7 @@
 ;; Most take one value; code and delivery the rest of their clause.
 ;; read-lab reads each once; every user asks lab-setting.
 
-(define-record-type setting
+(define-record-type setting-row
   (make-setting name default reader)
   setting?
   (name setting-name)

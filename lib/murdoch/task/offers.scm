@@ -33,7 +33,7 @@
 ;; A waiter answers its offers after the try or look it is in, which on a
 ;; busy lab may take seconds; a robot that moved on sooner went to a
 ;; worse-ranked task meanwhile.
-(define (offer-seconds) (lab-setting (current-lab) 'timeout))
+(define (offer-seconds) (setting 'timeout))
 
 ;; Whether w is offered a robot for each component it does not hold: two
 ;; robots freed together offer themselves to one task, and the second

@@ -123,7 +123,7 @@
          (else
           (if (or (not (equal? held (held-uids w))) (look-due? w)) (want-look!))
           (if (> (- (monotonic-seconds) (waiter-kept w))
-                 (/ (lab-setting (current-lab) 'lease) 4))
+                 (/ (setting 'lease) 4))
               (keep-held! w))
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
