@@ -114,7 +114,8 @@
   (let ((cc (assq c (waiter-capables w))))
     (and cc (cdr cc))))
 
-;; The tasks waiting here, best rank first, under *tasks-lock*.
+;; The tasks waiting here, best rank first, under *tasks-lock*.  Global,
+;; as the posed tasks are: a process is one poser.
 (define *waiters* '())
 
 (define (waiters) *waiters*)
@@ -204,7 +205,8 @@
               (request 'waiting-tasks waiting-ranks)))
 
 ;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
-;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*.
+;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*; global,
+;; as the lab's waiting tasks are the same for all this poser's.
 (define *lab-waiting* #f)
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,

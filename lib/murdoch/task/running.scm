@@ -168,6 +168,7 @@
 ;; component in one or the other.
 
 (define kept-ended 16)
+;; Global, as the running list is: a poser's report reads both.
 (define *ended* '())
 
 (define-record-type ending
