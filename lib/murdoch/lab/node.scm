@@ -3,7 +3,7 @@
 ;;;; (docs/architecture.md, "How an address space starts").
 
 (define-record-type node
-  (make-node lab)
+  (make-node lab wire limits sandbox membership server group monitors)
   node?
   (lab node-lab)                        ; read once; its settings by setting
   (wire node-wire node-wire-set!)       ; wire/frame.scm: the key, frame limits
@@ -20,7 +20,7 @@
 
 ;;> Makes this process a node of \var{lab}, its parts yet to be filled.
 (define (open-node! lab)
-  (set! *node* (make-node lab))
+  (set! *node* (make-node lab #f #f #f #f #f #f #f))
   *node*)
 
 (define (this-node)
