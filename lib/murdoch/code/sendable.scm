@@ -168,8 +168,9 @@
 
 ;;> Takes the value limits of this process's lab: max-depth, and max-frame / 2 pairs.
 (define (set-value-limits!)
-  (node-limits-set! (this-node) (make-value-limits (setting 'max-depth)
-                                                   (quotient (setting 'max-frame) 2))))
+  (node-limits-set! (this-node)
+                    (make-value-limits (setting 'max-depth)
+                                       (quotient (setting 'max-frame) 2))))
 
 (define (check-depth depth what)
   (if (> depth (limits-depth (the-limits)))

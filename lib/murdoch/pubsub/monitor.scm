@@ -136,12 +136,12 @@
 ;;> \var{on-free} runs, outside any lock, when exclusive subjects are freed.
 (define (initialize-subscriptions! entry on-free)
   (on-free! on-free)
-  (node-monitors-set! (this-node)
-                      (make-monitors (setting 'battery-charging) (setting 'battery-low)
-                                     (setting 'load-threshold)
-                                     (load-source (and entry
-                                                       (lab-aspace-clause entry 'load)))
-                                     (cons #f "")))
+  (node-monitors-set!
+   (this-node)
+   (make-monitors (setting 'battery-charging) (setting 'battery-low)
+                  (setting 'load-threshold)
+                  (load-source (and entry (lab-aspace-clause entry 'load)))
+                  (cons #f "")))
   (for-each subscribe (list 'all (local-aspace-uid)))
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)

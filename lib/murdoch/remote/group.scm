@@ -85,7 +85,8 @@
                    (write-simple (list (local-aspace-uid) sequence body) o))))
          (bytes (datagram-bytes text)))
     (and (<= (bytevector-length bytes) max-datagram)
-         (begin (send (group-socket (the-group)) bytes 0 (group-address (the-group))) #t))))
+         (begin (send (group-socket (the-group)) bytes 0 (group-address (the-group)))
+                #t))))
 
 (define (beacon-seconds)
   (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
@@ -100,7 +101,8 @@
     (for-each (lambda (uid)
                 (if (< (with-lock (group-last-heard-lock (the-group))
                          (lambda ()
-                           (hash-table-ref/default (group-last-heard (the-group)) uid now)))
+                           (hash-table-ref/default (group-last-heard (the-group))
+                                                   uid now)))
                        (- now (* 3 period)))
                     (note-unreachable! uid)))
               (known-uids))
@@ -114,7 +116,8 @@
 (define (receive-call)
   (let ((n (receive! (group-socket (the-group)) (group-buffer (the-group)))))
     (and (>= n 0)
-         (not (datagram-from? (group-buffer (the-group)) n (group-own-head (the-group))))
+         (not (datagram-from? (group-buffer (the-group)) n
+                              (group-own-head (the-group))))
          (heard (open-datagram (group-buffer (the-group)) n)))))
 
 ;; The call datagram d carries, once its sender is heard from.  Our own,
@@ -122,7 +125,8 @@
 ;; otherwise written is dropped here, so our uid never leaves the live set.
 (define (heard d)
   (lock! (group-last-heard-lock (the-group)))
-  (hash-table-set! (group-last-heard (the-group)) (datagram-sender d) (monotonic-seconds))
+  (hash-table-set! (group-last-heard (the-group)) (datagram-sender d)
+                   (monotonic-seconds))
   (unlock! (group-last-heard-lock (the-group)))
   (and (not (eq? (datagram-sender d) (local-aspace-uid)))
        (datagram-call (datagram-sender d) (datagram-body d))))

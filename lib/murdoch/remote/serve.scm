@@ -54,7 +54,8 @@
     (serving-fd-set! s (port-fileno (serving-in s)))
     ;; The hello, which proves the key, is due within frame-timeout of the
     ;; connect: anyone can connect, and a connection holds a descriptor.
-    (serving-deadline-set! s (+ (monotonic-seconds) (server-frame-timeout (the-server))))
+    (serving-deadline-set! s (+ (monotonic-seconds)
+                                (server-frame-timeout (the-server))))
     (janitor-wanted!)
     (watch-served! (serving-in s) s take-polled! polled-fault!)))
 
