@@ -23,6 +23,7 @@
   (set! *node* (make-node lab #f #f #f #f #f #f #f))
   *node*)
 
+;;> This process's node, for a layer to fill its part.
 (define (this-node)
   (or *node* (error "this process has not joined a lab")))
 
