@@ -126,7 +126,13 @@
     (test "refused: exit 3" #f (car made))
     (test-assert (text-contains? (cdr made) "box-layout: seed 2: refused: "))
     (test-assert "it says what is in the way" (text-contains? (cdr made) "from a wall"))
-    (test-assert "and writes no lab" (not (file-exists? (string-append dir "/two/lab.scm"))))))
+    (test-assert "and writes no lab" (not (file-exists? (string-append dir "/two/lab.scm")))))
+  ;; Seed 33's goal is 176 mm from a wall: the box arriving there would
+  ;; stand in it (the goal went unchecked, and the box was pushed into the
+  ;; wall and past its goal).
+  (let ((made (layout 33 "thirty-three")))
+    (test "refused: exit 3" #f (car made))
+    (test-assert (text-contains? (cdr made) "(the goal) is 176 mm from a wall"))))
 
 (delete-file-hierarchy dir)
 (test-end)
