@@ -123,8 +123,13 @@
 (define pi (acos -1))
 
 ;; Whether a robot at r (radius mm) is within 100 mm of the rear face of a
-;; box at b (side mm) moving by (dx dy): the face whose normal is nearest
-;; the motion's opposite.
+;; box at b (side mm) moving by (dx dy), the face whose normal is nearest
+;; the motion's opposite, with at least a quarter of its width behind the
+;; face: a pusher's body may hang past the face's end, for two bodies are
+;; wider than a box under 720 mm, and its centre may lie past it while half
+;; its front presses the face (generated seeds 40 and 48, 430 and 490 mm
+;; boxes: the spare's centre 10 to 60 mm past the end, its front 10 mm
+;; behind the face, for a fifth of the last third).
 (define (at-rear? r b side radius dx dy)
   (let* ((motion (atan dy dx))
          (h (* pi (/ (list-ref b 2) 180)))
@@ -132,7 +137,8 @@
          (rx (- (car r) (car b))) (ry (- (cadr r) (cadr b)))
          (u (+ (* rx (cos axis)) (* ry (sin axis))))
          (v (- (* ry (cos axis)) (* rx (sin axis)))))
-    (and (<= (- (- u) (/ side 2) radius) 100) (< u 0) (<= (abs v) (/ side 2)))))
+    (and (<= (- (- u) (/ side 2) radius) 100) (< u 0)
+         (<= (abs v) (+ (/ side 2) (/ radius 2))))))
 
 ;; (PUSHED LAST-THIRD-SHARE TRAVEL): mm the box moved while robot k was at
 ;; its rear face, the share of the last third of its travel it was, and
