@@ -125,11 +125,8 @@
 ;; Whether a robot at r (radius mm) is within 100 mm of the rear face of a
 ;; box at b (side mm) moving by (dx dy), the face whose normal is nearest
 ;; the motion's opposite, with at least a quarter of its width behind the
-;; face: a pusher's body may hang past the face's end, for two bodies are
-;; wider than a box under 720 mm, and its centre may lie past it while half
-;; its front presses the face (generated seeds 40 and 48, 430 and 490 mm
-;; boxes: the spare's centre 10 to 60 mm past the end, its front 10 mm
-;; behind the face, for a fifth of the last third).
+;; face: two bodies are wider than a small box, so a pusher pressing the
+;; face may have its centre past the face's end (docs/box-move.md).
 (define (at-rear? r b side radius dx dy)
   (let* ((motion (atan dy dx))
          (h (* pi (/ (list-ref b 2) 180)))
