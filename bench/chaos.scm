@@ -35,7 +35,7 @@
         (srfi 1) (srfi 18) (srfi 27) (srfi 132)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness)
-        (only (murdoch sys scheduler) monotonic-seconds) (only (murdoch lab) lab-setting)
+        (only (murdoch sys scheduler) monotonic-seconds) (only (murdoch lab) setting)
         (only (murdoch wire) error-message) (only (murdoch sys) utc-seconds))
 
 (define seconds
@@ -354,7 +354,7 @@
 (define (takeover-floor-once)
   (let ((t0 (monotonic-seconds)))
     (request 'all (lambda () (components-running)))
-    (+ (lab-setting (current-lab) 'heartbeat) (- (monotonic-seconds) t0))))
+    (+ (setting 'heartbeat) (- (monotonic-seconds) t0))))
 
 (let* ((floors (map (lambda (i) (floor-once)) (iota 7)))
        (takeover-floors (map (lambda (i) (takeover-floor-once)) (iota 7)))

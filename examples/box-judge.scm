@@ -123,8 +123,10 @@
 (define pi (acos -1))
 
 ;; Whether a robot at r (radius mm) is within 100 mm of the rear face of a
-;; box at b (side mm) moving by (dx dy): the face whose normal is nearest
-;; the motion's opposite.
+;; box at b (side mm) moving by (dx dy), the face whose normal is nearest
+;; the motion's opposite, with at least a quarter of its width behind the
+;; face: two bodies are wider than a small box, so a pusher pressing the
+;; face may have its centre past the face's end (docs/box-move.md).
 (define (at-rear? r b side radius dx dy)
   (let* ((motion (atan dy dx))
          (h (* pi (/ (list-ref b 2) 180)))
@@ -132,7 +134,8 @@
          (rx (- (car r) (car b))) (ry (- (cadr r) (cadr b)))
          (u (+ (* rx (cos axis)) (* ry (sin axis))))
          (v (- (* ry (cos axis)) (* rx (sin axis)))))
-    (and (<= (- (- u) (/ side 2) radius) 100) (< u 0) (<= (abs v) (/ side 2)))))
+    (and (<= (- (- u) (/ side 2) radius) 100) (< u 0)
+         (<= (abs v) (+ (/ side 2) (/ radius 2))))))
 
 ;; (PUSHED LAST-THIRD-SHARE TRAVEL): mm the box moved while robot k was at
 ;; its rear face, the share of the last third of its travel it was, and

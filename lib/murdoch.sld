@@ -22,7 +22,7 @@
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive receive-components
           get-system-load load-monitor battery-monitor
-          *battery-charging* *battery-low* *load-threshold*
+          battery-charging battery-low load-threshold
           set-battery-charging! set-battery-low! set-load-threshold!
           ;; pose-task, metrics and dynamic teams (lib/murdoch/task/pose-task.scm,
           ;; metric.scm, team.scm)

@@ -93,10 +93,10 @@
                   "set!: local-aspace-uid is imported"))
   (test "so is var-set! of one" #t
     (starts-with? (guard (e ((remote-error? e) (remote-error-message e)))
-                    (var-set! 'troy *load-threshold* "0"))
-                  "set!: *load-threshold* is imported"))
+                    (var-set! 'troy load-threshold "0"))
+                  "set!: load-threshold is imported"))
   (test "a setting changes through its procedure" "0.5"
-    (remote-apply (troy) (lambda () (set-load-threshold! "0.5") *load-threshold*)))
+    (remote-apply (troy) (lambda () (set-load-threshold! "0.5") (load-threshold))))
   (test "what the lab's code defines is the lab's own to change" 7
     (begin (var-set! 'troy *counter* 7) (var-ref 'troy *counter*)))
   (test "a define over an import stays inside the code that made it" '((2) 1)

@@ -6,14 +6,15 @@
                 (sendable-define define))
         (murdoch lab) (murdoch testing harness))
 
-;; The lab of clauses (max-depth, max-frame), read from a file of its own.
-(define (limits-of clauses)
-  (let* ((lab (make-test-lab clauses))
-         (limits (read-lab (test-lab-file lab))))
+;; The limits of a lab of clauses (max-depth, max-frame), read from a
+;; file of its own, this process's node.
+(define (take-limits! clauses)
+  (let ((lab (make-test-lab clauses)))
+    (open-node! (read-lab (test-lab-file lab)))
     (remove-test-lab! lab)
-    limits))
+    (set-value-limits!)))
 
-(set-value-limits! (limits-of '()))
+(take-limits! '())
 
 (define env (environment '(scheme base)))
 (define (round-trip x)
@@ -73,7 +74,7 @@
   (guard (e ((send-error? e) (error-object-message e))) (thunk) 'sent))
 (define (nested n) (if (= n 0) '() (list (nested (- n 1)))))
 (test-group "the limits, through the look that passes plain data as it is"
-  (set-value-limits! (limits-of '((max-depth 50) (max-frame 2000))))
+  (take-limits! '((max-depth 50) (max-frame 2000)))
   (test "plain data nested to the limit goes as it is" (nested 49)
     (encode (nested 49) env "it"))
   (test "deeper is refused" "it nests deeper than the lab's max-depth, 50"
@@ -89,7 +90,7 @@
       '(1 (2 "three") four)
     (let ((p (round-trip (list '(1 (2 "three")) (lambda () 'four)))))
       (list (caar p) (cadr (car p)) ((cadr p)))))
-  (set-value-limits! (limits-of '())))
+  (take-limits! '()))
 (test "a receiver's table of compiled sources, emptied when full, compiles again"
     '(0 4100 0)
   ;; 4,101 sources, more than the table holds, through one decoder.

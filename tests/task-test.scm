@@ -8,7 +8,7 @@
         (srfi 1) (srfi 18) (chibi test)
         (only (chibi process) kill signal/stop signal/continue)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
-        (murdoch cli command) (murdoch testing harness))
+        (only (murdoch lab) current-lab) (murdoch cli command) (murdoch testing harness))
 
 (define lab-code "
 ;; Each component's setup and cleanup count, here, how often they run.

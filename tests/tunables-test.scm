@@ -1,4 +1,4 @@
-;;; The settings that are parameters, or the thesis's globals, of the
+;;; The settings that are parameters, or the thesis's thresholds, of the
 ;;; layers above the lab: their defaults are the lab's table's, and an
 ;;; address space that joins a lab takes the lab file's values.
 (import (scheme base) (chibi test)
@@ -8,13 +8,11 @@
 
 (test-begin "tunables")
 
-(test "before a lab is joined, each is its default in the lab's table"
+(test "before a lab is joined, each parameter is its default in the lab's table"
     (map lab-default '(task-timeout trip-timeout trip-motion-timeout
-                       pose-task-retries pose-task-backoff
-                       battery-charging battery-low load-threshold))
+                       pose-task-retries pose-task-backoff))
   (list (task-timeout) (trip-timeout) (trip-motion-timeout)
-        (pose-task-retries) (pose-task-backoff)
-        *battery-charging* *battery-low* *load-threshold*))
+        (pose-task-retries) (pose-task-backoff)))
 
 (define lab
   (make-test-lab '((task-timeout 60) (trip-timeout 2) (trip-motion-timeout 30)
@@ -35,7 +33,7 @@
     '(60 2 30 1 0.5 120 90 ".5")
   (list (task-timeout) (trip-timeout) (trip-motion-timeout)
         (pose-task-retries) (pose-task-backoff)
-        *battery-charging* *battery-low* *load-threshold*))
+        (battery-charging) (battery-low) (load-threshold)))
 
 (test "parameterize still overrides the lab's value, for its extent" '(7 60)
   (list (parameterize ((task-timeout 7)) (task-timeout)) (task-timeout)))

@@ -156,7 +156,7 @@
            (legs (map list (drop-right path 1) (cdr path)))
            (names (cons "the box's start"
                         (map (lambda (i) (if (= i (length bends)) "the goal" "a bend"))
-                             (iota (length bends) 0)))))
+                             (iota (+ (length bends) 1))))))
       (or (any (lambda (p k)
                  (and (< (clearance p w d) sweep)
                       (string-append "the path's point " (point-words p) " (" k ") is "

@@ -8,7 +8,12 @@
           lab-key lab-clause lab-robot-radius read-source unread-lab-port-base
           lab-aspace-uid lab-aspace-index lab-aspace-host lab-aspace-port
           lab-aspace-clause random-hex lab-walls lab-boxes wall-from wall-to wall-thickness
-          box-centre box-width box-depth box-heading)
+          box-centre box-width box-depth box-heading
+          *node* open-node! this-node current-lab setting
+          node-wire node-wire-set! node-limits node-limits-set!
+          node-sandbox node-sandbox-set! node-membership node-membership-set!
+          node-server node-server-set! node-group node-group-set!
+          node-monitors node-monitors-set!)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
           (scheme process-context)
           (scheme inexact)
@@ -20,4 +25,5 @@
           (chibi io) (chibi edit-distance)
           (only (murdoch sys) condition-message))
   (include "lab/file.scm" "lab/settings.scm" "lab/clauses.scm" "lab/source.scm"
-           "lab/room.scm" "lab/key.scm"))
+           "lab/room.scm" "lab/key.scm"
+           "lab/node.scm"))

@@ -9,7 +9,7 @@
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive receive-components
           offer-subjects! addressed-here? get-system-load load-monitor battery-monitor
-          *battery-charging* *battery-low* *load-threshold*
+          battery-charging battery-low load-threshold
           set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)
   (import (murdoch pubsub messaging) (murdoch pubsub monitor)))

@@ -3,25 +3,25 @@
 ;;;; (connection, worker, call), the group, serving, proxies and delivery;
 ;;;; start-aspace! starts them in that order.
 
-;;> Makes this process the address space \var{uid} of \var{lab}, received
+;;> Makes this process the address space \var{uid} of its lab, received
 ;;> code running in \var{environment}, and starts answering calls;
 ;;> \var{port} may override the lab's port for uid.
-(define (start-aspace! lab uid environment . port)
-  (let ((entry (lab-aspace-by-uid lab uid)))
-    (join-lab! lab uid
-               (if entry (lab-aspace-host entry) (lab-setting lab 'interface))
+(define (start-aspace! uid environment . port)
+  (let ((entry (lab-aspace-by-uid (current-lab) uid)))
+    (join-lab! uid
+               (if entry (lab-aspace-host entry) (setting 'interface))
                (cond ((pair? port) (car port))
                      (entry (lab-aspace-port entry))
                      (else (error "not in the lab" uid)))
                environment
                (make-decoder environment decode-proxy))
     (set-log-name! (string-append "murdoch " (symbol->string uid)))
-    (start-wire! lab)
-    (set-value-limits! lab)
+    (start-wire!)
+    (set-value-limits!)
     (set-sandbox-ports! (current-output-port) (current-error-port))
-    (start-serving! lab)
+    (start-serving!)
     (spawn prober 'prober)
-    (start-group! lab serve-group)
+    (start-group! serve-group)
     (local-aspace)))
 
 ;;; From aux.scm

@@ -3,31 +3,32 @@
 ;;> Makes this process address space \var{uid} of the lab at
 ;;> \var{lab-file}, serving; answers the received-code environment.
 (define (join-lab lab-file uid . port)
-  (join-read-lab (read-lab lab-file) uid port))
+  (start-node! (read-lab lab-file) uid port))
 
-;; SIGPIPE is ignored, as by the simulator: a peer may die at any moment,
-;; and its end is seen by the connection's reader, not this process's death.
-(define (join-read-lab lab uid port)
+;; The one start of an address space: the node of lab, each layer taking
+;; its part in turn (docs/architecture.md).  SIGPIPE is ignored, as by the
+;; simulator: a peer may die at any moment, and its end is seen by the
+;; connection's reader, not this process's death.
+(define (start-node! lab uid port)
   (set-signal-action! signal/pipe #f)
-  (take-tunables! lab)
-  (let ((env (make-lab-environment lab))
+  (open-node! lab)
+  (take-tunables!)
+  (let ((env (make-lab-environment))
         (entry (lab-aspace-by-uid lab uid)))
     (if entry (take-body! lab entry))
-    (apply start-aspace! lab uid env port)
-    (initialize-subscriptions! lab entry robot-freed!)
+    (apply start-aspace! uid env port)
+    (initialize-subscriptions! entry robot-freed!)
     (offer-on-joining!)
     env))
 
-;; The settings that are the layers' parameters or globals, set before anything runs.
+;; The settings that are the layers' parameters, set before anything runs.
 (define tunables
   `((task-timeout . ,task-timeout) (trip-timeout . ,trip-timeout)
     (trip-motion-timeout . ,trip-motion-timeout)
-    (pose-task-retries . ,pose-task-retries) (pose-task-backoff . ,pose-task-backoff)
-    (battery-charging . ,set-battery-charging!) (battery-low . ,set-battery-low!)
-    (load-threshold . ,set-load-threshold!)))
+    (pose-task-retries . ,pose-task-retries) (pose-task-backoff . ,pose-task-backoff)))
 
-(define (take-tunables! lab)
-  (for-each (lambda (t) ((cdr t) (lab-setting lab (car t)))) tunables))
+(define (take-tunables!)
+  (for-each (lambda (t) ((cdr t) (setting (car t)))) tunables))
 
 ;; A robot drives its robot through trip; a workstation answers safe-reckon
 ;; from its position.  The simulator is up first, so one try is enough.
@@ -55,7 +56,7 @@
   ;; still shared with the loader (sys/heap-watch.c).
   (heap-on-huge-pages!)
   (start-heap-guard!
-   (lab-setting (current-lab) 'heap-max)
+   (setting 'heap-max)
    (string-append "murdoch " (symbol->string uid) ": ERROR: the heap passed"
                   " the lab's heap-max; exiting, for the lab to start it again"))
   (log-note "listening on " (aspace-host (local-aspace)) ":"
@@ -82,14 +83,14 @@
          (uid (or uid (string->symbol
                        (string-append "guest-" (number->string
                                                 (current-process-id))))))
-         (lab-env (join-read-lab lab uid
+         (lab-env (start-node! lab uid
                                  (if guest? (list (lab-guest-port lab)) '()))))
     (write-string (string-append "murdoch: a REPL in the lab "
                                  (symbol->string (lab-name lab)) ", as "
                                  (symbol->string uid) "; (help) says what to type,"
                                  " Ctrl-D leaves\n"))
     (tell-who-is-away lab)
-    (set-remote-timeout! (lab-setting lab 'repl-timeout))
+    (set-remote-timeout! (setting 'repl-timeout))
     ;; (chibi repl) is loaded, not imported: it costs seconds.
     ((eval 'repl (environment '(chibi repl)))
           'in: (waiting-input-port)

@@ -219,7 +219,8 @@
 ;;> `murdoch check LAB`: reads the lab file and loads its code, starting nothing.
 (define (run-check lab-file)
   (let ((lab (read-lab lab-file)))
-    (check-lab-code lab (make-lab-environment lab)))
+    (open-node! lab)
+    (check-lab-code lab (make-lab-environment)))
   (write-string (string-append lab-file ": no mistakes found\n")))
 
 ;;> `murdoch demo LAB`: becomes bin/murdoch-demo, found in \var{bin}.

@@ -97,11 +97,12 @@
   (out sandbox-out sandbox-out-set!)
   (err sandbox-err sandbox-err-set!))
 
-;; Global: the lab's max-alloc, for every call the process serves.
-(define *sandbox* #f)
+;; The node's sandbox part, for every call the process serves; #f before
+;; the lab's code is loaded.
+(define (the-sandbox) (and *node* (node-sandbox *node*)))
 
 (define (check-alloc! who count unit)
-  (let ((most (and *sandbox* (sandbox-max-alloc *sandbox*))))
+  (let ((most (and (the-sandbox) (sandbox-max-alloc (the-sandbox)))))
     (if (and most (real? count) (> (* count unit) most))
         (error (string-append who ": " (number->string count)
                               " would take more than the lab's max-alloc, "
@@ -146,12 +147,12 @@
 
 ;;> Gives the process's standard output and error, for received code to write to.
 (define (set-sandbox-ports! out err)
-  (sandbox-out-set! *sandbox* out)
-  (sandbox-err-set! *sandbox* err))
+  (sandbox-out-set! (the-sandbox) out)
+  (sandbox-err-set! (the-sandbox) err))
 
 ;; The process's port, by which (sandbox-out or sandbox-err), else current.
 (define (process-port which current)
-  (or (and *sandbox* (which *sandbox*)) current))
+  (or (and (the-sandbox) (which (the-sandbox))) current))
 
 ;; A port that writes through to port, closable alone, flushed at each call's end.
 (define (through-port port)
@@ -228,10 +229,12 @@
 
 ;;; Making the environments
 
-;;> A fresh environment for received code, the lab's code files evaluated in it.
-(define (make-lab-environment lab)
-  (set! *sandbox* (make-sandbox (lab-setting lab 'max-alloc) #f #f))
-  (let ((env (apply mutable-environment sandbox-libraries)))
+;;> A fresh environment for received code, the code files of this
+;;> process's lab evaluated in it.
+(define (make-lab-environment)
+  (node-sandbox-set! (this-node) (make-sandbox (setting 'max-alloc) #f #f))
+  (let ((env (apply mutable-environment sandbox-libraries))
+        (lab (current-lab)))
     (set! *guarded* (cons env *guarded*))
     (for-each (lambda (file) (load-into (lab-path lab file) env))
               (lab-code-files lab))

@@ -165,18 +165,19 @@
   (depth limits-depth)                  ; the lab's max-depth
   (pairs limits-pairs))                 ; a frame of max-frame bytes holds fewer
 
-;; Global: every value the process sends or receives is its lab's.
-(define *limits* #f)
+;; The node's limits part: every value the process sends or receives is its lab's.
+(define-syntax the-limits (syntax-rules () ((_) (node-limits *node*))))
 
-;;> Takes value limits from \var{lab}: max-depth, and max-frame / 2 pairs.
-(define (set-value-limits! lab)
-  (set! *limits* (make-value-limits (lab-setting lab 'max-depth)
-                                    (quotient (lab-setting lab 'max-frame) 2))))
+;;> Takes the value limits of this process's lab: max-depth, and max-frame / 2 pairs.
+(define (set-value-limits!)
+  (node-limits-set! (this-node)
+                    (make-value-limits (setting 'max-depth)
+                                       (quotient (setting 'max-frame) 2))))
 
 (define (check-depth depth what)
-  (if (> depth (limits-depth *limits*))
+  (if (> depth (limits-depth (the-limits)))
       (send-fail (what-string what) " nests deeper than the lab's max-depth, "
-                 (number->string (limits-depth *limits*)))))
+                 (number->string (limits-depth (the-limits))))))
 
 ;; (map f ls) by iteration, ls maybe improper: f gets its tail too.
 (define (map-elements f ls)
@@ -194,7 +195,7 @@
 
 ;; True of data that stands for itself, left uncopied (docs/speed.md);
 ;; plain-within? (plain.c) gives up at a budget of pairs or the depth limit.
-(define (plain? x) (plain-within? x 100000 (limits-depth *limits*)))
+(define (plain? x) (plain-within? x 100000 (limits-depth (the-limits))))
 
 ;;> The S-expression that stands for \var{x} on the wire: \var{env}'s
 ;;> procedures travel by name; \var{what} names \var{x} in errors.
@@ -205,7 +206,7 @@
 
 ;; Defined at the top (docs/speed.md); left is a vector of the pairs yet allowed.
 (define (encode-compound x env what)
-  (enc x env what 0 (make-vector 1 (limits-pairs *limits*))))
+  (enc x env what 0 (make-vector 1 (limits-pairs (the-limits)))))
 
 (define (spend! left n what)
   (vector-set! left 0 (- (vector-ref left 0) n))

@@ -3,9 +3,9 @@
 
 ;; Every setting a lab file may give, in one table: name, default, reader.
 ;; Most take one value; code and delivery the rest of their clause.
-;; read-lab reads each once; every user asks lab-setting.
+;; read-lab reads each once; a running address space asks setting (node.scm).
 
-(define-record-type setting
+(define-record-type setting-row
   (make-setting name default reader)
   setting?
   (name setting-name)
@@ -96,8 +96,8 @@
     ;; Chibi grows its heap by twice one allocation (code/sandbox.scm).
     (max-alloc "32M" ,(make-reader size-bytes
                                    "bytes, or a size in quotes such as \"32M\""))
-    ;; Defaults of the layers' parameters and globals, set as an address
-    ;; space joins (cli/command.scm).
+    ;; Defaults of the layers' parameters, set as an address space starts
+    ;; (cli/command.scm), and of the thesis's thresholds (pubsub/monitor.scm).
     (task-timeout 600 ,seconds)
     (trip-timeout 5 ,seconds)
     (trip-motion-timeout 120 ,seconds)

@@ -1,50 +1,57 @@
 ;;;; Monitors (thesis A.6) and each address space's first subscriptions
 ;;;; (A.2): capabilities that come and go with the machine's state.
 
-;; The thesis's names (A.5, A.6), global as there; received code cannot
-;; assign them (code/sandbox.scm) but uses their procedures.
-;;> The voltage, in tenths, above which a robot is taken to be on its
-;;> charging tether.
-(define *battery-charging* (lab-default 'battery-charging))
-;;> The voltage, in tenths, below which a robot's battery is low.
-(define *battery-low* (lab-default 'battery-low))
+;; The node's monitors part: the thesis's three thresholds (A.5, A.6),
+;; globals there, taken from the lab's settings and changed by their
+;; setters; the load's source and its last text.
+(define-record-type monitors
+  (make-monitors battery-charging battery-low load-threshold load-source last-load)
+  monitors?
+  (battery-charging monitors-battery-charging monitors-battery-charging-set!)
+  (battery-low monitors-battery-low monitors-battery-low-set!)
+  (load-threshold monitors-load-threshold monitors-load-threshold-set!)
+  (load-source monitors-load-source)    ; a thunk answering a number
+  (last-load monitors-last-load monitors-last-load-set!)) ; (LOAD . TEXT)
 
-;;> The load, a string such as ".75" (as the thesis sent it between
-;;> machines), below which the load monitor subscribes to idle.
-(define *load-threshold* (lab-default 'load-threshold))
+(define (the-monitors)
+  (or (node-monitors (this-node))
+      (error "this address space has not started its monitors")))
 
-;;> Sets *battery-charging*, in tenths of a volt.
-(define (set-battery-charging! tenths) (set! *battery-charging* tenths))
+;;> The thesis's *battery-charging*: the voltage, in tenths, above which a
+;;> robot is taken to be on its charging tether.
+(define (battery-charging) (monitors-battery-charging (the-monitors)))
 
-;;> Sets *battery-low*, in tenths of a volt.
-(define (set-battery-low! tenths) (set! *battery-low* tenths))
+;;> The thesis's *battery-low*: the voltage, in tenths, below which a
+;;> robot's battery is low.
+(define (battery-low) (monitors-battery-low (the-monitors)))
 
-;;> Sets *load-threshold*, a string such as ".75".
-(define (set-load-threshold! load) (set! *load-threshold* load))
+;;> The thesis's *load-threshold*: the load, a string such as ".75" (as the
+;;> thesis sent it between machines), below which the load monitor
+;;> subscribes to idle.
+(define (load-threshold) (monitors-load-threshold (the-monitors)))
 
-;; What the monitors take from the lab: monitor-period, and the load's source.
-(define-record-type monitoring
-  (make-monitoring period load-source last-load)
-  monitoring?
-  (period monitoring-period)            ; seconds between looks
-  (load-source monitoring-load-source)  ; a thunk answering a number
-  (last-load monitoring-last-load monitoring-last-load-set!)) ; (LOAD . TEXT)
+;;> Sets (battery-charging), in tenths of a volt.
+(define (set-battery-charging! tenths)
+  (monitors-battery-charging-set! (the-monitors) tenths))
 
-;; Global: the monitors are the thesis's procedures of no arguments.
-(define *monitoring* #f)
+;;> Sets (battery-low), in tenths of a volt.
+(define (set-battery-low! tenths) (monitors-battery-low-set! (the-monitors) tenths))
+
+;;> Sets (load-threshold), a string such as ".75".
+(define (set-load-threshold! load) (monitors-load-threshold-set! (the-monitors) load))
 
 ;;> This machine's load as a string, e.g. "0.42": from the lab's (load ...)
 ;;> clause, else the one-minute average of /proc/loadavg.
 (define (get-system-load)
-  (string-copy (load-text ((monitoring-load-source *monitoring*)))))
+  (string-copy (load-text ((monitors-load-source (the-monitors))))))
 
 ;; The text of load, kept while it stays (docs/speed.md), copied out for received code.
 (define (load-text load)
-  (let ((last (monitoring-last-load *monitoring*)))
+  (let ((last (monitors-last-load (the-monitors))))
     (if (eqv? load (car last))
         (cdr last)
         (let ((text (number->string load)))
-          (monitoring-last-load-set! *monitoring* (cons load text))
+          (monitors-last-load-set! (the-monitors) (cons load text))
           text))))
 
 (define (start-thread! name thunk)
@@ -59,7 +66,7 @@
   (lambda ()
     (let loop ()
       (if (present?) (subscribe subject) (unsubscribe subject))
-      (thread-sleep! (monitoring-period *monitoring*))
+      (thread-sleep! (setting 'monitor-period))
       (loop))))
 
 ;; Starts a monitor thread, terminating the one it replaces, as A.6 does.
@@ -73,20 +80,20 @@
   (watch 'idle
          (lambda ()
            (< (string->number (get-system-load))
-              (string->number *load-threshold*)))))
+              (string->number (load-threshold))))))
 
 (define battery-monitor-procedure
   (watch 'untethered
-         (lambda () (< (safe-battery-voltage) *battery-charging*))))
+         (lambda () (< (safe-battery-voltage) (battery-charging)))))
 
-;;> Subscribes to idle while the load is under *load-threshold*.
+;;> Subscribes to idle while the load is under (load-threshold).
 (define (load-monitor)
   (set! *load-monitor-thread*
         (restart-monitor! *load-monitor-thread* 'load-monitor
                           load-monitor-procedure))
   #t)
 
-;;> Subscribes to untethered while the battery is under *battery-charging*.
+;;> Subscribes to untethered while the battery is under (battery-charging).
 (define (battery-monitor)
   (set! *battery-monitor-thread*
         (restart-monitor! *battery-monitor-thread* 'battery-monitor
@@ -127,12 +134,14 @@
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
 ;;> capabilities, coordinator on a workstation, idle and untethered.
 ;;> \var{on-free} runs, outside any lock, when exclusive subjects are freed.
-(define (initialize-subscriptions! lab entry on-free)
+(define (initialize-subscriptions! entry on-free)
   (on-free! on-free)
-  (set! *monitoring*
-        (make-monitoring (lab-setting lab 'monitor-period)
-                         (load-source (and entry (lab-aspace-clause entry 'load)))
-                         (cons #f "")))
+  (node-monitors-set!
+   (this-node)
+   (make-monitors (setting 'battery-charging) (setting 'battery-low)
+                  (setting 'load-threshold)
+                  (load-source (and entry (lab-aspace-clause entry 'load)))
+                  (cons #f "")))
   (for-each subscribe (list 'all (local-aspace-uid)))
   (for-each subscribe
             (cond ((and entry (lab-aspace-clause entry 'capabilities)) => cdr)
@@ -141,5 +150,5 @@
   (if (and entry (lab-aspace-clause entry 'position)) (subscribe 'coordinator))
   (load-monitor)
   (if (and entry (lab-aspace-clause entry 'robot)) (battery-monitor))
-  (start-leases! lab)
+  (start-leases!)
   #t)

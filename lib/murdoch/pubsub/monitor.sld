@@ -3,7 +3,7 @@
 
 (define-library (murdoch pubsub monitor)
   (export get-system-load load-monitor battery-monitor
-          *battery-charging* *battery-low* *load-threshold*
+          battery-charging battery-low load-threshold
           set-battery-charging! set-battery-low! set-load-threshold!
           initialize-subscriptions!)
   (import (only (murdoch code) make-logged-thread)

@@ -64,23 +64,12 @@
 ;; Global, beside the subscriptions under their lock: those not yet promised away.
 (define *reservations* '())
 
-;; The lab's lease and the thread that frees what outlives it.
-(define-record-type leases
-  (make-leases seconds keeper)
-  leases?
-  (seconds lease-seconds)
-  (keeper lease-keeper-thread))
+;; The lab's lease.
+(define (lease) (setting 'lease))
 
-;; Global, as the subscriptions are: one lease keeper a process.
-(define *leases* #f)
-
-(define (lease) (lease-seconds *leases*))
-
-;;> Starts freeing the subjects of promises unapplied for \var{lab}'s lease.
-(define (start-leases! lab)
-  (set! *leases* (make-leases (lab-setting lab 'lease)
-                              (make-logged-thread lease-keeper 'lease-keeper)))
-  (thread-start! (lease-keeper-thread *leases*)))
+;;> Starts freeing the subjects of promises unapplied for the lab's lease.
+(define (start-leases!)
+  (thread-start! (make-logged-thread lease-keeper 'lease-keeper)))
 
 ;; Free for task when free or held by task: one robot may promise two of a
 ;; task's components, and conflict resolution gives it at most one.

@@ -12,12 +12,12 @@
   (host aspace-host)
   (port aspace-port))
 
-;; This process as an address space of its lab, made once by join-lab!.
+;; The node's membership part: this process as an address space of its
+;; lab, made once by join-lab!.
 (define-record-type membership
-  (make-membership lab started-at environment decode timeout peers unreachable
+  (make-membership started-at environment decode timeout peers unreachable
                    peers-lock)
   membership?
-  (lab membership-lab)
   (started-at membership-started-at)    ; (utc-seconds) at join-lab!
   (local membership-local membership-local-set!)
   (environment membership-environment)  ; received code runs in it
@@ -28,11 +28,9 @@
   (peers-lock membership-peers-lock)    ; over peers, unreachable and live
   (live membership-live membership-live-set!)) ; the live set, #f once changed
 
-;; Global: a process joins one lab, as one address space.
-(define *membership* #f)
-
 (define (joined)
-  (if *membership* *membership* (error "this process has not joined a lab")))
+  (or (and *node* (node-membership *node*))
+      (error "this process has not joined a lab")))
 
 (define (with-peers thunk)
   (with-lock (membership-peers-lock (joined)) thunk))
@@ -147,21 +145,18 @@
            (vector-ref encoded 1))
           (else proc))))
 
-;;> The lab this address space belongs to.
-(define (current-lab) (membership-lab (joined)))
-
-;;> Makes this process the address space \var{uid} of \var{lab}, on
+;;> Makes this process the address space \var{uid} of its lab, on
 ;;> \var{port}, receiving code into \var{environment} via \var{decode}.
-(define (join-lab! lab uid host port environment decode)
-  (set! *membership*
-        (make-membership lab (utc-seconds) environment decode
-                         (lab-setting lab 'timeout) (make-hash-table eq?)
-                         (make-hash-table eq?) (make-mutex 'peers)))
-  (membership-live-set! *membership* #f)
-  (membership-local-set! *membership* (make-aspace uid host port))
+(define (join-lab! uid host port environment decode)
+  (let ((m (make-membership (utc-seconds) environment decode (setting 'timeout)
+                            (make-hash-table eq?) (make-hash-table eq?)
+                            (make-mutex 'peers))))
+    (membership-live-set! m #f)
+    (membership-local-set! m (make-aspace uid host port))
+    (node-membership-set! (this-node) m))
   (for-each (lambda (a)
               (learn-aspace! (make-aspace (lab-aspace-uid a) (lab-aspace-host a)
                                           (lab-aspace-port a))))
-            (lab-aspaces lab))
+            (lab-aspaces (current-lab)))
   (learn-aspace! (local-aspace))
   (local-aspace))

@@ -32,49 +32,49 @@
   (last-heard group-last-heard)         ; uid -> monotonic-seconds
   (last-heard-lock group-last-heard-lock))
 
-;; Global: an address space is in at most one group, its lab's.
-(define *group* #f)
+;; The node's group part: an address space is in at most one group, its lab's.
+(define-syntax the-group (syntax-rules () ((_) (node-group *node*))))
 
 (define max-datagram 60000)
 (define lab-beacons-per-second 16)
 
-;;> Joins \var{lab}'s multicast group when delivery is multicast, starting
+;;> Joins the lab's multicast group when delivery is multicast, starting
 ;;> beacons and a thread applying \var{serve} to \scheme{receive-call}, which
 ;;> returns the next datagram's group-call or #f and raises for one not
 ;;> authentic or fresh (one thread at a time: one buffer).
-(define (start-group! lab serve)
+(define (start-group! serve)
   ;; (multicast GROUP [PORT]) or (broadcast)
-  (let ((delivery (lab-setting lab 'delivery)))
+  (let ((delivery (setting 'delivery)))
     (when (eq? (car delivery) 'multicast)
       (let ((group (cadr delivery))
             (port (if (pair? (cddr delivery))
                       (car (cddr delivery))
-                      (lab-planned-port lab 'multicast))))
-        (set! *group*
-              (make-group (open-multicast-socket group port
-                                                 (aspace-host (local-aspace)))
-                          (get-address-info group port)
-                          ;; One buffer (docs/speed.md, What Chibi charges).
-                          (make-bytevector 65536)
-                          (datagram-head (aspace-uid (local-aspace)))
-                          (lab-setting lab 'frame-timeout) (wall-microseconds)
-                          0 (make-mutex 'sequence) (make-hash-table eq?)
-                          (make-hash-table eq?) (make-mutex 'last-heard)))
+                      (lab-planned-port (current-lab) 'multicast))))
+        (node-group-set!
+         (this-node)
+         (make-group (open-multicast-socket group port (aspace-host (local-aspace)))
+                     (get-address-info group port)
+                     ;; One buffer (docs/speed.md, What Chibi charges).
+                     (make-bytevector 65536)
+                     (datagram-head (aspace-uid (local-aspace)))
+                     (setting 'frame-timeout) (wall-microseconds)
+                     0 (make-mutex 'sequence) (make-hash-table eq?)
+                     (make-hash-table eq?) (make-mutex 'last-heard)))
         (spawn (lambda () (serve receive-call)) 'multicast)
         (spawn send-beacons 'beacon)))))
 
 ;;> How publish and request reach the lab: \scheme{multicast} or \scheme{broadcast}.
-(define (delivery-mode) (if *group* 'multicast 'broadcast))
+(define (delivery-mode) (if (and *node* (the-group)) 'multicast 'broadcast))
 
 ;;; Sending
 
 ;; The next datagram's sequence: two threads sending at once take two,
 ;; lest receivers drop the second as a replay.
 (define (next-sequence!)
-  (with-lock (group-sequence-lock *group*)
+  (with-lock (group-sequence-lock (the-group))
     (lambda ()
-      (let ((sequence (max (+ (group-sequence *group*) 1) (wall-microseconds))))
-        (group-sequence-set! *group* sequence)
+      (let ((sequence (max (+ (group-sequence (the-group)) 1) (wall-microseconds))))
+        (group-sequence-set! (the-group) sequence)
         sequence))))
 
 ;;> Sends \var{body} to the group; #f when it is too large for a datagram.
@@ -85,7 +85,8 @@
                    (write-simple (list (local-aspace-uid) sequence body) o))))
          (bytes (datagram-bytes text)))
     (and (<= (bytevector-length bytes) max-datagram)
-         (begin (send (group-socket *group*) bytes 0 (group-address *group*)) #t))))
+         (begin (send (group-socket (the-group)) bytes 0 (group-address (the-group)))
+                #t))))
 
 (define (beacon-seconds)
   (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
@@ -98,9 +99,10 @@
   (let ((now (monotonic-seconds))
         (period (beacon-seconds)))
     (for-each (lambda (uid)
-                (if (< (with-lock (group-last-heard-lock *group*)
+                (if (< (with-lock (group-last-heard-lock (the-group))
                          (lambda ()
-                           (hash-table-ref/default (group-last-heard *group*) uid now)))
+                           (hash-table-ref/default (group-last-heard (the-group))
+                                                   uid now)))
                        (- now (* 3 period)))
                     (note-unreachable! uid)))
               (known-uids))
@@ -112,18 +114,20 @@
 ;; On every group call's path: no let, match or with-lock (docs/speed.md).
 
 (define (receive-call)
-  (let ((n (receive! (group-socket *group*) (group-buffer *group*))))
+  (let ((n (receive! (group-socket (the-group)) (group-buffer (the-group)))))
     (and (>= n 0)
-         (not (datagram-from? (group-buffer *group*) n (group-own-head *group*)))
-         (heard (open-datagram (group-buffer *group*) n)))))
+         (not (datagram-from? (group-buffer (the-group)) n
+                              (group-own-head (the-group))))
+         (heard (open-datagram (group-buffer (the-group)) n)))))
 
 ;; The call datagram d carries, once its sender is heard from.  Our own,
 ;; looped back, are dropped unread before (receive-call); one naming us
 ;; otherwise written is dropped here, so our uid never leaves the live set.
 (define (heard d)
-  (lock! (group-last-heard-lock *group*))
-  (hash-table-set! (group-last-heard *group*) (datagram-sender d) (monotonic-seconds))
-  (unlock! (group-last-heard-lock *group*))
+  (lock! (group-last-heard-lock (the-group)))
+  (hash-table-set! (group-last-heard (the-group)) (datagram-sender d)
+                   (monotonic-seconds))
+  (unlock! (group-last-heard-lock (the-group)))
   (and (not (eq? (datagram-sender d) (local-aspace-uid)))
        (datagram-call (datagram-sender d) (datagram-body d))))
 
@@ -133,7 +137,7 @@
 
 (define (fresh-datagram d)
   (check-fresh (datagram-sender d) (datagram-sequence d))
-  (hash-table-set! (group-last-sequence *group*) (datagram-sender d)
+  (hash-table-set! (group-last-sequence (the-group)) (datagram-sender d)
                    (datagram-sequence d))
   d)
 
@@ -142,13 +146,13 @@
 (define (datagram-body d) (list-ref d 2))
 
 (define (check-fresh sender sequence)
-  (cond ((<= sequence (cell-value (hash-table-cell (group-last-sequence *group*)
+  (cond ((<= sequence (cell-value (hash-table-cell (group-last-sequence (the-group))
                                                    sender #f)
                                   0))
          (frame-fail "replayed or out of order"))
-        ((< sequence (group-started *group*))
+        ((< sequence (group-started (the-group)))
          (frame-fail "sent before this address space started"))
-        ((< sequence (- (wall-microseconds) (* 1000000 (group-window *group*))))
+        ((< sequence (- (wall-microseconds) (* 1000000 (group-window (the-group)))))
          (frame-fail "older than frame-timeout"))))
 
 ;;> A call that came by the group: sender, \var{id}, \var{kind}, procedure and arguments.

@@ -40,8 +40,9 @@
   (janitor-resting? server-janitor-resting? server-janitor-resting?-set!)
   (last-refusal server-last-refusal server-last-refusal-set!)) ; monotonic
 
-;; Global: a process is one address space, which serves on one port.
-(define *server* #f)
+;; The node's server part: a process is one address space, which serves
+;; on one port.
+(define-syntax the-server (syntax-rules () ((_) (node-server *node*))))
 
 (define janitor-seconds 0.1)
 (define takeover-seconds 0.1)
@@ -53,7 +54,8 @@
     (serving-fd-set! s (port-fileno (serving-in s)))
     ;; The hello, which proves the key, is due within frame-timeout of the
     ;; connect: anyone can connect, and a connection holds a descriptor.
-    (serving-deadline-set! s (+ (monotonic-seconds) (server-frame-timeout *server*)))
+    (serving-deadline-set! s (+ (monotonic-seconds)
+                                (server-frame-timeout (the-server))))
     (janitor-wanted!)
     (watch-served! (serving-in s) s take-polled! polled-fault!)))
 
@@ -66,8 +68,9 @@
     (serving-fd-set! s #f)
     (serving-frames-set! s '())
     (serving-greeting-set! s #f)
-    (with-lock (server-lock *server*)
-      (lambda () (server-servings-set! *server* (cons s (server-servings *server*)))))
+    (with-lock (server-lock (the-server))
+      (lambda ()
+        (server-servings-set! (the-server) (cons s (server-servings (the-server))))))
     s))
 
 ;; Runs a reader's loop; the connection ends with it, unless handed on.
@@ -82,12 +85,12 @@
 ;; Once: the janitor and the reader may both end it.  The poller lets go of
 ;; the descriptor first, as a closed number may be another connection's next.
 (define (end-serving! s)
-  (when (with-lock (server-lock *server*)
+  (when (with-lock (server-lock (the-server))
           (lambda ()
-            (and (memq s (server-servings *server*))
+            (and (memq s (server-servings (the-server)))
                  (begin (server-servings-set!
-                         *server* (remove (lambda (x) (eq? x s))
-                                          (server-servings *server*)))
+                         (the-server) (remove (lambda (x) (eq? x s))
+                                          (server-servings (the-server))))
                         #t))))
     (if (serving-fd s) (unwatch-served! (serving-fd s) #f))
     (guard (e (#t #f)) (close-input-port (serving-in s)))
@@ -118,7 +121,7 @@
   (cond ((positive? (poller-buffered (serving-fd s)))
          (unless (serving-deadline s)
            (serving-deadline-set! s (+ (monotonic-seconds)
-                                       (server-frame-timeout *server*)))
+                                       (server-frame-timeout (the-server))))
            (janitor-wanted!)))
         ((serving-greeting s) (serving-deadline-set! s #f))))
 
@@ -133,7 +136,7 @@
   (serving-deadline-set! s #f)
   (let ((t (make-guarded-thread (lambda () (read-as-reader s (serving-read-on s)))
                                 'connection)))
-    (with-lock (server-lock *server*) (lambda () (serving-thread-set! s t)))
+    (with-lock (server-lock (the-server)) (lambda () (serving-thread-set! s t)))
     (thread-start! t)))
 
 ;; The next message of s for its reader, or an eof object; a frame begun
@@ -180,10 +183,10 @@
   (janitor))
 
 (define (serving-where moment time)
-  (with-lock (server-lock *server*)
+  (with-lock (server-lock (the-server))
     (lambda ()
       (filter (lambda (s) (let ((t (moment s))) (and t (< t time))))
-              (server-servings *server*)))))
+              (server-servings (the-server))))))
 
 ;; The janitor rests while no frame is half read and no reader applies
 ;; (docs/speed.md).  It raises its flag before it looks and holds its
@@ -191,22 +194,22 @@
 ;; reads the flag: so either the look sees it, or its wake-up finds the
 ;; janitor waiting.
 (define (rest-while-idle)
-  (let ((m (server-janitor-mutex *server*)))
+  (let ((m (server-janitor-mutex (the-server))))
     (lock! m)
-    (server-janitor-resting?-set! *server* #t)
+    (server-janitor-resting?-set! (the-server) #t)
     (cond ((pair? (serving-where (lambda (s) (or (serving-deadline s)
                                                  (serving-busy-since s)))
                                  +inf.0))
-           (server-janitor-resting?-set! *server* #f)
+           (server-janitor-resting?-set! (the-server) #f)
            (unlock! m))
-          (else (unlock-waiting! m (server-janitor-wake *server*))))))
+          (else (unlock-waiting! m (server-janitor-wake (the-server)))))))
 
 (define (janitor-wanted!)
-  (when (server-janitor-resting? *server*)
-    (lock! (server-janitor-mutex *server*))
-    (server-janitor-resting?-set! *server* #f)
-    (condition-variable-signal! (server-janitor-wake *server*))
-    (unlock! (server-janitor-mutex *server*))))
+  (when (server-janitor-resting? (the-server))
+    (lock! (server-janitor-mutex (the-server)))
+    (server-janitor-resting?-set! (the-server) #f)
+    (condition-variable-signal! (server-janitor-wake (the-server)))
+    (unlock! (server-janitor-mutex (the-server)))))
 
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
@@ -215,7 +218,7 @@
   (end-serving! s))
 
 (define (take-over! s)
-  (lock! (server-lock *server*))
+  (lock! (server-lock (the-server)))
   (when (serving-busy-since s)          ; its apply may just have ended
     (let ((t (make-guarded-thread
               (lambda () (read-as-reader s (serving-read-on s)))
@@ -223,36 +226,36 @@
       (serving-busy-since-set! s #f)
       (serving-thread-set! s t)
       (thread-start! t)))
-  (unlock! (server-lock *server*)))
+  (unlock! (server-lock (the-server))))
 
 ;;> Run by an apply that runs long, a task's component say: its connection
 ;;> gets a new reader now, so the caller's next calls do not wait.
 (define (hand-over-connection!)
-  (lock! (server-lock *server*))
+  (lock! (server-lock (the-server)))
   (let ((s (find (lambda (s) (and (eq? (serving-thread s) (current-thread))
                                   (serving-busy-since s)))
-                 (server-servings *server*))))
-    (unlock! (server-lock *server*))
+                 (server-servings (the-server)))))
+    (unlock! (server-lock (the-server)))
     (if s (take-over! s))))
 
 ;; Marks the reader's inline apply of call id, during which a caller giving
 ;; up finds the thread; ending answers whether it is still the reader.
 (define (inline-apply-begins! s id)
-  (lock! (server-lock *server*))
+  (lock! (server-lock (the-server)))
   (serving-applying-set! s (cons (cons id (current-thread))
                                  (serving-applying s)))
   (serving-busy-since-set! s (monotonic-seconds))
-  (unlock! (server-lock *server*))
+  (unlock! (server-lock (the-server)))
   (janitor-wanted!))
 
 (define (inline-apply-ends! s)
-  (lock! (server-lock *server*))
+  (lock! (server-lock (the-server)))
   (serving-applying-set! s (without-thread (serving-applying s) (current-thread)))
   (apply-ended! s (reader? s)))
 
 (define (apply-ended! s still)
   (if still (serving-busy-since-set! s #f))
-  (unlock! (server-lock *server*))
+  (unlock! (server-lock (the-server)))
   (if (abandoned?) (forget-abandoned! (current-thread)))
   still)
 
@@ -265,15 +268,16 @@
 ;;> Lets the call that \var{thread} runs here go from its caller, whose
 ;;> giving up no longer stops it: a component a new coordinator adopts.
 (define (release-call! thread)
-  (with-lock (server-lock *server*)
+  (with-lock (server-lock (the-server))
     (lambda ()
       (for-each (lambda (s)
                   (serving-applying-set! s (without-thread (serving-applying s) thread)))
-                (server-servings *server*)))))
+                (server-servings (the-server))))))
 
 ;; The caller of apply id gave up: its thread is marked to stop (code/abandon.scm).
 (define (abandon-call! s id)
-  (let ((a (with-lock (server-lock *server*) (lambda () (assv id (serving-applying s))))))
+  (let ((a (with-lock (server-lock (the-server))
+             (lambda () (assv id (serving-applying s))))))
     (when a
       (log-note "call " id " from " (serving-peer s) " abandoned by its caller;"
                 " it stops at its next remote call or robot command")
@@ -297,29 +301,29 @@
 ;; Whether a connection from host stays under the lab's caps, in all and a
 ;; host: connections that never say hello could take every descriptor.
 (define (room-for? host)
-  (with-lock (server-lock *server*)
+  (with-lock (server-lock (the-server))
     (lambda ()
-      (let* ((servings (server-servings *server*))
+      (let* ((servings (server-servings (the-server)))
              (from-host (count (lambda (s) (equal? (serving-host s) host))
                                servings)))
-        (and (< (length servings) (server-max-connections *server*))
-             (< from-host (server-max-connections-per-host *server*)))))))
+        (and (< (length servings) (server-max-connections (the-server)))
+             (< from-host (server-max-connections-per-host (the-server))))))))
 
 ;; Closes a connection over the caps; the log tells of one a second.
 (define (refuse-connection! fd peer)
   (close-port (open-input-file-descriptor fd #t))
-  (when (> (monotonic-seconds) (+ (server-last-refusal *server*) 1))
-    (server-last-refusal-set! *server* (monotonic-seconds))
+  (when (> (monotonic-seconds) (+ (server-last-refusal (the-server)) 1))
+    (server-last-refusal-set! (the-server) (monotonic-seconds))
     (log-warn "connection from " peer " refused: over max-connections"
               " or max-connections-per-host")))
 
-;;> Serves calls here under \var{lab}'s limits, and starts the janitor.
-(define (start-serving! lab)
-  (set! *server*
-        (make-server (lab-setting lab 'frame-timeout) (lab-setting lab 'max-connections)
-                     (lab-setting lab 'max-connections-per-host) '()
-                     (make-mutex 'serving) (make-mutex 'janitor)
-                     (make-condition-variable 'janitor) #f -inf.0))
+;;> Serves calls here under the lab's limits, and starts the janitor.
+(define (start-serving!)
+  (node-server-set! (this-node)
+                    (make-server (setting 'frame-timeout) (setting 'max-connections)
+                                 (setting 'max-connections-per-host) '()
+                                 (make-mutex 'serving) (make-mutex 'janitor)
+                                 (make-condition-variable 'janitor) #f -inf.0))
   (let* ((host (aspace-host (local-aspace)))
          (port (aspace-port (local-aspace)))
          (addr (get-address-info host port)))

@@ -91,7 +91,7 @@
       (set! *handed* (remove (lambda (x) (eq? x h)) *handed*))
       (if (null? *handed*) (unsubscribe 'lab-tasks)))))
 
-(define (period) (lab-setting (current-lab) 'heartbeat))
+(define (period) (setting 'heartbeat))
 
 ;;; The poser's side
 
@@ -224,7 +224,7 @@
                 (handed-copy-set! h (list (task-state t) (task-status t) results
                                           (task-turn-copy t) (utc-seconds)))
                 (progress (handed-id h) ": ended; results kept for "
-                          (lab-setting (current-lab) 'keep-results) " s"))))
+                          (setting 'keep-results) " s"))))
           'coordinator)))
     (thread-start! (make-logged-thread (lambda () (keep-watch h epoch)) 'coordinator))))
 
@@ -266,7 +266,7 @@
 
 (define (kept-enough? copy)
   (and (copy-ended copy)
-       (> (- (utc-seconds) (copy-ended copy)) (lab-setting (current-lab) 'keep-results))))
+       (> (- (utc-seconds) (copy-ended copy)) (setting 'keep-results))))
 
 (define (send-copy! h copy)
   (let ((uid (handed-partner h)))

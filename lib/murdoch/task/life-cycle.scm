@@ -7,7 +7,7 @@
 ;;
 ;;  1. The task is negotiated as pose-task negotiates it.
 ;;  2. Each component runs on its robot inside run-component, which
-;;     registers it there.  Every (lab-setting lab 'heartbeat) seconds the
+;;     registers it there.  Every (setting 'heartbeat) seconds the
 ;;     poser remote-applies component-heartbeat! on the robot: an answer
 ;;     tells the poser that the robot lives, its arrival tells the robot
 ;;     that its poser does.
@@ -213,7 +213,7 @@
                    'failed)))
         (if (and (eq? (task-state t) 'failed) (not (task-why t)))
             (task-why-set! t (first-failure t)))
-        (forget-over! (lab-setting (current-lab) 'tasks-kept))))
+        (forget-over! (setting 'tasks-kept))))
     (progress (task-id t) ": " (task-state-text t))
     (mailbox-put! (task-done t) results)))
 
@@ -293,7 +293,7 @@
 (define (restart? c)
   (and (component-restartable? c)
        (< (length (component-attempts c))
-          (lab-setting (current-lab) 'max-attempts))))
+          (setting 'max-attempts))))
 
 ;; The next robot for c, (uid proc arg ...), or #f: c is negotiated alone,
 ;; without the robots it had, nor those of the task's other components.
@@ -320,7 +320,7 @@
 ;; or (lost WHY).
 (define (attempt t c uid work)
   (let* ((a (uid->aspace uid))
-         (period (lab-setting (current-lab) 'heartbeat))
+         (period (setting 'heartbeat))
          (patience (heartbeat-patience))
          (answer (make-mailbox))
          (runner (make-logged-thread

@@ -33,7 +33,7 @@
 ;; A waiter answers its offers after the try or look it is in, which on a
 ;; busy lab may take seconds; a robot that moved on sooner went to a
 ;; worse-ranked task meanwhile.
-(define (offer-seconds) (lab-setting (current-lab) 'timeout))
+(define (offer-seconds) (setting 'timeout))
 
 ;; Whether w is offered a robot for each component it does not hold: two
 ;; robots freed together offer themselves to one task, and the second
@@ -48,7 +48,7 @@
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
-;; tasks leave it alone meanwhile.
+;; tasks leave it alone meanwhile.  Global: one poser a process.
 (define *offers* '())
 
 (define (offered-to-others w)
@@ -58,13 +58,15 @@
 
 ;;; The robot's side: offers when its subjects are freed
 
+;; Global: a process drives at most one robot, which offers itself.
 (define *offering* #f)                  ; an offer round runs here
 (define *offer-again* #f)               ; and another was asked for meanwhile
 (define *offer-lock* (make-mutex 'offers))
 
 ;; Whether a task may wait for this robot: set when a task starts to
 ;; wait anywhere, cleared by an offer round that finds none, so that a lab
-;; where no task waits sends nothing more when a robot is freed.
+;; where no task waits sends nothing more when a robot is freed.  Global,
+;; as the offer rounds are.
 (define *waiters-here?* #f)
 
 ;;> What a poser, \var{poser}, publishes to the lab when one of its tasks
@@ -85,7 +87,7 @@
 ;; A round asks them alone, 8 posers where the lab has 73 address spaces,
 ;; and the whole lab again every ten heartbeats or a third of the lease,
 ;; as a poser looks: a poser this robot missed (it joined later) is then
-;; found.  #f until it has asked the lab.
+;; found.  #f until it has asked the lab.  Global, as the offer rounds are.
 (define *posers* #f)
 (define *posers-asked* #f)              ; when the lab was last asked
 
@@ -116,7 +118,8 @@
 ;; goes before its next offer's.  While posers posed thousands, a note
 ;; came between any two offers, and every robot asked who waits again
 ;; after each offer, never getting past the best task of the lab, which
-;; declined all but one robot a component (docs/allocation.md).
+;; declined all but one robot a component (docs/allocation.md).  Global,
+;; as the offer rounds are.
 (define *new-waiters* #f)
 
 (define (ask-again-before? waiting)
@@ -164,13 +167,14 @@
 ;; while it asks who waits, if tasks waited at its last round, nobody may,
 ;; so that no task takes it before the best-ranked has been offered it.
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
+;; Global, as the offer rounds are.
 (define *waiters-seen* #f)
 
 ;; Each poser answers its best offer-depth tasks that may use the robot,
 ;; and the robot asks for twice as many when every one declined it, in
 ;; this round or the next, until it is taken: the best-ranked of the lab
 ;; are among them, and a round costs the same with 20 tasks waiting or
-;; 2,000 (docs/allocation.md).
+;; 2,000 (docs/allocation.md).  Global, as the offer rounds are.
 (define offer-depth 4)
 (define *depth* offer-depth)
 

@@ -56,6 +56,8 @@
   (name negotiation-name)
   (rank negotiation-rank)
   (rivals negotiation-rivals negotiation-rivals-set!))
+
+;; Global, as the poses are: over *poses* and *negotiating*.
 (define *poses-lock* (make-mutex 'poses))
 
 (define (with-poses thunk) (with-lock *poses-lock* thunk))

@@ -16,7 +16,7 @@
 ;; A turn from start-task's keywords and their values.
 (define (read-turn who options)
   (let loop ((kv options)
-             (wait (eq? (lab-setting (current-lab) 'when-robots-busy) 'wait))
+             (wait (eq? (setting 'when-robots-busy) 'wait))
              (hold #f)
              (priority (pose-task-priority))
              (deadline #f))
@@ -52,12 +52,12 @@
            (>= (count (lambda (t) (and (task-turn t) (turn-wait? (task-turn t))
                                        (memq (task-state t) '(negotiating waiting holding))))
                       (posed-tasks))
-               (lab-setting (current-lab) 'max-waiting)))
+               (setting 'max-waiting)))
       (error "start-task: this address space has max-waiting tasks waiting already"
-             (lab-setting (current-lab) 'max-waiting))))
+             (setting 'max-waiting))))
 
 (define (turn-rank turn id)
-  (list (- (turn-priority turn) (* (lab-setting (current-lab) 'aging) (turn-posed turn)))
+  (list (- (turn-priority turn) (* (setting 'aging) (turn-posed turn)))
         (turn-posed turn) (symbol->string id)))
 
 ;; The parts of a rank, (SCORE POSED ID) as turn-rank makes it: it travels
@@ -79,8 +79,8 @@
 ;; the lease if that is sooner, so a look comes before a held robot's
 ;; lease runs out.
 (define (look-period)
-  (min (* 10 (lab-setting (current-lab) 'heartbeat))
-       (/ (lab-setting (current-lab) 'lease) 3)))
+  (min (* 10 (setting 'heartbeat))
+       (/ (setting 'lease) 3)))
 
 ;; The better of ranks a and b, either #f for none.
 (define (better-rank a b)
@@ -114,7 +114,8 @@
   (let ((cc (assq c (waiter-capables w))))
     (and cc (cdr cc))))
 
-;; The tasks waiting here, best rank first, under *tasks-lock*.
+;; The tasks waiting here, best rank first, under *tasks-lock*.  Global,
+;; as the posed tasks are: a process is one poser.
 (define *waiters* '())
 
 (define (waiters) *waiters*)
@@ -204,7 +205,8 @@
               (request 'waiting-tasks waiting-ranks)))
 
 ;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
-;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*.
+;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*; global,
+;; as the lab's waiting tasks are the same for all this poser's.
 (define *lab-waiting* #f)
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
@@ -221,7 +223,7 @@
          (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
          (all (if (and cached
                        (< (- now (car cached))
-                          (* (lab-setting (current-lab) 'heartbeat)
+                          (* (setting 'heartbeat)
                              (max 1 (/ (length (cdr cached)) 100)))))
                   (cdr cached)
                   (let ((fresh (waiting-elsewhere)))

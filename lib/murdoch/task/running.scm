@@ -84,11 +84,11 @@
 
 ;;> How many silent heartbeat periods a component waits for its poser
 ;;> before it stops: the lab's orphan-periods.
-(define (orphan-periods) (lab-setting (current-lab) 'orphan-periods))
+(define (orphan-periods) (setting 'orphan-periods))
 
 ;;> How many silent heartbeat periods a poser waits before it declares a
 ;;> robot lost: the lab's lost-periods.
-(define (lost-periods) (lab-setting (current-lab) 'lost-periods))
+(define (lost-periods) (setting 'lost-periods))
 
 (define (watch-poser r period)
   (thread-sleep! (/ period 4))
@@ -168,6 +168,7 @@
 ;; component in one or the other.
 
 (define kept-ended 16)
+;; Global, as the running list is: a poser's report reads both.
 (define *ended* '())
 
 (define-record-type ending

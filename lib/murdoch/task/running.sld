@@ -13,6 +13,6 @@
           components-running components-ended ended-id ended-index ended-started
           ended-ended ended-end orphan-periods lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
-          (murdoch robot) (only (murdoch lab) lab-setting)
-          (only (murdoch remote) hand-over-connection! release-call! current-lab))
+          (murdoch robot) (only (murdoch lab) setting)
+          (only (murdoch remote) hand-over-connection! release-call!))
   (include "running.scm"))

@@ -257,7 +257,7 @@
         (+ waits (max 1 (* 2 (team-period))))
         (if (> waits 0) (+ waits 1) (remote-timeout)))))
 
-(define (team-period) (lab-setting (current-lab) 'heartbeat))
+(define (team-period) (setting 'heartbeat))
 
 ;; The uid of the address space that holds team id now, or #f.
 (define (team-holder id)

@@ -8,7 +8,7 @@
           make-coordinator release-coordinator! team-answer team-held?)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 27) (srfi 132)
           (only (chibi ast) thread-interrupt!) (murdoch sys) (murdoch code)
-          (only (murdoch wire) error-message) (only (murdoch lab) lab-default lab-setting)
+          (only (murdoch wire) error-message) (only (murdoch lab) lab-default setting)
           (murdoch remote) (only (murdoch pubsub) request) (murdoch task progress)
           (murdoch task metric))
   (include "team.scm"))

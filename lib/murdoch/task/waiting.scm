@@ -44,7 +44,7 @@
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes (500 posed at once
 ;; were 500 publications, each to every address space), with the best of
-;; their ranks.
+;; their ranks.  Global: a process is one poser, with one line of tasks.
 (define *noting* #f)                    ; a publication goes
 (define *note-again* #f)                ; the best rank waiting since, or #f
 
@@ -123,7 +123,7 @@
          (else
           (if (or (not (equal? held (held-uids w))) (look-due? w)) (want-look!))
           (if (> (- (monotonic-seconds) (waiter-kept w))
-                 (/ (lab-setting (current-lab) 'lease) 4))
+                 (/ (setting 'lease) 4))
               (keep-held! w))
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
@@ -135,7 +135,7 @@
 ;; to the others are left alone, and so are all but those offered to w,
 ;; the uids offered, when w can take robots one at a time (it holds, or
 ;; needs one): a robot may be kept for this poser on its way to offer
-;; itself to another of its tasks.
+;; itself to another of its tasks.  Global: one poser a process.
 (define *try-lock* (make-mutex 'tries))
 
 (define (try-in-turn w try offered)
@@ -180,6 +180,7 @@
 
 ;;; The poser's look, for all its waiting tasks at once
 
+;; Global: one poser a process, so one looking thread.
 (define *looker* #f)                    ; the poser's looking thread runs
 (define *look-bell* (make-mailbox))     ; rung by a task that wants a look
 
@@ -276,7 +277,7 @@
 ;; is asked to offer itself (again), best rank first, rather than taken by
 ;; a try out of turn.  A robot just freed is offering itself already: a
 ;; look that reminded every robot it found free, with hundreds of tasks
-;; waiting, kept them all answering reminders.
+;; waiting, kept them all answering reminders.  Global, as the look is.
 (define *free-seen* '())                ; the free robots of the last look
 
 (define (remind-free! free)

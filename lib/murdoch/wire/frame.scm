@@ -102,13 +102,13 @@
   (max-frame wire-max-frame)
   (max-depth wire-max-depth))
 
-;; Global: the lab's key and limits, for every frame of the process.
-(define *wire* #f)
+;; The node's wire part: the lab's key and limits, read by every frame.
+(define-syntax the-wire (syntax-rules () ((_) (node-wire *node*))))
 
-;;> Makes this process's frames those of \var{lab}, once, before any frame.
-(define (start-wire! lab)
-  (set! *wire* (make-wire (lab-key lab) (lab-setting lab 'max-frame)
-                          (lab-setting lab 'max-depth))))
+;;> Makes this process's frames those of its lab, once, before any frame.
+(define (start-wire!)
+  (node-wire-set! (this-node) (make-wire (lab-key (current-lab)) (setting 'max-frame)
+                                         (setting 'max-depth))))
 
 ;; A connection's frame text goes to its own string port, emptied before
 ;; each frame, so a write that failed half-way leaves nothing behind.
@@ -119,7 +119,7 @@
 
 ;; The receiver would close the connection, failing calls unrelated to this one.
 (define (within-max-frame text)
-  (if (> (+ 64 (string-size text)) (wire-max-frame *wire*))
+  (if (> (+ 64 (string-size text)) (wire-max-frame (the-wire)))
       (error (string-append "the message is larger than the lab's max-frame, "
                             (number->string (max-frame)) " bytes")))
   text)
@@ -155,7 +155,7 @@
   (within-max-frame (string-append (car parts) (fixnum->decimal id) (cdr parts))))
 
 (define (write-frame! out text nonce count)
-  (hmac-sha256-write! (wire-key *wire*) text (list nonce ":" count ":") out))
+  (hmac-sha256-write! (wire-key (the-wire)) text (list nonce ":" count ":") out))
 
 (define (send-frame! out text-port nonce count message)
   (write-frame! out (frame-text text-port message) nonce count)
@@ -167,7 +167,7 @@
 
 ;; The next frame's message, or an eof object; a bad frame raises.
 (define (read-frame in nonce count)
-  (let ((payload (read-netstring in (wire-max-frame *wire*))))
+  (let ((payload (read-netstring in (wire-max-frame (the-wire)))))
     (if (eof-object? payload)
         payload
         (open-frame payload nonce count))))
@@ -179,11 +179,11 @@
                   (list nonce ":" count ":"))))
 
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
-(define (max-frame) (wire-max-frame *wire*))
+(define (max-frame) (wire-max-frame (the-wire)))
 
 ;; The text after the MAC in bytes, once the MAC is that of parts and the text.
 (define (authentic-text bytes end parts)
-  (mac-checked (hmac-sha256-open (wire-key *wire*) bytes end parts)))
+  (mac-checked (hmac-sha256-open (wire-key (the-wire)) bytes end parts)))
 
 ;; No or, whose let makes a closure (docs/speed.md).
 (define (mac-checked text) (if text text (frame-fail "bad MAC")))
@@ -192,7 +192,7 @@
 ;; of datum labels, so nesting deeper than twice max-depth (the envelope,
 ;; and a value one level too deep to decode), or a label, is refused.
 (define (parse-message text)
-  (if (not (nests-within? text (* 2 (wire-max-depth *wire*))))
+  (if (not (nests-within? text (* 2 (wire-max-depth (the-wire)))))
       (frame-fail "nests deeper than twice max-depth, or has a datum label"))
   (let ((in (open-input-string text)))
     (whole-datum in (read-datum in))))
@@ -218,7 +218,7 @@
 
 ;;> The bytes of a datagram carrying \var{text}, with its MAC.
 (define (datagram-bytes text)
-  (string->utf8 (hmac-sha256-sign (wire-key *wire*) text '("mcast:"))))
+  (string->utf8 (hmac-sha256-sign (wire-key (the-wire)) text '("mcast:"))))
 
 ;;> The message of the authentic datagram in the first n bytes of buffer.
 (define (open-datagram-text buffer n)

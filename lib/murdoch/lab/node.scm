@@ -1,0 +1,34 @@
+;;;; The node, part of (murdoch lab): this process as an address space of
+;;;; its lab, one record whose parts the layers fill as it starts
+;;;; (docs/architecture.md, "How an address space starts").
+
+(define-record-type node
+  (make-node lab wire limits sandbox membership server group monitors)
+  node?
+  (lab node-lab)                        ; read once; its settings by setting
+  (wire node-wire node-wire-set!)       ; wire/frame.scm: the key, frame limits
+  (limits node-limits node-limits-set!) ; code/sendable.scm: values sent
+  (sandbox node-sandbox node-sandbox-set!) ; code/sandbox.scm: max-alloc, ports
+  (membership node-membership node-membership-set!) ; remote/aspace.scm
+  (server node-server node-server-set!) ; remote/serve.scm
+  (group node-group node-group-set!)    ; remote/group.scm, #f under broadcast
+  (monitors node-monitors node-monitors-set!)) ; pubsub/monitor.scm: thresholds
+
+;; Global: a process is one address space of one lab.  The layers' hot
+;; paths read their part straight from it (docs/speed.md).
+(define *node* #f)
+
+;;> Makes this process a node of \var{lab}, its parts yet to be filled.
+(define (open-node! lab)
+  (set! *node* (make-node lab #f #f #f #f #f #f #f))
+  *node*)
+
+;;> This process's node, for a layer to fill its part.
+(define (this-node)
+  (or *node* (error "this process has not joined a lab")))
+
+;;> The lab this address space belongs to.
+(define (current-lab) (node-lab (this-node)))
+
+;;> The value of setting \var{key} of this address space's lab.
+(define (setting key) (lab-setting (current-lab) key))
