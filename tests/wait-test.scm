@@ -1,7 +1,8 @@
 ;;; (murdoch sys wait): wind as Chibi's dynamic-wind, the locks the remote
-;;; layer takes on every call, undoing on a raise, and mailboxes by id.
+;;; layer takes on every call, undoing on a raise, and mailboxes by id;
+;;; (murdoch sys record)'s records.
 (import (scheme base) (scheme write) (srfi 18) (srfi 69) (chibi test)
-        (only (chibi ast) gc) (murdoch sys))
+        (only (chibi ast) gc) (murdoch sys) (only (murdoch sys wait) wind))
 
 ;; What ran, in order, through (note! x).
 (define trail '())
@@ -81,6 +82,36 @@
     (trail-of (lambda ()
                 (undo-on-raise (lambda () (note! 'undone)) (lambda () 1))
                 (raise 'later)))))
+
+(test-group "undo-on-raise in halves"
+  ;; The point is taken before the thunk runs: an argument of a call that runs it.
+  (define (halves thunk)
+    (trail-of (lambda () (ended (undo-begun! (lambda () (note! 'undone))) thunk))))
+  (define (ended here thunk) (undo-ended here (thunk)))
+  (test "undo does not run when what ran between returns" '((value 3))
+    (halves (lambda () 3)))
+  (test "undo runs when it raises" '(undone (raised boom))
+    (halves (lambda () (raise 'boom)))))
+
+;; Fields declared in another order than the constructor takes them.
+(define-lean-record-type lean
+  (make-lean c a)
+  lean?
+  (a lean-a)
+  (b lean-b lean-b-set!)
+  (c lean-c lean-c-set!))
+
+(test-group "define-lean-record-type"
+  (test "each field where the constructor put it" '(#t 1 3)
+    (let ((r (make-lean 3 1)))
+      (list (lean? r) (lean-a r) (lean-c r))))
+  (test "set as Chibi's records are" '(2 4)
+    (let ((r (make-lean 3 1)))
+      (lean-b-set! r 2)
+      (lean-c-set! r 4)
+      (list (lean-b r) (lean-c r))))
+  (test "another value is not one" '(#f #f) (list (lean? 5) (lean? (vector 3 1))))
+  (test-error "an accessor refuses another record" (lean-a (make-gathering))))
 
 (test-group "gatherings"
   (define (answer! item value) (set-car! item value))

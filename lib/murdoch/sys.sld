@@ -8,9 +8,10 @@
           set-parent-death-signal! monotonic-seconds wall-microseconds
           stack-guard-tripped? port-wait! poller-port poller-watch!
           poller-unwatch! poller-release! poller-buffered poller-ready
-          poller-frames! lock! unlock! unlocked unlock-waiting! cell-value wind with-lock
-          with-lock-by seconds-until undo-on-raise map-guarded make-mailbox
+          poller-frames! lock! unlock! unlocked unlock-waiting! cell-value with-lock
+          with-lock-by seconds-until undo-on-raise undo-begun! undo-ended map-guarded make-mailbox
           mailbox-put! mailbox-take mailbox-empty! take-mailbox!
-          take-all-mailboxes! make-gathering gathering-put! gathering-wait)
+          take-all-mailboxes! make-gathering gathering-put! gathering-wait
+          define-lean-record-type)
   (import (murdoch sys guard) (murdoch sys log) (murdoch sys process)
-          (murdoch sys scheduler) (murdoch sys wait)))
+          (murdoch sys scheduler) (murdoch sys wait) (murdoch sys record)))

@@ -14,7 +14,7 @@
 ;;   #(murdoch:void) #(murdoch:eof)
 ;; Anything else (a port, a record) stops at the sender, naming what held it.
 
-(define-record-type sendable-info
+(define-lean-record-type sendable-info
   (make-sendable-info source+names values)
   sendable-info?
   (source+names sendable-info-source+names)
@@ -92,11 +92,13 @@
   proc)
 
 (define (closure-var proc pred)
-  (let ((vars (procedure-vars proc)))
-    (let loop ((i 0))
-      (cond ((= i (vector-length vars)) #f)
-            ((pred (vector-ref vars i)) (vector-ref vars i))
-            (else (loop (+ i 1)))))))
+  (var-from (procedure-vars proc) pred 0))
+
+;; No named let, whose closure each look would make (docs/speed.md).
+(define (var-from vars pred i)
+  (cond ((= i (vector-length vars)) #f)
+        ((pred (vector-ref vars i)) (vector-ref vars i))
+        (else (var-from vars pred (+ i 1)))))
 
 (define (closure-info proc) (closure-var proc sendable-info?))
 

@@ -14,6 +14,7 @@
                 strip-syntactic-closures
                 make-exception exception? exception-kind)
           (chibi ast)
-          (srfi 1) (srfi 18) (srfi 69) (murdoch lab))
+          (srfi 1) (srfi 18) (srfi 69) (only (murdoch sys) define-lean-record-type)
+          (murdoch lab))
   (include-shared "sendable")
   (include "sendable.scm"))

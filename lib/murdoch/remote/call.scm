@@ -1,7 +1,7 @@
 ;;;; remote-run! and remote-apply (thesis §3.3.2), and their -all forms.
 
 ;; A call leaving this address space, encoded once for all its targets.
-(define-record-type call
+(define-lean-record-type call
   (make-call kind proc args proc-code args-code seconds)
   call?
   (kind call-kind)                      ; run or apply
@@ -13,9 +13,8 @@
 
 ;;> The call of \var{kind}, run or apply, of \var{proc} to \var{args}, encoded.
 (define (new-call kind proc args)
-  (let ((seconds (current-timeout)))
-    (make-call kind proc args (encode proc (lab-environment) "the procedure")
-               (encode-arguments args) seconds)))
+  (make-call kind proc args (encode proc (lab-environment) "the procedure")
+             (encode-arguments args) (current-timeout)))
 
 ;;> The outcome of a call to one of many address spaces.
 (define-record-type result
@@ -29,12 +28,16 @@
 
 (define (caller-name kind) (if (eq? kind 'run) "remote-run!" "remote-apply"))
 
+;; No let, whose closure every call would make (docs/speed.md).
 (define (call-to a kind proc args)
   (check-not-abandoned (caller-name kind))
-  (let ((c (new-call kind proc args)))
-    (let ((deadline (+ (monotonic-seconds) (call-seconds c)))
-          (g (make-gathering)))
-      (finish-call (start-call a (call-tail c) deadline g) g deadline c))))
+  (call-gathered a (new-call kind proc args)))
+
+(define (call-gathered a c)
+  (call-by a c (+ (monotonic-seconds) (call-seconds c)) (make-gathering)))
+
+(define (call-by a c deadline g)
+  (finish-call (start-call a (call-tail c) deadline g) g deadline c))
 
 (define (call-tail c)
   (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
@@ -49,11 +52,12 @@
   (answer-value p c))
 
 ;; Waits for each pending call of ps, or the deadline; a wait interrupted
-;; (Ctrl-C) gives up every call that has no answer.
+;; (Ctrl-C) gives up every call that has no answer.  One closure, not two.
 (define (await-answers g ps deadline)
-  (undo-on-raise
-   (lambda () (for-each give-up! ps))
-   (lambda () (gathering-wait g (length ps) deadline))))
+  (awaited g ps deadline (undo-begun! (lambda () (for-each give-up! ps)))))
+
+(define (awaited g ps deadline here)
+  (undo-ended here (gathering-wait g (length ps) deadline)))
 
 ;; Forgets p, unless its answer came, and tells its callee.
 (define (give-up! p)
@@ -161,16 +165,16 @@
 (define (capture-each uid-of entry items)
   (map-guarded entry items (lambda (item e) (failure-result (uid-of item) e))))
 
-(define (encode-arguments args)
-  (let loop ((args args) (i 1) (acc '()))
-    (if (null? args)
-        (reverse acc)
-        (loop (cdr args) (+ i 1)
-              ;; Named only for an error (docs/speed.md, What Chibi charges).
-              (cons (encode (car args) (lab-environment)
-                            (lambda () (string-append "argument "
-                                                      (number->string i))))
-                    acc)))))
+;; No named let, whose closure each call would make (docs/speed.md).
+(define (encode-arguments args) (encoded-arguments args 1))
+
+(define (encoded-arguments args i)
+  (if (null? args)
+      '()
+      ;; Named only for an error (docs/speed.md, What Chibi charges).
+      (cons (encode (car args) (lab-environment)
+                    (lambda () (string-append "argument " (number->string i))))
+            (encoded-arguments (cdr args) (+ i 1)))))
 
 (define (local? a) (eq? (aspace-uid a) (aspace-uid (local-aspace))))
 

@@ -1,7 +1,7 @@
 ;;;; Served calls, part of (murdoch remote serve): reading, running, answering.
 
 ;; A call read from a connection or the group, answered their way (reply!).
-(define-record-type served-call
+(define-lean-record-type served-call
   (make-served-call caller id kind proc-code args-code answer)
   served-call?
   (caller served-call-caller)           ; its uid, or for the group its aspace

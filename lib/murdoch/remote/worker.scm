@@ -52,14 +52,19 @@
   (lock! *workers-lock*)
   (set! *idle-workers* (cons mb *idle-workers*))
   (unlock! *workers-lock*)
-  (or (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds) no-job)
-      ;; Timed out; but a caller may have taken this worker meanwhile.
-      (and (not (with-lock *workers-lock*
-                  (lambda ()
-                    (and (memq mb *idle-workers*)
-                         (begin (set! *idle-workers*
-                                      (delete mb *idle-workers* eq?))
-                                #t)))))
-           (mailbox-take mb (+ (monotonic-seconds) 3600) no-job))))
+  (job-or-late mb (mailbox-take mb (+ (monotonic-seconds) worker-idle-seconds) no-job)))
+
+;; No or, whose let makes a closure a job (docs/speed.md).
+(define (job-or-late mb job)
+  (if job job (late-job mb)))
+
+;; Timed out; but a caller may have taken this worker meanwhile.
+(define (late-job mb)
+  (and (not (with-lock *workers-lock*
+              (lambda ()
+                (and (memq mb *idle-workers*)
+                     (begin (set! *idle-workers* (delete mb *idle-workers* eq?))
+                            #t)))))
+       (mailbox-take mb (+ (monotonic-seconds) 3600) no-job)))
 
 (define (no-job) #f)

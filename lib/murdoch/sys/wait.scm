@@ -45,6 +45,7 @@
 
 (define %mutex-lock! (srfi-18-primitive '%mutex-lock!))
 (define %mutex-unlock! (srfi-18-primitive '%mutex-unlock!))
+(define thread-timeout? (srfi-18-primitive 'thread-timeout?))
 
 ;;> Applies \var{thunk} holding the mutex \var{m}, freed however thunk leaves.
 (define (with-lock m thunk)
@@ -68,12 +69,19 @@
 
 ;; Frees m and waits on cv for left seconds; #f when none were left or they ran out.
 (define (waited? m cv left)
-  (and (> left 0.) (unlock-waiting! m cv left)))
+  (and (> left 0.) (woken? m cv left)))
 
 ;;> srfi 18's (mutex-unlock! m cv [timeout]): frees \var{m} and waits on \var{cv}.
 (define (unlock-waiting! m cv . timeout)
+  (woken? m cv (if (pair? timeout) (car timeout) #f)))
+
+;; As srfi 18's mutex-unlock!, seconds a number or #f, without its two
+;; lets' closures and its rest list, once a wait (docs/speed.md).
+(define (woken? m cv seconds)
   (if lock-order-checked? (released! m))
-  (apply mutex-unlock! m cv timeout))
+  (if (%mutex-unlock! m cv seconds)
+      #t
+      (begin (thread-yield!) (not (thread-timeout?)))))
 
 ;;; The lock order (docs/architecture.md), checked in a process started
 ;;; with MURDOCH_LOCK_ORDER naming a folder (tests/run does): a thread
@@ -144,13 +152,24 @@
 
 ;;> Calls thunk; should it raise, calls undo on the way out (docs/speed.md).
 (define (undo-on-raise undo thunk)
-  (undone-on-raise (%dk) undo thunk))
+  (undone-after (undo-begun! undo) thunk))
 
-(define (undone-on-raise here undo thunk)
+(define (undone-after here thunk)
+  (undo-ended here (thunk)))
+
+;;> undo-on-raise in halves, for a caller whose thunk would be a closure
+;;> made only to be passed: answers the wind point to give back to
+;;> \scheme{undo-ended}, with the value of what ran between them.  Chibi
+;;> evaluates arguments right to left, so the point is an argument of a
+;;> procedure whose body runs what it guards.
+(define (undo-begun! undo)
+  (undo-pushed! (%dk) undo))
+
+(define (undo-pushed! here undo)
   (%dk (point! (make-vector 4) (+ 1 (vector-ref here 0)) nothing undo here))
-  (unwound-quietly here (thunk)))
+  here)
 
-(define (unwound-quietly here value)
+(define (undo-ended here value)
   (%dk here)
   value)
 
@@ -170,7 +189,7 @@
 
 ;; A one-shot mailbox: the reader puts an answer, the caller takes it or
 ;; gives up; emptied by its taker once no other thread can put to it.
-(define-record-type mailbox
+(define-lean-record-type mailbox
   (%make-mailbox mutex condvar value full?)
   mailbox?
   (mutex mailbox-mutex)
@@ -234,7 +253,7 @@
 
 ;;> A gathering: the poller hands in the answers to a caller's calls, and
 ;;> the caller wakes once, at the nth or its deadline, not n times.
-(define-record-type gathering
+(define-lean-record-type gathering
   (%make-gathering mutex condvar got wanted)
   gathering?
   (mutex gathering-mutex)

@@ -5,11 +5,11 @@
 (define-library (murdoch sys wait)
   (export lock! unlock! unlocked unlock-waiting! cell-value wind with-lock with-lock-by
           lock-ranks
-          seconds-until undo-on-raise map-guarded
+          seconds-until undo-on-raise undo-begun! undo-ended map-guarded
           make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)
-  (import (scheme base) (only (chibi) %dk) (only (meta) find-module module-env)
+  (import (scheme base) (only (chibi) %dk) (murdoch sys record) (only (meta) find-module module-env)
           (only (scheme eval) eval) (only (scheme process-context) get-environment-variable)
           (only (scheme write) write) (only (scheme file) open-output-file)
           (only (chibi) call-with-output-string) (only (chibi process) current-process-id)
