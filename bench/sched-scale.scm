@@ -15,19 +15,24 @@
 ;;; rest at random arrivals faster than the lab serves them, so that the
 ;;; queue grows to about 2,000.  The posers pose in parallel, each its own
 ;;; tasks.  Each component tells this address space when it starts and
-;;; ends, as in make bench-sched, and bench/schedule.sld judges the run
-;;; beside its ideal schedule: the same lines as make bench-sched's,
-;;; named sched-scale-.  Besides, once a second, the lab's CPU (the posers'
+;;; ends, as in make bench-sched, and each poser what its waiting tasks
+;;; hold as that changes; bench/schedule.sld judges the run beside its
+;;; ideal schedule: the same lines as make bench-sched's, named
+;;; sched-scale-.  Besides, once a second, the lab's CPU (the posers'
 ;;; and robots' processes) and how many tasks have started and are
 ;;; queued (posed, not started):
 ;;;   bench: sched-scale-cpu-per-start-us-at-Q X us, the lab's CPU over
 ;;;          the seconds when the queue held Q/sqrt(2) to Q*sqrt(2) tasks,
 ;;;          over the tasks started then, for Q 500 and 2000;
+;;;   bench: sched-scale-posers-cpu-per-start-us-at-Q X us, the same of
+;;;          the posers' CPU alone;
 ;;;   bench: sched-scale-cpu-per-start-growth X x, the second over the
 ;;;          first, beside sched-scale-log-growth, log 2000 / log 500.
 ;;; Sizes: MURDOCH_SCHED_SCALE_ROBOTS (64, a multiple of 4), _POSERS (8),
 ;;; _TASKS (2500), _BURST (500), _GAP (mean seconds between arrivals,
-;;; 0.008); MURDOCH_SCHED_SEED (30).
+;;; 0.008); MURDOCH_SCHED_SEED (30).  MURDOCH_SCHED_SCALE_SAVE=FILE writes
+;;; the run to FILE, and MURDOCH_SCHED_SCALE_REPLAY=FILE judges it again,
+;;; with the same sizes and seed, without a lab.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
         (scheme time) (scheme process-context) (scheme inexact) (scheme file) (scheme read)
         (srfi 1) (srfi 18) (srfi 132)

@@ -14,12 +14,16 @@
 ;;; components took in the run, and no cost of messages or negotiation.
 ;;; It prints
 ;;;   bench: sched-completed N, sched-lost N
-;;;   bench: sched-deadlocks N          stalls of 2 s with tasks waiting
-;;;                                     and no component running
-;;;   bench: sched-priority-inversions N   tasks that started while a
-;;;                                     better-ranked one waited (see
-;;;                                     inversions below); each is told on
-;;;                                     standard error
+;;;   bench: sched-deadlocks N          holding cycles of 2 s: waiting
+;;;                                     tasks each with a component whose
+;;;                                     every robot is held by one of them
+;;;   bench: sched-stalls N             2 s with tasks waiting and no
+;;;                                     component running
+;;;   bench: sched-priority-inversions N   robots that went to a task while
+;;;                                     a better-ranked one waited with a
+;;;                                     component open that accepts them
+;;;                                     (bench/schedule.sld); each is told
+;;;                                     on standard error
 ;;;   bench: sched-makespan-over-ideal X x
 ;;;   bench: sched-makespan-over-bound X x, over
 ;;;          max(sum of robots x seconds / 8, the longest task)

@@ -398,17 +398,21 @@
                        (if s (cons (list (list-ref e 4) (car s) (car e)) out) out)))))))
 
     ;; The windows of 2 s or more, seen every 0.1 s, in which quiet? holds
-    ;; at each second, given the robots running then.
+    ;; at each second, given the robots running then: the runs are swept
+    ;; in order of start, as a run's thousands are too many to look
+    ;; through at each step.
     (define (windows run quiet?)
-      (let ((runs (runs-on-robots run)) (makespan (schedule-makespan run)))
-        (let loop ((t 0) (quiet 0) (n 0))
+      (let ((makespan (schedule-makespan run)))
+        (let loop ((t 0) (runs (list-sort (lambda (a b) (< (cadr a) (cadr b)))
+                                          (runs-on-robots run)))
+                   (active '()) (quiet 0) (n 0))
           (if (> t makespan)
               n
-              (let* ((running (filter-map (lambda (r) (and (<= (cadr r) t) (< t (car (cddr r)))
-                                                           (car r)))
-                                          runs))
-                     (quiet (if (quiet? t running) (+ quiet 0.1) 0)))
-                (loop (+ t 0.1) quiet (if (and (>= quiet 2) (< quiet 2.1)) (+ n 1) n)))))))
+              (let* ((started (take-while (lambda (r) (<= (cadr r) t)) runs))
+                     (active (filter (lambda (r) (< t (car (cddr r)))) (append started active)))
+                     (quiet (if (quiet? t (map car active)) (+ quiet 0.1) 0)))
+                (loop (+ t 0.1) (drop runs (length started)) active quiet
+                      (if (and (>= quiet 2) (< quiet 2.1)) (+ n 1) n)))))))
 
     ;; Stalls: 2 s or more with a task posed and not started, and no
     ;; component running: the lab idle while tasks wait, a cost of the
@@ -430,8 +434,11 @@
 
     (define (holding-cycle? run holders t)
       (let* ((now (filter-map (lambda (y)
-                                (let ((held (held-at run y t)) (sy (first-start run y)))
-                                  (and (pair? held) (or (not sy) (> sy t)) (cons y held))))
+                                (let ((hs (vector-ref (run-holdings run) (car y))))
+                                  (and (<= (caar hs) t (car (last hs)))
+                                       (let ((held (held-at run y t)) (sy (first-start run y)))
+                                         (and (pair? held) (or (not sy) (> sy t))
+                                              (cons y held))))))
                               holders))
              (held (append-map cdr now))
              (kind-of (lambda (uid) (cdr (assq uid (run-robots run)))))

@@ -217,22 +217,47 @@
 ;; of a poser's hundreds of tasks was the posers' share of the lab's CPU
 ;; a start, and grew with the queue (docs/allocation.md).
 (define (look-all! ws)
-  (let* ((layouts (delete-duplicates (append-map waiter-layouts ws)))
-         (lines (map cons layouts (explain-components layouts)))
-         (line (line-of (guard (e (#t '())) (lab-waiting))))
-         ;; Those that hold robots, no more than the robots: each task
-         ;; asks those of them that rank after it to give way.
-         (holders (list-sort (lambda (a b) (rank<? (waiting-there-rank a) (waiting-there-rank b)))
-                             (guard (e (#t '())) (lab-holders))))
-         (told (told-lines)))
-    (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines))))
-    (fold (lambda (w holders)
-            (let ((after (drop-while (lambda (h) (rank<? (waiting-there-rank h) (waiter-rank w)))
-                                     holders)))
-              (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
-                     after line told)
-              after))
-          holders ws)))
+  (let*-values (((line) (line-of (guard (e (#t '())) (lab-waiting))))
+                ((lines fresh?) (takers-of (delete-duplicates (append-map waiter-layouts ws))
+                                           (vector-length line))))
+    ;; Those that hold robots, no more than the robots, best first: each
+    ;; task asks those of them that rank after it to give way.
+    (let ((holders (list-sort (lambda (a b)
+                                (rank<? (waiting-there-rank a) (waiting-there-rank b)))
+                              (guard (e (#t '())) (lab-holders))))
+          (told (told-lines)))
+      (if fresh?
+          (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines)))))
+      (fold (lambda (w holders)
+              (let ((after (drop-while (lambda (h)
+                                         (rank<? (waiting-there-rank h) (waiter-rank w)))
+                                       holders)))
+                (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
+                       after line told)
+                after))
+            holders ws))))
+
+;; The takers of each of layouts, ((LAYOUT . EXPLANATION) ...), and
+;; whether they were asked afresh; else as the last look that asked the
+;; lab found them, when that was less than a
+;; heartbeat ago for every 100 of the n tasks waiting in the lab and it
+;; asked for them all, as the line is asked (waiting-at-others): each
+;; poser's look asking the whole lab once a second, the robots' answers
+;; were most of their CPU a start with thousands queued.  Who is capable
+;; and free, and why a task waits, may so be n/100 heartbeats old; who
+;; is offered a robot is decided by the robot's round, never by this.
+(define *takers* #f)                    ; (WHEN (LAYOUT . EXPLANATION) ...)
+
+(define (takers-of layouts n)
+  (let ((now (monotonic-seconds)))
+    (if (and *takers*
+             (< (- now (car *takers*))
+                (* (lab-setting (current-lab) 'heartbeat) (max 1 (/ n 100))))
+             (every (lambda (l) (assoc l (cdr *takers*))) layouts))
+        (values (cdr *takers*) #f)
+        (let ((lines (map cons layouts (explain-components layouts))))
+          (set! *takers* (cons now lines))
+          (values lines #t)))))
 
 ;; The line a look tells of explanation e for component number i, trimmed,
 ;; made once a look for each.
