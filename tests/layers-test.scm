@@ -6,7 +6,6 @@
 ;;; follows it, and names every library.
 (import (scheme base) (scheme read) (scheme file) (scheme write) (scheme cxr)
         (srfi 1) (chibi test)
-        (only (chibi filesystem) directory-files file-directory?)
         (only (chibi string) string-split)
         (murdoch testing harness))
 
@@ -65,18 +64,8 @@
 
 (define (ours? name) (and (pair? name) (eq? (car name) 'murdoch)))
 
-;; Every .sld under dir, in its folders too.
-(define (sld-files dir)
-  (append-map (lambda (f)
-                (let ((path (string-append dir "/" f)))
-                  (cond ((member f '("." "..")) '())
-                        ((file-directory? path) (sld-files path))
-                        ((text-contains? f ".sld") (list path))
-                        (else '()))))
-              (directory-files dir)))
-
 (define library-files
-  (cons (tool-path "lib/murdoch.sld") (sld-files (tool-path "lib/murdoch"))))
+  (cons (tool-path "lib/murdoch.sld") (files-under (tool-path "lib/murdoch") ".sld")))
 
 ;; (name . imports of ours), for every library.
 (define graph
@@ -316,6 +305,12 @@
   (let ((exported (exports (library-form (tool-path "lib/murdoch.sld")))))
     (list (lset-difference eq? exported reference-names)
           (lset-difference eq? reference-names exported))))
+
+(test "no Scheme file in lib/ is over 500 lines" '()
+  (filter-map (lambda (f)
+                (let ((n (length (text-lines (file-text f)))))
+                  (and (> n 500) (list f n))))
+              (files-under (tool-path "lib") ".scm")))
 
 (test "received code reaches (murdoch) and no other library of ours" '((murdoch))
   sandbox-murdoch-libraries)

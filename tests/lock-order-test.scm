@@ -73,20 +73,6 @@
                                                                           (unlock! tries)))))
                                     (unlock! tasks)))))))
 
-;; Every .scm under folder.
-(define (scheme-files folder)
-  (append-map (lambda (f)
-                (let ((path (string-append folder "/" f)))
-                  (cond ((member f '("." "..")) '())
-                        ((file-directory? path) (scheme-files path))
-                        ((string-suffix? ".scm" f) (list path))
-                        (else '()))))
-              (directory-files folder)))
-
-(define (string-suffix? end s)
-  (let ((n (string-length s)) (k (string-length end)))
-    (and (>= n k) (string=? end (substring s (- n k) n)))))
-
 ;; What follows each "(make-mutex" of text: the name it is made with, as
 ;; read, or #f when it is made with none.
 (define (mutex-names text)
@@ -110,7 +96,7 @@
 (test-group "every mutex has a place"
   (let ((made (append-map (lambda (f)
                             (map (lambda (name) (cons name f)) (mutex-names (file-text f))))
-                          (scheme-files (tool-path "lib/murdoch")))))
+                          (files-under (tool-path "lib/murdoch") ".scm"))))
     (test-assert "lib/ makes mutexes" (> (length made) 20))
     (test "each is made with a name that lock-ranks places" '()
           (remove (lambda (m) (assq (car m) lock-ranks)) made))

@@ -26,4 +26,4 @@
                         resume-steps step-task-id team-keeper)
                   (start-steps start-steps-here))
           (only (murdoch pubsub) subscribe unsubscribe request get-system-load))
-  (include "detached.scm"))
+  (include "detached.scm" "standby.scm" "lab-tasks.scm"))

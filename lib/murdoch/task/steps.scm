@@ -65,7 +65,7 @@
 ;;> How the teams of the tasks of steps started under it outlive the
 ;;> address space that coordinates them: #f, or a procedure that (KEEPER
 ;;> TASK-ID TEAM-ID) answers the state kept for a step's team, or #f, and
-;;> (KEEPER TASK-ID TEAM-ID STATE) keeps it (detached.scm's keep-team).
+;;> (KEEPER TASK-ID TEAM-ID STATE) keeps it (standby.scm's keep-team).
 (define team-keeper (make-parameter #f))
 
 ;;> Runs a task of steps and answers, as task-wait, each step's results.

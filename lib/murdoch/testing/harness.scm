@@ -97,6 +97,21 @@
       (and (<= (+ i n) (string-length text))
            (or (string=? word (substring text i (+ i n))) (loop (+ i 1)))))))
 
+;;> Every file under \var{folder}, in its folders too, whose name ends
+;;> with \var{suffix}.
+(define (files-under folder suffix)
+  (append-map (lambda (f)
+                (let ((path (string-append folder "/" f)))
+                  (cond ((member f '("." "..")) '())
+                        ((file-directory? path) (files-under path suffix))
+                        ((name-ends-with? f suffix) (list path))
+                        (else '()))))
+              (directory-files folder)))
+
+(define (name-ends-with? name end)
+  (let ((n (string-length name)) (k (string-length end)))
+    (and (>= n k) (string=? end (substring name (- n k) n)))))
+
 ;;> Writes a lab file of \var{clauses} and \var{files} in a fresh folder, on a free port base.
 (define (make-test-lab clauses . files)
   (let* ((dir (temporary-directory))

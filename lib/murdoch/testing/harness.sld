@@ -8,17 +8,18 @@
           start-lab-aspace! start-murdoch-lab! median-seconds
           wait-for-port wait-until remove-test-lab!
           tool-path temporary-directory free-port-base file-text
-          text-contains? listen-on-free-port read-lines text-lines error-text
+          text-contains? files-under listen-on-free-port read-lines text-lines error-text
           command-output)
   (import (scheme base) (scheme time) (scheme write) (scheme file)
           (scheme read) (scheme process-context)
-          (srfi 18) (srfi 132)
+          (only (srfi 1) append-map) (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
           (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab) (only (murdoch wire) open-connection)
           (only (murdoch remote) remote-error? remote-error-message)
           (only (chibi test) test-failure-count)
           (only (chibi filesystem) delete-file-hierarchy current-directory directory-files
+                file-directory?
                 create-directory
                 open-input-file-descriptor open-output-file-descriptor
                 open-pipe duplicate-file-descriptor-to))
