@@ -112,15 +112,11 @@
 
 ;; Whether a task started to wait, or was reminded of, since this robot's
 ;; offer round asked who waits: the round's list may lack a better-ranked
-;; task, and it asks again before its next offer (forty tasks posed at
-;; once: a round that had asked before the best of them waited went on
-;; down its list to a worse one).  The best rank of those noted, or #t
-;; for one not known (a reminder): a round asks again only if that rank
-;; goes before its next offer's.  While posers posed thousands, a note
-;; came between any two offers, and every robot asked who waits again
-;; after each offer, never getting past the best task of the lab, which
-;; declined all but one robot a component (docs/allocation.md).  Global,
-;; as the offer rounds are.
+;; task, and it asks again before its next offer.  The best rank of those
+;; noted, or #t for one not known (a reminder): a round asks again only
+;; if that rank goes before its next offer's, else with posers posing
+;; non-stop it never gets past the lab's best task (docs/allocation.md).
+;; Global, as the offer rounds are.
 (define *new-waiters* #f)
 
 (define (ask-again-before? waiting)

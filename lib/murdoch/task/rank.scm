@@ -241,13 +241,10 @@
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
 ;; asked of the lab at most once a heartbeat for every 100 tasks it
-;; waited last time, for all the tasks waiting here.  Each look numbers
-;; its tasks' places in the line: with W tasks waiting, a look that asked
-;; every poser each time cost W squared a period lab-wide, and one a
-;; heartbeat, 2,500 tasks' entries twice a second a poser.  A place may
-;; so be W/100 heartbeats old for tasks posed elsewhere; who is offered a
-;; robot is decided by the robot's own round, never by this list, and who
-;; holds what is asked afresh (lab-holders).
+;; waited last time, for all the tasks waiting here (docs/allocation.md).
+;; A place may so be W/100 heartbeats old for tasks posed elsewhere; who
+;; is offered a robot is decided by the robot's own round, never by this
+;; list, and who holds what is asked afresh (lab-holders).
 (define (waiting-at-others)
   (let* ((now (monotonic-seconds))
          (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))

@@ -42,8 +42,7 @@
   (note-lab! (waiter-rank w)))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
-;; tasks that start to wait while the publication goes (500 posed at once
-;; were 500 publications, each to every address space), with the best of
+;; tasks that start to wait while the publication goes, with the best of
 ;; their ranks.  Global: a process is one poser, with one line of tasks.
 (define *noting* #f)                    ; a publication goes
 (define *note-again* #f)                ; the best rank waiting since, or #f
@@ -214,9 +213,7 @@
 ;; lab's line as lab-waiting has it, whatever the number of tasks.  What
 ;; each task is told is made once a look for each of the layouts and
 ;; numbers its components have, and the holders that rank after each task
-;; are found by going down both lists together: the look's work for each
-;; of a poser's hundreds of tasks was the posers' share of the lab's CPU
-;; a start, and grew with the queue (docs/allocation.md).
+;; are found by going down both lists together (docs/allocation.md).
 (define (look-all! ws)
   (let*-values (((line) (line-of (guard (e (#t '())) (lab-waiting))))
                 ((lines fresh?) (takers-of (delete-duplicates (append-map waiter-layouts ws))
