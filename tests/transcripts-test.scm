@@ -1,7 +1,7 @@
 ;;; Replays every tests/transcripts/*.txt against a fresh lab of its own
 ;;; (docs/transcripts.md): `bin/murdoch lab` on a free port base, then
 ;;; `bin/murdoch repl` with the transcript's input piped in.
-(import (scheme base) (srfi 1) (chibi test)
+(import (scheme base) (srfi 1) (chibi test) (only (chibi string) string-suffix?)
         (only (chibi filesystem) directory-files open-pipe
               open-input-file-descriptor open-output-file-descriptor)
         (murdoch testing harness) (murdoch testing transcript))
@@ -11,10 +11,6 @@
     (map (lambda (f) (string-append dir "/" f))
          (sort-strings (filter (lambda (f) (string-suffix? ".txt" f))
                                (directory-files dir))))))
-
-(define (string-suffix? suffix s)
-  (let ((n (string-length s)) (k (string-length suffix)))
-    (and (>= n k) (string=? suffix (substring s (- n k) n)))))
 
 (define (sort-strings ls)
   (if (null? ls)

@@ -104,13 +104,9 @@
                 (let ((path (string-append folder "/" f)))
                   (cond ((member f '("." "..")) '())
                         ((file-directory? path) (files-under path suffix))
-                        ((name-ends-with? f suffix) (list path))
+                        ((string-suffix? suffix f) (list path))
                         (else '()))))
               (directory-files folder)))
-
-(define (name-ends-with? name end)
-  (let ((n (string-length name)) (k (string-length end)))
-    (and (>= n k) (string=? end (substring name (- n k) n)))))
 
 ;;> Writes a lab file of \var{clauses} and \var{files} in a fresh folder, on a free port base.
 (define (make-test-lab clauses . files)

@@ -14,6 +14,7 @@
           (scheme read) (scheme process-context)
           (only (srfi 1) append-map) (srfi 18) (srfi 132)
           (chibi net) (chibi process) (chibi io)
+          (only (chibi string) string-suffix?)
           (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab) (only (murdoch wire) open-connection)
           (only (murdoch remote) remote-error? remote-error-message)
