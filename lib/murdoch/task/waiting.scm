@@ -42,8 +42,7 @@
   (note-lab! (waiter-rank w)))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
-;; tasks that start to wait while the publication goes (500 posed at once
-;; were 500 publications, each to every address space), with the best of
+;; tasks that start to wait while the publication goes, with the best of
 ;; their ranks.  Global: a process is one poser, with one line of tasks.
 (define *noting* #f)                    ; a publication goes
 (define *note-again* #f)                ; the best rank waiting since, or #f
@@ -211,46 +210,85 @@
 
 ;; Looks at the lab for the waiting tasks ws: one request for the takers
 ;; of all their components, one for the tasks that hold robots, and the
-;; lab's line as lab-waiting has it, whatever the number of tasks.
+;; lab's line as lab-waiting has it, whatever the number of tasks.  What
+;; each task is told is made once a look for each of the layouts and
+;; numbers its components have, and the holders that rank after each task
+;; are found by going down both lists together (docs/allocation.md).
 (define (look-all! ws)
-  (let* ((layouts (delete-duplicates (append-map waiter-layouts ws)))
-         (lines (map cons layouts (explain-components layouts)))
-         (line (line-of (guard (e (#t '())) (lab-waiting))))
-         ;; Those that hold robots, no more than the robots: each task
-         ;; asks those of them that rank after it to give way.
-         (holders (guard (e (#t '())) (lab-holders))))
-    (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines))))
-    (for-each (lambda (w)
+  (let*-values (((line) (line-of (guard (e (#t '())) (lab-waiting))))
+                ((lines fresh?) (takers-of (delete-duplicates (append-map waiter-layouts ws))
+                                           (vector-length line))))
+    ;; Those that hold robots, no more than the robots, best first: each
+    ;; task asks those of them that rank after it to give way.
+    (let ((holders (list-sort (lambda (a b)
+                                (rank<? (waiting-there-rank a) (waiting-there-rank b)))
+                              (guard (e (#t '())) (lab-holders))))
+          (told (told-lines)))
+      (if fresh?
+          (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines)))))
+      (fold (lambda (w holders)
+              (let ((after (drop-while (lambda (h)
+                                         (rank<? (waiting-there-rank h) (waiter-rank w)))
+                                       holders)))
                 (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
-                       holders line))
-              ws)))
+                       after line told)
+                after))
+            holders ws))))
+
+;; The takers of each of layouts, ((LAYOUT . EXPLANATION) ...), and
+;; whether they were asked afresh; else as the last look that asked the
+;; lab found them, when that was less than a heartbeat ago for every 100
+;; of the n tasks waiting in the lab (docs/allocation.md).  Who is capable
+;; and free, and why a task waits, may so be n/100 heartbeats old; who
+;; is offered a robot is decided by the robot's round, never by this.
+;; Global: one poser, one look at a time.
+(define *takers* #f)                    ; (WHEN (LAYOUT . EXPLANATION) ...)
+
+(define (takers-of layouts n)
+  (let ((now (monotonic-seconds)))
+    (if (and *takers*
+             (< (- now (car *takers*))
+                (* (setting 'heartbeat) (max 1 (/ n 100))))
+             (every (lambda (l) (assoc l (cdr *takers*))) layouts))
+        (values (cdr *takers*) #f)
+        (let ((lines (map cons layouts (explain-components layouts))))
+          (set! *takers* (cons now lines))
+          (values lines #t)))))
+
+;; The line a look tells of explanation e for component number i, trimmed,
+;; made once a look for each.
+(define (told-lines)
+  (let ((made '()))
+    (lambda (e i)
+      (let ((key (find (lambda (m) (and (eq? (car m) e) (= (cadr m) i))) made)))
+        (if key
+            (car (cddr key))
+            (let ((text (trimmed (explanation-line e i))))
+              (set! made (cons (list e i text) made))
+              text))))))
 
 (define (waiter-layouts w)
   (map (lambda (c) (capability-layout (component-capabilities c))) (waiter-components w)))
 
 ;; What a look tells w, from lines, the explanations of its components,
-;; holders, the lab's waiting tasks that hold robots, and line, the ranks
-;; of all its waiting tasks in order: why it waits, and its place in line,
-;; in its components' states; or why it never can be served, its waiting
-;; task told.
-(define (look! w lines holders line)
+;; holders, the lab's waiting tasks that hold robots and rank after it,
+;; line, the ranks of all its waiting tasks in order, and told, its
+;; lines' text: why it waits, and its place in line, in its components'
+;; states; or why it never can be served, its waiting task told.
+(define (look! w lines holders line told)
   (waiter-looked-set! w (monotonic-seconds))
   (let* ((cs (waiter-components w))
          (capable (map (lambda (line)
-                         (remove (lambda (uid) (memq uid (waiter-excluded w)))
-                                 (explanation-capable line)))
+                         (let ((all (explanation-capable line)))
+                           (if (null? (waiter-excluded w))
+                               all
+                               (remove (lambda (uid) (memq uid (waiter-excluded w))) all))))
                        lines))
-         (exclusive (filter-map (lambda (c caps)
-                                  (and (pair? (car (capability-layout
-                                                    (component-capabilities c))))
-                                       caps))
-                                cs capable))
          (never (cond
                  ((any null? capable)
                   (string-append "no live robot of the lab is capable of it:"
                                  (apply string-append (explanation-lines lines))))
-                 ((< (length (delete-duplicates (apply append exclusive)))
-                     (length exclusive))
+                 ((too-few-capable? cs capable)
                   "fewer live robots of the lab are capable of it than it has components")
                  (else #f))))
     (cond
@@ -258,9 +296,9 @@
       (waiter-never-set! w never)
       (tell-waiter! w '(looked)))
      (else
-      (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (waiter-capable-set! w (union-of capable))
       (waiter-capables-set! w (map cons cs capable))
-      (waiter-why-set! w (map trimmed (explanation-lines lines)))
+      (waiter-why-set! w (map told lines (iota (length lines) 1)))
       (ask-way! w lines holders)
       (if (blocked-on-itself? w) (tell-waiter! w '(looked)))
       (move-up! w line)
@@ -271,6 +309,24 @@
                                 (held-uids w)))
                     "")
                 ", " (waiter-position w) " in line")))))
+
+;; Whether fewer robots are capable of the exclusive components of cs,
+;; capable the uids capable of each, than they are: never when each has
+;; as many as they are, which a look of a lab with spare robots finds at
+;; once.
+(define (too-few-capable? cs capable)
+  (let ((exclusive (filter-map (lambda (c caps)
+                                 (and (pair? (car (capability-layout (component-capabilities c))))
+                                      caps))
+                               cs capable)))
+    (and (any (lambda (caps) (< (length caps) (length exclusive))) exclusive)
+         (< (length (union-of exclusive)) (length exclusive)))))
+
+;; The uids in any of lists, once each.
+(define (union-of lists)
+  (fold (lambda (uids out)
+          (append (remove (lambda (uid) (memq uid out)) uids) out))
+        '() lists))
 
 ;; Robots that a look finds free may have made their offers before these
 ;; tasks waited, or be making them: each found free by the last look too
