@@ -297,12 +297,14 @@
 
 ;; Whether w may use robot uid, subscribed to subjects (or #f): for a
 ;; component it does not hold, when it has looked; a robot its look did
-;; not know, if subjects serve a component.  Offered to a task that held
-;; the one component it could take, a robot went down its round to no
-;; avail, and sat free while tasks waited for it further down.
+;; not know, or before it looked, if subjects serve a component.  Offered
+;; to a task that held the one component it could take, a robot went down
+;; its round to no avail, and sat free while tasks waited for it further
+;; down; offered to each task just posed, a robot of another kind made it
+;; try for nothing.
 (define (wants? w uid subjects)
   (let ((capable (waiter-capable w)))
-    (cond ((eq? capable #t) #t)
+    (cond ((eq? capable #t) (or (not subjects) (serves? subjects w)))
           ((memq uid capable)
            (any (lambda (cc)
                   (and (not (assv (component-index (car cc)) (waiter-held w)))

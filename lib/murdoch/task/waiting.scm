@@ -148,19 +148,26 @@
                                     (request-audience (audience w offered excluded)))
                        (try w))))))))
 
-;; Whom w's negotiations ask: the robots its last look found capable and
-;; those offered, but those excluded; the whole lab before it has looked.
+;; Whom w's negotiations ask, but those excluded: the robots offered
+;; alone when w takes them one at a time, else those offered and those
+;; its last look found capable; the whole lab before it has looked.  A
+;; task posed a moment before, offered a robot it could not use, asked
+;; the whole lab and took one freed for a better-ranked task, on its way
+;; to offer itself there.
 (define (audience w offered excluded)
-  (and (list? (waiter-capable w))
-       (remove (lambda (uid) (memq uid excluded))
-               (append offered (waiter-capable w)))))
+  (let ((asked (cond ((and (pair? offered) (one-at-a-time? w)) offered)
+                     ((list? (waiter-capable w)) (append offered (waiter-capable w)))
+                     (else #f))))
+    (and asked (remove (lambda (uid) (memq uid excluded)) asked))))
 
 (define (not-offered w offered)
-  (let ((t (waiter-task w)))
-    (if (and (pair? offered) (list? (waiter-capable w))
-             (or (turn-hold? (task-turn t)) (= 1 (length (waiter-components w)))))
-        (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
-        '())))
+  (if (and (pair? offered) (list? (waiter-capable w)) (one-at-a-time? w))
+      (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
+      '()))
+
+;; Whether w can take robots one at a time: it holds, or needs one.
+(define (one-at-a-time? w)
+  (or (turn-hold? (task-turn (waiter-task w))) (= 1 (length (waiter-components w)))))
 
 (define (look-due? w)
   (or (not (waiter-looked w)) (> (- (monotonic-seconds) (waiter-looked w)) 1)))
