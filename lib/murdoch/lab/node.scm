@@ -3,9 +3,10 @@
 ;;;; (docs/architecture.md, "How an address space starts").
 
 (define-record-type node
-  (make-node lab wire limits sandbox membership server group monitors)
+  (make-node lab role wire limits sandbox membership server group monitors)
   node?
   (lab node-lab)                        ; read once; its settings by setting
+  (role node-role)                      ; aspace, or repl: a person waits at it
   (wire node-wire node-wire-set!)       ; wire/frame.scm: the key, frame limits
   (limits node-limits node-limits-set!) ; code/sendable.scm: values sent
   (sandbox node-sandbox node-sandbox-set!) ; code/sandbox.scm: max-alloc, ports
@@ -18,9 +19,10 @@
 ;; paths read their part straight from it (docs/speed.md).
 (define *node* #f)
 
-;;> Makes this process a node of \var{lab}, its parts yet to be filled.
-(define (open-node! lab)
-  (set! *node* (make-node lab #f #f #f #f #f #f #f))
+;;> Makes this process a node of \var{lab}, its parts yet to be filled;
+;;> \var{role} is \scheme{repl} for a person's REPL, else \scheme{aspace}.
+(define (open-node! lab . role)
+  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f))
   *node*)
 
 ;;> This process's node, for a layer to fill its part.
@@ -32,3 +34,8 @@
 
 ;;> The value of setting \var{key} of this address space's lab.
 (define (setting key) (lab-setting (current-lab) key))
+
+;;> Seconds a call waits for its answer unless told otherwise: at a REPL,
+;;> where a person waits and Ctrl-C gives a call up, repl-timeout.
+(define (call-timeout)
+  (setting (if (eq? (node-role (this-node)) 'repl) 'repl-timeout 'timeout)))
