@@ -13,7 +13,7 @@
           node-wire node-wire-set! node-limits node-limits-set!
           node-sandbox node-sandbox-set! node-membership node-membership-set!
           node-server node-server-set! node-group node-group-set!
-          node-monitors node-monitors-set!)
+          node-subscriber node-subscriber-set! node-monitors node-monitors-set!)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
           (scheme process-context)
           (scheme inexact)

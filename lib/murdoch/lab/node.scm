@@ -3,7 +3,8 @@
 ;;;; (docs/architecture.md, "How an address space starts").
 
 (define-record-type node
-  (make-node lab role wire limits sandbox membership server group monitors)
+  (make-node lab role wire limits sandbox membership server group subscriber
+             monitors)
   node?
   (lab node-lab)                        ; read once; its settings by setting
   (role node-role)                      ; aspace, or repl: a person waits at it
@@ -13,6 +14,7 @@
   (membership node-membership node-membership-set!) ; remote/aspace.scm
   (server node-server node-server-set!) ; remote/serve.scm
   (group node-group node-group-set!)    ; remote/group.scm, #f under broadcast
+  (subscriber node-subscriber node-subscriber-set!) ; pubsub/messaging.scm
   (monitors node-monitors node-monitors-set!)) ; pubsub/monitor.scm: thresholds
 
 ;; Global: a process is one address space of one lab.  The layers' hot
@@ -22,7 +24,7 @@
 ;;> Makes this process a node of \var{lab}, its parts yet to be filled;
 ;;> \var{role} is \scheme{repl} for a person's REPL, else \scheme{aspace}.
 (define (open-node! lab . role)
-  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f))
+  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f #f))
   *node*)
 
 ;;> This process's node, for a layer to fill its part.
