@@ -1,6 +1,7 @@
 ;;; bin/murdoch lab and pose, as real processes: a lab comes up and goes
 ;;; down whole, an address space that dies is started again, one that
 ;;; cannot start stops the lab, and pose poses the task a file names.
+;;; tests/run: long
 (import (scheme base) (scheme write) (scheme file) (scheme read) (srfi 1) (chibi test)
         (only (chibi process) system system? kill signal/kill signal/interrupt
               signal/term)
