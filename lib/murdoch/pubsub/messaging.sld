@@ -12,6 +12,6 @@
           receive-request-non-exclusive receive-components start-leases!
           open-subscriber! offer-subjects! addressed-here?)
   (import (only (murdoch code) make-logged-thread) (scheme base) (srfi 1) (srfi 18)
-          (chibi match) (murdoch sys) (murdoch lab) (murdoch remote)
+          (murdoch sys) (murdoch lab) (murdoch remote)
           (only (murdoch wire) error-message))
   (include "messaging.scm" "receiving.scm"))

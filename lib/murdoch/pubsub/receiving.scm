@@ -31,12 +31,14 @@
 ;;> for each component.
 (define (receive-components components task-name uid)
   (map (lambda (c)
-         (match c
-           ((type layout proc askings)
-            (let ((answer (if (eq? type 'exclusive)
-                              (receive-request-exclusive layout task-name uid proc '())
-                              (receive-request (cadr layout) uid proc '()))))
-              (list answer (if (evaluated? answer) (map ask-here askings) '()))))))
+         (if (not (and (list? c) (= 4 (length c))))
+             (error "receive-components: a component is (type layout proc askings)" c))
+         (apply (lambda (type layout proc askings)
+                  (let ((answer (if (eq? type 'exclusive)
+                                    (receive-request-exclusive layout task-name uid proc '())
+                                    (receive-request (cadr layout) uid proc '()))))
+                    (list answer (if (evaluated? answer) (map ask-here askings) '()))))
+                c))
        components))
 
 ;; An asking is user code: one raising costs only its answer (docs/speed.md).
