@@ -163,7 +163,7 @@
           (begin
             (system? "sh" "-c"
                      "i=0; while [ $i -lt 10 ]; do i=$((i+1));
-                        timeout -s KILL 60 \"$1\" pose \"$2\" \"$3\" >\"$4.$i\" 2>&1 &
+                        timeout -s KILL 120 \"$1\" pose \"$2\" \"$3\" >\"$4.$i\" 2>&1 &
                       done; wait"
                      "guests" (tool-path "bin/murdoch") (test-lab-file lab)
                      (in-dir "task.scm") (in-dir "guest.out"))
