@@ -58,6 +58,44 @@ static void skip_space (struct plain *s) {
 
 static sexp plain_datum (sexp ctx, struct plain *s, long depth);
 
+/* The symbols read lately, by a hash of their names.  Chibi's intern
+ * hashes the name and walks a bucket of its table, a few hundred
+ * instructions a symbol, and a frame has several, the same in every
+ * call.  Chibi's table holds each symbol for good (its collector marks
+ * the table), so a symbol kept here is never freed under us. */
+#define KNOWN_SYMBOLS 512
+#define KNOWN_SYMBOL_BYTES 32
+static struct known_symbol {
+  sexp symbol;
+  long size;
+  char name[KNOWN_SYMBOL_BYTES];
+} known_symbols[KNOWN_SYMBOLS];
+
+static int known_as (struct known_symbol *k, const char *name, long size) {
+  return k->symbol && k->size == size && memcmp(k->name, name, size) == 0;
+}
+
+/* Each name has two places, for names whose first place another took. */
+static sexp plain_symbol (sexp ctx, const char *name, long size) {
+  unsigned long h = 2166136261u;
+  long i;
+  struct known_symbol *a, *b;
+  sexp sym;
+  for (i = 0; i < size; i++) h = (h ^ (unsigned char)name[i]) * 16777619u;
+  a = &known_symbols[h % KNOWN_SYMBOLS];
+  b = &known_symbols[(h >> 16) % KNOWN_SYMBOLS];
+  if (known_as(a, name, size)) return a->symbol;
+  if (known_as(b, name, size)) return b->symbol;
+  sym = sexp_intern(ctx, name, size);
+  if (!sexp_exceptionp(sym) && size <= KNOWN_SYMBOL_BYTES) {
+    if (a->symbol) a = b;
+    a->symbol = sym;
+    a->size = size;
+    memcpy(a->name, name, size);
+  }
+  return sym;
+}
+
 /* An integer of at most 17 digits, a fixnum on any Chibi; a symbol that
  * cannot be taken for a number; else other. */
 static sexp plain_atom (sexp ctx, struct plain *s) {
@@ -79,7 +117,7 @@ static sexp plain_atom (sexp ctx, struct plain *s) {
    * read; + and - alone are symbols. */
   if (*start == '.' || ((*start == '+' || *start == '-') && start + 1 < s->p))
     return s->other;
-  return sexp_intern(ctx, (const char *)start, s->p - start);
+  return plain_symbol(ctx, (const char *)start, s->p - start);
 }
 
 static sexp plain_string (sexp ctx, struct plain *s) {
