@@ -83,11 +83,9 @@
 
 ;; No wind around the lock: nothing under it raises, and every call comes here.
 (define (live-connection-to uid)
-  (live-connection-in (the-connections) uid))
-
-(define (live-connection-in cs uid)
-  (lock! (connections-lock cs))
-  (open-in (unlocked (connections-lock cs) (hash-table-cell (connections-table cs) uid #f))))
+  (lock! (connections-lock (the-connections)))
+  (open-in (unlocked (connections-lock (the-connections))
+                     (hash-table-cell (connections-table (the-connections)) uid #f))))
 
 (define (open-in cell)
   (and cell (connection-open? (cdr cell)) (cdr cell)))
