@@ -119,11 +119,11 @@
           (all w1 #(murdoch:closure (lambda () #t) ((x . -12) (s . "a\"b\nc"))) ()))
   (plain "(apply 17 #(murdoch:global receive-request) (all w1 #(murdoch:closure (lambda () #t) ((x . -12) (s . \"a\\\"b\\nc\"))) ()))"))
 (test "what is not plain is left to read"
-  (make-list 21 #t)
+  (make-list 22 #t)
   (map (lambda (t) (eq? other (plain t)))
        '("0.5" "1/2" "+i" "-inf.0" ".5" "..." "#\\a" "'a" "(a ;c\n)" "|a b|"
          "#u8(1)" "#0=(a . #0#)" "\"\\x41;\"" "caf\xe9;" "(1 2" "" "x y" " x " "#(1 . 2)"
-         "123456789012345678" "abc#t")))
+         "123456789012345678" "abc#t" "\"a\\\x0;b\"")))
 (test "nesting up to the limit, and not past it" '(#t #t)
   (let ((nest (lambda (n) (string-append (make-string n #\() "x" (make-string n #\))))))
     (list (pair? (plain (nest 100))) (eq? other (plain (nest 101))))))

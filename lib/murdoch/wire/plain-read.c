@@ -129,7 +129,8 @@ static sexp plain_string (sexp ctx, struct plain *s) {
   for ( ; s->p < s->end && *s->p != '"'; s->p++) {
     if (*s->p >= 0x80) return s->other;
     if (*s->p == '\\') {
-      if (++s->p == s->end || !strchr("\\\"nt", *s->p)) return s->other;
+      /* strchr finds a NUL byte too: the string's own end. */
+      if (++s->p == s->end || !*s->p || !strchr("\\\"nt", *s->p)) return s->other;
       escaped = 1;
     }
   }
