@@ -128,8 +128,8 @@
   (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
     (and a (lab-aspace-clause a 'capabilities) #t)))
 
-;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
-;; starts an offer round, or asks the one running for another.  A round
+;; Runs on every freeing of exclusive subjects here (the hook given to
+;; pubsub's open-subscriber!): starts an offer round, or asks the one running for another.  A round
 ;; that runs keeps the robot as it is: offered to a poser, a runner-up of
 ;; that poser's negotiation is freed while the robot waits for its answer,
 ;; and the task that tries must still find the robot its poser's.

@@ -4,11 +4,12 @@
 ;; waits for them, holding nothing and trying only when a robot offers
 ;; itself, while its poser subscribes to waiting-tasks and tells the lab
 ;; that a task waits (note-waiters!).  When a robot's exclusive subjects
-;; are freed (pubsub's on-free!), the robot asks waiting-tasks who waits
-;; for it, and offers itself to each in rank order, its subjects kept for
-;; that one's poser while it tries, until one starts or none can.  A rank
-;; is (KEY POSED ID), KEY being the task's priority less aging times the
-;; second it was posed: the higher KEY goes first, then the earlier
+;; are freed (robot-freed!, given to pubsub's open-subscriber!), the robot
+;; asks waiting-tasks who waits for it, and offers itself to each in rank
+;; order, its subjects kept for that one's poser while it tries, until
+;; one starts or none can.  A rank is (KEY POSED ID), KEY being the task's
+;; priority less aging times the second it was posed: the higher KEY goes
+;; first, then the earlier
 ;; POSED, then the smaller ID.  That is a total order, the same in every
 ;; address space, and aging does not reorder the tasks that wait: it
 ;; raises all their priorities alike, and only a task posed later starts
