@@ -4,21 +4,21 @@
 ;; waits for them, holding nothing and trying only when a robot offers
 ;; itself, while its poser subscribes to waiting-tasks and tells the lab
 ;; that a task waits (note-waiters!).  When a robot's exclusive subjects
-;; are freed (robot-freed!, given to pubsub's open-subscriber!), the robot
-;; asks waiting-tasks who waits for it, and offers itself to each in rank
-;; order, its subjects kept for that one's poser while it tries, until
-;; one starts or none can.  A rank is (KEY POSED ID), KEY being the task's
-;; priority less aging times the second it was posed: the higher KEY goes
-;; first, then the earlier
-;; POSED, then the smaller ID.  That is a total order, the same in every
-;; address space, and aging does not reorder the tasks that wait: it
-;; raises all their priorities alike, and only a task posed later starts
-;; from lower down.  A task no live robot of the lab is capable of fails
-;; at once; one whose capable robots all die while it waits fails at its
-;; poser's next look at the lab, every ten heartbeats or a third of the
-;; lease, whichever is sooner.  A poser looks once for all its waiting
-;; tasks (look-all!): a task that waits sends nothing to the lab by
-;; itself, so that W tasks waiting do not cost W looks a period.
+;; are freed (robot-freed!, given to pubsub's open-subscriber!), the
+;; robot asks waiting-tasks who waits for it, and offers itself to each
+;; in rank order, its subjects kept for that one's poser while it tries,
+;; until one starts or none can.  A rank is (KEY POSED ID), KEY being
+;; the task's priority less aging times the second it was posed: the
+;; higher KEY goes first, then the earlier POSED, then the smaller ID.
+;; That is a total order, the same in every address space, and aging
+;; does not reorder the tasks that wait: it raises all their priorities
+;; alike, and only a task posed later starts from lower down.  A task no
+;; live robot of the lab is capable of fails at once; one whose capable
+;; robots all die while it waits fails at its poser's next look at the
+;; lab, every ten heartbeats or a third of the lease, whichever is
+;; sooner.  A poser looks once for all its waiting tasks (look-all!): a
+;; task that waits sends nothing to the lab by itself, so that W tasks
+;; waiting do not cost W looks a period.
 
 (define (enlist! w)
   (waiter-held-set! w '())
