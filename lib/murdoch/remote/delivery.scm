@@ -27,6 +27,7 @@
               (id (car expected))
               (waiting (cdr expected)))
          (define (forget!) (forget-answers! id))
+         (define sent (monotonic-seconds))
          (if (send-datagram! (make-message 'call id (call-kind c) (call-proc-code c)
                                            (call-args-code c)))
              (let* ((here (capture (local-aspace-uid)
@@ -36,13 +37,25 @@
                (undo-on-raise forget!
                               (lambda () (await-answers g waiting deadline)))
                (forget!)
-               (cons here
-                     (capture-each pending-call-uid
-                                   (lambda (p)
-                                     (make-result (pending-call-uid p) #t
-                                                  (answer-value p c)))
-                                   waiting)))
+               (let ((results (capture-each pending-call-uid
+                                            (lambda (p)
+                                              (make-result (pending-call-uid p) #t
+                                                           (answer-value p c)))
+                                            waiting)))
+                 (keep-heard! waiting sent)
+                 (cons here results)))
              (begin (forget!) #f)))))
+
+;; Those of waiting that did not answer, but whose datagrams came after
+;; the call was sent, stay live: they were not yet listening when it went
+;; (a lab starting), and out of the live set, they would still take the
+;; calls that follow, unheard: a request's reservations left to their
+;; lease.
+(define (keep-heard! waiting sent)
+  (for-each (lambda (p)
+              (if (and (not (pending-call-answer p)) (heard-since? (pending-call-uid p) sent))
+                  (note-reachable! (pending-call-uid p))))
+            waiting))
 
 ;;; Serving the group's calls
 ;; As a connection (serve.scm): the listener applies, the janitor relieves it.

@@ -68,25 +68,26 @@
 
 ;;; Sending
 
-;; The next datagram's sequence: two threads sending at once take two,
-;; lest receivers drop the second as a replay.
+;; The next datagram's sequence.  Under the sequence's lock, with the
+;; send: receivers drop a datagram whose sequence they have passed, and
+;; two threads that took theirs in one order and sent in the other lost
+;; the first (8 threads publishing at once lost some of 80).
 (define (next-sequence!)
-  (with-lock (group-sequence-lock (the-group))
-    (lambda ()
-      (let ((sequence (max (+ (group-sequence (the-group)) 1) (wall-microseconds))))
-        (group-sequence-set! (the-group) sequence)
-        sequence))))
+  (let ((sequence (max (+ (group-sequence (the-group)) 1) (wall-microseconds))))
+    (group-sequence-set! (the-group) sequence)
+    sequence))
 
 ;;> Sends \var{body} to the group; #f when it is too large for a datagram.
 (define (send-datagram! body)
-  (let* ((sequence (next-sequence!))
-         (text (call-with-output-string
-                 (lambda (o)
-                   (write-simple (list (local-aspace-uid) sequence body) o))))
-         (bytes (datagram-bytes text)))
-    (and (<= (bytevector-length bytes) max-datagram)
-         (begin (send (group-socket (the-group)) bytes 0 (group-address (the-group)))
-                #t))))
+  (with-lock (group-sequence-lock (the-group))
+    (lambda ()
+      (let* ((text (call-with-output-string
+                     (lambda (o)
+                       (write-simple (list (local-aspace-uid) (next-sequence!) body) o))))
+             (bytes (datagram-bytes text)))
+        (and (<= (bytevector-length bytes) max-datagram)
+             (begin (send (group-socket (the-group)) bytes 0 (group-address (the-group)))
+                    #t))))))
 
 (define (beacon-seconds)
   (max 1 (/ (length (known-uids)) (inexact lab-beacons-per-second))))
@@ -108,6 +109,14 @@
               (known-uids))
     (thread-sleep! period))
   (send-beacons))
+
+;;> Whether a datagram from \var{uid} came at \var{t}, a
+;;> (monotonic-seconds), or after.
+(define (heard-since? uid t)
+  (with-lock (group-last-heard-lock (the-group))
+    (lambda ()
+      (let ((heard (hash-table-ref/default (group-last-heard (the-group)) uid #f)))
+        (and heard (>= heard t))))))
 
 ;;; Receiving
 ;;

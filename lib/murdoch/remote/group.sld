@@ -2,7 +2,7 @@
 ;;> replayed, and beacons that keep the live set.
 
 (define-library (murdoch remote group)
-  (export start-group! delivery-mode send-datagram!
+  (export start-group! delivery-mode send-datagram! heard-since?
           group-call? group-call-sender group-call-id group-call-kind
           group-call-proc-code group-call-args-code)
   (import (scheme base) (scheme write) (srfi 18) (srfi 69)
