@@ -1,5 +1,6 @@
 ;;; bin/murdoch's command line: help, version, and a mistake said in one
 ;;; line with the usage, exit 2, and no stack trace.
+;;; tests/run: long
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
         (only (chibi process) system)
         (only (chibi filesystem) delete-file-hierarchy open-input-file-descriptor)

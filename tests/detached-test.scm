@@ -4,6 +4,7 @@
 ;;; standby is in charge.  Workstations stand in for robots, as in
 ;;; task-test; each component writes (begin TAG UID SECOND) and (end TAG
 ;;; UID SECOND) to its own address space's log, which the tests read.
+;;; tests/run: long
 (import (except (scheme base) lambda define) (scheme write) (scheme read) (scheme eval)
         (srfi 1) (srfi 18) (srfi 132) (chibi test)
         (only (chibi process) kill signal/stop signal/continue)

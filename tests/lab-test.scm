@@ -1,6 +1,7 @@
 ;;; bin/murdoch lab and pose, as real processes: a lab comes up and goes
 ;;; down whole, an address space that dies is started again, one that
 ;;; cannot start stops the lab, and pose poses the task a file names.
+;;; tests/run: long
 (import (scheme base) (scheme write) (scheme file) (scheme read) (srfi 1) (chibi test)
         (only (chibi process) system system? kill signal/kill signal/interrupt
               signal/term)
@@ -162,7 +163,7 @@
           (begin
             (system? "sh" "-c"
                      "i=0; while [ $i -lt 10 ]; do i=$((i+1));
-                        timeout -s KILL 60 \"$1\" pose \"$2\" \"$3\" >\"$4.$i\" 2>&1 &
+                        timeout -s KILL 120 \"$1\" pose \"$2\" \"$3\" >\"$4.$i\" 2>&1 &
                       done; wait"
                      "guests" (tool-path "bin/murdoch") (test-lab-file lab)
                      (in-dir "task.scm") (in-dir "guest.out"))

@@ -1,6 +1,7 @@
 ;;; Replays every tests/transcripts/*.txt against a fresh lab of its own
 ;;; (docs/transcripts.md): `bin/murdoch lab` on a free port base, then
 ;;; `bin/murdoch repl` with the transcript's input piped in.
+;;; tests/run: long
 (import (scheme base) (srfi 1) (chibi test) (only (chibi string) string-suffix?)
         (only (chibi filesystem) directory-files open-pipe
               open-input-file-descriptor open-output-file-descriptor)

@@ -6,6 +6,7 @@
 ;;; options, and a robot killed while tasks wait.  Workstations stand in
 ;;; for robots; a component "holds" its robot until the test opens its
 ;;; gate there.
+;;; tests/run: long
 (import (except (scheme base) lambda define) (scheme write) (scheme eval) (scheme time)
         (srfi 1) (srfi 18) (chibi test)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)

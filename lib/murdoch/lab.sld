@@ -9,11 +9,11 @@
           lab-aspace-uid lab-aspace-index lab-aspace-host lab-aspace-port
           lab-aspace-clause random-hex lab-walls lab-boxes wall-from wall-to wall-thickness
           box-centre box-width box-depth box-heading
-          *node* open-node! this-node current-lab setting
+          *node* open-node! this-node current-lab setting call-timeout
           node-wire node-wire-set! node-limits node-limits-set!
           node-sandbox node-sandbox-set! node-membership node-membership-set!
           node-server node-server-set! node-group node-group-set!
-          node-monitors node-monitors-set!)
+          node-subscriber node-subscriber-set! node-monitors node-monitors-set!)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
           (scheme process-context)
           (scheme inexact)

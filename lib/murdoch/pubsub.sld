@@ -11,5 +11,5 @@
           offer-subjects! addressed-here? get-system-load load-monitor battery-monitor
           battery-charging battery-low load-threshold
           set-battery-charging! set-battery-low! set-load-threshold!
-          initialize-subscriptions!)
+          open-subscriber! initialize-subscriptions!)
   (import (murdoch pubsub messaging) (murdoch pubsub monitor)))

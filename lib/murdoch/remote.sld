@@ -5,7 +5,7 @@
   (export aspace? aspace-uid aspace-host aspace-port local-aspace
           local-aspace-uid aspace-started-at uid->aspace known-uids live-uids
           live-aspace remote-run! remote-apply remote-timeout
-          set-remote-timeout! remote-apply-all remote-run-all! outcome-uid
+          remote-apply-all remote-run-all! outcome-uid
           outcome-ok? outcome-value call-all broadcast-apply broadcast-run!
           make-result result-uid result-ok? result-value delivery-mode
           remote-error? remote-error-uid remote-error-message

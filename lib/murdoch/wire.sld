@@ -2,7 +2,7 @@
 ;;> multicast sockets, connecting with a timeout, and frames.
 
 (define-library (murdoch wire)
-  (export open-connection socket-port make-message message-id check-message
+  (export open-connection socket-port make-message message-id message-field check-message
           check-datagram start-wire! frame-text message-without-id spliced-text
           write-frame! send-frame! read-frame open-frame max-frame frame-fail
           protocol-fault? fault-message log-fault datagram-bytes

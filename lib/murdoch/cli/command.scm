@@ -3,21 +3,22 @@
 ;;> Makes this process address space \var{uid} of the lab at
 ;;> \var{lab-file}, serving; answers the received-code environment.
 (define (join-lab lab-file uid . port)
-  (start-node! (read-lab lab-file) uid port))
+  (start-node! (read-lab lab-file) 'aspace uid port))
 
 ;; The one start of an address space: the node of lab, each layer taking
 ;; its part in turn (docs/architecture.md).  SIGPIPE is ignored, as by the
 ;; simulator: a peer may die at any moment, and its end is seen by the
 ;; connection's reader, not this process's death.
-(define (start-node! lab uid port)
+(define (start-node! lab role uid port)
   (set-signal-action! signal/pipe #f)
-  (open-node! lab)
+  (open-node! lab role)
+  (open-subscriber! robot-freed!)
   (take-tunables!)
   (let ((env (make-lab-environment))
         (entry (lab-aspace-by-uid lab uid)))
     (if entry (take-body! lab entry))
     (apply start-aspace! uid env port)
-    (initialize-subscriptions! entry robot-freed!)
+    (initialize-subscriptions! entry)
     (offer-on-joining!)
     env))
 
@@ -83,14 +84,13 @@
          (uid (or uid (string->symbol
                        (string-append "guest-" (number->string
                                                 (current-process-id))))))
-         (lab-env (start-node! lab uid
+         (lab-env (start-node! lab 'repl uid
                                  (if guest? (list (lab-guest-port lab)) '()))))
     (write-string (string-append "murdoch: a REPL in the lab "
                                  (symbol->string (lab-name lab)) ", as "
                                  (symbol->string uid) "; (help) says what to type,"
                                  " Ctrl-D leaves\n"))
     (tell-who-is-away lab)
-    (set-remote-timeout! (setting 'repl-timeout))
     ;; (chibi repl) is loaded, not imported: it costs seconds.
     ((eval 'repl (environment '(chibi repl)))
           'in: (waiting-input-port)

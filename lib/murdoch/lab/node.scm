@@ -3,24 +3,28 @@
 ;;;; (docs/architecture.md, "How an address space starts").
 
 (define-record-type node
-  (make-node lab wire limits sandbox membership server group monitors)
+  (make-node lab role wire limits sandbox membership server group subscriber
+             monitors)
   node?
   (lab node-lab)                        ; read once; its settings by setting
+  (role node-role)                      ; aspace, or repl: a person waits at it
   (wire node-wire node-wire-set!)       ; wire/frame.scm: the key, frame limits
   (limits node-limits node-limits-set!) ; code/sendable.scm: values sent
   (sandbox node-sandbox node-sandbox-set!) ; code/sandbox.scm: max-alloc, ports
   (membership node-membership node-membership-set!) ; remote/aspace.scm
   (server node-server node-server-set!) ; remote/serve.scm
   (group node-group node-group-set!)    ; remote/group.scm, #f under broadcast
+  (subscriber node-subscriber node-subscriber-set!) ; pubsub/messaging.scm
   (monitors node-monitors node-monitors-set!)) ; pubsub/monitor.scm: thresholds
 
 ;; Global: a process is one address space of one lab.  The layers' hot
 ;; paths read their part straight from it (docs/speed.md).
 (define *node* #f)
 
-;;> Makes this process a node of \var{lab}, its parts yet to be filled.
-(define (open-node! lab)
-  (set! *node* (make-node lab #f #f #f #f #f #f #f))
+;;> Makes this process a node of \var{lab}, its parts yet to be filled;
+;;> \var{role} is \scheme{repl} for a person's REPL, else \scheme{aspace}.
+(define (open-node! lab . role)
+  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f #f))
   *node*)
 
 ;;> This process's node, for a layer to fill its part.
@@ -32,3 +36,8 @@
 
 ;;> The value of setting \var{key} of this address space's lab.
 (define (setting key) (lab-setting (current-lab) key))
+
+;;> Seconds a call waits for its answer unless told otherwise: at a REPL,
+;;> where a person waits and Ctrl-C gives a call up, repl-timeout.
+(define (call-timeout)
+  (setting (if (eq? (node-role (this-node)) 'repl) 'repl-timeout 'timeout)))

@@ -14,14 +14,31 @@
   (status subscription-status subscription-status-set!) ; (), task, shared
   (holds subscription-holds subscription-holds-set!))   ; live reservations
 
-;; The thesis's names (A.8), global as there, under the lock as monitors
-;; change the list; replaced, never changed, so addressed-here? needs no lock.
-(define *subscriptions* '())
-(define *subscriptions-lock* (make-mutex 'subscriptions))
+;; The node's subscriber part: this address space's subscription list
+;; (the thesis's *subscriptions*, A.8), its reservations not yet promised
+;; away (receiving.scm), the poser a freed robot is offered to, and the
+;; task layer's hook run when exclusive subjects are freed.  All under the
+;; lock; the list is replaced, never changed, so addressed-here? needs none.
+(define-record-type subscriber
+  (make-subscriber list lock reservations offered on-free)
+  subscriber?
+  (list subscriber-list subscriber-list-set!)
+  (lock subscriber-lock)
+  (reservations subscriber-reservations subscriber-reservations-set!)
+  (offered subscriber-offered subscriber-offered-set!) ; (uid . until), or #f
+  (on-free subscriber-on-free))
 
-(define (with-subscriptions thunk) (with-lock *subscriptions-lock* thunk))
+(define-syntax the-subscriber (syntax-rules () ((_) (node-subscriber *node*))))
 
-(define (find-subscription topic) (subscription-in *subscriptions* topic))
+;;> Makes this node a subscriber, listening to nothing yet: \var{on-free}
+;;> is run, outside any lock, whenever exclusive subjects here are freed.
+(define (open-subscriber! on-free)
+  (node-subscriber-set! (this-node)
+                        (make-subscriber '() (make-mutex 'subscriptions) '() #f on-free)))
+
+(define (with-subscriptions thunk) (with-lock (subscriber-lock (the-subscriber)) thunk))
+
+(define (find-subscription topic) (subscription-in (subscriber-list (the-subscriber)) topic))
 
 ;; A loop of its own, not find (docs/speed.md).
 (define (subscription-in subscriptions topic)
@@ -31,13 +48,14 @@
 
 (define (add-subscription! topic)
   (if (not (find-subscription topic))
-      (set! *subscriptions*
-            (cons (make-subscription topic '() 0) *subscriptions*))))
+      (subscriber-list-set! (the-subscriber)
+                            (cons (make-subscription topic '() 0)
+                                  (subscriber-list (the-subscriber))))))
 
 (define (remove-subscription! topic)
-  (set! *subscriptions*
-        (remove (lambda (s) (eq? (subscription-topic s) topic))
-                *subscriptions*)))
+  (subscriber-list-set! (the-subscriber)
+                        (remove (lambda (s) (eq? (subscription-topic s) topic))
+                                (subscriber-list (the-subscriber)))))
 
 ;;> Starts listening to \var{topic}; does nothing if already listening.
 (define (subscribe topic)
@@ -53,7 +71,8 @@
 
 ;;> The subjects this address space listens to.
 (define (subscriptions)
-  (with-subscriptions (lambda () (map subscription-topic *subscriptions*))))
+  (with-subscriptions
+    (lambda () (map subscription-topic (subscriber-list (the-subscriber))))))
 
 ;;> The status of \var{topic}: () when free, the task-name that holds it
 ;;> exclusively, \scheme{shared}, or #f when not subscribed.
@@ -123,8 +142,8 @@
 ;;> no matcher, the common case (docs/speed.md).
 (define (addressed-here? topic)
   (if (list? topic)
-      (subjects-here? *subscriptions* topic)
-      (subject-here? *subscriptions* topic)))
+      (subjects-here? (subscriber-list (the-subscriber)) topic)
+      (subject-here? (subscriber-list (the-subscriber)) topic)))
 
 (define (subjects-here? subscriptions subjects)
   (or (null? subjects)
@@ -291,4 +310,4 @@
                       (and (matches? (subscription-topic s))
                            (list (subscription-topic s)
                                  (subscription-status s))))
-                    *subscriptions*)))))
+                    (subscriber-list (the-subscriber)))))))

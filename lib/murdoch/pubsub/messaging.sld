@@ -10,8 +10,8 @@
           request-status subscription-statuses
           receive-publication receive-request receive-request-exclusive
           receive-request-non-exclusive receive-components start-leases!
-          on-free! offer-subjects! addressed-here?)
+          open-subscriber! offer-subjects! addressed-here?)
   (import (only (murdoch code) make-logged-thread) (scheme base) (srfi 1) (srfi 18)
-          (chibi match) (murdoch sys) (murdoch lab) (murdoch remote)
+          (murdoch sys) (murdoch lab) (murdoch remote)
           (only (murdoch wire) error-message))
   (include "messaging.scm" "receiving.scm"))

@@ -134,8 +134,7 @@
 ;;> clause (the thesis's make-subscription-initializer): all, its uid, its
 ;;> capabilities, coordinator on a workstation, idle and untethered.
 ;;> \var{on-free} runs, outside any lock, when exclusive subjects are freed.
-(define (initialize-subscriptions! entry on-free)
-  (on-free! on-free)
+(define (initialize-subscriptions! entry)
   (node-monitors-set!
    (this-node)
    (make-monitors (setting 'battery-charging) (setting 'battery-low)

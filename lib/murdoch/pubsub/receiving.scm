@@ -31,12 +31,14 @@
 ;;> for each component.
 (define (receive-components components task-name uid)
   (map (lambda (c)
-         (match c
-           ((type layout proc askings)
-            (let ((answer (if (eq? type 'exclusive)
-                              (receive-request-exclusive layout task-name uid proc '())
-                              (receive-request (cadr layout) uid proc '()))))
-              (list answer (if (evaluated? answer) (map ask-here askings) '()))))))
+         (if (not (and (list? c) (= 4 (length c))))
+             (error "receive-components: a component is (type layout proc askings)" c))
+         (apply (lambda (type layout proc askings)
+                  (let ((answer (if (eq? type 'exclusive)
+                                    (receive-request-exclusive layout task-name uid proc '())
+                                    (receive-request (cadr layout) uid proc '()))))
+                    (list answer (if (evaluated? answer) (map ask-here askings) '()))))
+                c))
        components))
 
 ;; An asking is user code: one raising costs only its answer (docs/speed.md).
@@ -60,9 +62,6 @@
   (shared reservation-shared)           ; subjects held for sharing
   (deadline reservation-deadline reservation-deadline-set!)
   (state reservation-state reservation-state-set!)) ; reserved running done
-
-;; Global, beside the subscriptions under their lock: those not yet promised away.
-(define *reservations* '())
 
 ;; The lab's lease.
 (define (lease) (setting 'lease))
@@ -129,7 +128,8 @@
 (define (new-reservation! task exclusive shared)
   (let ((r (make-reservation task exclusive shared
                              (+ (monotonic-seconds) (lease)) 'reserved)))
-    (set! *reservations* (cons r *reservations*))
+    (subscriber-reservations-set! (the-subscriber)
+                                  (cons r (subscriber-reservations (the-subscriber))))
     r))
 
 (define (in-use-subject topic)
@@ -142,35 +142,31 @@
           (and (not (eq? (reservation-state r) 'done))
                (begin
                  (reservation-state-set! r 'done)
-                 (set! *reservations* (remove (lambda (x) (eq? x r)) *reservations*))
+                 (drop-reservation! r)
                  (for-each (lambda (topic) (let-go! topic #t))
                            (reservation-exclusive r))
                  (for-each (lambda (topic) (let-go! topic #f))
                            (reservation-shared r))
                  (pair? (reservation-exclusive r))))))
-      (*on-free*)))
+      ((subscriber-on-free (the-subscriber)))))
 
-;; Global, as the subscriptions are: the task layer's hook (task/offers.scm),
-;; run when exclusive subjects here are freed, passed in at start.
-(define *on-free* (lambda () #f))
-
-;;> Sets the thunk run, outside any lock, when exclusive subjects are freed.
-(define (on-free! thunk) (set! *on-free* thunk))
-
-;; Global, under the subscriptions' lock: (uid . until) while a freed robot
-;; is offered to uid, a waiting task's poser, whose requests alone get it.
-(define *offered* #f)
+;; Under the lock.
+(define (drop-reservation! r)
+  (subscriber-reservations-set!
+   (the-subscriber) (remove (lambda (x) (eq? x r)) (subscriber-reservations (the-subscriber)))))
 
 ;;> For \var{seconds}, reserves exclusive subjects here for \var{uid}'s requests; #f ends that.
 (define (offer-subjects! uid . seconds)
   (with-subscriptions
     (lambda ()
-      (set! *offered* (and uid (cons uid (+ (monotonic-seconds) (car seconds))))))))
+      (subscriber-offered-set! (the-subscriber)
+                               (and uid (cons uid (+ (monotonic-seconds) (car seconds))))))))
 
 ;; Caller holds the lock.
 (define (offered-elsewhere? uid)
-  (and *offered* (not (eq? (car *offered*) uid))
-       (< (monotonic-seconds) (cdr *offered*))))
+  (let ((offered (subscriber-offered (the-subscriber))))
+    (and offered (not (eq? (car offered) uid))
+         (< (monotonic-seconds) (cdr offered)))))
 
 (define (let-go! topic exclusive?)
   (let ((s (find-subscription topic)))
@@ -186,8 +182,7 @@
     (lambda ()
       (and (eq? (reservation-state r) 'reserved)
            (begin (reservation-state-set! r 'running)
-                  (set! *reservations*
-                        (remove (lambda (x) (eq? x r)) *reservations*))
+                  (drop-reservation! r)
                   #t)))))
 
 (define (promise-for r proc args)
@@ -231,5 +226,5 @@
               (lambda ()
                 (filter (lambda (r)
                           (< (reservation-deadline r) (monotonic-seconds)))
-                        *reservations*))))
+                        (subscriber-reservations (the-subscriber))))))
   (lease-keeper))

@@ -22,7 +22,7 @@
   (local membership-local membership-local-set!)
   (environment membership-environment)  ; received code runs in it
   (decode membership-decode)            ; received code is rebuilt by it
-  (timeout membership-timeout membership-timeout-set!) ; remote-apply's default
+  (timeout membership-timeout)          ; remote-apply's default
   (peers membership-peers)              ; uid -> aspace, from lab and hellos
   (unreachable membership-unreachable)  ; uid -> #t: out of the live set
   (peers-lock membership-peers-lock)    ; over peers, unreachable and live
@@ -119,9 +119,6 @@
 
 ;;; The timeout
 
-;;> Seconds remote-apply waits for an answer by default (else the lab's timeout).
-(define (set-remote-timeout! seconds) (membership-timeout-set! (joined) seconds))
-
 ;;> A per-call override: (parameterize ((remote-timeout 1)) ...).
 (define remote-timeout (make-parameter #f))
 (sandbox-parameter! remote-timeout)
@@ -148,7 +145,7 @@
 ;;> Makes this process the address space \var{uid} of its lab, on
 ;;> \var{port}, receiving code into \var{environment} via \var{decode}.
 (define (join-lab! uid host port environment decode)
-  (let ((m (make-membership (utc-seconds) environment decode (setting 'timeout)
+  (let ((m (make-membership (utc-seconds) environment decode (call-timeout)
                             (make-hash-table eq?) (make-hash-table eq?)
                             (make-mutex 'peers))))
     (membership-live-set! m #f)

@@ -7,7 +7,7 @@
           aspace-started-at uid->aspace known-uids
           learn-aspace! note-unreachable! note-reachable! unreachable-uids
           live-uids live-aspaces live-aspace join-lab!
-          remote-timeout set-remote-timeout! current-timeout
+          remote-timeout current-timeout
           lab-environment decode-value describe-procedure)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (murdoch sys) (murdoch lab)
           (murdoch code))

@@ -10,7 +10,7 @@
           capture-each await-answers answer-value datagram-others
           expect-answers! forget-answers!
           take-datagram-answer! prober)
-  (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (chibi match) (murdoch sys)
+  (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (murdoch sys)
           (murdoch wire) (murdoch code) (murdoch remote aspace)
           (murdoch remote connection) (murdoch remote worker))
   (include "call.scm"))

@@ -236,11 +236,10 @@
 (define (welcome-nonce w uid)
   (if (eof-object? w)
       (error "the connection closed before its welcome"))
-  (match (check-message w '(welcome) "a welcome")
-    (('welcome found nonce)
-     (if (not (eq? found uid))
-         (error (string-append "found " (symbol->string found) " at its address")))
-     nonce)))
+  (let ((found (message-field (check-message w '(welcome) "a welcome") 'uid)))
+    (if (not (eq? found uid))
+        (error (string-append "found " (symbol->string found) " at its address")))
+    (message-field w 'nonce)))
 
 ;; No wind around the lock (nothing under it raises), no match or let.
 (define (deliver-answer! c answer)

@@ -9,6 +9,6 @@
   (import (only (murdoch code) make-logged-thread)
           (scheme base) (srfi 18) (srfi 69) (only (chibi string) string-prefix?)
           (only (chibi) port-fileno)
-          (chibi match) (murdoch sys) (murdoch wire) (murdoch lab)
+          (murdoch sys) (murdoch wire) (murdoch lab)
           (murdoch remote aspace))
   (include "connection.scm"))

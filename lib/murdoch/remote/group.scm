@@ -177,8 +177,7 @@
       (beacon-heard! sender message)))
 
 (define (beacon-heard! sender beacon)
-  (match beacon
-    (('beacon uid host port)
-     (learn-aspace! (make-aspace uid host port))
-     (note-reachable! sender)
-     #f)))
+  (learn-aspace! (make-aspace (message-field beacon 'uid) (message-field beacon 'host)
+                              (message-field beacon 'port)))
+  (note-reachable! sender)
+  #f)

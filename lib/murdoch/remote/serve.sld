@@ -9,7 +9,7 @@
   (import (scheme base) (srfi 1) (srfi 18)
           (only (chibi filesystem) open-input-file-descriptor open-output-file-descriptor)
           (only (chibi) port-fileno)
-          (chibi net) (chibi match) (murdoch sys) (murdoch code) (murdoch wire)
+          (chibi net) (murdoch sys) (murdoch code) (murdoch wire)
           (murdoch lab) (murdoch remote aspace) (murdoch remote worker)
           (murdoch remote call)
           (only (murdoch remote connection) watch-served! unwatch-served!))

@@ -73,18 +73,19 @@
   (flushed greeting-flushed greeting-flushed-set!)) ; sent when last flushed
 
 (define (greet! s hello)
-  (match (check-message hello '(hello) "a hello")
-    (('hello uid host port caller-nonce)
-     (learn-aspace! (make-aspace uid host port))
-     (let ((g (make-greeting uid caller-nonce (random-hex 16) (open-output-string)
-                             (make-mutex 'served-write)
-                             (lambda (c kind value) (answer-call s c kind value))
-                             0 0 0)))
-       (serving-greeting-set! s g)
-       (serving-deadline-set! s #f)
-       (serving-read-on-set! s (lambda () (serve-greeted s)))
-       (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
-                    (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))))
+  (check-message hello '(hello) "a hello")
+  (learn-aspace! (make-aspace (message-field hello 'uid) (message-field hello 'host)
+                              (message-field hello 'port)))
+  (let* ((caller-nonce (message-field hello 'nonce))
+         (g (make-greeting (message-field hello 'uid) caller-nonce (random-hex 16)
+                           (open-output-string) (make-mutex 'served-write)
+                           (lambda (c kind value) (answer-call s c kind value))
+                           0 0 0)))
+    (serving-greeting-set! s g)
+    (serving-deadline-set! s #f)
+    (serving-read-on-set! s (lambda () (serve-greeted s)))
+    (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
+                 (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))
 
 (define (serve-greeted s)
   (read-calls s (lambda (r) (read-on s r))

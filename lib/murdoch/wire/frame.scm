@@ -86,6 +86,15 @@
 ;;> The id of \var{message} (all kinds but hello, welcome, datagram, beacon).
 (define (message-id message) (cadr message))
 
+;;> The field named \var{name} of \var{message}, a checked message, as
+;;> the table names it.
+(define (message-field message name)
+  (let loop ((fields (cdr (assq (car message) message-kinds)))
+             (values (cdr message)))
+    (cond ((null? fields) (error "no such field in a message" (car message) name))
+          ((eq? (caar fields) name) (car values))
+          (else (loop (cdr fields) (cdr values))))))
+
 ;; No or, whose let makes a closure (docs/speed.md).
 (define (fields-pass? values checks)
   (cond ((null? checks) (null? values))

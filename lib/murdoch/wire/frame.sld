@@ -3,7 +3,7 @@
 ;;> written at the head of lib/murdoch/wire/frame.scm.
 
 (define-library (murdoch wire frame)
-  (export message-kinds make-message message-id check-message check-datagram
+  (export message-kinds make-message message-id message-field check-message check-datagram
           start-wire! frame-text message-without-id spliced-text write-frame!
           send-frame! read-frame
           open-frame max-frame
