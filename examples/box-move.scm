@@ -617,10 +617,8 @@
 ;; that it may come); else, until a spare speaks, only while the box is
 ;; still within clear-run of where it was when the two last pushed
 ;; together, so that it leaves the lost partner's body behind and the
-;; spare finds that place clear sooner, unless the box must turn toward
-;; its side by 10 degrees or more (generated seed 42's 440 mm box turned
-;; 29 degrees the wrong way in those 400 mm); or while its push turns the
-;; box toward its way: a
+;; spare finds that place clear sooner, or while its push turns the box
+;; toward its way: a
 ;; push off the middle turns the box away from the pusher's side, so while
 ;; the box must turn that way by more than 3 degrees, what it will turn
 ;; within turn-lead at its rate now counted.  One that pushed on, sliding
@@ -630,11 +628,10 @@
 (define paired-at #f)                   ; the box when last pushed by two
 (define clear-run (+ body-radius body-radius 40))
 (define (lone-push? box side)
-  (let ((toward (* side (- (clip (turn-error box) 20) (* turn-lead turn-rate)))))
-    (or (alone?)
-        (spare-spoke?)
-        (and paired-at (< (distance box paired-at) clear-run) (< toward 10))
-        (< toward -3))))
+  (or (alone?)
+      (spare-spoke?)
+      (and paired-at (< (distance box paired-at) clear-run))
+      (< (* side (- (clip (turn-error box) 20) (* turn-lead turn-rate))) -3)))
 
 ;; A pusher's share of push-speed in a pair: both push less the further
 ;; the box is turned off its way (forward at a third from 30 degrees off),
