@@ -2,32 +2,12 @@
 ;;
 ;; pose-task blocks until its components are done, as in the thesis.
 ;; start-task poses the same task and answers at once with a task record,
-;; which task-status, task-wait and cancel-task read and act on, and it
-;; keeps watch over each component while it runs:
-;;
-;;  1. The task is negotiated as pose-task negotiates it.
-;;  2. Each component runs on its robot inside run-component, which
-;;     registers it there.  Every (setting 'heartbeat) seconds the
-;;     poser remote-applies component-heartbeat! on the robot: an answer
-;;     tells the poser that the robot lives, its arrival tells the robot
-;;     that its poser does.
-;;  3. A component's robot is lost when it is silent for lost-periods (four)
-;;     heartbeat periods, when its address space is gone (the call's connection is
-;;     lost), or when the component raises a robot failure: its trip
-;;     connection closed, or its base stalled.  A restartable component
-;;     is then negotiated again, without the robots it had and those of
-;;     the task's other components, and started again, on at most
-;;     max-attempts robots in all.  Any other component is failed, as is
-;;     one that raises an ordinary error, as pose-task reports it.
-;;  4. A component whose poser is silent for two periods stops on its
-;;     robot, at its next robot command or remote call (abandon.scm), and
-;;     so frees its reservation: no orphans.  The same rule stops the
-;;     component of a robot cut off from its poser at least one full
-;;     period before the poser can declare it lost and start the component
-;;     elsewhere: no ghosts (running.scm gives the margin).
-;;  5. cancel-task stops every component on its robot so, at once, and
-;;     what is still being negotiated is freed when the negotiation ends.
-;;
+;; which task-status, task-wait and cancel-task read and act on.  Each
+;; component runs on its robot inside run-component, watched by the
+;; poser's heartbeats: a robot silent for lost-periods, gone, or failing
+;; has its component started again elsewhere when it is restartable, and
+;; a component whose poser is silent for orphan-periods stops on its
+;; robot (running.scm).  docs/tasks.md tells the life cycle step by step.
 ;; A task of steps (start-steps) is a sequence of such tasks, one a step.
 
 ;;; The poser's side
