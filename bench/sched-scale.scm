@@ -15,21 +15,26 @@
 ;;; rest at random arrivals faster than the lab serves them, so that the
 ;;; queue grows to about 2,000.  The posers pose in parallel, each its own
 ;;; tasks.  Each component tells this address space when it starts and
-;;; ends, as in make bench-sched, and bench/schedule.sld judges the run
-;;; beside its ideal schedule: the same lines as make bench-sched's,
-;;; named sched-scale-.  Besides, once a second, the lab's CPU (the posers'
+;;; ends, as in make bench-sched, and each poser what its waiting tasks
+;;; hold as that changes; bench/schedule.sld judges the run beside its
+;;; ideal schedule: the same lines as make bench-sched's, named
+;;; sched-scale-.  Besides, once a second, the lab's CPU (the posers'
 ;;; and robots' processes) and how many tasks have started and are
 ;;; queued (posed, not started):
 ;;;   bench: sched-scale-cpu-per-start-us-at-Q X us, the lab's CPU over
 ;;;          the seconds when the queue held Q/sqrt(2) to Q*sqrt(2) tasks,
 ;;;          over the tasks started then, for Q 500 and 2000;
+;;;   bench: sched-scale-posers-cpu-per-start-us-at-Q X us, the same of
+;;;          the posers' CPU alone;
 ;;;   bench: sched-scale-cpu-per-start-growth X x, the second over the
 ;;;          first, beside sched-scale-log-growth, log 2000 / log 500.
 ;;; Sizes: MURDOCH_SCHED_SCALE_ROBOTS (64, a multiple of 4), _POSERS (8),
 ;;; _TASKS (2500), _BURST (500), _GAP (mean seconds between arrivals,
-;;; 0.008); MURDOCH_SCHED_SEED (30).
+;;; 0.008); MURDOCH_SCHED_SEED (30).  MURDOCH_SCHED_SCALE_SAVE=FILE writes
+;;; the run to FILE, and MURDOCH_SCHED_SCALE_REPLAY=FILE judges it again,
+;;; with the same sizes and seed, without a lab.
 (import (except (scheme base) lambda define) (scheme write) (scheme eval)
-        (scheme time) (scheme process-context) (scheme inexact)
+        (scheme time) (scheme process-context) (scheme inexact) (scheme file) (scheme read)
         (srfi 1) (srfi 18) (srfi 132)
         (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
         (murdoch cli command) (murdoch testing harness)
@@ -61,41 +66,15 @@
 
 (define lab-code (string-append bench-lab-code "
 ;; Run on the posers: subjects, one a component.
-(define posed '())                      ; (id . task)
 (define (pose-bench! id subjects seconds priority)
-  (set! posed
-        (cons (cons id
-                    (start-task 'bench (length subjects)
-                                (map (lambda (s) (list '(station) (list s))) subjects)
-                                (map (lambda (s) #f) subjects)
-                                (map (lambda (k) (lambda () (bench-work id k seconds)))
-                                     (iota (length subjects) 1))
-                                'wait #t 'hold #t 'priority priority))
-              posed))
+  (posed! id (start-task 'bench (length subjects)
+                         (map (lambda (s) (list '(station) (list s))) subjects)
+                         (map (lambda (s) #f) subjects)
+                         (map (lambda (k) (lambda () (bench-work id k seconds)))
+                              (iota (length subjects) 1))
+                         'wait #t 'hold #t 'priority priority))
   #t)
-(define (bench-results)
-  (map (lambda (p) (list (car p) (task-wait (cdr p) 1200))) posed))
 "))
-
-(define lab
-  (make-test-lab
-   ;; Every address space is on this host: the bench's and each poser's
-   ;; hear from every robot, more than the 64 a host that the lab allows
-   ;; by default (they refused the robots' calls, and the lab stalled).
-   ;; A heartbeat of 1 s: with 73 address spaces on two cores (load
-   ;; averages of 30), a poser's heartbeats to its components' robots fell
-   ;; more than the two periods of 0.5 s behind, and the robots stopped
-   ;; them as orphans (docs/allocation.md).
-   `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 1)
-     (max-connections-per-host ,(* 2 (+ n-robots n-posers 1)))
-     (aspace bench)
-     ,@(map (lambda (uid) `(aspace ,uid)) posers)
-     ,@(map (lambda (r) `(aspace ,(car r) (capabilities ,@(subjects-of (cdr r)))))
-            robots))
-   `(("code.scm" . ,lab-code))))
-
-(define uids (append posers (map car robots)))
-(define pids (start-bench-lab! lab uids 60))
 
 ;;; The tasks
 
@@ -126,100 +105,144 @@
 
 ;; A task's rank is read from its poser's clock, between the two seconds
 ;; noted here as it is posed: before the call that poses it, and after.
-(define posed-at (make-vector n-tasks #f))
-(define posed-by (make-vector n-tasks #f))
-(define n-posed 0)
-(define t0 (current-second))
+;; Each poser poses its own tasks, at their seconds, in a thread of its
+;; own.  Answers what the judge reads: (POSED-AT POSED-BY EVENTS HOLDINGS
+;; SAMPLES COMPLETED), the seconds from the run's start.
+(define (run-lab!)
+  (define lab
+    (make-test-lab
+     ;; Every address space is on this host: the bench's and each poser's
+     ;; hear from every robot, more than the 64 a host that the lab allows
+     ;; by default (they refused the robots' calls, and the lab stalled).
+     ;; A heartbeat of 1 s: with 73 address spaces on two cores (load
+     ;; averages of 30), a poser's heartbeats to its components' robots fell
+     ;; more than the two periods of 0.5 s behind, and the robots stopped
+     ;; them as orphans (docs/allocation.md).
+     `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 1)
+       (max-connections-per-host ,(* 2 (+ n-robots n-posers 1)))
+       (aspace bench)
+       ,@(map (lambda (uid) `(aspace ,uid)) posers)
+       ,@(map (lambda (r) `(aspace ,(car r) (capabilities ,@(subjects-of (cdr r)))))
+              robots))
+     `(("code.scm" . ,lab-code))))
+  (define uids (append posers (map car robots)))
+  (define pids (start-bench-lab! lab uids 60))
+  (define posed-at (make-vector n-tasks #f))
+  (define posed-by (make-vector n-tasks #f))
+  (define n-posed 0)
+  (define t0 (current-second))
+  (define (pose-all! poser mine)
+    (for-each (lambda (t)
+                (let ((wait (- (list-ref t 4) (- (current-second) t0))))
+                  (if (> wait 0) (thread-sleep! wait)))
+                (vector-set! posed-at (car t) (- (current-second) t0))
+                (parameterize ((remote-timeout 60))
+                  (remote-apply (uid->aspace poser) (lab-proc 'pose-bench!) (car t)
+                                (cadr t) (list-ref t 2) (list-ref t 3)))
+                (vector-set! posed-by (car t) (- (current-second) t0))
+                (set! n-posed (+ n-posed 1)))
+              mine))
+  (define samples '())
+  (define sampling #t)
+  (define sampler
+    (thread-start! (make-thread (lambda ()
+                                  (let loop ()
+                                    (set! samples (cons (sample! pids t0 n-posed) samples))
+                                    (thread-sleep! 1)
+                                    (if sampling (loop)))))))
+  (for-each thread-join!
+            (map (lambda (poser i)
+                   (thread-start!
+                    (make-thread
+                     (lambda ()
+                       (pose-all! poser (filter (lambda (t) (= (modulo (car t) n-posers) i))
+                                                plan))))))
+                 posers (iota n-posers)))
+  (let* ((results (append-map (lambda (p)
+                                (parameterize ((remote-timeout 1300))
+                                  (remote-apply (uid->aspace p) (lab-proc 'bench-results) 1200)))
+                              posers))
+         (events (bench-told 'events t0))
+         (holdings (bench-told 'holdings t0)))
+    (set! sampling #f)
+    (thread-join! sampler)
+    (stop-all-processes!)
+    (remove-test-lab! lab)
+    (list posed-at posed-by events holdings (reverse samples)
+          (count (lambda (r) (ok? (cadr r))) results))))
 
-;; Each poser poses its own tasks, at their seconds, in a thread of its own.
-(define (pose-all! poser mine)
-  (for-each (lambda (t)
-              (let ((wait (- (list-ref t 4) (- (current-second) t0))))
-                (if (> wait 0) (thread-sleep! wait)))
-              (vector-set! posed-at (car t) (- (current-second) t0))
-              (parameterize ((remote-timeout 60))
-                (remote-apply (uid->aspace poser) (lab-proc 'pose-bench!) (car t)
-                              (cadr t) (list-ref t 2) (list-ref t 3)))
-              (vector-set! posed-by (car t) (- (current-second) t0))
-              (set! n-posed (+ n-posed 1)))
-            mine))
+(define (ok? result) (and (list? result) (every symbol? result)))
 
-;; Once a second: (second lab-cpu-us started queued).
-(define samples '())
-(define (started-count) (eval 'started (lab-environment)))
-(define (sample!)
-  (let* ((started (started-count))
+;; Once a second: (SECOND LAB-CPU-US STARTED QUEUED POSERS-CPU-US), the
+;; posers' CPU apart, to see where the lab's goes; told as it goes, so
+;; that a run cut short still tells how far it got.
+(define (sample! pids t0 n-posed)
+  (let* ((started (eval 'started (lab-environment)))
          (s (list (- (current-second) t0) (processes-cpu-us pids) started
-                  (- n-posed started))))
-    (set! samples (cons s samples))
-    ;; As it goes, so that a run cut short still tells how far it got.
+                  (- n-posed started) (processes-cpu-us (take pids n-posers)))))
     (write-string (string-append "sched-scale: at " (number->string (round (car s)))
                                  " s: lab cpu " (number->string (round (/ (cadr s) 1e6)))
-                                 " s, started " (number->string started)
+                                 " s (posers " (number->string (round (/ (list-ref s 4) 1e6)))
+                                 " s), started " (number->string started)
                                  ", queued " (number->string (list-ref s 3)) "\n")
-                  (current-error-port))))
-(define sampling #t)
-(define sampler
-  (thread-start! (make-thread (lambda ()
-                                (let loop ()
-                                  (sample!)
-                                  (thread-sleep! 1)
-                                  (if sampling (loop)))))))
+                  (current-error-port))
+    s))
 
-(for-each thread-join!
-          (map (lambda (poser i)
-                 (thread-start!
-                  (make-thread (lambda ()
-                                 (pose-all! poser (filter (lambda (t) (= (modulo (car t) n-posers) i))
-                                                          plan))))))
-               posers (iota n-posers)))
-
-(define results
-  (append-map (lambda (p)
-                (parameterize ((remote-timeout 1300))
-                  (remote-apply (uid->aspace p) (lab-proc 'bench-results))))
-              posers))
-(set! sampling #f)
-(thread-join! sampler)
-
-(define events
-  (map (lambda (e) (cons (- (car e) t0) (cdr e)))
-       (reverse (remote-apply (uid->aspace 'bench)
-                              (eval '(lambda () events) (lab-environment))))))
-
-(stop-all-processes!)
-(remove-test-lab! lab)
+;; MURDOCH_SCHED_SCALE_SAVE names a file the run is written to, and
+;; MURDOCH_SCHED_SCALE_REPLAY one to judge again rather than run the lab
+;; (the same sizes and seed), so that a judge's change is tried on a
+;; run already made.
+(define recorded
+  (cond ((get-environment-variable "MURDOCH_SCHED_SCALE_REPLAY")
+         => (lambda (file) (call-with-input-file file read)))
+        (else
+         (let ((r (run-lab!)))
+           (cond ((get-environment-variable "MURDOCH_SCHED_SCALE_SAVE")
+                  => (lambda (file)
+                       (call-with-output-file file (lambda (out) (write r out))))))
+           r))))
+(define posed-at (list-ref recorded 0))
+(define posed-by (list-ref recorded 1))
+(define events (list-ref recorded 2))
+(define holdings (list-ref recorded 3))
+(define samples (list-ref recorded 4))
 
 ;;; The figures
 
-(define (ok? result) (and (list? result) (every symbol? result)))
 (define tasks (map (lambda (t) (list (car t) (map accepted (cadr t)) (list-ref t 2)
                                      (list-ref t 3) 0))
                    plan))
-(define run (make-schedule-run tasks posed-at posed-by events robots aging))
-(schedule-completed! run (count (lambda (r) (ok? (cadr r))) results))
+(define run (make-schedule-run tasks posed-at posed-by events holdings robots aging))
+(schedule-completed! run (list-ref recorded 5))
 (bench "sched-scale-robots" n-robots "")
 (bench "sched-scale-posers" n-posers "")
 (print-schedule-figures run "sched-scale")
 
-;; The lab's CPU per task started over the seconds whose queue, at their
-;; start and end, was within a factor sqrt 2 of q; #f if none was.
-(define (cpu-per-start q)
-  (let loop ((ss (reverse samples)) (cpu 0) (starts 0))
+;; The CPU per task started over the seconds whose queue, at their start
+;; and end, was within a factor sqrt 2 of q, of the lab, or of its posers
+;; alone if posers? is true; #f if no second's queue was.
+(define (cpu-per-start q posers?)
+  (let loop ((ss samples) (cpu 0) (starts 0))
     (if (or (null? ss) (null? (cdr ss)))
         (and (> starts 0) (/ cpu starts))
         (let* ((a (car ss)) (b (cadr ss))
+               (cpu-of (lambda (s) (list-ref s (if posers? 4 1))))
                (within? (lambda (s) (<= (/ q (sqrt 2)) (list-ref s 3) (* q (sqrt 2))))))
           (if (and (within? a) (within? b))
-              (loop (cdr ss) (+ cpu (- (cadr b) (cadr a)))
+              (loop (cdr ss) (+ cpu (- (cpu-of b) (cpu-of a)))
                     (+ starts (- (list-ref b 2) (list-ref a 2))))
               (loop (cdr ss) cpu starts))))))
 
-(define at-500 (cpu-per-start 500))
-(define at-2000 (cpu-per-start 2000))
+(define (cpu-line name q posers?)
+  (let ((us (cpu-per-start q posers?)))
+    (bench name (if us (round us) "none") "us")
+    us))
+
 (bench "sched-scale-queue-max" (apply max 0 (map (lambda (s) (list-ref s 3)) samples)) "")
-(bench "sched-scale-cpu-per-start-us-at-500" (if at-500 (round at-500) "none") "us")
-(bench "sched-scale-cpu-per-start-us-at-2000" (if at-2000 (round at-2000) "none") "us")
+(define at-500 (cpu-line "sched-scale-cpu-per-start-us-at-500" 500 #f))
+(define at-2000 (cpu-line "sched-scale-cpu-per-start-us-at-2000" 2000 #f))
+(cpu-line "sched-scale-posers-cpu-per-start-us-at-500" 500 #t)
+(cpu-line "sched-scale-posers-cpu-per-start-us-at-2000" 2000 #t)
 (if (and at-500 at-2000)
     (bench "sched-scale-cpu-per-start-growth" (round-to (/ at-2000 at-500) 3) "x"))
 (bench "sched-scale-log-growth" (round-to (/ (log 2000) (log 500)) 3) "x")

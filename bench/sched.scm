@@ -14,12 +14,16 @@
 ;;; components took in the run, and no cost of messages or negotiation.
 ;;; It prints
 ;;;   bench: sched-completed N, sched-lost N
-;;;   bench: sched-deadlocks N          stalls of 2 s with tasks waiting
-;;;                                     and no component running
-;;;   bench: sched-priority-inversions N   tasks that started while a
-;;;                                     better-ranked one waited (see
-;;;                                     inversions below); each is told on
-;;;                                     standard error
+;;;   bench: sched-deadlocks N          holding cycles of 2 s: waiting
+;;;                                     tasks each with a component whose
+;;;                                     every robot is held by one of them
+;;;   bench: sched-stalls N             2 s with tasks waiting and no
+;;;                                     component running
+;;;   bench: sched-priority-inversions N   robots that went to a task while
+;;;                                     a better-ranked one waited with a
+;;;                                     component open that accepts them
+;;;                                     (bench/schedule.sld); each is told
+;;;                                     on standard error
 ;;;   bench: sched-makespan-over-ideal X x
 ;;;   bench: sched-makespan-over-bound X x, over
 ;;;          max(sum of robots x seconds / 8, the longest task)
@@ -53,18 +57,12 @@
 
 (define lab-code (string-append bench-lab-code "
 ;; Run on the posers.
-(define posed '())                      ; (id . task)
 (define (pose-bench! id n seconds priority)
-  (set! posed
-        (cons (cons id
-                    (start-task 'bench n (make-list n '((arm) ())) (make-list n #f)
-                                (map (lambda (k) (lambda () (bench-work id k seconds)))
-                                     (iota n 1))
-                                'wait #t 'hold #t 'priority priority))
-              posed))
+  (posed! id (start-task 'bench n (make-list n '((arm) ())) (make-list n #f)
+                         (map (lambda (k) (lambda () (bench-work id k seconds)))
+                              (iota n 1))
+                         'wait #t 'hold #t 'priority priority))
   #t)
-(define (bench-results)
-  (map (lambda (p) (list (car p) (task-wait (cdr p) 600))) posed))
 "))
 
 (define lab
@@ -115,17 +113,13 @@
 (define results
   (append-map (lambda (p)
                 (parameterize ((remote-timeout 900))
-                  (remote-apply (uid->aspace p) (lab-proc 'bench-results))))
+                  (remote-apply (uid->aspace p) (lab-proc 'bench-results) 600)))
               posers))
-
-(define events
-  (map (lambda (e) (cons (- (car e) t0) (cdr e)))
-       (reverse (remote-apply (uid->aspace 'bench)
-                              (eval '(lambda () events) (lab-environment))))))
 
 (define (ok? result) (and (list? result) (every symbol? result)))
 
-(define run (make-schedule-run tasks posed-at posed-by events
+(define run (make-schedule-run tasks posed-at posed-by (bench-told 'events t0)
+                               (bench-told 'holdings t0)
                                (map (lambda (uid) (cons uid 'arm)) robots) aging))
 (schedule-completed! run (count (lambda (r) (ok? (cadr r))) results))
 (print-schedule-figures run "sched")

@@ -36,7 +36,7 @@ lib/murdoch/%.so: lib/murdoch/%.c $(NATIVE_CHIBI_HEADERS)
 # The plain C that a stub includes.
 lib/murdoch/sys/guard.so: lib/murdoch/sys/heap-watch.c
 lib/murdoch/wire/hmac.so: lib/murdoch/wire/hmac-sha256.c
-lib/murdoch/wire/netstring.so: lib/murdoch/wire/netstring-scan.c
+lib/murdoch/wire/netstring.so: lib/murdoch/wire/netstring-scan.c lib/murdoch/wire/plain-read.c
 lib/murdoch/code/sendable.so: lib/murdoch/code/plain.c
 lib/murdoch/code/sandbox.so: lib/murdoch/code/call-bindings.c
 lib/murdoch/wire/connect.so: lib/murdoch/wire/nonblocking-connect.c

@@ -1,5 +1,6 @@
 ;;; The strict netstring reader: good frames, and each kind of bad one.
-(import (scheme base) (chibi test) (chibi io) (murdoch wire netstring))
+(import (scheme base) (scheme read) (scheme write) (chibi test) (chibi io)
+        (murdoch wire netstring))
 
 (define (bytes s) (string->utf8 s))
 (define (read-all s max)
@@ -92,6 +93,63 @@
                             (outcome (trickle input) 10))
                     disagreements
                     (cons (utf8->string input) disagreements)))))))
+
+;; plain-message reads what our writer writes, in C, as read would; on
+;; anything else it answers its last argument, and read takes over.
+(define other (list 'other))
+(define (plain text) (plain-message text 100 other))
+(define (read-whole text)
+  (guard (e (#t 'unreadable))
+    (let* ((in (open-input-string text)) (x (read in)))
+      (if (eof-object? (peek-char in)) x 'trailing))))
+(define (written x)
+  (let ((out (open-output-string))) (write-simple x out) (get-output-string out)))
+;; The texts plain-message read that read reads otherwise.
+(define (misread texts)
+  (filter-texts (lambda (t) (let ((x (plain t)))
+                              (and (not (eq? x other)) (not (equal? x (read-whole t))))))
+                texts))
+(define (filter-texts keep? texts)
+  (cond ((null? texts) '())
+        ((keep? (car texts)) (cons (car texts) (filter-texts keep? (cdr texts))))
+        (else (filter-texts keep? (cdr texts)))))
+
+(test "a request's call"
+  '(apply 17 #(murdoch:global receive-request)
+          (all w1 #(murdoch:closure (lambda () #t) ((x . -12) (s . "a\"b\nc"))) ()))
+  (plain "(apply 17 #(murdoch:global receive-request) (all w1 #(murdoch:closure (lambda () #t) ((x . -12) (s . \"a\\\"b\\nc\"))) ()))"))
+(test "what is not plain is left to read"
+  (make-list 22 #t)
+  (map (lambda (t) (eq? other (plain t)))
+       '("0.5" "1/2" "+i" "-inf.0" ".5" "..." "#\\a" "'a" "(a ;c\n)" "|a b|"
+         "#u8(1)" "#0=(a . #0#)" "\"\\x41;\"" "caf\xe9;" "(1 2" "" "x y" " x " "#(1 . 2)"
+         "123456789012345678" "abc#t" "\"a\\\x0;b\"")))
+(test "nesting up to the limit, and not past it" '(#t #t)
+  (let ((nest (lambda (n) (string-append (make-string n #\() "x" (make-string n #\))))))
+    (list (pair? (plain (nest 100))) (eq? other (plain (nest 101))))))
+(test "fixed texts are read as read reads them" '()
+  (misread '("()" "#()" "(a . b)" "(a . (b c))" "(a . b c)" "(. a)" "(a .b)" "+" "-"
+             "007" "-0" "+5" "12345678901234567" "#t" "#f" "#true" "mobile.in_use" "->x"
+             "(#t#f)" "(\"a\"b)" "(\r\n a\t)" "  x" "a.b.c" "[a]" "{a}")))
+;; Values of every kind the wire carries, from the fixed seed.
+(define (random-value depth)
+  (case (random-below (if (> depth 4) 6 9))
+    ((0) (- (random-below 2000000) 1000000))
+    ((1) (vector-ref '#(a b mobile.in_use murdoch:closure lambda + - ! $x <=? |\x3bb;|)
+                     (random-below 11)))
+    ((2) (vector-ref '#("" "a b" "q\"uote" "back\\slash" "nl\nx" "tab\tx" "\xe9;" "ctl\x1;")
+                     (random-below 8)))
+    ((3) (zero? (random-below 2)))
+    ((4) (vector-ref '#(0.5 -1.25 1e100 1/3 #\a) (random-below 5)))
+    ((5) '())
+    ((6) (random-list (random-below 5) depth))
+    ((7) (cons (random-value (+ depth 1)) (random-value (+ depth 1))))
+    (else (list->vector (random-list (random-below 4) depth)))))
+(define (random-list n depth)
+  (if (zero? n) '() (cons (random-value (+ depth 1)) (random-list (- n 1) depth))))
+(test "2000 written values are read as read reads them" '()
+  (misread (let loop ((i 0) (acc '()))
+             (if (= i 2000) acc (loop (+ i 1) (cons (written (random-value 0)) acc))))))
 
 (test-end)
 (test-exit)

@@ -12,6 +12,7 @@
           *node* open-node! this-node current-lab setting call-timeout
           node-wire node-wire-set! node-limits node-limits-set!
           node-sandbox node-sandbox-set! node-membership node-membership-set!
+          node-connections node-connections-set!
           node-server node-server-set! node-group node-group-set!
           node-subscriber node-subscriber-set! node-monitors node-monitors-set!)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)

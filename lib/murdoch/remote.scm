@@ -17,6 +17,7 @@
                (make-decoder environment decode-proxy))
     (set-log-name! (string-append "murdoch " (symbol->string uid)))
     (start-wire!)
+    (open-connections!)
     (set-value-limits!)
     (set-sandbox-ports! (current-output-port) (current-error-port))
     (start-serving!)

@@ -16,5 +16,6 @@
   (import (scheme base) (scheme write) (murdoch sys) (murdoch wire) (murdoch lab)
           (murdoch code) (murdoch remote aspace) (murdoch remote worker)
           (murdoch remote call) (murdoch remote serve) (murdoch remote group)
-          (murdoch remote proxy) (murdoch remote delivery))
+          (murdoch remote proxy) (murdoch remote delivery)
+          (only (murdoch remote connection) open-connections!))
   (include "remote.scm"))

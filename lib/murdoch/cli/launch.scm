@@ -155,6 +155,9 @@
   ;; Ctrl-C is for bin/murdoch-lab; the children inherit this, as sh's `&`'s do.
   (set-signal-action! signal/interrupt #f)
   (set-signal-action! signal/quit #f)
+  ;; Each fork starts with the whole free heap, not with what loading
+  ;; happened to leave since its last collection (docs/speed.md).
+  (gc)
   (let loop ()
     (let ((line (read-line in)))
       (cond

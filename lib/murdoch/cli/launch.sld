@@ -12,7 +12,7 @@
           (only (chibi filesystem) open-pipe open open/read open/write open/append
                 open/create duplicate-file-descriptor-to set-file-descriptor-flags!
                 open-input-file-descriptor open-output-file-descriptor)
-          (only (chibi string) string-prefix?)
+          (only (chibi string) string-prefix?) (only (chibi ast) gc)
           (only (srfi 27) random-source-pseudo-randomize! default-random-source)
           (only (scheme time) current-second)
           (only (srfi 151) bitwise-and bitwise-ior arithmetic-shift)

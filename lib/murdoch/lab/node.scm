@@ -3,8 +3,8 @@
 ;;;; (docs/architecture.md, "How an address space starts").
 
 (define-record-type node
-  (make-node lab role wire limits sandbox membership server group subscriber
-             monitors)
+  (make-node lab role wire limits sandbox membership connections server group
+             subscriber monitors)
   node?
   (lab node-lab)                        ; read once; its settings by setting
   (role node-role)                      ; aspace, or repl: a person waits at it
@@ -12,6 +12,7 @@
   (limits node-limits node-limits-set!) ; code/sendable.scm: values sent
   (sandbox node-sandbox node-sandbox-set!) ; code/sandbox.scm: max-alloc, ports
   (membership node-membership node-membership-set!) ; remote/aspace.scm
+  (connections node-connections node-connections-set!) ; remote/connection.scm
   (server node-server node-server-set!) ; remote/serve.scm
   (group node-group node-group-set!)    ; remote/group.scm, #f under broadcast
   (subscriber node-subscriber node-subscriber-set!) ; pubsub/messaging.scm
@@ -24,7 +25,7 @@
 ;;> Makes this process a node of \var{lab}, its parts yet to be filled;
 ;;> \var{role} is \scheme{repl} for a person's REPL, else \scheme{aspace}.
 (define (open-node! lab . role)
-  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f #f))
+  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f #f #f))
   *node*)
 
 ;;> This process's node, for a layer to fill its part.

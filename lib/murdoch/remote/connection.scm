@@ -38,12 +38,24 @@
   (gathering-put! (pending-call-gathering p) p answer
                   pending-call-answer pending-call-answer-set!))
 
-;; Global: one connection to each peer for the process, made by the first
-;; call to it, from any thread; and a lock for each uid being connected
-;; to, so that a peer that does not answer holds up only the calls to it.
-(define *connections* (make-hash-table eq?))  ; uid -> connection
-(define *connecting* (make-hash-table eq?))   ; uid -> mutex
-(define *connections-lock* (make-mutex 'connections))
+;; The node's connections part: one connection to each peer, made by the
+;; first call to it, from any thread; and a lock for each uid being
+;; connected to, so that a peer that does not answer holds up only the
+;; calls to it.
+(define-record-type connections
+  (make-connections table connecting lock)
+  connections?
+  (table connections-table)             ; uid -> connection
+  (connecting connections-connecting)   ; uid -> mutex
+  (lock connections-lock))              ; over both, and the poller's table
+
+(define-syntax the-connections (syntax-rules () ((_) (node-connections *node*))))
+
+;;> Makes the node's connections part, before any call or served connection.
+(define (open-connections!)
+  (node-connections-set! (this-node)
+                         (make-connections (make-hash-table eq?) (make-hash-table eq?)
+                                           (make-mutex 'connections))))
 
 ;; The open connection to a, made and greeted by the deadline if there is
 ;; none.  No let or or, whose closures every call to every peer would make
@@ -65,24 +77,25 @@
        (lambda ()
          (or (live-connection-to uid)
              (let ((c (connect! a deadline)))
-               (with-lock *connections-lock*
-                 (lambda () (hash-table-set! *connections* uid c)))
+               (with-lock (connections-lock (the-connections))
+                 (lambda () (hash-table-set! (connections-table (the-connections)) uid c)))
                c)))))))
 
 ;; No wind around the lock: nothing under it raises, and every call comes here.
 (define (live-connection-to uid)
-  (lock! *connections-lock*)
-  (open-in (unlocked *connections-lock* (hash-table-cell *connections* uid #f))))
+  (lock! (connections-lock (the-connections)))
+  (open-in (unlocked (connections-lock (the-connections))
+                     (hash-table-cell (connections-table (the-connections)) uid #f))))
 
 (define (open-in cell)
   (and cell (connection-open? (cdr cell)) (cdr cell)))
 
 (define (connecting-lock uid)
-  (with-lock *connections-lock*
+  (with-lock (connections-lock (the-connections))
     (lambda ()
-      (or (hash-table-ref/default *connecting* uid #f)
+      (or (hash-table-ref/default (connections-connecting (the-connections)) uid #f)
           (let ((m (make-mutex 'connecting)))
-            (hash-table-set! *connecting* uid m)
+            (hash-table-set! (connections-connecting (the-connections)) uid m)
             m)))))
 
 (define (connect! a deadline)
@@ -126,7 +139,7 @@
 
 ;; Global, as the process has one poller: the watched connections by
 ;; descriptor, a vector the poller reads without a lock (a vector-set! is
-;; whole), replaced by a larger one under *connections-lock*.
+;; whole), replaced by a larger one under the connections' lock.
 (define *watched* (make-vector 64 #f))
 (define *poller-port* #f)               ; on the epoll descriptor
 
@@ -143,7 +156,7 @@
 ;; entry is set before epoll watches it, since the poller drops a ready
 ;; descriptor it does not know, and with it the welcome.
 (define (watch-port! in entry)
-  (with-lock *connections-lock*
+  (with-lock (connections-lock (the-connections))
     (lambda ()
       (if (not *poller-port*) (start-poller!))
       (let ((fd (port-fileno in)))
@@ -156,7 +169,7 @@
 ;;> The poller stops reading served descriptor \var{fd}: for good, or with
 ;;> \var{keep?} leaving its buffer to a thread of its own.
 (define (unwatch-served! fd keep?)
-  (with-lock *connections-lock*
+  (with-lock (connections-lock (the-connections))
     (lambda ()
       (vector-set! *watched* fd #f)
       (if keep? (poller-release! fd) (poller-unwatch! fd)))))
@@ -263,7 +276,7 @@
               (connection-open?-set! c #f)
               (take-all-mailboxes! (connection-pending c))))))
     (when fd
-      (with-lock *connections-lock*
+      (with-lock (connections-lock (the-connections))
         (lambda ()
           (vector-set! *watched* fd #f)
           (poller-unwatch! fd)))

@@ -2,7 +2,7 @@
 ;;> space called, and the poller that reads them all.
 
 (define-library (murdoch remote connection)
-  (export connection-to send-call! give-up-call! send-datagram-answer!
+  (export open-connections! connection-to send-call! give-up-call! send-datagram-answer!
           make-pending-call pending-call? pending-call-uid
           pending-call-connection pending-call-id pending-call-answer
           answer-call! watch-served! unwatch-served!)

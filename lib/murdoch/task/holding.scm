@@ -150,25 +150,21 @@
             (with-lock *tasks-lock* waiters))
   #t)
 
-;; Asks the waiting tasks that rank after w, and hold robots w could
-;; start with, to give way, when with those robots and the free ones each
-;; of w's components not held would have one.
-(define (ask-way! w lines others)
-  (let* ((worse (filter (lambda (o) (rank<? (waiter-rank w) (waiting-there-rank o)))
-                        others))
-         (yieldable (append-map waiting-there-held worse))
-         (held (map held-index (waiter-held w)))
+;; Asks the waiting tasks that rank after w, worse, and hold robots w
+;; could start with, to give way, when with those robots and the free
+;; ones each of w's components not held would have one.  A look asks it
+;; of each of its poser's hundreds of tasks: it first looks for a held
+;; robot that w could use at all.
+(define (ask-way! w lines worse)
+  (let* ((yieldable (append-map waiting-there-held worse))
+         (mine (held-uids w))
          (open (filter-map (lambda (c line)
-                             (and (not (memv (component-index c) held))
-                                  (filter (lambda (uid)
-                                            (or (memq uid (explanation-free line))
-                                                (memq uid yieldable)))
-                                          (remove (lambda (u) (memq u (held-uids w)))
-                                                  (explanation-capable line)))))
+                             (and (not (assv (component-index c) (waiter-held w))) line))
                            (waiter-components w) lines))
-         (wanted (filter (lambda (uid) (memq uid yieldable)) (apply append open))))
-    (when (and (pair? wanted) (every pair? open)
-               (>= (length (delete-duplicates (apply append open))) (length open)))
+         (wanted (filter (lambda (uid)
+                           (any (lambda (line) (memq uid (explanation-capable line))) open))
+                         yieldable)))
+    (when (and (pair? wanted) (startable? open wanted mine))
       (for-each (lambda (o)
                   (for-each (lambda (uid)
                               (if (memq uid wanted)
@@ -178,3 +174,15 @@
                             (waiting-there-held o)))
                 worse))))
 
+;; Whether each of the open components' explanations has a robot, free or
+;; wanted from a worse task, not w's own (mine), and they have as many in
+;; all as they are.
+(define (startable? open wanted mine)
+  (let ((candidates (map (lambda (line)
+                           (filter (lambda (uid)
+                                     (and (not (memq uid mine))
+                                          (memq uid (explanation-capable line))))
+                                   (append (explanation-free line) wanted)))
+                         open)))
+    (and (every pair? candidates)
+         (>= (length (delete-duplicates (apply append candidates))) (length open)))))

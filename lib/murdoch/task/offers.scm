@@ -7,8 +7,9 @@
 
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
 ;;> task tries again at once; answers whether it started, #f when it is
-;;> no longer waiting here, is already offered a robot for each component
-;;> it does not hold, or did not answer within offer-seconds.
+;;> no longer waiting here, the robots it is offered already could take
+;;> every component this one could, or it did not answer within
+;;> offer-seconds.
 (define (receive-offer id uid)
   (let* ((reply (make-mailbox))
          (offer (cons uid id))
@@ -16,7 +17,7 @@
               (lambda ()
                 (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
                                (waiters))))
-                  (and w (not (offered-enough? w))
+                  (and w (not (offered-enough? w uid))
                        (begin (set! *offers* (cons offer *offers*)) w)))))))
     (and w
          (dynamic-wind
@@ -35,16 +36,39 @@
 ;; worse-ranked task meanwhile.
 (define (offer-seconds) (setting 'timeout))
 
-;; Whether w is offered a robot for each component it does not hold: two
-;; robots freed together offer themselves to one task, and the second
-;; goes on to the next task at once rather than after the first's try.
-;; A robot that w won, holding, in the try its offer began is no longer
-;; one of them, though its offer is answered only when that try ends.
-;; Under *tasks-lock*.
-(define (offered-enough? w)
-  (let ((id (task-id (waiter-task w))) (held (held-uids w)))
-    (>= (count (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held)))) *offers*)
-        (- (length (waiter-components w)) (length held)))))
+;; Whether robot uid would add nothing to the robots offered to w and not
+;; held: with it, they could take, one each, no more of w's open
+;; components than without.  Two robots freed together offer themselves
+;; to one task, and the second goes on to the next task at once rather
+;; than after the first's try.  Counted by kind, not by number: a task
+;; that waited for a b and a d robot, offered two d, declined the b it
+;; needed, which went to a worse task.  A robot that w won, holding, in
+;; the try its offer began is no longer one of them, though its offer is
+;; answered only when that try ends.  Under *tasks-lock*.
+(define (offered-enough? w uid)
+  (let* ((id (task-id (waiter-task w)))
+         (held (held-uids w))
+         (offered (filter-map (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held))
+                                               (car o)))
+                              *offers*))
+         (open (remove (lambda (c) (assv (component-index c) (waiter-held w)))
+                       (waiter-components w)))
+         (fits? (lambda (uid c)
+                  (let ((capable (looked-capable w c)))
+                    (or (not capable) (memq uid capable))))))
+    (= (most-matched open offered fits?) (most-matched open (cons uid offered) fits?))))
+
+;; The most of components cs that uids, one a component, can take: a
+;; task has a few components, and is offered a few robots at once.
+(define (most-matched cs uids fits?)
+  (if (null? cs)
+      0
+      (fold (lambda (uid most)
+              (if (fits? uid (car cs))
+                  (max most (+ 1 (most-matched (cdr cs) (delete uid uids eq?) fits?)))
+                  most))
+            (most-matched (cdr cs) uids fits?)
+            uids)))
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
@@ -82,44 +106,17 @@
   (if (and (robot-here?) (free-here?)) (robot-freed!))
   #t)
 
-;; The posers that may have tasks waiting: those that said so, and those
-;; subscribed to waiting-tasks when this robot last asked the whole lab.
-;; A round asks them alone, 8 posers where the lab has 73 address spaces,
-;; and the whole lab again every ten heartbeats or a third of the lease,
-;; as a poser looks: a poser this robot missed (it joined later) is then
-;; found.  #f until it has asked the lab.  Global, as the offer rounds are.
-(define *posers* #f)
-(define *posers-asked* #f)              ; when the lab was last asked
-
-(define (know-poser! uid)
-  (if (and *posers* (not (memq uid *posers*))) (set! *posers* (cons uid *posers*))))
-
-(define (ask-lab-due?)
-  (or (not *posers*)
-      (> (- (monotonic-seconds) *posers-asked*) (look-period))))
-
 ;; Each poser's (UID (WANTING ...)) for this robot, best offer-depth first.
 (define (who-waits me depth)
-  (if (ask-lab-due?)
-      (let ((answers (request 'waiting-tasks waiting-for me (subjects-here) depth)))
-        (set! *posers* (delete-duplicates (append (map car answers) (or *posers* '()))))
-        (set! *posers-asked* (monotonic-seconds))
-        answers)
-      (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
-                  (remote-apply-all (filter-map live-aspace *posers*)
-                                    waiting-for me (subjects-here) depth))))
+  (ask-posers waiting-for me (subjects-here) depth))
 
 ;; Whether a task started to wait, or was reminded of, since this robot's
 ;; offer round asked who waits: the round's list may lack a better-ranked
-;; task, and it asks again before its next offer (forty tasks posed at
-;; once: a round that had asked before the best of them waited went on
-;; down its list to a worse one).  The best rank of those noted, or #t
-;; for one not known (a reminder): a round asks again only if that rank
-;; goes before its next offer's.  While posers posed thousands, a note
-;; came between any two offers, and every robot asked who waits again
-;; after each offer, never getting past the best task of the lab, which
-;; declined all but one robot a component (docs/allocation.md).  Global,
-;; as the offer rounds are.
+;; task, and it asks again before its next offer.  The best rank of those
+;; noted, or #t for one not known (a reminder): a round asks again only
+;; if that rank goes before its next offer's, else with posers posing
+;; non-stop it never gets past the lab's best task (docs/allocation.md).
+;; Global, as the offer rounds are.
 (define *new-waiters* #f)
 
 (define (ask-again-before? waiting)
@@ -131,8 +128,8 @@
   (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
     (and a (lab-aspace-clause a 'capabilities) #t)))
 
-;; Runs on every freeing of exclusive subjects here (pubsub's on-free!):
-;; starts an offer round, or asks the one running for another.  A round
+;; Runs on every freeing of exclusive subjects here (the hook given to
+;; pubsub's open-subscriber!): starts an offer round, or asks the one running for another.  A round
 ;; that runs keeps the robot as it is: offered to a poser, a runner-up of
 ;; that poser's negotiation is freed while the robot waits for its answer,
 ;; and the task that tries must still find the robot its poser's.

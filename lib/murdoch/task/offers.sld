@@ -1,5 +1,5 @@
 ;;> Offers: a robot whose subjects are freed offers itself to the tasks
-;;> that wait for it, best rank first (note-waiters!, and on-free!'s
+;;> that wait for it, best rank first (note-waiters!, and robot-freed!'s
 ;;> round), and receive-offer is what a waiting task's poser answers.
 
 (define-library (murdoch task offers)

@@ -196,13 +196,43 @@
   (rank waiting-there-rank)
   (held waiting-there-held))
 
-;; Every task of the lab that waits, each a waiting-there; request
+;; Every task of the lab that waits, each a waiting-there; ask-posers
 ;; answers (POSER ENTRIES) for each poser.
 (define (waiting-elsewhere)
   (append-map (lambda (answer)
                 (map (lambda (e) (apply make-waiting-there (car answer) e))
                      (cadr answer)))
-              (request 'waiting-tasks waiting-ranks)))
+              (ask-posers waiting-ranks)))
+
+;; The posers that may have tasks waiting, as this address space knows
+;; them: those that said so (note-waiters!, published to the whole lab),
+;; and those subscribed to waiting-tasks when it last asked the whole lab,
+;; which it does every look-period, so that a poser it missed (one that
+;; joined later) is found: asking every address space each round cost
+;; the robots most of their CPU (docs/speed.md).  #f until it has asked
+;; the lab.  Global: one address space, one view of the lab's posers.
+(define *posers* #f)
+(define *posers-asked* #f)              ; when the lab was last asked
+
+;;> Notes that poser \var{uid} has tasks waiting.
+(define (know-poser! uid)
+  (if (and *posers* (not (memq uid *posers*))) (set! *posers* (cons uid *posers*))))
+
+(define (ask-lab-due?)
+  (or (not *posers*)
+      (> (- (monotonic-seconds) *posers-asked*) (look-period))))
+
+;;> What request of waiting-tasks answers, \var{proc} applied to
+;;> \var{args} by each poser with tasks waiting, ((UID VALUE) ...), asked
+;;> of the posers known to have some, of the whole lab every look-period.
+(define (ask-posers proc . args)
+  (if (ask-lab-due?)
+      (let ((answers (apply request 'waiting-tasks proc args)))
+        (set! *posers* (delete-duplicates (append (map car answers) (or *posers* '()))))
+        (set! *posers-asked* (monotonic-seconds))
+        answers)
+      (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
+                  (apply remote-apply-all (filter-map live-aspace *posers*) proc args))))
 
 ;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
 ;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*; global,
@@ -211,13 +241,10 @@
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
 ;; asked of the lab at most once a heartbeat for every 100 tasks it
-;; waited last time, for all the tasks waiting here.  Each look numbers
-;; its tasks' places in the line: with W tasks waiting, a look that asked
-;; every poser each time cost W squared a period lab-wide, and one a
-;; heartbeat, 2,500 tasks' entries twice a second a poser.  A place may
-;; so be W/100 heartbeats old for tasks posed elsewhere; who is offered a
-;; robot is decided by the robot's own round, never by this list, and who
-;; holds what is asked afresh (lab-holders).
+;; waited last time, for all the tasks waiting here (docs/allocation.md).
+;; A place may so be W/100 heartbeats old for tasks posed elsewhere; who
+;; is offered a robot is decided by the robot's own round, never by this
+;; list, and who holds what is asked afresh (lab-holders).
 (define (waiting-at-others)
   (let* ((now (monotonic-seconds))
          (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
@@ -246,7 +273,7 @@
   (append-map (lambda (answer)
                 (map (lambda (e) (apply make-waiting-there (car answer) e))
                      (cadr answer)))
-              (request 'waiting-tasks waiting-ranks #t)))
+              (ask-posers waiting-ranks #t)))
 
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
@@ -270,12 +297,14 @@
 
 ;; Whether w may use robot uid, subscribed to subjects (or #f): for a
 ;; component it does not hold, when it has looked; a robot its look did
-;; not know, if subjects serve a component.  Offered to a task that held
-;; the one component it could take, a robot went down its round to no
-;; avail, and sat free while tasks waited for it further down.
+;; not know, or before it looked, if subjects serve a component.  Offered
+;; to a task that held the one component it could take, a robot went down
+;; its round to no avail, and sat free while tasks waited for it further
+;; down; offered to each task just posed, a robot of another kind made it
+;; try for nothing.
 (define (wants? w uid subjects)
   (let ((capable (waiter-capable w)))
-    (cond ((eq? capable #t) #t)
+    (cond ((eq? capable #t) (or (not subjects) (serves? subjects w)))
           ((memq uid capable)
            (any (lambda (cc)
                   (and (not (assv (component-index (car cc)) (waiter-held w)))

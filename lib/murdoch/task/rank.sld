@@ -18,7 +18,8 @@
           take-news! answer-offers! held-index held-winner held-type held-uid
           held-uids place-in-line line-of waiting-ranks waiting-there?
           waiting-there-poser waiting-there-rank
-          waiting-there-held waiting-elsewhere waiting-at-others lab-waiting lab-holders waiting-for waiting-entries waiting-entry
+          waiting-there-held waiting-elsewhere waiting-at-others lab-waiting lab-holders
+          know-poser! ask-posers waiting-for waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132) (murdoch sys)

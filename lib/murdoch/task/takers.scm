@@ -33,6 +33,7 @@
   (free explanation-free)
   (capable explanation-capable))
 
+;;> The line of explanation \var{e} for the component numbered \var{i}.
 (define (explanation-line e i)
   (string-append "  component " (number->string i) " " (explanation-needs e) "\n"))
 

@@ -3,6 +3,7 @@
 
 (define-library (murdoch task takers)
   (export explain-no-takers explain-components takers-here explanation? explanation-lines
+          explanation-line
           explanation-free explanation-capable)
   (import (scheme base) (scheme write) (srfi 1) (only (chibi) call-with-output-string)
           (murdoch lab) (murdoch code) (murdoch remote) (murdoch pubsub))

@@ -4,20 +4,21 @@
 ;; waits for them, holding nothing and trying only when a robot offers
 ;; itself, while its poser subscribes to waiting-tasks and tells the lab
 ;; that a task waits (note-waiters!).  When a robot's exclusive subjects
-;; are freed (pubsub's on-free!), the robot asks waiting-tasks who waits
-;; for it, and offers itself to each in rank order, its subjects kept for
-;; that one's poser while it tries, until one starts or none can.  A rank
-;; is (KEY POSED ID), KEY being the task's priority less aging times the
-;; second it was posed: the higher KEY goes first, then the earlier
-;; POSED, then the smaller ID.  That is a total order, the same in every
-;; address space, and aging does not reorder the tasks that wait: it
-;; raises all their priorities alike, and only a task posed later starts
-;; from lower down.  A task no live robot of the lab is capable of fails
-;; at once; one whose capable robots all die while it waits fails at its
-;; poser's next look at the lab, every ten heartbeats or a third of the
-;; lease, whichever is sooner.  A poser looks once for all its waiting
-;; tasks (look-all!): a task that waits sends nothing to the lab by
-;; itself, so that W tasks waiting do not cost W looks a period.
+;; are freed (robot-freed!, given to pubsub's open-subscriber!), the
+;; robot asks waiting-tasks who waits for it, and offers itself to each
+;; in rank order, its subjects kept for that one's poser while it tries,
+;; until one starts or none can.  A rank is (KEY POSED ID), KEY being
+;; the task's priority less aging times the second it was posed: the
+;; higher KEY goes first, then the earlier POSED, then the smaller ID.
+;; That is a total order, the same in every address space, and aging
+;; does not reorder the tasks that wait: it raises all their priorities
+;; alike, and only a task posed later starts from lower down.  A task no
+;; live robot of the lab is capable of fails at once; one whose capable
+;; robots all die while it waits fails at its poser's next look at the
+;; lab, every ten heartbeats or a third of the lease, whichever is
+;; sooner.  A poser looks once for all its waiting tasks (look-all!): a
+;; task that waits sends nothing to the lab by itself, so that W tasks
+;; waiting do not cost W looks a period.
 
 (define (enlist! w)
   (waiter-held-set! w '())
@@ -42,8 +43,7 @@
   (note-lab! (waiter-rank w)))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
-;; tasks that start to wait while the publication goes (500 posed at once
-;; were 500 publications, each to every address space), with the best of
+;; tasks that start to wait while the publication goes, with the best of
 ;; their ranks.  Global: a process is one poser, with one line of tasks.
 (define *noting* #f)                    ; a publication goes
 (define *note-again* #f)                ; the best rank waiting since, or #f
@@ -149,19 +149,26 @@
                                     (request-audience (audience w offered excluded)))
                        (try w))))))))
 
-;; Whom w's negotiations ask: the robots its last look found capable and
-;; those offered, but those excluded; the whole lab before it has looked.
+;; Whom w's negotiations ask, but those excluded: the robots offered
+;; alone when w takes them one at a time, else those offered and those
+;; its last look found capable; the whole lab before it has looked.  A
+;; task posed a moment before, offered a robot it could not use, asked
+;; the whole lab and took one freed for a better-ranked task, on its way
+;; to offer itself there.
 (define (audience w offered excluded)
-  (and (list? (waiter-capable w))
-       (remove (lambda (uid) (memq uid excluded))
-               (append offered (waiter-capable w)))))
+  (let ((asked (cond ((and (pair? offered) (one-at-a-time? w)) offered)
+                     ((list? (waiter-capable w)) (append offered (waiter-capable w)))
+                     (else #f))))
+    (and asked (remove (lambda (uid) (memq uid excluded)) asked))))
 
 (define (not-offered w offered)
-  (let ((t (waiter-task w)))
-    (if (and (pair? offered) (list? (waiter-capable w))
-             (or (turn-hold? (task-turn t)) (= 1 (length (waiter-components w)))))
-        (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
-        '())))
+  (if (and (pair? offered) (list? (waiter-capable w)) (one-at-a-time? w))
+      (remove (lambda (uid) (memq uid offered)) (waiter-capable w))
+      '()))
+
+;; Whether w can take robots one at a time: it holds, or needs one.
+(define (one-at-a-time? w)
+  (or (turn-hold? (task-turn (waiter-task w))) (= 1 (length (waiter-components w)))))
 
 (define (look-due? w)
   (or (not (waiter-looked w)) (> (- (monotonic-seconds) (waiter-looked w)) 1)))
@@ -211,46 +218,85 @@
 
 ;; Looks at the lab for the waiting tasks ws: one request for the takers
 ;; of all their components, one for the tasks that hold robots, and the
-;; lab's line as lab-waiting has it, whatever the number of tasks.
+;; lab's line as lab-waiting has it, whatever the number of tasks.  What
+;; each task is told is made once a look for each of the layouts and
+;; numbers its components have, and the holders that rank after each task
+;; are found by going down both lists together (docs/allocation.md).
 (define (look-all! ws)
-  (let* ((layouts (delete-duplicates (append-map waiter-layouts ws)))
-         (lines (map cons layouts (explain-components layouts)))
-         (line (line-of (guard (e (#t '())) (lab-waiting))))
-         ;; Those that hold robots, no more than the robots: each task
-         ;; asks those of them that rank after it to give way.
-         (holders (guard (e (#t '())) (lab-holders))))
-    (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines))))
-    (for-each (lambda (w)
+  (let*-values (((line) (line-of (guard (e (#t '())) (lab-waiting))))
+                ((lines fresh?) (takers-of (delete-duplicates (append-map waiter-layouts ws))
+                                           (vector-length line))))
+    ;; Those that hold robots, no more than the robots, best first: each
+    ;; task asks those of them that rank after it to give way.
+    (let ((holders (list-sort (lambda (a b)
+                                (rank<? (waiting-there-rank a) (waiting-there-rank b)))
+                              (guard (e (#t '())) (lab-holders))))
+          (told (told-lines)))
+      (if fresh?
+          (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines)))))
+      (fold (lambda (w holders)
+              (let ((after (drop-while (lambda (h)
+                                         (rank<? (waiting-there-rank h) (waiter-rank w)))
+                                       holders)))
                 (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
-                       holders line))
-              ws)))
+                       after line told)
+                after))
+            holders ws))))
+
+;; The takers of each of layouts, ((LAYOUT . EXPLANATION) ...), and
+;; whether they were asked afresh; else as the last look that asked the
+;; lab found them, when that was less than a heartbeat ago for every 100
+;; of the n tasks waiting in the lab (docs/allocation.md).  Who is capable
+;; and free, and why a task waits, may so be n/100 heartbeats old; who
+;; is offered a robot is decided by the robot's round, never by this.
+;; Global: one poser, one look at a time.
+(define *takers* #f)                    ; (WHEN (LAYOUT . EXPLANATION) ...)
+
+(define (takers-of layouts n)
+  (let ((now (monotonic-seconds)))
+    (if (and *takers*
+             (< (- now (car *takers*))
+                (* (setting 'heartbeat) (max 1 (/ n 100))))
+             (every (lambda (l) (assoc l (cdr *takers*))) layouts))
+        (values (cdr *takers*) #f)
+        (let ((lines (map cons layouts (explain-components layouts))))
+          (set! *takers* (cons now lines))
+          (values lines #t)))))
+
+;; The line a look tells of explanation e for component number i, trimmed,
+;; made once a look for each.
+(define (told-lines)
+  (let ((made '()))
+    (lambda (e i)
+      (let ((key (find (lambda (m) (and (eq? (car m) e) (= (cadr m) i))) made)))
+        (if key
+            (car (cddr key))
+            (let ((text (trimmed (explanation-line e i))))
+              (set! made (cons (list e i text) made))
+              text))))))
 
 (define (waiter-layouts w)
   (map (lambda (c) (capability-layout (component-capabilities c))) (waiter-components w)))
 
 ;; What a look tells w, from lines, the explanations of its components,
-;; holders, the lab's waiting tasks that hold robots, and line, the ranks
-;; of all its waiting tasks in order: why it waits, and its place in line,
-;; in its components' states; or why it never can be served, its waiting
-;; task told.
-(define (look! w lines holders line)
+;; holders, the lab's waiting tasks that hold robots and rank after it,
+;; line, the ranks of all its waiting tasks in order, and told, its
+;; lines' text: why it waits, and its place in line, in its components'
+;; states; or why it never can be served, its waiting task told.
+(define (look! w lines holders line told)
   (waiter-looked-set! w (monotonic-seconds))
   (let* ((cs (waiter-components w))
          (capable (map (lambda (line)
-                         (remove (lambda (uid) (memq uid (waiter-excluded w)))
-                                 (explanation-capable line)))
+                         (let ((all (explanation-capable line)))
+                           (if (null? (waiter-excluded w))
+                               all
+                               (remove (lambda (uid) (memq uid (waiter-excluded w))) all))))
                        lines))
-         (exclusive (filter-map (lambda (c caps)
-                                  (and (pair? (car (capability-layout
-                                                    (component-capabilities c))))
-                                       caps))
-                                cs capable))
          (never (cond
                  ((any null? capable)
                   (string-append "no live robot of the lab is capable of it:"
                                  (apply string-append (explanation-lines lines))))
-                 ((< (length (delete-duplicates (apply append exclusive)))
-                     (length exclusive))
+                 ((too-few-capable? cs capable)
                   "fewer live robots of the lab are capable of it than it has components")
                  (else #f))))
     (cond
@@ -258,9 +304,9 @@
       (waiter-never-set! w never)
       (tell-waiter! w '(looked)))
      (else
-      (waiter-capable-set! w (delete-duplicates (apply append capable)))
+      (waiter-capable-set! w (union-of capable))
       (waiter-capables-set! w (map cons cs capable))
-      (waiter-why-set! w (map trimmed (explanation-lines lines)))
+      (waiter-why-set! w (map told lines (iota (length lines) 1)))
       (ask-way! w lines holders)
       (if (blocked-on-itself? w) (tell-waiter! w '(looked)))
       (move-up! w line)
@@ -271,6 +317,24 @@
                                 (held-uids w)))
                     "")
                 ", " (waiter-position w) " in line")))))
+
+;; Whether fewer robots are capable of the exclusive components of cs,
+;; capable the uids capable of each, than they are: never when each has
+;; as many as they are, which a look of a lab with spare robots finds at
+;; once.
+(define (too-few-capable? cs capable)
+  (let ((exclusive (filter-map (lambda (c caps)
+                                 (and (pair? (car (capability-layout (component-capabilities c))))
+                                      caps))
+                               cs capable)))
+    (and (any (lambda (caps) (< (length caps) (length exclusive))) exclusive)
+         (< (length (union-of exclusive)) (length exclusive)))))
+
+;; The uids in any of lists, once each.
+(define (union-of lists)
+  (fold (lambda (uids out)
+          (append (remove (lambda (uid) (memq uid out)) uids) out))
+        '() lists))
 
 ;; Robots that a look finds free may have made their offers before these
 ;; tasks waited, or be making them: each found free by the last look too

@@ -4,12 +4,12 @@
 
 (define-library (murdoch task waiting)
   (export negotiate-turn move-up!)
-  (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18)
+  (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18) (srfi 132)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (murdoch task progress) (murdoch task pose-task)
           (only (murdoch pubsub) subscribe unsubscribe publish capability-layout
                 request-audience)
-          (only (murdoch task takers) explain-components explanation-lines
+          (only (murdoch task takers) explain-components explanation-lines explanation-line
                 explanation-free explanation-capable)
           (murdoch task record) (murdoch task rank) (murdoch task offers)
           (murdoch task holding))
