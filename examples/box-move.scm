@@ -549,19 +549,21 @@
   (wrap (- (heading-to box (aim-point box)) (place-axis box))))
 
 ;; Where on the rear face this pusher pushes from, mm left of its middle:
-;; its own place while its partner is at the face or coming with a way to
-;; it; while a spare waits for a body to clear its place, where lone-offset
-;; says, sliding there along its own half; with no partner at all, where
-;; lone-offset says, kept until that has moved by more than 80 mm, for a
-;; pusher that slides far along a face it pushes drags the box round the
-;; wrong way: it comes up afresh to each new spot (approach!).
+;; its own place until it is alone; then where lone-offset says, kept
+;; until that has moved by more than 80 mm, for a pusher that slides far
+;; along a face it pushes drags the box round the wrong way: it comes up
+;; afresh to each new spot (approach!).  Before it is alone a spare may
+;; come to the other half, and a lone pusher that slid toward the middle
+;; as it pushed turned the box 45 degrees the wrong way in 5 s while the
+;; spare waited for the lost pusher's body to clear its place (generated
+;; seed 13).
 (define lone-at #f)
 (define (push-offset view side)
-  (if (or (paired?) (spare-on-its-way?))
+  (if (not (alone?))
       (begin (set! lone-at #f) (* side pusher-offset))
       (let ((want (lone-offset (car view) (cadr view) side)))
         (cond ((not lone-at) (set! lone-at (* side pusher-offset)))
-              ((or (not (alone?)) (> (abs (- want lone-at)) 80)) (set! lone-at want)))
+              ((> (abs (- want lone-at)) 80) (set! lone-at want)))
         lone-at)))
 
 ;; Whether this pusher has heard nothing from a partner for 10 s (long
@@ -575,17 +577,61 @@
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
 ;; pushes harder (pair-share).  A pusher alone (its partner has not said
-;; lately that it is at the face) turns the box by where it pushes
-;; (push-offset), and holds while the box turns faster than max-turn-rate.
-;; A spare coming turns the box the most: once the spare has a way to its
-;; place, the lone pusher holds at its own, leaving the spare's free.
+;; lately that it is at the face) pushes from its own place, which turns
+;; the box away from its side, until it is alone (push-offset); it holds
+;; while the box turns faster than max-turn-rate, and once a spare has a
+;; way to the other place, leaving that free.  Before a spare speaks it
+;; pushes on only until the box has left the lost partner's body behind,
+;; and then only while its push turns the box toward its way (lone-push?).
 (define (steer! view side offset)
-  (let ((box (car view)))
-    (push-at! box (place-axis box) offset
-              (cond ((paired?) (pair-share box side))
+  (let* ((box (car view))
+         (share (cond ((paired?) (pair-share box side))
                     ((spare-on-its-way?) 0)
                     ((> (abs turn-rate) max-turn-rate) 0)
-                    (else 0.5)))))
+                    ((lone-push? box side) 0.5)
+                    (else 0))))
+    (if (paired?) (set! paired-at box))
+    (if (or (paired?) (alone?) (= share 0))
+        (push-at! box (place-axis box) offset share)
+        (lone-push! box side share))))
+
+;; Pushes at share of push-speed from where this pusher stands at the face,
+;; heading lone-slant degrees off the box's axis toward its middle, and only
+;; while it heads so (within 6 degrees), else turning there first.  A push
+;; off the middle turns the box away from the pusher's side; the pusher,
+;; pressed to the face, turns with the box and lags it, heading out, and the
+;; face sliding on its front then turns the box further the same way: the
+;; lone pusher of generated seed 13, steering back to its place as it
+;; pushed, headed 13 to 19 degrees out and turned the box 6 degrees a
+;; second the wrong way.  Slanted in, that slide turns the box back.
+(define lone-slant 10)
+(define (lone-push! box side share)
+  (let* ((axis (place-axis box))
+         (want (- axis (* side lone-slant)))
+         (turn (wrap (- want (list-ref (reckon) 2)))))
+    (drive! (if (< (abs turn) 6) (* push-speed (slowing box) share) 0)
+            (clip (* 2 turn) 40))))
+
+;; Whether a pusher whose partner is not at the face pushes: alone, or
+;; while a spare waits for a lost pusher's body to clear its place (so
+;; that it may come); else, until a spare speaks, only while the box is
+;; still within clear-run of where it was when the two last pushed
+;; together, so that it leaves the lost partner's body behind and the
+;; spare finds that place clear sooner, or while its push turns the box
+;; toward its way: a
+;; push off the middle turns the box away from the pusher's side, so while
+;; the box must turn that way by more than 3 degrees, what it will turn
+;; within turn-lead at its rate now counted.  One that pushed on, sliding
+;; toward the middle, turned the box 15 to 30 degrees the wrong way before
+;; the spare came (generated seeds 13 and 38, the box to turn toward the
+;; lone pusher's side), and the pair could not bring it back by the goal.
+(define paired-at #f)                   ; the box when last pushed by two
+(define clear-run (+ body-radius body-radius 40))
+(define (lone-push? box side)
+  (or (alone?)
+      (spare-spoke?)
+      (and paired-at (< (distance box paired-at) clear-run))
+      (< (* side (- (clip (turn-error box) 20) (* turn-lead turn-rate))) -3)))
 
 ;; A pusher's share of push-speed in a pair: both push less the further
 ;; the box is turned off its way (forward at a third from 30 degrees off),
@@ -619,18 +665,21 @@
 (define (spare-on-its-way?)
   (and (< (coming-age) 2) (< partner-coming-mm 1e8)))
 
+;; Whether a spare said lately (within 2 s) how far it has to come, with a
+;; way or none (a lost pusher's body at its place, which the lone pusher's
+;; push clears).
+(define (spare-spoke?) (< (coming-age) 2))
+
 ;; Where a pusher alone pushes, mm left of the middle of the rear face:
 ;; 10 mm aside a degree the box must turn, to the right of the middle to
-;; turn it left, anywhere along the face, or only on its own half while a
-;; spare is on its way to the other; or the spot nearest that, its own side
-;; first, that is clear of the lost pushers' bodies as a place must be
+;; turn it left, anywhere along the face; or the spot nearest that, its own
+;; side first, that is clear of the lost pushers' bodies as a place must be
 ;; (staging), else its own place.
 (define (lone-offset box bodies side)
   (let* ((axis (place-axis box))
          (want (clip (* -10 (turn-error box)) pusher-offset))
-         (half? (not (alone?)))
          (clear? (lambda (o)
-                   (and (<= (abs o) pusher-offset) (or (not half?) (>= (* side o) 0))
+                   (and (<= (abs o) pusher-offset)
                         (clear-of? bodies (list (behind-at box axis o)) -40)))))
     (let loop ((k 0))
       (cond ((> k (* 2 pusher-offset)) (* side pusher-offset))
@@ -679,8 +728,15 @@
 ;; box of view, (BOX BODIES): along a planned way (plan-way) to a staging
 ;; point, then into the place: along the box's axis from a point behind it,
 ;; or, when a body lies right behind the place, along the face from a point
-;; beside it, turning in place there.
+;; beside it, turning in place there.  A robot counts itself at a staging
+;; point within stage-reach of it, and once docking beside the place it
+;; keeps on while it is no further from the place than the staging point
+;; and stage-reach: the spare of generated seed 13, its fault drawn,
+;; stopped 52 mm past its staging point, 502 mm from its place, where it
+;; neither docked (within 500 mm) nor planned a way on, and stood for 60 s.
 (define stage-back 450)
+(define stage-out 450)                  ; a staging point beside the place
+(define stage-reach 150)
 (define docking #f)             ; the staging point reached, while docking
 (define waypoint #f)
 
@@ -689,7 +745,7 @@
   (let* ((box (car view)) (axis (place-axis box))
          (off (offsets-to box axis offset)) (place (behind-at box axis offset))
          (stage (staging box axis offset (cadr view))))
-    (if (and stage (or (< (distance (reckon) (car stage)) 150)
+    (if (and stage (or (< (distance (reckon) (car stage)) stage-reach)
                        (and (eq? (cdr stage) 'behind) (in-corridor? off 1))))
         (set! docking (cdr stage)))
     (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box axis place))
@@ -698,7 +754,7 @@
           ((and (eq? docking 'behind) (in-corridor? off 2))
            (set! held "it does not come into its place along the box's axis")
            (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
-          ((and (eq? docking 'beside) (< (distance (reckon) place) 500))
+          ((and (eq? docking 'beside) (< (distance (reckon) place) (+ stage-out stage-reach)))
            (set! held "it does not come into its place along the box's face")
            (if (> (distance (reckon) place) 40)
                (drive-to! place)
@@ -743,8 +799,9 @@
 ;; (POINT . behind) or (POINT . beside): stage-back mm behind it, or
 ;; nearer, or out to its side, whichever first is clear of the bodies and
 ;; of what else the sonar hears (a wall behind the box: the echoes of a
-;; body are the body's, whose margin is clear-of?'s); beside it, 450 mm out,
-;; when a body lies right behind it.  #f when the place itself is not clear.
+;; body are the body's, whose margin is clear-of?'s); beside it, stage-out
+;; mm out, when a body lies right behind it.  #f when the place itself is
+;; not clear.
 (define (staging box axis offset bodies)
   (let ((out (if (< offset 0) -1 1)) (heard (echoes (reckon) box)))
     (define (clear p kind)
@@ -759,7 +816,7 @@
                                       (+ box-half body-radius face-gap back))
                            'behind))
                   (list stage-back (- stage-back 100) (- stage-back 200)))
-             (clear (behind-at box axis (+ offset (* out 450))) 'beside)))))
+             (clear (behind-at box axis (+ offset (* out stage-out))) 'beside)))))
 
 ;; A point some 400 mm along a shortest way from here to goal, on a grid of
 ;; cells 100 mm square, that keeps clear of the box, of the bodies (X Y)
