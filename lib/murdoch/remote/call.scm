@@ -88,6 +88,11 @@
 
 (define (timed-out uid proc seconds)
   (note-unreachable! uid)
+  (no-answer uid proc seconds))
+
+;;> Raises the error of a call of \var{proc} that \var{uid} did not answer
+;;> within \var{seconds}, leaving uid in the live set.
+(define (no-answer uid proc seconds)
   (remote-error 'timed-out uid (describe-procedure proc)
                 (string-append "no answer within " (number->string seconds) " s")))
 

@@ -7,7 +7,7 @@
           new-call call? call-kind call-proc call-args call-proc-code call-args-code
           call-seconds call-all make-result result? result-uid result-ok? result-value
           encode-arguments send-all local-call capture
-          capture-each await-answers answer-value datagram-others
+          capture-each await-answers answer-value no-answer datagram-others
           expect-answers! forget-answers!
           take-datagram-answer! prober)
   (import (scheme base) (srfi 1) (srfi 18) (srfi 69) (murdoch sys)

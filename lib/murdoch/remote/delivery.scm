@@ -37,25 +37,23 @@
                (undo-on-raise forget!
                               (lambda () (await-answers g waiting deadline)))
                (forget!)
-               (let ((results (capture-each pending-call-uid
-                                            (lambda (p)
-                                              (make-result (pending-call-uid p) #t
-                                                           (answer-value p c)))
-                                            waiting)))
-                 (keep-heard! waiting sent)
-                 (cons here results)))
+               (cons here
+                     (capture-each pending-call-uid
+                                   (lambda (p)
+                                     (make-result (pending-call-uid p) #t
+                                                  (datagram-answer-value p c sent)))
+                                   waiting)))
              (begin (forget!) #f)))))
 
-;; Those of waiting that did not answer, but whose datagrams came after
-;; the call was sent, stay live: they were not yet listening when it went
-;; (a lab starting), and out of the live set, they would still take the
-;; calls that follow, unheard: a request's reservations left to their
-;; lease.
-(define (keep-heard! waiting sent)
-  (for-each (lambda (p)
-              (if (and (not (pending-call-answer p)) (heard-since? (pending-call-uid p) sent))
-                  (note-reachable! (pending-call-uid p))))
-            waiting))
+;; What p's answer says, as answer-value has it, but for a member heard
+;; after the call was sent that did not answer: it stays in the live set.
+;; It was not yet listening when the call went (a lab starting); out of
+;; the live set, it would still take the calls that follow, unheard: a
+;; request's reservations left to their lease.
+(define (datagram-answer-value p c sent)
+  (if (and (not (pending-call-answer p)) (heard-since? (pending-call-uid p) sent))
+      (no-answer (pending-call-uid p) (call-proc c) (call-seconds c))
+      (answer-value p c)))
 
 ;;; Serving the group's calls
 ;; As a connection (serve.scm): the listener applies, the janitor relieves it.

@@ -100,23 +100,22 @@
   (let ((now (monotonic-seconds))
         (period (beacon-seconds)))
     (for-each (lambda (uid)
-                (if (< (with-lock (group-last-heard-lock (the-group))
-                         (lambda ()
-                           (hash-table-ref/default (group-last-heard (the-group))
-                                                   uid now)))
-                       (- now (* 3 period)))
+                (if (< (last-heard uid now) (- now (* 3 period)))
                     (note-unreachable! uid)))
               (known-uids))
     (thread-sleep! period))
   (send-beacons))
 
+;; When uid's last datagram came, or default if none did.
+(define (last-heard uid default)
+  (with-lock (group-last-heard-lock (the-group))
+    (lambda () (hash-table-ref/default (group-last-heard (the-group)) uid default))))
+
 ;;> Whether a datagram from \var{uid} came at \var{t}, a
 ;;> (monotonic-seconds), or after.
 (define (heard-since? uid t)
-  (with-lock (group-last-heard-lock (the-group))
-    (lambda ()
-      (let ((heard (hash-table-ref/default (group-last-heard (the-group)) uid #f)))
-        (and heard (>= heard t))))))
+  (let ((heard (last-heard uid #f)))
+    (and heard (>= heard t))))
 
 ;;; Receiving
 ;;
