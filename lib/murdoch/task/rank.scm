@@ -196,13 +196,14 @@
   (rank waiting-there-rank)
   (held waiting-there-held))
 
-;; Every task of the lab that waits, each a waiting-there; ask-posers
-;; answers (POSER ENTRIES) for each poser.
-(define (waiting-elsewhere)
+;; Every task of the lab that waits, each a waiting-there, or only those
+;; holding robots if holding is given and true, as waiting-ranks has it;
+;; ask-posers answers (POSER ENTRIES) for each poser.
+(define (waiting-elsewhere . holding)
   (append-map (lambda (answer)
                 (map (lambda (e) (apply make-waiting-there (car answer) e))
                      (cadr answer)))
-              (ask-posers waiting-ranks)))
+              (apply ask-posers waiting-ranks holding)))
 
 ;; The posers that may have tasks waiting, as this address space knows
 ;; them: those that said so (note-waiters!, published to the whole lab),
@@ -269,11 +270,7 @@
 
 ;; Every task of the lab that waits holding robots, asked afresh: no more
 ;; of them than robots.
-(define (lab-holders)
-  (append-map (lambda (answer)
-                (map (lambda (e) (apply make-waiting-there (car answer) e))
-                     (cadr answer)))
-              (ask-posers waiting-ranks #t)))
+(define (lab-holders) (waiting-elsewhere #t))
 
 ;;> The (RANK POSER ID) of each task waiting here that may use robot
 ;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
