@@ -372,8 +372,8 @@
        ((pair? x) (check-depth (+ depth 1) "a received value")
                   (dec-elements! x (+ depth 1))
                   x)
-       ((not (vector? x)) x)
-       (else (dec-tagged x depth))))
+       ((vector? x) (dec-tagged x depth))
+       (else x)))
     ;; By iteration down the cdrs; no let or or (see known-encoding).
     (define (dec-elements! p depth)
       (if (pair? (car p))

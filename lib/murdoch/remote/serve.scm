@@ -119,10 +119,11 @@
 
 (define (await-whole! s)
   (cond ((positive? (poller-buffered (serving-fd s)))
-         (unless (serving-deadline s)
-           (serving-deadline-set! s (+ (monotonic-seconds)
-                                       (server-frame-timeout (the-server))))
-           (janitor-wanted!)))
+         (if (serving-deadline s)
+             #f
+             (begin (serving-deadline-set! s (+ (monotonic-seconds)
+                                                (server-frame-timeout (the-server))))
+                    (janitor-wanted!))))
         ((serving-greeting s) (serving-deadline-set! s #f))))
 
 ;; A frame that breaks the protocol, or a wrong hello, ends its connection.

@@ -98,12 +98,14 @@
 (define (read-on s r)
   (serve-read! s r (read-served s)))
 
+;; No unless, nor not below: each a call to Chibi's not (docs/speed.md).
 (define (serve-read! s r message)
-  (unless (eof-object? message)
-    (serve-frame r (greeting-uid (serving-greeting s))
-                 (greeting-answer (serving-greeting s)) message)
-    (flush-if-idle! s (serving-greeting s))
-    (if (reader? s) (read-on s r))))
+  (if (eof-object? message)
+      message
+      (begin (serve-frame r (greeting-uid (serving-greeting s))
+                          (greeting-answer (serving-greeting s)) message)
+             (flush-if-idle! s (serving-greeting s))
+             (if (reader? s) (read-on s r)))))
 
 (define (answer-call s c kind value)
   (if (eq? kind 'ack)
@@ -137,11 +139,11 @@
 
 ;; Nothing to flush after a frame that had no answer; under the write lock.
 (define (flush-if-idle! s g)
-  (when (and (not (= (greeting-flushed g) (greeting-sent g)))
-             (null? (serving-frames s)))
-    (lock! (greeting-write-lock g))
-    (flush! s g)
-    (unlock! (greeting-write-lock g))))
+  (cond ((= (greeting-flushed g) (greeting-sent g)))
+        ((null? (serving-frames s))
+         (lock! (greeting-write-lock g))
+         (flush! s g)
+         (unlock! (greeting-write-lock g)))))
 
 ;; Lets go of s's write lock, should a raise (see answer!) have left it held.
 (define (let-go-of-writes! s)
@@ -184,6 +186,4 @@
 (define (served-arguments c) (decode-value (served-call-args-code c)))
 
 (define (checked-procedure proc)
-  (if (not (procedure? proc))
-      (error "not a procedure" proc))
-  proc)
+  (if (procedure? proc) proc (error "not a procedure" proc)))

@@ -26,7 +26,8 @@
 ;;> srfi 18's mutex-lock! and mutex-unlock!, no timeout or condition variable, no garbage.
 (define (lock! m)
   (if lock-order-checked? (taking! m))
-  (if (not (%mutex-lock! m #f #t))      ; no or: a closure a lock (docs/speed.md)
+  (if (%mutex-lock! m #f #t)            ; no or, no not (docs/speed.md)
+      #t
       (begin (thread-yield!) (mutex-lock! m)))   ; as srfi 18's, once it failed
   (if lock-order-checked? (took! m)))
 

@@ -66,22 +66,22 @@
 
 ;;> A message of \var{kind} with \var{fields}, as many as the table says.
 (define (make-message kind . fields)
-  (if (not (= (length fields) (car (checks-of kind))))
-      (error "wrong number of fields for a message" kind fields))
-  (cons kind fields))
+  (if (= (length fields) (car (checks-of kind)))
+      (cons kind fields)
+      (error "wrong number of fields for a message" kind fields)))
 
 ;;> \var{message} when it is one of \var{kinds} with good fields, else a protocol error.
 (define (check-message message kinds what)
-  (if (not (and (pair? message) (memq (car message) kinds)
-                (fields-pass? (cdr message) (cdr (checks-of (car message))))))
-      (frame-fail "expected " what))
-  message)
+  (if (and (pair? message) (memq (car message) kinds)
+           (fields-pass? (cdr message) (cdr (checks-of (car message)))))
+      message
+      (frame-fail "expected " what)))
 
 ;;> A datagram's (SENDER SEQUENCE BODY), checked as check-message does.
 (define (check-datagram d)
-  (if (not (fields-pass? d (cdr (checks-of 'datagram))))
-      (protocol-fail "datagram" "not a datagram"))
-  d)
+  (if (fields-pass? d (cdr (checks-of 'datagram)))
+      d
+      (protocol-fail "datagram" "not a datagram")))
 
 ;;> The id of \var{message} (all kinds but hello, welcome, datagram, beacon).
 (define (message-id message) (cadr message))
@@ -212,11 +212,13 @@
 (define not-plain (list 'not-plain))
 
 (define (plain-else-read text limit plain)
-  (cond ((not (eq? plain not-plain)) plain)
-        ((not (nests-within? text limit))
-         (frame-fail "nests deeper than twice max-depth, or has a datum label"))
-        (else (let ((in (open-input-string text)))
-                (whole-datum in (read-datum in))))))
+  (if (eq? plain not-plain) (read-not-plain text limit) plain))
+
+(define (read-not-plain text limit)
+  (if (nests-within? text limit)
+      (let ((in (open-input-string text)))
+        (whole-datum in (read-datum in)))
+      (frame-fail "nests deeper than twice max-depth, or has a datum label")))
 
 ;; The message read from in, when it is all there is (docs/speed.md).
 (define (whole-datum in message)
