@@ -348,13 +348,19 @@
       (cdr cell)
       (error "no procedure of this name here" name)))
 
+;; A closure that captures nothing is made once, and comes as that one.
+(define (kept-maker maker key)
+  (if (null? (cdr key))
+      (let ((proc (maker))) (lambda () proc))
+      maker))
+
 (define (make-closure-compiler env)
   (let ((makers (make-hash-table chibi-equal?)))
     ;; See known-encoding.
     (define (maker entry key)
       (if entry (cdr entry) (compile! key)))
     (define (compile! key)
-      (let ((maker (eval `(lambda ,(cdr key) ,(car key)) env)))
+      (let ((maker (kept-maker (eval `(lambda ,(cdr key) ,(car key)) env) key)))
         (if (>= (hash-table-size makers) max-makers)
             (set! makers (make-hash-table chibi-equal?)))
         (hash-table-set! makers key maker)
