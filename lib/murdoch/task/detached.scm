@@ -70,26 +70,37 @@
 (define (copy-turn c) (list-ref c 3))
 (define (copy-ended c) (list-ref c 4))
 
-;; Global: the calls of peers find them by name.
-(define *handed* '())
-(define *handed-lock* (make-mutex 'handed))
+;; The node's handing part: the tasks handed here, coordinated or stood
+;; by for, which the calls of peers find by id.
+(define-record-type handing
+  (make-handing list lock)
+  handing?
+  (list handing-list handing-list-set!)
+  (lock handing-lock))
+
+(define-syntax the-handing (syntax-rules () ((_) (node-handing *node*))))
+
+(define (open-handing!)
+  (node-handing-set! (this-node) (make-handing '() (make-mutex 'handed))))
 
 (define (handed-by-id id)
-  (with-lock *handed-lock*
-    (lambda () (find (lambda (h) (eq? (handed-id h) id)) *handed*))))
+  (with-lock (handing-lock (the-handing))
+    (lambda () (find (lambda (h) (eq? (handed-id h) id)) (handing-list (the-handing))))))
 
 (define (hold-handed! h)
-  (with-lock *handed-lock*
-    (lambda ()
-      (set! *handed* (cons h (remove (lambda (x) (eq? (handed-id x) (handed-id h)))
-                                     *handed*)))
-      (subscribe 'lab-tasks))))
+  (let ((hs (the-handing)))
+    (with-lock (handing-lock hs)
+      (lambda ()
+        (handing-list-set! hs (cons h (remove (lambda (x) (eq? (handed-id x) (handed-id h)))
+                                              (handing-list hs))))
+        (subscribe 'lab-tasks)))))
 
 (define (drop-handed! h)
-  (with-lock *handed-lock*
-    (lambda ()
-      (set! *handed* (remove (lambda (x) (eq? x h)) *handed*))
-      (if (null? *handed*) (unsubscribe 'lab-tasks)))))
+  (let ((hs (the-handing)))
+    (with-lock (handing-lock hs)
+      (lambda ()
+        (handing-list-set! hs (remove (lambda (x) (eq? x h)) (handing-list hs)))
+        (if (null? (handing-list hs)) (unsubscribe 'lab-tasks))))))
 
 (define (period) (setting 'heartbeat))
 

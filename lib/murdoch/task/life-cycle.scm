@@ -58,7 +58,7 @@
    args))
 
 (define (new-task id task-name capability-list metrics procs restartable turn)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (check-waiting-room turn)
       (let ((t (make-task
@@ -183,7 +183,7 @@
 ;; finishes here no more: its new coordinator finishes it.
 (define (finish! t results)
   (when (not (let-go? t))
-    (with-lock *tasks-lock*
+    (with-lock (tasks-lock)
       (lambda ()
         (if (not (memq (task-state t) '(cancelled deadline failed)))
             (task-state-set!
@@ -265,7 +265,7 @@
 ;; another of the task's, and so be in the team twice.  Under the lock:
 ;; two components may be lost at once.
 (define (replace-member! t k uid)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (task-team-set! t (map (lambda (u i) (if (= i k) uid u))
                              (task-team t) (iota (length (task-team t)) 1))))))
@@ -403,7 +403,7 @@
 ;;> peer.
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (if (not (over? task)) (task-state-set! task 'cancelled))))
   (if (task-waiter task) (tell-waiter! (task-waiter task) '(cancel)))
@@ -426,7 +426,7 @@
 ;;> ID INDEX POSER) for each component it runs.  listed-id and the other
 ;;> listed- procedures read them.
 (define (tasks)
-  (let* ((posed (with-lock *tasks-lock* posed-tasks))
+  (let* ((posed (with-lock (tasks-lock) posed-tasks))
          (line (and (any task-waiter posed)
                     (line-of (guard (e (#t '())) (lab-waiting))))))
     (append (map (lambda (t) (posed-entry t line)) posed)

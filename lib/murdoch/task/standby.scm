@@ -38,7 +38,7 @@
          (begin (set-team! h team-id state) #t))))
 
 (define (set-team! h team-id state)
-  (with-lock *handed-lock*
+  (with-lock (handing-lock (the-handing))
     (lambda ()
       (handed-teams-set! h (cons (list team-id state)
                                  (remove (lambda (x) (eq? (car x) team-id))

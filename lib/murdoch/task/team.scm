@@ -288,13 +288,23 @@
   (live? held-team-live?)
   (proc held-team-proc))
 
-;; Global: the teams held here, found by id from members' calls.
-(define *teams* '())
-(define *teams-lock* (make-mutex 'teams))
+;; The node's teams part: the teams held here, found by id from members'
+;; calls.
+(define-record-type held-teams
+  (make-held-teams list lock)
+  held-teams?
+  (list held-teams-list held-teams-list-set!)
+  (lock held-teams-lock))
+
+(define-syntax the-teams (syntax-rules () ((_) (node-teams *node*))))
+
+(define (open-teams!) (node-teams-set! (this-node) (make-held-teams '() (make-mutex 'teams))))
 
 (define (find-held-team id)
-  (with-lock *teams-lock*
-    (lambda () (find (lambda (c) (eq? (address-id (held-team-address c)) id)) *teams*))))
+  (with-lock (held-teams-lock (the-teams))
+    (lambda ()
+      (find (lambda (c) (eq? (address-id (held-team-address c)) id))
+            (held-teams-list (the-teams))))))
 
 ;;> Whether this address space holds team \var{id} and acts for it.
 (define (team-held? id)
@@ -320,17 +330,21 @@
   (let ((c (make-held-team (list id (local-aspace-uid) (and keep #t)) live?
                            (coordinator-proc team-of live? keep
                                              (or (and keep (keep)) '(() ()))))))
-    (with-lock *teams-lock*
+    (with-lock (held-teams-lock (the-teams))
       (lambda ()
-        (set! *teams* (cons c (remove (lambda (x) (eq? (address-id (held-team-address x)) id))
-                                      *teams*)))))
+        (held-teams-list-set!
+         (the-teams)
+         (cons c (remove (lambda (x) (eq? (address-id (held-team-address x)) id))
+                         (held-teams-list (the-teams)))))))
     (held-team-address c)))
 
 ;;> Forgets the coordinator at \var{address}, made here by make-coordinator.
 (define (release-coordinator! address)
-  (with-lock *teams-lock*
+  (with-lock (held-teams-lock (the-teams))
     (lambda ()
-      (set! *teams* (remove (lambda (c) (eq? (held-team-address c) address)) *teams*)))))
+      (held-teams-list-set! (the-teams)
+                            (remove (lambda (c) (eq? (held-team-address c) address))
+                                    (held-teams-list (the-teams)))))))
 
 ;; The coordinator's calls, its state (ARRIVED LETTERS) to begin with:
 ;; ARRIVED the (NAME . UID) come to a barrier, LETTERS those not known
