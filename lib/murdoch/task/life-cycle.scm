@@ -1,14 +1,11 @@
 ;;;; Tasks that survive failure: the task life cycle (after MURDOCH 2002).
 ;;
-;; pose-task blocks until its components are done, as in the thesis.
-;; start-task poses the same task and answers at once with a task record,
-;; which task-status, task-wait and cancel-task read and act on.  Each
-;; component runs on its robot inside run-component, watched by the
-;; poser's heartbeats: a robot silent for lost-periods, gone, or failing
-;; has its component started again elsewhere when it is restartable, and
-;; a component whose poser is silent for orphan-periods stops on its
-;; robot (running.scm).  docs/tasks.md tells the life cycle step by step.
-;; A task of steps (start-steps) is a sequence of such tasks, one a step.
+;; start-task poses a task as pose-task does and answers at once with a
+;; task record, which task-status, task-wait and cancel-task read.  A
+;; component's robot silent for lost-periods, gone or failing has it
+;; started again elsewhere when it is restartable; a component whose
+;; poser is silent for orphan-periods stops (running.scm).  docs/tasks.md
+;; tells the life cycle step by step.
 
 ;;; The poser's side
 

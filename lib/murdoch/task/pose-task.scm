@@ -1,10 +1,9 @@
 ;;;; pose-task (thesis §4.2, appendix A.7 new-task.scm).
 ;;
-;; pose-task asks the lab who is capable (request-exclusive for a
-;; component that needs a resource to itself, request otherwise), ranks
-;; each component's candidates by its metric, gives each, in priority
-;; order, the best not already chosen, frees every unused promise, and
-;; runs the team.  Beyond the thesis: docs/allocation.md.
+;; It asks the lab who is capable (request-exclusive, or request for a
+;; shared component), ranks candidates by each component's metric, gives
+;; each in priority order the best not chosen, frees every unused
+;; promise, and runs the team.  Beyond the thesis: docs/allocation.md.
 
 ;;; pose-task
 

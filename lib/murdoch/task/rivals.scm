@@ -103,12 +103,10 @@
   (filter-map (lambda (answer) (and (eq? (cadr answer) #t) (car answer)))
               (guard (e (#t '())) (request 'lab-tasks thunk))))
 
-;; After a try that found too few robots: whether another may do better.
-;; It may when other poses hold robots it could use, and those poses are
-;; told of this one's rank; or when such a robot is free now that was no
-;; candidate in the try: its holder let it go in between, as a pose that
-;; gives way does a moment after it is told (a try then found it held and
-;; this look found it free, and the pose gave up with the robots free).
+;; After a try that found too few robots: whether another may do better,
+;; when other poses hold robots it could use and are told of this one's
+;; rank, or when such a robot is free now that was no candidate in the
+;; try (its holder, told to give way, let it go in between).
 (define (contended! task)
   (let* ((statuses (capable-statuses (pose-layouts task) (pose-type-list task)))
          (holders (rival-holders (pose-name task) statuses)))

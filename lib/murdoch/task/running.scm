@@ -172,12 +172,9 @@
   (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
        (with-lock (runs-lock (the-runs)) (lambda () (runs-running (the-runs))))))
 
-;;; The components ended here
-;;
-;; The last kept-ended of them, newest first, each an ending.  A component
-;; leaves the running list and joins this one at once, under the lock: a
-;; report that reads the running list first, then this one, finds every
-;; component in one or the other.
+;;; The components ended here: the last kept-ended, newest first.  A
+;;; component leaves the running list and joins this one under one lock,
+;;; so a report reading both finds it in one or the other.
 
 (define kept-ended 16)
 

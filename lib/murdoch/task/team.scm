@@ -127,18 +127,13 @@
 ;;; Synchronization inside a team, MOVER's way
 ;;
 ;; Members wait at named barriers and pass values by uid through the
-;; team's coordinator, held where the task is coordinated, under the
-;; team's id.  A member reaches it by its address, (ID UID KEPT?); when
-;; UID is lost, or holds the team no more, the member of a team that is
-;; kept (a detached task's, taken over) asks the lab who holds ID now
-;; (the lab-tasks subject, which the members holding a detached task
-;; subscribe to), and calls again there.
-;; So any call may count twice: an arrival counts once however often it
-;; comes, a letter carries its sender's key and is kept once, a member
-;; takes each key once, and a letter stays with the coordinator until the
-;; member's next receive says that it came.  A coordinator that is kept
-;; (make-coordinator's keep) keeps an arrival or a letter before its
-;; member hears that it counted.
+;; team's coordinator, held under the team's id where the task is
+;; coordinated, and reached by its address, (ID UID KEPT?).  A member of
+;; a kept team (a detached task's) whose UID is lost asks the lab-tasks
+;; subject who holds ID now and calls again there, so any call may count
+;; twice: an arrival counts once, a letter carries its sender's key and
+;; is kept and taken once, and stays until the member's next receive
+;; says it came.  A kept coordinator keeps each before its member hears.
 
 ;; What a member of a team keeps, in the thread running its procedure.
 (define-record-type teammate
