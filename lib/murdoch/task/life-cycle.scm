@@ -215,10 +215,9 @@
       (list (winner-promise winner) #t)
       (list (component-proc c))))
 
-;; Runs component c on uid, and again elsewhere while its robot is lost
-;; and it may be restarted.
-;; work is (PROC ARG ...), or adopted for a component of a detached task
-;; that runs on uid already, where a new coordinator found it.
+;; Runs component c on uid, and elsewhere while its robot is lost and it
+;; may restart; work is (PROC ARG ...), or adopted for a detached task's
+;; component that a new coordinator found running on uid.
 (define (supervise t c uid work)
   (if (not (eq? work 'adopted))
       (component-state-set! c (list 'running uid (utc-seconds))))
