@@ -48,7 +48,7 @@
 
 ;;> Seconds a component may run before its caller gives up on it, when
 ;;> on-list is not given a timeout; it stops on its robot at its next
-;;> command (abandon.scm).
+;;> command (code/abandon.scm).
 (define task-timeout (make-parameter (lab-default 'task-timeout)))
 (sandbox-parameter! task-timeout)
 
@@ -84,7 +84,7 @@
                  uids procs)))))
 
 ;; The threads' results, in order; left early (Ctrl-C), the threads are
-;; interrupted too and each gives up its component (abandon.scm).
+;; interrupted too and each gives up its component (code/abandon.scm).
 (define (join-or-interrupt threads)
   (undo-on-raise (lambda () (for-each thread-interrupt! threads))
                  (lambda () (map thread-join! threads))))
@@ -100,7 +100,7 @@
     result))
 
 ;; A component this address space won runs in a thread of its own, so
-;; seconds bound it as they bound one elsewhere (abandon.scm).
+;; seconds bound it as they bound one elsewhere (code/abandon.scm).
 (define (apply-here-by proc seconds)
   (let* ((outcome #f)
          (runner (make-logged-thread
