@@ -99,6 +99,14 @@
     (let ((first ((decode (code 0)))))
       (do ((n 1 (+ n 1))) ((= n 4100)) (decode (code n)))
       (list first ((decode (code 4100))) ((decode (code 0)))))))
+(test "a closure that captures nothing comes as one procedure; one that captures comes anew"
+    '(#t 5 #f (1 2))
+  (let ((decode (make-decoder env (lambda (uid id) #f)))
+        (free (lambda () (vector 'murdoch:closure '(lambda (x) (+ x 1)) '())))
+        (bound (lambda (n) (vector 'murdoch:closure '(lambda () n) (list (cons 'n n))))))
+    (let ((a (decode (free))) (b (decode (free)))
+          (c (decode (bound 1))) (d (decode (bound 2))))
+      (list (eq? a b) (b 4) (eq? c d) (list (c) (d))))))
 (test-group "the encodings kept by procedure"
   (let ((genv (mutable-environment '(scheme base))))
     (eval '(define (twice x) (* 2 x)) genv)
