@@ -210,17 +210,18 @@
 ;; and those subscribed to waiting-tasks when it last asked the whole lab,
 ;; which it does every look-period, so that a poser it missed (one that
 ;; joined later) is found: asking every address space each round cost
-;; the robots most of their CPU (docs/speed.md).  #f until it has asked
-;; the lab.  Global: one address space, one view of the lab's posers.
-(define *posers* #f)
-(define *posers-asked* #f)              ; when the lab was last asked
+;; the robots most of their CPU (docs/speed.md).  A poser heard of while
+;; the first ask went is kept: its note may be the last.  Global: one
+;; address space, one view of the lab's posers.
+(define *posers* '())
+(define *posers-asked* #f)              ; when the lab was last asked, or #f
 
 ;;> Notes that poser \var{uid} has tasks waiting.
 (define (know-poser! uid)
-  (if (and *posers* (not (memq uid *posers*))) (set! *posers* (cons uid *posers*))))
+  (if (not (memq uid *posers*)) (set! *posers* (cons uid *posers*))))
 
 (define (ask-lab-due?)
-  (or (not *posers*)
+  (or (not *posers-asked*)
       (> (- (monotonic-seconds) *posers-asked*) (look-period))))
 
 ;;> What request of waiting-tasks answers, \var{proc} applied to
@@ -229,7 +230,7 @@
 (define (ask-posers proc . args)
   (if (ask-lab-due?)
       (let ((answers (apply request 'waiting-tasks proc args)))
-        (set! *posers* (delete-duplicates (append (map car answers) (or *posers* '()))))
+        (set! *posers* (delete-duplicates (append (map car answers) *posers*)))
         (set! *posers-asked* (monotonic-seconds))
         answers)
       (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))

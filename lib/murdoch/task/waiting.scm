@@ -44,7 +44,11 @@
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
-;; their ranks.  Global: a process is one poser, with one line of tasks.
+;; their ranks.  In a thread of its own: the task whose enlisting began
+;; the publications, run in its own thread, went on publishing for the
+;; others while its poser posed, 16 s in a burst, and answered no offer
+;; (docs/allocation.md).  Global: a process is one poser, with one line
+;; of tasks.
 (define *noting* #f)                    ; a publication goes
 (define *note-again* #f)                ; the best rank waiting since, or #f
 
@@ -54,16 +58,19 @@
             (if *noting*
                 (begin (set! *note-again* (better-rank rank *note-again*)) #f)
                 (begin (set! *noting* #t) #t))))
-    (let loop ((rank rank))
-      (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
-        (publish 'all note-waiters! (local-aspace-uid) rank))
-      (let ((again (with-lock *tasks-lock*
-                     (lambda ()
-                       (let ((again *note-again*))
-                         (set! *note-again* #f)
-                         (if (not again) (set! *noting* #f))
-                         again)))))
-        (if again (loop again))))))
+    (thread-start! (make-logged-thread (lambda () (publish-notes! rank)) 'notes))))
+
+(define (publish-notes! rank)
+  (let loop ((rank rank))
+    (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
+      (publish 'all note-waiters! (local-aspace-uid) rank))
+    (let ((again (with-lock *tasks-lock*
+                   (lambda ()
+                     (let ((again *note-again*))
+                       (set! *note-again* #f)
+                       (if (not again) (set! *noting* #f))
+                       again)))))
+      (if again (loop again)))))
 
 ;; The offers w had not answered are declined: a robot waits for no task
 ;; that no longer waits.
