@@ -125,7 +125,7 @@
     (set! *waiters* (append before (cons w after)))))
 (define (drop-waiter! w) (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*)))
 
-;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
+;; A piece of news is (first), try at once, (cancel), (give-way UID) or (offer REPLY
 ;; UID): its kind, then what it says, read by name.
 (define (news-kind n) (car n))
 (define (offer? n) (eq? (news-kind n) 'offer))
