@@ -142,11 +142,15 @@
 ;; to the others are left alone, and so are all but those offered to w,
 ;; the uids offered, when w can take robots one at a time (it holds, or
 ;; needs one): a robot may be kept for this poser on its way to offer
-;; itself to another of its tasks.  Global: one poser a process.
-(define *try-lock* (make-mutex 'tries))
+;; itself to another of its tasks.  The tries wait their turn best rank
+;; first: under a mutex one task of a scale run waited 20 s while its
+;; poser's others tried again and again, the robots offered to it kept
+;; waiting for its answer.  Global: one poser a process.
+(define *trying* #f)                    ; a try runs here
+(define *try-turns* '())                ; (WAITER . BELL) of those waiting, best first
 
 (define (try-in-turn w try offered)
-  (with-lock *try-lock*
+  (in-try-turn w
     (lambda ()
       (waiter-offered-set! w offered)
       (let ((excluded (append (offered-to-others w) (not-offered w offered)
@@ -155,6 +159,35 @@
                      (parameterize ((pose-task-excluded excluded)
                                     (request-audience (audience w offered excluded)))
                        (try w))))))))
+
+;; Runs thunk once no other try of this poser runs, those waiting let
+;; in best rank first.
+(define (in-try-turn w thunk)
+  (let* ((bell (make-mailbox))
+         (now? (with-lock *tasks-lock*
+                 (lambda ()
+                   (if *trying*
+                       (let-values (((before after)
+                                     (break (lambda (x) (rank<? (waiter-rank w)
+                                                                (waiter-rank (car x))))
+                                            *try-turns*)))
+                         (set! *try-turns* (append before (cons (cons w bell) after)))
+                         #f)
+                       (begin (set! *trying* #t) #t))))))
+    (let wait ()
+      (if (not (or now? (mailbox-take bell (+ (monotonic-seconds) 60) (lambda () #f))))
+          (wait)))
+    (dynamic-wind
+     (lambda () #f)
+     thunk
+     (lambda ()
+       (with-lock *tasks-lock*
+         (lambda ()
+           (if (null? *try-turns*)
+               (set! *trying* #f)
+               (let ((next (car *try-turns*)))
+                 (set! *try-turns* (cdr *try-turns*))
+                 (mailbox-put! (cdr next) #t)))))))))
 
 ;; Whom w's negotiations ask, but those excluded: the robots offered
 ;; alone when w takes them one at a time, else those offered and those
