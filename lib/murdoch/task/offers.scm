@@ -206,11 +206,26 @@
                                (append-map cadr answers))))
       (offering-waiters-seen-set! o (pair? waiting))
       (if (pair? waiting) (offering-waiters-here?-set! o #t))
-      (offer-to me waiting)
+      (offer-to me (within-horizon waiting answers depth))
       (cond ((not (free-here?)) (offering-depth-set! o offer-depth))
             ((any (lambda (a) (>= (length (cadr a)) depth)) answers)
              (offering-depth-set! o (* 2 depth))
              (if (not (offering-new-waiters o)) (offer-round)))))))
+
+;; The entries of waiting that rank no later than the last of any poser's
+;; answer of depth entries: that poser may have more past it, better
+;; than the entries after.  A robot that went on down its list once a
+;; poser's four had declined it went to tasks ranked after that poser's
+;; fifth (docs/allocation.md); it asks for more instead.
+(define (within-horizon waiting answers depth)
+  (let ((horizon (fold (lambda (a h)
+                         (if (>= (length (cadr a)) depth)
+                             (better-rank (wanting-rank (last (cadr a))) h)
+                             h))
+                       #f answers)))
+    (if horizon
+        (take-while (lambda (e) (not (rank<? horizon (wanting-rank e)))) waiting)
+        waiting)))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
