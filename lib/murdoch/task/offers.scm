@@ -55,6 +55,29 @@
 (define (update-offers! f)
   (let ((o (the-offering))) (offering-offers-set! o (f (offering-offers o)))))
 
+;;> The (RANK POSER ID) of each task waiting here that may use robot
+;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
+;;> when it last looked, or that has a component those subjects serve (a
+;;> robot that joined since).  Best rank first, and only the first
+;;> \var{limit} if given: a robot offers itself to the best first, and
+;;> asks for more only when those all decline it, so that an offer round
+;;> does not carry every waiting task of the lab.  Not a task that would
+;;> decline it at once, the robots offered to it already enough: in a
+;;> scale run a start cost five such declines, each a call.
+(define (waiting-for uid . subjects+limit)
+  (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
+        (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
+                    (cadr subjects+limit))))
+    (let loop ((ws (with-lock (tasks-lock) waiters)) (n 0) (out '()))
+      (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
+            ((and (wants? (car ws) uid subjects)
+                  (not (with-lock (tasks-lock) (lambda () (offered-enough? (car ws) uid)))))
+             (loop (cdr ws) (+ n 1)
+                   (cons (list (waiter-rank (car ws)) (local-aspace-uid)
+                               (task-id (waiter-task (car ws))))
+                         out)))
+            (else (loop (cdr ws) n out))))))
+
 ;; How long a robot waits for the answer to its offer: the lab's timeout.
 ;; A waiter answers its offers after the try or look it is in, which on a
 ;; busy lab may take seconds; a robot that moved on sooner went to a

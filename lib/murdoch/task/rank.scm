@@ -286,27 +286,7 @@
 ;; of them than robots.
 (define (lab-holders) (waiting-elsewhere #t))
 
-;;> The (RANK POSER ID) of each task waiting here that may use robot
-;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
-;;> when it last looked, or that has a component those subjects serve (a
-;;> robot that joined since).  Best rank first, and only the first
-;;> \var{limit} if given: a robot offers itself to the best first, and
-;;> asks for more only when those all decline it, so that an offer round
-;;> does not carry every waiting task of the lab.
-(define (waiting-for uid . subjects+limit)
-  (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
-        (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
-                    (cadr subjects+limit))))
-    (let loop ((ws (with-lock (tasks-lock) waiters)) (n 0) (out '()))
-      (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
-            ((wants? (car ws) uid subjects)
-             (loop (cdr ws) (+ n 1)
-                   (cons (list (waiter-rank (car ws)) (local-aspace-uid)
-                               (task-id (waiter-task (car ws))))
-                         out)))
-            (else (loop (cdr ws) n out))))))
-
-;; Whether w may use robot uid, subscribed to subjects (or #f): for a
+;;> Whether w may use robot uid, subscribed to subjects (or #f): for a
 ;; component it does not hold, when it has looked; a robot its look did
 ;; not know, or before it looked, if subjects serve a component.  Offered
 ;; to a task that held the one component it could take, a robot went down
