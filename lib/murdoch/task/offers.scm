@@ -182,8 +182,10 @@
                    (if (offering-round? o)
                        (begin (offering-again?-set! o #t) #f)
                        (begin (offering-round?-set! o #t) #t)))))
-      ;; At once, not in the round's thread, which may start late.
-      (if (offering-waiters-seen o) (offer-subjects! 'nobody 3))
+      ;; At once, not in the round's thread, which may start late: a task
+      ;; trying for several robots at once, not holding, took this one
+      ;; before its offer reached the task it was freed for.
+      (offer-subjects! 'nobody 3)
       (thread-start! (make-logged-thread offer-rounds 'offers)))))
 
 ;; The robot is kept for the poser it was last offered to until the
@@ -204,8 +206,9 @@
 
 ;; Offers this robot, while it is free, to the tasks that wait for it,
 ;; best rank first.  While one tries, only its poser may reserve here;
-;; while it asks who waits, if tasks waited at its last round, nobody may,
-;; so that no task takes it before the best-ranked has been offered it.
+;; while it asks who waits, if tasks waited at its last round or one was
+;; noted since, nobody may, so that no task takes it before the
+;; best-ranked has been offered it.
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
 ;; waiters-seen says whether tasks waited at its last round.
 
@@ -219,10 +222,11 @@
 (define (offer-round)
   (let* ((me (local-aspace-uid))
          (o (the-offering))
-         (depth (offering-depth o)))
+         (depth (offering-depth o))
+         (keep? (or (offering-waiters-seen o) (offering-waiters-here? o))))
     (offering-waiters-here?-set! o #f)  ; before asking: a note after it stands
     (offering-new-waiters-set! o #f)
-    (offer-subjects! (and (offering-waiters-seen o) 'nobody) 3)
+    (offer-subjects! (and keep? 'nobody) 3)
     (let* ((answers (guard (e (#t '()))
                       (who-waits me depth)))
            (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
