@@ -61,9 +61,8 @@
 ;;> robot that joined since).  Best rank first, and only the first
 ;;> \var{limit} if given: a robot offers itself to the best first, and
 ;;> asks for more only when those all decline it, so that an offer round
-;;> does not carry every waiting task of the lab.  Not a task that would
-;;> decline it at once, the robots offered to it already enough: in a
-;;> scale run a start cost five such declines, each a call.
+;;> does not carry every waiting task of the lab.  Not one that the
+;;> robots offered to it already serve, which would decline it.
 (define (waiting-for uid . subjects+limit)
   (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
         (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
@@ -182,9 +181,7 @@
                    (if (offering-round? o)
                        (begin (offering-again?-set! o #t) #f)
                        (begin (offering-round?-set! o #t) #t)))))
-      ;; At once, not in the round's thread, which may start late: a task
-      ;; trying for several robots at once, not holding, took this one
-      ;; before its offer reached the task it was freed for.
+      ;; At once, not in the round's thread, which may start late.
       (offer-subjects! 'nobody 3)
       (thread-start! (make-logged-thread offer-rounds 'offers)))))
 
@@ -240,10 +237,7 @@
              (if (not (offering-new-waiters o)) (offer-round)))))))
 
 ;; The entries of waiting that rank no later than the last of any poser's
-;; answer of depth entries: that poser may have more past it, better
-;; than the entries after.  A robot that went on down its list once a
-;; poser's four had declined it went to tasks ranked after that poser's
-;; fifth (docs/allocation.md); it asks for more instead.
+;; answer of depth entries: that poser may have better ones past it.
 (define (within-horizon waiting answers depth)
   (let ((horizon (fold (lambda (a h)
                          (if (>= (length (cadr a)) depth)

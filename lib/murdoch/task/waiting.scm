@@ -64,10 +64,8 @@
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
-;; their ranks, from a thread of its own: the task whose enlisting began
-;; the publications went on publishing for the others while its poser
-;; posed, 16 s of a scale run's burst, and answered no offer
-;; (docs/allocation.md).
+;; their ranks, from a thread of its own: a task publishing for the
+;; others answered no offer meanwhile (docs/allocation.md).
 (define (note-lab! rank)
   (when (with-lock (tasks-lock)
           (lambda ()
@@ -160,10 +158,8 @@
 ;; to the others are left alone, and so are all but those offered to w,
 ;; the uids offered, when w can take robots one at a time (it holds, or
 ;; needs one): a robot may be kept for this poser on its way to offer
-;; itself to another of its tasks.  The tries wait their turn best rank
-;; first: under a mutex one task of a scale run waited 20 s while its
-;; poser's others tried again and again, the robots offered to it kept
-;; waiting for its answer.
+;; itself to another of its tasks.  They wait their turn best rank first:
+;; under a mutex one waited 20 s (docs/allocation.md).
 
 (define (try-in-turn w try offered)
   (in-try-turn w
@@ -439,9 +435,8 @@
                       (map (lambda (c) "") (waiter-components w))))))))
 
 ;; Tells w, just posed, to try at once when no better-ranked task of the
-;; lab waits.  From a thread of its own: finding out may ask every poser
-;; for its line, which in a scale run's burst took 3 s, while the robots
-;; offered to w waited for its answer and the others were declined.
+;; lab waits; from a thread of its own, as asking the posers may take
+;; seconds, and w answers its offers meanwhile.
 (define (check-first! w)
   (thread-start!
    (make-logged-thread (lambda () (if (not (behind-others? w)) (tell-waiter! w '(first))))
