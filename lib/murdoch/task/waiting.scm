@@ -173,34 +173,45 @@
                        (try w))))))))
 
 ;; Runs thunk once no other try of this poser runs, those waiting let
-;; in best rank first.
+;; in best rank first.  A thread that leaves while it waits (cancelled,
+;; abandoned) leaves the queue, or passes on the turn it was given.
 (define (in-try-turn w thunk)
-  (let* ((bell (make-mailbox))
-         (now? (with-lock (tasks-lock)
-                 (lambda ()
-                   (let ((l (the-looking)))
-                     (if (looking-trying? l)
-                         (let-values (((before after)
-                                       (break (lambda (x) (rank<? (waiter-rank w)
-                                                                  (waiter-rank (car x))))
-                                              (looking-try-turns l))))
-                           (looking-try-turns-set! l (append before (cons (cons w bell) after)))
-                           #f)
-                         (begin (looking-trying?-set! l #t) #t)))))))
-    (let wait ()
-      (if (not (or now? (mailbox-take bell (+ (monotonic-seconds) 60) (lambda () #f))))
-          (wait)))
+  (let ((turn (cons w (make-mailbox))))
     (dynamic-wind
      (lambda () #f)
-     thunk
      (lambda ()
-       (with-lock (tasks-lock)
-         (lambda ()
-           (let* ((l (the-looking)) (turns (looking-try-turns l)))
-             (if (null? turns)
-                 (looking-trying?-set! l #f)
-                 (begin (looking-try-turns-set! l (cdr turns))
-                        (mailbox-put! (cdar turns) #t))))))))))
+       (if (not (join-try-turns! turn))
+           (let wait ()
+             (if (not (mailbox-take (cdr turn) (+ (monotonic-seconds) 60) (lambda () #f)))
+                 (wait))))
+       (thunk))
+     (lambda () (leave-try-turns! turn)))))
+
+;; Whether turn may try at once; else it is queued by its waiter's rank.
+(define (join-try-turns! turn)
+  (with-lock (tasks-lock)
+    (lambda ()
+      (let ((l (the-looking)))
+        (if (looking-trying? l)
+            (let-values (((before after)
+                          (break (lambda (x) (rank<? (waiter-rank (car turn))
+                                                     (waiter-rank (car x))))
+                                 (looking-try-turns l))))
+              (looking-try-turns-set! l (append before (cons turn after)))
+              #f)
+            (begin (looking-trying?-set! l #t) #t))))))
+
+;; A turn still queued leaves the queue; one that was given the try
+;; gives it to the next, or ends the trying.
+(define (leave-try-turns! turn)
+  (with-lock (tasks-lock)
+    (lambda ()
+      (let* ((l (the-looking)) (turns (looking-try-turns l)))
+        (cond ((memq turn turns)
+               (looking-try-turns-set! l (remove (lambda (x) (eq? x turn)) turns)))
+              ((null? turns) (looking-trying?-set! l #f))
+              (else (looking-try-turns-set! l (cdr turns))
+                    (mailbox-put! (cdar turns) #t)))))))
 
 ;; Whom w's negotiations ask, but those excluded: the robots offered
 ;; alone when w takes them one at a time, else those offered and those
