@@ -85,13 +85,10 @@
 
 ;; Whether robot uid would add nothing to the robots offered to w and not
 ;; held: with it, they could take, one each, no more of w's open
-;; components than without.  Two robots freed together offer themselves
-;; to one task, and the second goes on to the next task at once rather
-;; than after the first's try.  Counted by kind, not by number: a task
-;; that waited for a b and a d robot, offered two d, declined the b it
-;; needed, which went to a worse task.  A robot that w won, holding, in
-;; the try its offer began is no longer one of them, though its offer is
-;; answered only when that try ends.  Under (tasks-lock).
+;; components than without, counted by kind, not number, so that of two
+;; robots freed together the second goes on at once.  A robot that w won,
+;; holding, in the try its offer began is no longer one of them, though
+;; its offer is answered only when that try ends.  Under (tasks-lock).
 (define (offered-enough? w uid)
   (let* ((id (task-id (waiter-task w)))
          (held (held-uids w))
@@ -169,10 +166,10 @@
     (and a (lab-aspace-clause a 'capabilities) #t)))
 
 ;; Runs on every freeing of exclusive subjects here (the hook given to
-;; pubsub's open-subscriber!): starts an offer round, or asks the one running for another.  A round
-;; that runs keeps the robot as it is: offered to a poser, a runner-up of
-;; that poser's negotiation is freed while the robot waits for its answer,
-;; and the task that tries must still find the robot its poser's.
+;; open-subscriber!): starts an offer round, or asks the running one for
+;; another.  A running round keeps the robot as it is: a runner-up of the
+;; poser's negotiation is freed while the robot waits for its answer, and
+;; the task that tries must still find the robot its poser's.
 (define (robot-freed!)
   (let ((o (the-offering)))
     (when (and (offering-waiters-here? o)

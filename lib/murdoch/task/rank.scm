@@ -286,13 +286,10 @@
 ;; of them than robots.
 (define (lab-holders) (waiting-elsewhere #t))
 
-;;> Whether w may use robot uid, subscribed to subjects (or #f): for a
-;; component it does not hold, when it has looked; a robot its look did
-;; not know, or before it looked, if subjects serve a component.  Offered
-;; to a task that held the one component it could take, a robot went down
-;; its round to no avail, and sat free while tasks waited for it further
-;; down; offered to each task just posed, a robot of another kind made it
-;; try for nothing.
+;;> Whether waiter \var{w} may use robot \var{uid}, subscribed to
+;;> \var{subjects} (or #f): for a component it does not hold, when its
+;;> look found uid capable; else, a robot its look did not know or before
+;;> it looked, when subjects serve such a component.
 (define (wants? w uid subjects)
   (let ((capable (waiter-capable w)))
     (cond ((eq? capable #t) (or (not subjects) (serves? subjects w)))

@@ -1,24 +1,14 @@
 ;;;; Tasks that wait their turn (thesis ch. 6; docs/tasks.md)
 ;;
 ;; A task started with wait #t that finds too few capable robots free
-;; waits for them, holding nothing and trying only when a robot offers
-;; itself, while its poser subscribes to waiting-tasks and tells the lab
-;; that a task waits (note-waiters!).  When a robot's exclusive subjects
-;; are freed (robot-freed!, given to pubsub's open-subscriber!), the
-;; robot asks waiting-tasks who waits for it, and offers itself to each
-;; in rank order, its subjects kept for that one's poser while it tries,
-;; until one starts or none can.  A rank is (KEY POSED ID), KEY being
-;; the task's priority less aging times the second it was posed: the
-;; higher KEY goes first, then the earlier POSED, then the smaller ID.
-;; That is a total order, the same in every address space, and aging
-;; does not reorder the tasks that wait: it raises all their priorities
-;; alike, and only a task posed later starts from lower down.  A task no
-;; live robot of the lab is capable of fails at once; one whose capable
-;; robots all die while it waits fails at its poser's next look at the
-;; lab, every ten heartbeats or a third of the lease, whichever is
-;; sooner.  A poser looks once for all its waiting tasks (look-all!): a
-;; task that waits sends nothing to the lab by itself, so that W tasks
-;; waiting do not cost W looks a period.
+;; waits, trying only when a robot offers itself, while its poser
+;; subscribes to waiting-tasks and tells the lab (note-waiters!).  A robot
+;; freed (robot-freed!) asks who waits for it and offers itself to each
+;; in rank order (offers.scm) until one starts.  A rank (rank.scm) is a
+;; total order, the same everywhere, that aging does not reshuffle.  A
+;; poser looks at the lab once for all its waiting tasks (look-all!), and
+;; a task whose capable robots are all gone fails at the next look.
+;; docs/tasks.md tells it all.
 
 (define (enlist! w)
   (waiter-held-set! w '())
@@ -151,15 +141,12 @@
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
-;; One try of w's, after the tries of this address space's other waiting
-;; tasks: two at once, each offered a robot, each reserved the other's
-;; robot as a candidate of its negotiation, and the one that lost its
-;; robot so, for a moment, found none and declined it.  The robots offered
-;; to the others are left alone, and so are all but those offered to w,
-;; the uids offered, when w can take robots one at a time (it holds, or
-;; needs one): a robot may be kept for this poser on its way to offer
-;; itself to another of its tasks.  They wait their turn best rank first:
-;; under a mutex one waited 20 s (docs/allocation.md).
+;; One try of w's, in turn with this poser's other waiting tasks' (two at
+;; once each reserved the robot offered to the other), best rank first.
+;; The robots offered to the others are left alone, and so are all but
+;; those offered to w, offered, when w can take robots one at a time (it
+;; holds, or needs one): a robot may be kept for this poser on its way to
+;; another of its tasks.
 
 (define (try-in-turn w try offered)
   (in-try-turn w
