@@ -30,48 +30,48 @@
                       (remove (lambda (f) (member f '("." ".."))) (directory-files folder)))
           (file-text (string-append name ".err")))))
 
-(define tasks-then-tries
-  '((define tasks (make-mutex 'tasks))
-    (define tries (make-mutex 'tries))))
+(define running-then-tasks
+  '((define running (make-mutex 'running))
+    (define tasks (make-mutex 'tasks))))
 
 (test-begin "lock-order")
 
 (test-group "a break of the order is caught, and only a break"
-  (let ((r (checked-run (append tasks-then-tries
-                                '((lock! tasks) (lock! tries) (unlock! tries) (unlock! tasks))))))
-    (test "tries under tasks: reported to the folder" '("lock order: took tries holding tasks")
+  (let ((r (checked-run (append running-then-tasks
+                                '((lock! running) (lock! tasks) (unlock! tasks) (unlock! running))))))
+    (test "tasks under running: reported to the folder" '("lock order: took tasks holding running")
           (car r))
-    (test-assert "and to standard error" (text-contains? (cadr r) "took tries holding tasks")))
-  (test "tasks under tries, as the order has it: nothing" '()
-        (car (checked-run (append tasks-then-tries
-                                  '((with-lock tries (lambda () (with-lock tasks (lambda () #t)))))))))
-  (test "with-lock-by is checked as lock! is" '("lock order: took tries holding tasks")
-        (car (checked-run (append tasks-then-tries
-                                  '((with-lock tasks
+    (test-assert "and to standard error" (text-contains? (cadr r) "took tasks holding running")))
+  (test "running under tasks, as the order has it: nothing" '()
+        (car (checked-run (append running-then-tasks
+                                  '((with-lock tasks (lambda () (with-lock running (lambda () #t)))))))))
+  (test "with-lock-by is checked as lock! is" '("lock order: took tasks holding running")
+        (car (checked-run (append running-then-tasks
+                                  '((with-lock running
                                       (lambda ()
-                                        (with-lock-by tries (+ (monotonic-seconds) 1)
+                                        (with-lock-by tasks (+ (monotonic-seconds) 1)
                                                       (lambda () 'late) (lambda () 'in)))))))))
-  (test "a lock let go is no longer held: tasks, then tries, one after the other" '()
-        (car (checked-run (append tasks-then-tries
-                                  '((with-lock tasks (lambda () #t))
-                                    (with-lock tries (lambda () #t)))))))
+  (test "a lock let go is no longer held: running, then tasks, one after the other" '()
+        (car (checked-run (append running-then-tasks
+                                  '((with-lock running (lambda () #t))
+                                    (with-lock tasks (lambda () #t)))))))
   (test "a mailbox waited on, its deadline past, is let go of" '()
         (car (checked-run '((define running (make-mutex 'running))
                             (mailbox-take (make-mailbox) (+ (monotonic-seconds) 0.1)
                                           (lambda () #f))
                             (with-lock running (lambda () #t))))))
   (test "a lock of no place, taken under another, is a break"
-        '("lock order: took nameless holding tasks")
-        (car (checked-run '((define tasks (make-mutex 'tasks))
-                            (with-lock tasks
+        '("lock order: took nameless holding running")
+        (car (checked-run '((define running (make-mutex 'running))
+                            (with-lock running
                               (lambda () (with-lock (make-mutex 'nameless) (lambda () #t))))))))
   (test "each thread holds its own" '()
-        (car (checked-run (append tasks-then-tries
-                                  '((lock! tasks)
+        (car (checked-run (append running-then-tasks
+                                  '((lock! running)
                                     (thread-join! (thread-start! (make-thread
-                                                                  (lambda () (lock! tries)
-                                                                          (unlock! tries)))))
-                                    (unlock! tasks)))))))
+                                                                  (lambda () (lock! tasks)
+                                                                          (unlock! tasks)))))
+                                    (unlock! running)))))))
 
 ;; What follows each "(make-mutex" of text: the name it is made with, as
 ;; read, or #f when it is made with none.

@@ -91,8 +91,7 @@
 ;; A mutex's rank, by the name it was made with; a name of no rank is a
 ;; break of the order wherever it is taken under another.
 (define lock-ranks
-  '((tries . 1)
-    (tasks . 2) (offers . 2)
+  '((tasks . 2) (offers . 2)
     (team-keeping . 2.2) (handed . 2.5)
     (poses . 3) (running . 3) (subscriptions . 3)
     (connecting . 4.1) (connection-write . 4.2) (connections . 4.3) (peers . 4.4)

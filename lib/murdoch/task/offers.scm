@@ -55,6 +55,28 @@
 (define (update-offers! f)
   (let ((o (the-offering))) (offering-offers-set! o (f (offering-offers o)))))
 
+;;> The (RANK POSER ID) of each task waiting here that may use robot
+;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
+;;> when it last looked, or that has a component those subjects serve (a
+;;> robot that joined since).  Best rank first, and only the first
+;;> \var{limit} if given: a robot offers itself to the best first, and
+;;> asks for more only when those all decline it, so that an offer round
+;;> does not carry every waiting task of the lab.  Not one that the
+;;> robots offered to it already serve, which would decline it.
+(define (waiting-for uid . subjects+limit)
+  (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
+        (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
+                    (cadr subjects+limit))))
+    (let loop ((ws (with-lock (tasks-lock) waiters)) (n 0) (out '()))
+      (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
+            ((and (wants? (car ws) uid subjects)
+                  (not (with-lock (tasks-lock) (lambda () (offered-enough? (car ws) uid)))))
+             (loop (cdr ws) (+ n 1)
+                   (cons (list (waiter-rank (car ws)) (local-aspace-uid)
+                               (task-id (waiter-task (car ws))))
+                         out)))
+            (else (loop (cdr ws) n out))))))
+
 ;; How long a robot waits for the answer to its offer: the lab's timeout.
 ;; A waiter answers its offers after the try or look it is in, which on a
 ;; busy lab may take seconds; a robot that moved on sooner went to a
@@ -63,13 +85,10 @@
 
 ;; Whether robot uid would add nothing to the robots offered to w and not
 ;; held: with it, they could take, one each, no more of w's open
-;; components than without.  Two robots freed together offer themselves
-;; to one task, and the second goes on to the next task at once rather
-;; than after the first's try.  Counted by kind, not by number: a task
-;; that waited for a b and a d robot, offered two d, declined the b it
-;; needed, which went to a worse task.  A robot that w won, holding, in
-;; the try its offer began is no longer one of them, though its offer is
-;; answered only when that try ends.  Under (tasks-lock).
+;; components than without, counted by kind, not number, so that of two
+;; robots freed together the second goes on at once.  A robot that w won,
+;; holding, in the try its offer began is no longer one of them, though
+;; its offer is answered only when that try ends.  Under (tasks-lock).
 (define (offered-enough? w uid)
   (let* ((id (task-id (waiter-task w)))
          (held (held-uids w))
@@ -147,10 +166,10 @@
     (and a (lab-aspace-clause a 'capabilities) #t)))
 
 ;; Runs on every freeing of exclusive subjects here (the hook given to
-;; pubsub's open-subscriber!): starts an offer round, or asks the one running for another.  A round
-;; that runs keeps the robot as it is: offered to a poser, a runner-up of
-;; that poser's negotiation is freed while the robot waits for its answer,
-;; and the task that tries must still find the robot its poser's.
+;; open-subscriber!): starts an offer round, or asks the running one for
+;; another.  A running round keeps the robot as it is: a runner-up of the
+;; poser's negotiation is freed while the robot waits for its answer, and
+;; the task that tries must still find the robot its poser's.
 (define (robot-freed!)
   (let ((o (the-offering)))
     (when (and (offering-waiters-here? o)
@@ -160,7 +179,7 @@
                        (begin (offering-again?-set! o #t) #f)
                        (begin (offering-round?-set! o #t) #t)))))
       ;; At once, not in the round's thread, which may start late.
-      (if (offering-waiters-seen o) (offer-subjects! 'nobody 3))
+      (offer-subjects! 'nobody 3)
       (thread-start! (make-logged-thread offer-rounds 'offers)))))
 
 ;; The robot is kept for the poser it was last offered to until the
@@ -181,8 +200,9 @@
 
 ;; Offers this robot, while it is free, to the tasks that wait for it,
 ;; best rank first.  While one tries, only its poser may reserve here;
-;; while it asks who waits, if tasks waited at its last round, nobody may,
-;; so that no task takes it before the best-ranked has been offered it.
+;; while it asks who waits, if tasks waited at its last round or one was
+;; noted since, nobody may, so that no task takes it before the
+;; best-ranked has been offered it.
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
 ;; waiters-seen says whether tasks waited at its last round.
 
@@ -196,21 +216,34 @@
 (define (offer-round)
   (let* ((me (local-aspace-uid))
          (o (the-offering))
-         (depth (offering-depth o)))
+         (depth (offering-depth o))
+         (keep? (or (offering-waiters-seen o) (offering-waiters-here? o))))
     (offering-waiters-here?-set! o #f)  ; before asking: a note after it stands
     (offering-new-waiters-set! o #f)
-    (offer-subjects! (and (offering-waiters-seen o) 'nobody) 3)
+    (offer-subjects! (and keep? 'nobody) 3)
     (let* ((answers (guard (e (#t '()))
                       (who-waits me depth)))
            (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                                (append-map cadr answers))))
       (offering-waiters-seen-set! o (pair? waiting))
       (if (pair? waiting) (offering-waiters-here?-set! o #t))
-      (offer-to me waiting)
+      (offer-to me (within-horizon waiting answers depth))
       (cond ((not (free-here?)) (offering-depth-set! o offer-depth))
             ((any (lambda (a) (>= (length (cadr a)) depth)) answers)
              (offering-depth-set! o (* 2 depth))
              (if (not (offering-new-waiters o)) (offer-round)))))))
+
+;; The entries of waiting that rank no later than the last of any poser's
+;; answer of depth entries: that poser may have better ones past it.
+(define (within-horizon waiting answers depth)
+  (let ((horizon (fold (lambda (a h)
+                         (if (>= (length (cadr a)) depth)
+                             (better-rank (wanting-rank (last (cadr a))) h)
+                             h))
+                       #f answers)))
+    (if horizon
+        (take-while (lambda (e) (not (rank<? horizon (wanting-rank e)))) waiting)
+        waiting)))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))

@@ -3,7 +3,7 @@
 ;;> round), and receive-offer is what a waiting task's poser answers.
 
 (define-library (murdoch task offers)
-  (export open-offering! receive-offer offered-to-others note-waiters! robot-freed!
+  (export open-offering! waiting-for receive-offer offered-to-others note-waiters! robot-freed!
           offer-on-joining!)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)

@@ -127,7 +127,7 @@
 
 (define-syntax the-line (syntax-rules () ((_) (node-line *node*))))
 
-(define (open-line!) (node-line-set! (this-node) (make-line '() #f #f #f)))
+(define (open-line!) (node-line-set! (this-node) (make-line '() '() #f #f)))
 
 (define (waiters) (line-waiters (the-line)))
 (define (add-waiter! w)
@@ -137,7 +137,7 @@
 (define (drop-waiter! w)
   (line-waiters-set! (the-line) (remove (lambda (x) (eq? x w)) (waiters))))
 
-;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
+;; A piece of news is (first), try at once, (cancel), (give-way UID) or (offer REPLY
 ;; UID): its kind, then what it says, read by name.
 (define (news-kind n) (car n))
 (define (offer? n) (eq? (news-kind n) 'offer))
@@ -222,17 +222,17 @@
 ;; and those subscribed to waiting-tasks when it last asked the whole lab,
 ;; which it does every look-period, so that a poser it missed (one that
 ;; joined later) is found: asking every address space each round cost
-;; the robots most of their CPU (docs/speed.md).  #f until it has asked
-;; the lab.
+;; the robots most of their CPU (docs/speed.md).  A poser heard of while
+;; the first ask went is kept: its note may be the last.
 
 ;;> Notes that poser \var{uid} has tasks waiting.
 (define (know-poser! uid)
   (let ((posers (line-posers (the-line))))
-    (if (and posers (not (memq uid posers)))
+    (if (not (memq uid posers))
         (line-posers-set! (the-line) (cons uid posers)))))
 
 (define (ask-lab-due?)
-  (or (not (line-posers (the-line)))
+  (or (not (line-posers-asked (the-line)))
       (> (- (monotonic-seconds) (line-posers-asked (the-line))) (look-period))))
 
 ;;> What request of waiting-tasks answers, \var{proc} applied to
@@ -243,7 +243,7 @@
       (let ((answers (apply request 'waiting-tasks proc args)))
         (line-posers-set! (the-line)
                           (delete-duplicates (append (map car answers)
-                                                     (or (line-posers (the-line)) '()))))
+                                                     (line-posers (the-line)))))
         (line-posers-asked-set! (the-line) (monotonic-seconds))
         answers)
       (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
@@ -286,33 +286,10 @@
 ;; of them than robots.
 (define (lab-holders) (waiting-elsewhere #t))
 
-;;> The (RANK POSER ID) of each task waiting here that may use robot
-;;> \var{uid}, whose subjects are \var{subjects}: one it found capable
-;;> when it last looked, or that has a component those subjects serve (a
-;;> robot that joined since).  Best rank first, and only the first
-;;> \var{limit} if given: a robot offers itself to the best first, and
-;;> asks for more only when those all decline it, so that an offer round
-;;> does not carry every waiting task of the lab.
-(define (waiting-for uid . subjects+limit)
-  (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
-        (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
-                    (cadr subjects+limit))))
-    (let loop ((ws (with-lock (tasks-lock) waiters)) (n 0) (out '()))
-      (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
-            ((wants? (car ws) uid subjects)
-             (loop (cdr ws) (+ n 1)
-                   (cons (list (waiter-rank (car ws)) (local-aspace-uid)
-                               (task-id (waiter-task (car ws))))
-                         out)))
-            (else (loop (cdr ws) n out))))))
-
-;; Whether w may use robot uid, subscribed to subjects (or #f): for a
-;; component it does not hold, when it has looked; a robot its look did
-;; not know, or before it looked, if subjects serve a component.  Offered
-;; to a task that held the one component it could take, a robot went down
-;; its round to no avail, and sat free while tasks waited for it further
-;; down; offered to each task just posed, a robot of another kind made it
-;; try for nothing.
+;;> Whether waiter \var{w} may use robot \var{uid}, subscribed to
+;;> \var{subjects} (or #f): for a component it does not hold, when its
+;;> look found uid capable; else, a robot its look did not know or before
+;;> it looked, when subjects serve such a component.
 (define (wants? w uid subjects)
   (let ((capable (waiter-capable w)))
     (cond ((eq? capable #t) (or (not subjects) (serves? subjects w)))

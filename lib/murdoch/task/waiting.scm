@@ -1,24 +1,14 @@
 ;;;; Tasks that wait their turn (thesis ch. 6; docs/tasks.md)
 ;;
 ;; A task started with wait #t that finds too few capable robots free
-;; waits for them, holding nothing and trying only when a robot offers
-;; itself, while its poser subscribes to waiting-tasks and tells the lab
-;; that a task waits (note-waiters!).  When a robot's exclusive subjects
-;; are freed (robot-freed!, given to pubsub's open-subscriber!), the
-;; robot asks waiting-tasks who waits for it, and offers itself to each
-;; in rank order, its subjects kept for that one's poser while it tries,
-;; until one starts or none can.  A rank is (KEY POSED ID), KEY being
-;; the task's priority less aging times the second it was posed: the
-;; higher KEY goes first, then the earlier POSED, then the smaller ID.
-;; That is a total order, the same in every address space, and aging
-;; does not reorder the tasks that wait: it raises all their priorities
-;; alike, and only a task posed later starts from lower down.  A task no
-;; live robot of the lab is capable of fails at once; one whose capable
-;; robots all die while it waits fails at its poser's next look at the
-;; lab, every ten heartbeats or a third of the lease, whichever is
-;; sooner.  A poser looks once for all its waiting tasks (look-all!): a
-;; task that waits sends nothing to the lab by itself, so that W tasks
-;; waiting do not cost W looks a period.
+;; waits, trying only when a robot offers itself, while its poser
+;; subscribes to waiting-tasks and tells the lab (note-waiters!).  A robot
+;; freed (robot-freed!) asks who waits for it and offers itself to each
+;; in rank order (offers.scm) until one starts.  A rank (rank.scm) is a
+;; total order, the same everywhere, that aging does not reshuffle.  A
+;; poser looks at the lab once for all its waiting tasks (look-all!), and
+;; a task whose capable robots are all gone fails at the next look.
+;; docs/tasks.md tells it all.
 
 (define (enlist! w)
   (waiter-held-set! w '())
@@ -45,11 +35,12 @@
 ;; The node's looking part: a poser's one line of tasks, and what its
 ;; notes to the lab, its tries and its one looking thread share.
 (define-record-type looking
-  (make-looking noting? note-again try-lock looker? bell takers free-seen)
+  (make-looking noting? note-again trying? try-turns looker? bell takers free-seen)
   looking?
   (noting? looking-noting? looking-noting?-set!)    ; a publication goes
   (note-again looking-note-again looking-note-again-set!) ; best rank since, or #f
-  (try-lock looking-try-lock)
+  (trying? looking-trying? looking-trying?-set!)   ; a try runs here
+  (try-turns looking-try-turns looking-try-turns-set!) ; (WAITER . BELL) waiting, best first
   (looker? looking-looker? looking-looker?-set!)    ; the looking thread runs
   (bell looking-bell)                   ; rung by a task that wants a look
   (takers looking-takers looking-takers-set!)
@@ -59,11 +50,12 @@
 
 (define (open-looking!)
   (node-looking-set! (this-node)
-                     (make-looking #f #f (make-mutex 'tries) #f (make-mailbox) #f '())))
+                     (make-looking #f #f #f '() #f (make-mailbox) #f '())))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
-;; their ranks.
+;; their ranks, from a thread of its own: a task publishing for the
+;; others answered no offer meanwhile (docs/allocation.md).
 (define (note-lab! rank)
   (when (with-lock (tasks-lock)
           (lambda ()
@@ -72,16 +64,19 @@
                   (begin (looking-note-again-set! l (better-rank rank (looking-note-again l)))
                          #f)
                   (begin (looking-noting?-set! l #t) #t)))))
-    (let loop ((rank rank))
-      (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
-        (publish 'all note-waiters! (local-aspace-uid) rank))
-      (let ((again (with-lock (tasks-lock)
-                     (lambda ()
-                       (let ((again (looking-note-again (the-looking))))
-                         (looking-note-again-set! (the-looking) #f)
-                         (if (not again) (looking-noting?-set! (the-looking) #f))
-                         again)))))
-        (if again (loop again))))))
+    (thread-start! (make-logged-thread (lambda () (publish-notes! rank)) 'notes))))
+
+(define (publish-notes! rank)
+  (let loop ((rank rank))
+    (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
+      (publish 'all note-waiters! (local-aspace-uid) rank))
+    (let ((again (with-lock (tasks-lock)
+                   (lambda ()
+                     (let ((again (looking-note-again (the-looking))))
+                       (looking-note-again-set! (the-looking) #f)
+                       (if (not again) (looking-noting?-set! (the-looking) #f))
+                       again)))))
+      (if again (loop again)))))
 
 ;; The offers w had not answered are declined: a robot waits for no task
 ;; that no longer waits.
@@ -104,8 +99,8 @@
     (if (not (turn-wait? (task-turn t)))
         (try w)
         (dynamic-wind
-         (lambda () (enlist! w))
-         (lambda () (wait-turn w try '((posed))))
+         (lambda () (enlist! w) (check-first! w))
+         (lambda () (wait-turn w try '()))
          (lambda () (let-go-held! w) (delist! w))))))
 
 ;; Tries, answers the offers that woke it, and waits for the next.  It
@@ -127,7 +122,7 @@
      ((past? (turn-deadline (task-turn t))) (answer-offers! offers #f) 'deadline)
      (else
       (let ((team (if (or (pair? offers)
-                          (and (equal? news '((posed))) (not (behind-others? w))))
+                          (assq 'first news))
                       (try-in-turn w try (map offer-uid offers))
                       'not-enough-takers)))
         (answer-offers! offers (pair? team))
@@ -146,17 +141,15 @@
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
-;; One try of w's, after the tries of this address space's other waiting
-;; tasks: two at once, each offered a robot, each reserved the other's
-;; robot as a candidate of its negotiation, and the one that lost its
-;; robot so, for a moment, found none and declined it.  The robots offered
-;; to the others are left alone, and so are all but those offered to w,
-;; the uids offered, when w can take robots one at a time (it holds, or
-;; needs one): a robot may be kept for this poser on its way to offer
-;; itself to another of its tasks.
+;; One try of w's, in turn with this poser's other waiting tasks' (two at
+;; once each reserved the robot offered to the other), best rank first.
+;; The robots offered to the others are left alone, and so are all but
+;; those offered to w, offered, when w can take robots one at a time (it
+;; holds, or needs one): a robot may be kept for this poser on its way to
+;; another of its tasks.
 
 (define (try-in-turn w try offered)
-  (with-lock (looking-try-lock (the-looking))
+  (in-try-turn w
     (lambda ()
       (waiter-offered-set! w offered)
       (let ((excluded (append (offered-to-others w) (not-offered w offered)
@@ -165,6 +158,47 @@
                      (parameterize ((pose-task-excluded excluded)
                                     (request-audience (audience w offered excluded)))
                        (try w))))))))
+
+;; Runs thunk once no other try of this poser runs, those waiting let
+;; in best rank first.  A thread that leaves while it waits (cancelled,
+;; abandoned) leaves the queue, or passes on the turn it was given.
+(define (in-try-turn w thunk)
+  (let ((turn (cons w (make-mailbox))))
+    (dynamic-wind
+     (lambda () #f)
+     (lambda ()
+       (if (not (join-try-turns! turn))
+           (let wait ()
+             (if (not (mailbox-take (cdr turn) (+ (monotonic-seconds) 60) (lambda () #f)))
+                 (wait))))
+       (thunk))
+     (lambda () (leave-try-turns! turn)))))
+
+;; Whether turn may try at once; else it is queued by its waiter's rank.
+(define (join-try-turns! turn)
+  (with-lock (tasks-lock)
+    (lambda ()
+      (let ((l (the-looking)))
+        (if (looking-trying? l)
+            (let-values (((before after)
+                          (break (lambda (x) (rank<? (waiter-rank (car turn))
+                                                     (waiter-rank (car x))))
+                                 (looking-try-turns l))))
+              (looking-try-turns-set! l (append before (cons turn after)))
+              #f)
+            (begin (looking-trying?-set! l #t) #t))))))
+
+;; A turn still queued leaves the queue; one that was given the try
+;; gives it to the next, or ends the trying.
+(define (leave-try-turns! turn)
+  (with-lock (tasks-lock)
+    (lambda ()
+      (let* ((l (the-looking)) (turns (looking-try-turns l)))
+        (cond ((memq turn turns)
+               (looking-try-turns-set! l (remove (lambda (x) (eq? x turn)) turns)))
+              ((null? turns) (looking-trying?-set! l #f))
+              (else (looking-try-turns-set! l (cdr turns))
+                    (mailbox-put! (cdar turns) #t)))))))
 
 ;; Whom w's negotiations ask, but those excluded: the robots offered
 ;; alone when w takes them one at a time, else those offered and those
@@ -398,9 +432,18 @@
                       (waiter-why w)
                       (map (lambda (c) "") (waiter-components w))))))))
 
-;; Whether a better-ranked task of the lab waits: w, just posed, has not
-;; looked at which robots it may use.
+;; Tells w, just posed, to try at once when no better-ranked task of the
+;; lab waits; from a thread of its own, as asking the posers may take
+;; seconds, and w answers its offers meanwhile.
+(define (check-first! w)
+  (thread-start!
+   (make-logged-thread (lambda () (if (not (behind-others? w)) (tell-waiter! w '(first))))
+                       'first)))
+
+;; Whether a better-ranked task of the lab waits, or w waits no more: w,
+;; just posed, has not looked at which robots it may use.
 (define (behind-others? w)
-  (or (rank<? (waiter-rank (car (with-lock (tasks-lock) waiters))) (waiter-rank w))
+  (or (let ((ws (with-lock (tasks-lock) waiters)))
+        (or (not (memq w ws)) (rank<? (waiter-rank (car ws)) (waiter-rank w))))
       (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
            (guard (e (#t '())) (waiting-at-others)))))
