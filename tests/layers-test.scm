@@ -18,7 +18,7 @@
     (remote aspace (connection worker call) group serve proxy delivery)
     (pubsub messaging monitor)
     (task (assign progress metric takers) team (pose-task running) record rank
-          (offers holding) waiting life-cycle steps detached status)
+          (offers holding) waiting life-cycle steps detached status parts)
     murdoch cli view testing))
 
 (define (layer-folder layer) (if (pair? layer) (car layer) layer))

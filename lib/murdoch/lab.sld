@@ -14,7 +14,11 @@
           node-sandbox node-sandbox-set! node-membership node-membership-set!
           node-connections node-connections-set!
           node-server node-server-set! node-group node-group-set!
-          node-subscriber node-subscriber-set! node-monitors node-monitors-set!)
+          node-subscriber node-subscriber-set! node-monitors node-monitors-set!
+          node-teams node-teams-set! node-poses node-poses-set! node-runs node-runs-set!
+          node-posed node-posed-set! node-line node-line-set! node-looking
+          node-looking-set! node-offering node-offering-set! node-handing
+          node-handing-set!)
   (import (scheme base) (scheme char) (scheme read) (scheme write) (scheme file)
           (scheme process-context)
           (scheme inexact)

@@ -5,7 +5,7 @@
 ;;> exports what the families above use of them.
 
 (define-library (murdoch task)
-  (export task-key-parts run-component run-posed-component component-heartbeat!
+  (export open-tasks! task-key-parts run-component run-posed-component component-heartbeat!
           stop-component! components-ended ended-id ended-index ended-started
           ended-ended ended-end start-task task? task-id task-name task-status
           task-state task-why task-state-text task-wait cancel-task status-index
@@ -36,4 +36,4 @@
           (murdoch task offers) (murdoch task holding)
           (except (murdoch task life-cycle) start-task task-status task-wait cancel-task)
           (except (murdoch task steps) start-steps)
-          (murdoch task detached) (murdoch task status)))
+          (murdoch task detached) (murdoch task status) (murdoch task parts)))

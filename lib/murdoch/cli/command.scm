@@ -13,6 +13,7 @@
   (set-signal-action! signal/pipe #f)
   (open-node! lab role)
   (open-subscriber! robot-freed!)
+  (open-tasks!)
   (take-tunables!)
   (let ((env (make-lab-environment))
         (entry (lab-aspace-by-uid lab uid)))

@@ -11,6 +11,6 @@
                 open-input-file-descriptor)
           (only (srfi 151) bitwise-ior) (murdoch sys) (murdoch code) (murdoch cli hints)
           (murdoch lab) (murdoch remote) (murdoch pubsub) (murdoch robot)
-          (only (murdoch task) task-timeout pose-task-retries pose-task-backoff
+          (only (murdoch task) open-tasks! task-timeout pose-task-retries pose-task-backoff
                 robot-freed! offer-on-joining!))
   (include "command.scm"))

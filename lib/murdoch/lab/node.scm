@@ -4,7 +4,7 @@
 
 (define-record-type node
   (make-node lab role wire limits sandbox membership connections server group
-             subscriber monitors)
+             subscriber monitors teams poses runs posed line looking offering handing)
   node?
   (lab node-lab)                        ; read once; its settings by setting
   (role node-role)                      ; aspace, or repl: a person waits at it
@@ -16,7 +16,16 @@
   (server node-server node-server-set!) ; remote/serve.scm
   (group node-group node-group-set!)    ; remote/group.scm, #f under broadcast
   (subscriber node-subscriber node-subscriber-set!) ; pubsub/messaging.scm
-  (monitors node-monitors node-monitors-set!)) ; pubsub/monitor.scm: thresholds
+  (monitors node-monitors node-monitors-set!) ; pubsub/monitor.scm: thresholds
+  ;; The task layer's parts, made by its open-tasks! (task/parts.scm):
+  (teams node-teams node-teams-set!)    ; task/team.scm: teams held here
+  (poses node-poses node-poses-set!)    ; task/pose-task.scm: negotiating
+  (runs node-runs node-runs-set!)       ; task/running.scm: components run here
+  (posed node-posed node-posed-set!)    ; task/record.scm: tasks started here
+  (line node-line node-line-set!)       ; task/rank.scm: waiting, known posers
+  (looking node-looking node-looking-set!) ; task/waiting.scm: the poser's look
+  (offering node-offering node-offering-set!) ; task/offers.scm: offer rounds
+  (handing node-handing node-handing-set!)) ; task/detached.scm: tasks handed
 
 ;; Global: a process is one address space of one lab.  The layers' hot
 ;; paths read their part straight from it (docs/speed.md).
@@ -25,7 +34,8 @@
 ;;> Makes this process a node of \var{lab}, its parts yet to be filled;
 ;;> \var{role} is \scheme{repl} for a person's REPL, else \scheme{aspace}.
 (define (open-node! lab . role)
-  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace) #f #f #f #f #f #f #f #f #f))
+  (set! *node* (make-node lab (if (pair? role) (car role) 'aspace)
+                         #f #f #f #f #f #f #f #f #f #f #f #f #f #f #f #f #f))
   *node*)
 
 ;;> This process's node, for a layer to fill its part.

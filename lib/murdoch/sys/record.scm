@@ -1,10 +1,6 @@
-;;;; Records made without a closure.
-;;
-;; Chibi's define-record-type makes a record in a let of its constructor,
-;; and a let is a closure made each time: a record cost about a thousand
-;; instructions more than the allocation, and two objects (docs/speed.md).
-;; This one makes the record bare, by Chibi's own maker, and fills its
-;; fields in a procedure of their own, by their places.
+;;;; Records made without a closure (Chibi's constructor makes one each
+;;;; time: docs/speed.md): made bare by Chibi's own maker, their fields
+;;;; filled by their places in a procedure of their own.
 
 ;;> R7RS's define-record-type: the same records, made without a closure.
 (define-syntax define-lean-record-type

@@ -83,11 +83,9 @@
       #t
       (begin (thread-yield!) (not (thread-timeout?)))))
 
-;;; The lock order (docs/architecture.md), checked in a process started
-;;; with MURDOCH_LOCK_ORDER naming a folder (tests/run does): a thread
-;;; holding a lock takes another only of a higher rank, and a process that
-;;; breaks the order writes what it took, and what it held, to standard
-;;; error and to a file of that folder named by its process id.
+;;; The lock order (docs/architecture.md), checked under MURDOCH_LOCK_ORDER:
+;;; a thread holding a lock takes another only of a higher rank, else it
+;;; writes both to standard error and to a file of that folder.
 
 ;; A mutex's rank, by the name it was made with; a name of no rank is a
 ;; break of the order wherever it is taken under another.

@@ -20,11 +20,9 @@
            (let ((assignment (hungarian (finite-costs costs) n m)))
              (and (allowed? costs assignment) assignment))))))
 
-;; The costs, inexact (flonums compare fast: docs/speed.md), with each
-;; +inf.0 made the dominant cost, so that the method's arithmetic stays
-;; finite and an assignment with fewer of them always costs less.  Each
-;; row gains a column 0, never read, so that the method indexes it as it
-;; counts, from 1.
+;; The costs, inexact, each +inf.0 made the dominant cost, so the
+;; arithmetic stays finite and fewer of them always cost less; each row
+;; gains a column 0, never read, as the method counts from 1.
 (define (finite-costs costs)
   (let ((forbidden (inexact (dominant-cost costs))))
     (vector-map (lambda (row)

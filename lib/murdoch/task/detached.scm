@@ -1,36 +1,20 @@
 ;;;; Tasks handed to the lab: a detached task's coordinator and its standby.
 ;;
 ;; start-task and start-steps with 'detach #t hand the task to the lab,
-;; which keeps it on two of its members, chosen as it chooses robots:
+;; which keeps it on two of its members (docs/tasks.md, "Tasks handed to
+;; the lab", gives the argument):
 ;;
-;;  1. The poser asks the address spaces with the coordinator capability
-;;     (the workstations, by default) for their load, and hands the task
-;;     to the least loaded one other than itself, its coordinator.  It
-;;     answers the task's id, and may leave.
-;;  2. The coordinator starts the task as start-task would, and does for
-;;     it all a poser does: heartbeats, reassignments, its place in line.
-;;     It chooses a standby the same way, on another member, and sends it
-;;     a copy of the task's record whenever it changes, and every period,
-;;     and of a step's team at each arrival or letter, before the member
-;;     that made the call hears back (team.scm).
-;;  3. Never two coordinators.  The standby pings the coordinator every
-;;     heartbeat period.  The coordinator acts for the task (heartbeats,
-;;     starts, negotiations) only while the pings arrive: silent for two
-;;     periods, it lets the task go.  The standby takes over when no ping
-;;     has been answered for four periods, or one period after it finds
-;;     the coordinator's process gone (its port refuses, or its new
-;;     process holds no such task).  docs/tasks.md gives the argument.
-;;  4. Taking over, the standby asks the lab which of the task's
-;;     components run or ended where, adopts each where it is, re-runs the
-;;     negotiation of a task that had not started, with its rank, and
-;;     chooses a new standby.  The members of a step's team find its
-;;     coordinator there by the step's id.  A coordinator that let the
-;;     task go because its standby fell silent takes it back the same way
-;;     once it finds the standby's process gone, and drops it if the
-;;     standby took over.
-;;  5. Any peer finds the task by its id through the lab-tasks subject,
-;;     which the members holding a task subscribe to.  A finished task's
-;;     results are kept for the lab's keep-results seconds.
+;;  1. The poser hands the task to the least loaded coordinator other
+;;     than itself, answers its id, and may leave.
+;;  2. The coordinator does for it all a poser does, and copies its record
+;;     to a standby, chosen the same way, on every change and every
+;;     period, and a step's team before a member's call is answered.
+;;  3. Never two coordinators: the coordinator acts only while its
+;;     standby's pings arrive; the standby takes over after four periods
+;;     unanswered, or one after it finds the coordinator's process gone.
+;;  4. Taking over, it adopts each component where it runs, negotiates
+;;     again a task not started, and chooses a new standby.
+;;  5. Any peer finds the task by id through the lab-tasks subject.
 ;;
 ;; Its components wait detached-patience times longer for their
 ;; coordinator than a poser's, so a takeover comes before they stop.
@@ -70,26 +54,37 @@
 (define (copy-turn c) (list-ref c 3))
 (define (copy-ended c) (list-ref c 4))
 
-;; Global: the calls of peers find them by name.
-(define *handed* '())
-(define *handed-lock* (make-mutex 'handed))
+;; The node's handing part: the tasks handed here, coordinated or stood
+;; by for, which the calls of peers find by id.
+(define-record-type handing
+  (make-handing list lock)
+  handing?
+  (list handing-list handing-list-set!)
+  (lock handing-lock))
+
+(define-syntax the-handing (syntax-rules () ((_) (node-handing *node*))))
+
+(define (open-handing!)
+  (node-handing-set! (this-node) (make-handing '() (make-mutex 'handed))))
 
 (define (handed-by-id id)
-  (with-lock *handed-lock*
-    (lambda () (find (lambda (h) (eq? (handed-id h) id)) *handed*))))
+  (with-lock (handing-lock (the-handing))
+    (lambda () (find (lambda (h) (eq? (handed-id h) id)) (handing-list (the-handing))))))
 
 (define (hold-handed! h)
-  (with-lock *handed-lock*
-    (lambda ()
-      (set! *handed* (cons h (remove (lambda (x) (eq? (handed-id x) (handed-id h)))
-                                     *handed*)))
-      (subscribe 'lab-tasks))))
+  (let ((hs (the-handing)))
+    (with-lock (handing-lock hs)
+      (lambda ()
+        (handing-list-set! hs (cons h (remove (lambda (x) (eq? (handed-id x) (handed-id h)))
+                                              (handing-list hs))))
+        (subscribe 'lab-tasks)))))
 
 (define (drop-handed! h)
-  (with-lock *handed-lock*
-    (lambda ()
-      (set! *handed* (remove (lambda (x) (eq? x h)) *handed*))
-      (if (null? *handed*) (unsubscribe 'lab-tasks)))))
+  (let ((hs (the-handing)))
+    (with-lock (handing-lock hs)
+      (lambda ()
+        (handing-list-set! hs (remove (lambda (x) (eq? x h)) (handing-list hs)))
+        (if (null? (handing-list hs)) (unsubscribe 'lab-tasks))))))
 
 (define (period) (setting 'heartbeat))
 

@@ -4,7 +4,7 @@
 ;;> anywhere, and lab-tasks.  See lib/murdoch/task/detached.scm's header.
 
 (define-library (murdoch task detached)
-  (export start-task start-steps task-status task-wait cancel-task lab-tasks
+  (export open-handing! start-task start-steps task-status task-wait cancel-task lab-tasks
           lab-task-id lab-task-role lab-task-epoch lab-task-state lab-task-coordinator
           lab-task-standby lab-task-poser lab-task-took-over
           coordinate-task! coordinator-ping become-standby! receive-copy

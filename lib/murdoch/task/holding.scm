@@ -147,7 +147,7 @@
   (for-each (lambda (w)
               (if (and (memq uid (held-uids w)) (rank<? rank (waiter-rank w)))
                   (tell-waiter! w (list 'give-way uid))))
-            (with-lock *tasks-lock* waiters))
+            (with-lock (tasks-lock) waiters))
   #t)
 
 ;; Asks the waiting tasks that rank after w, worse, and hold robots w

@@ -12,7 +12,7 @@
                  (if (eq? role 'standby) (handed-partner h) me)
                  (if (eq? role 'standby) me (handed-partner h))
                  (handed-poser h) (handed-took-over h))))
-       (with-lock *handed-lock* (lambda () *handed*))))
+       (with-lock (handing-lock (the-handing)) (lambda () (handing-list (the-handing))))))
 
 ;;> The task's id in \var{e}, an entry of lab-tasks or handed-entries.
 (define (lab-task-id e) (car e))

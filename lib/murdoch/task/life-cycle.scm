@@ -1,14 +1,11 @@
 ;;;; Tasks that survive failure: the task life cycle (after MURDOCH 2002).
 ;;
-;; pose-task blocks until its components are done, as in the thesis.
-;; start-task poses the same task and answers at once with a task record,
-;; which task-status, task-wait and cancel-task read and act on.  Each
-;; component runs on its robot inside run-component, watched by the
-;; poser's heartbeats: a robot silent for lost-periods, gone, or failing
-;; has its component started again elsewhere when it is restartable, and
-;; a component whose poser is silent for orphan-periods stops on its
-;; robot (running.scm).  docs/tasks.md tells the life cycle step by step.
-;; A task of steps (start-steps) is a sequence of such tasks, one a step.
+;; start-task poses a task as pose-task does and answers at once with a
+;; task record, which task-status, task-wait and cancel-task read.  A
+;; component's robot silent for lost-periods, gone or failing has it
+;; started again elsewhere when it is restartable; a component whose
+;; poser is silent for orphan-periods stops (running.scm).  docs/tasks.md
+;; tells the life cycle step by step.
 
 ;;; The poser's side
 
@@ -58,7 +55,7 @@
    args))
 
 (define (new-task id task-name capability-list metrics procs restartable turn)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (check-waiting-room turn)
       (let ((t (make-task
@@ -183,7 +180,7 @@
 ;; finishes here no more: its new coordinator finishes it.
 (define (finish! t results)
   (when (not (let-go? t))
-    (with-lock *tasks-lock*
+    (with-lock (tasks-lock)
       (lambda ()
         (if (not (memq (task-state t) '(cancelled deadline failed)))
             (task-state-set!
@@ -218,10 +215,9 @@
       (list (winner-promise winner) #t)
       (list (component-proc c))))
 
-;; Runs component c on uid, and again elsewhere while its robot is lost
-;; and it may be restarted.
-;; work is (PROC ARG ...), or adopted for a component of a detached task
-;; that runs on uid already, where a new coordinator found it.
+;; Runs component c on uid, and elsewhere while its robot is lost and it
+;; may restart; work is (PROC ARG ...), or adopted for a detached task's
+;; component that a new coordinator found running on uid.
 (define (supervise t c uid work)
   (if (not (eq? work 'adopted))
       (component-state-set! c (list 'running uid (utc-seconds))))
@@ -265,7 +261,7 @@
 ;; another of the task's, and so be in the team twice.  Under the lock:
 ;; two components may be lost at once.
 (define (replace-member! t k uid)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (task-team-set! t (map (lambda (u i) (if (= i k) uid u))
                              (task-team t) (iota (length (task-team t)) 1))))))
@@ -406,7 +402,7 @@
 ;;> peer.
 (define (cancel-task task)
   (check-task-record "cancel-task" task)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (if (not (over? task)) (task-state-set! task 'cancelled))))
   (if (task-waiter task) (tell-waiter! (task-waiter task) '(cancel)))
@@ -429,7 +425,7 @@
 ;;> ID INDEX POSER) for each component it runs.  listed-id and the other
 ;;> listed- procedures read them.
 (define (tasks)
-  (let* ((posed (with-lock *tasks-lock* posed-tasks))
+  (let* ((posed (with-lock (tasks-lock) posed-tasks))
          (line (and (any task-waiter posed)
                     (line-of (guard (e (#t '())) (lab-waiting))))))
     (append (map (lambda (t) (posed-entry t line)) posed)

@@ -3,6 +3,27 @@
 ;;;; offers that come for it by a try (the poser's side).  waiting.scm
 ;;;; has the whole protocol.
 
+;; The node's offering part: the offers this poser answers, and its
+;; robot's offer rounds (a process drives at most one robot); each field
+;; is described where it is used.
+(define-record-type offering
+  (make-offering offers round? again? lock waiters-here? new-waiters waiters-seen depth)
+  offering?
+  (offers offering-offers offering-offers-set!)
+  (round? offering-round? offering-round?-set!)    ; an offer round runs here
+  (again? offering-again? offering-again?-set!)    ; another was asked for since
+  (lock offering-lock)
+  (waiters-here? offering-waiters-here? offering-waiters-here?-set!)
+  (new-waiters offering-new-waiters offering-new-waiters-set!)
+  (waiters-seen offering-waiters-seen offering-waiters-seen-set!)
+  (depth offering-depth offering-depth-set!))
+
+(define-syntax the-offering (syntax-rules () ((_) (node-offering *node*))))
+
+(define (open-offering!)
+  (node-offering-set! (this-node)
+                      (make-offering '() #f #f (make-mutex 'offers) #f #f #f offer-depth)))
+
 ;;; The poser's side
 
 ;;> What a freed robot \var{uid} calls where task \var{id} waits: the
@@ -13,12 +34,12 @@
 (define (receive-offer id uid)
   (let* ((reply (make-mailbox))
          (offer (cons uid id))
-         (w (with-lock *tasks-lock*
+         (w (with-lock (tasks-lock)
               (lambda ()
                 (let ((w (find (lambda (w) (eq? (task-id (waiter-task w)) id))
                                (waiters))))
                   (and w (not (offered-enough? w uid))
-                       (begin (set! *offers* (cons offer *offers*)) w)))))))
+                       (begin (update-offers! (lambda (os) (cons offer os))) w)))))))
     (and w
          (dynamic-wind
           (lambda () #f)
@@ -26,9 +47,13 @@
             (tell-waiter! w (list 'offer reply uid))
             (mailbox-take reply (+ (monotonic-seconds) (offer-seconds)) (lambda () #f)))
           (lambda ()
-            (with-lock *tasks-lock*
+            (with-lock (tasks-lock)
               (lambda ()
-                (set! *offers* (remove (lambda (o) (eq? o offer)) *offers*)))))))))
+                (update-offers! (lambda (os) (remove (lambda (o) (eq? o offer)) os))))))))))
+
+;; Under (tasks-lock).
+(define (update-offers! f)
+  (let ((o (the-offering))) (offering-offers-set! o (f (offering-offers o)))))
 
 ;; How long a robot waits for the answer to its offer: the lab's timeout.
 ;; A waiter answers its offers after the try or look it is in, which on a
@@ -44,13 +69,13 @@
 ;; that waited for a b and a d robot, offered two d, declined the b it
 ;; needed, which went to a worse task.  A robot that w won, holding, in
 ;; the try its offer began is no longer one of them, though its offer is
-;; answered only when that try ends.  Under *tasks-lock*.
+;; answered only when that try ends.  Under (tasks-lock).
 (define (offered-enough? w uid)
   (let* ((id (task-id (waiter-task w)))
          (held (held-uids w))
          (offered (filter-map (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held))
                                                (car o)))
-                              *offers*))
+                              (offering-offers (the-offering))))
          (open (remove (lambda (c) (assv (component-index c) (waiter-held w)))
                        (waiter-components w)))
          (fits? (lambda (uid c)
@@ -72,36 +97,30 @@
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting
-;; tasks leave it alone meanwhile.  Global: one poser a process.
-(define *offers* '())
+;; tasks leave it alone meanwhile.
 
 (define (offered-to-others w)
   (let ((id (task-id (waiter-task w))))
     (filter-map (lambda (o) (and (not (eq? (cdr o) id)) (car o)))
-                (with-lock *tasks-lock* (lambda () *offers*)))))
+                (with-lock (tasks-lock) (lambda () (offering-offers (the-offering)))))))
 
 ;;; The robot's side: offers when its subjects are freed
 
-;; Global: a process drives at most one robot, which offers itself.
-(define *offering* #f)                  ; an offer round runs here
-(define *offer-again* #f)               ; and another was asked for meanwhile
-(define *offer-lock* (make-mutex 'offers))
-
-;; Whether a task may wait for this robot: set when a task starts to
-;; wait anywhere, cleared by an offer round that finds none, so that a lab
-;; where no task waits sends nothing more when a robot is freed.  Global,
-;; as the offer rounds are.
-(define *waiters-here?* #f)
+;; Whether a task may wait for this robot (waiters-here?): set when a task
+;; starts to wait anywhere, cleared by an offer round that finds none, so
+;; that a lab where no task waits sends nothing more when a robot is freed.
 
 ;;> What a poser, \var{poser}, publishes to the lab when one of its tasks
 ;;> starts to wait, \var{rank} the best rank of those that did since its
 ;;> last note: the robots offer themselves when freed, and a free robot
 ;;> at once, since a task posed behind others waits for the offers.
 (define (note-waiters! . poser+rank)
-  (set! *waiters-here?* #t)
-  (set! *new-waiters* (if (and (= 2 (length poser+rank)) (not (eq? *new-waiters* #t)))
-                          (better-rank (cadr poser+rank) *new-waiters*)
-                          #t))
+  (let* ((o (the-offering))
+         (new (offering-new-waiters o)))
+    (offering-waiters-here?-set! o #t)
+    (offering-new-waiters-set! o (if (and (= 2 (length poser+rank)) (not (eq? new #t)))
+                                     (better-rank (cadr poser+rank) new)
+                                     #t)))
   (if (pair? poser+rank) (know-poser! (car poser+rank)))
   (if (and (robot-here?) (free-here?)) (robot-freed!))
   #t)
@@ -116,13 +135,12 @@
 ;; noted, or #t for one not known (a reminder): a round asks again only
 ;; if that rank goes before its next offer's, else with posers posing
 ;; non-stop it never gets past the lab's best task (docs/allocation.md).
-;; Global, as the offer rounds are.
-(define *new-waiters* #f)
-
+;; This is new-waiters.
 (define (ask-again-before? waiting)
-  (and *new-waiters*
-       (or (eq? *new-waiters* #t) (null? waiting)
-           (rank<? *new-waiters* (wanting-rank (car waiting))))))
+  (let ((new (offering-new-waiters (the-offering))))
+    (and new
+         (or (eq? new #t) (null? waiting)
+             (rank<? new (wanting-rank (car waiting)))))))
 
 (define (robot-here?)
   (let ((a (lab-aspace-by-uid (current-lab) (local-aspace-uid))))
@@ -134,29 +152,31 @@
 ;; that poser's negotiation is freed while the robot waits for its answer,
 ;; and the task that tries must still find the robot its poser's.
 (define (robot-freed!)
-  (when (and *waiters-here?*
-             (with-lock *offer-lock*
-               (lambda ()
-                 (if *offering*
-                     (begin (set! *offer-again* #t) #f)
-                     (begin (set! *offering* #t) #t)))))
-    ;; At once, not in the round's thread, which may start late.
-    (if *waiters-seen* (offer-subjects! 'nobody 3))
-    (thread-start! (make-logged-thread offer-rounds 'offers))))
+  (let ((o (the-offering)))
+    (when (and (offering-waiters-here? o)
+               (with-lock (offering-lock o)
+                 (lambda ()
+                   (if (offering-round? o)
+                       (begin (offering-again?-set! o #t) #f)
+                       (begin (offering-round?-set! o #t) #t)))))
+      ;; At once, not in the round's thread, which may start late.
+      (if (offering-waiters-seen o) (offer-subjects! 'nobody 3))
+      (thread-start! (make-logged-thread offer-rounds 'offers)))))
 
 ;; The robot is kept for the poser it was last offered to until the
 ;; rounds end, so that no task takes it between two rounds.
 (define (offer-rounds)
   (guard (e (#t (log-warn "offering this robot: " (error-message e))))
     (offer-round))
-  (if (with-lock *offer-lock*
-        (lambda ()
-          (let ((again *offer-again*))
-            (set! *offer-again* #f)
-            (when (not again)
-              (offer-subjects! #f)
-              (set! *offering* #f))
-            again)))
+  (if (let ((o (the-offering)))
+        (with-lock (offering-lock o)
+          (lambda ()
+            (let ((again (offering-again? o)))
+              (offering-again?-set! o #f)
+              (when (not again)
+                (offer-subjects! #f)
+                (offering-round?-set! o #f))
+              again))))
       (offer-rounds)))
 
 ;; Offers this robot, while it is free, to the tasks that wait for it,
@@ -164,34 +184,33 @@
 ;; while it asks who waits, if tasks waited at its last round, nobody may,
 ;; so that no task takes it before the best-ranked has been offered it.
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
-;; Global, as the offer rounds are.
-(define *waiters-seen* #f)
+;; waiters-seen says whether tasks waited at its last round.
 
 ;; Each poser answers its best offer-depth tasks that may use the robot,
 ;; and the robot asks for twice as many when every one declined it, in
 ;; this round or the next, until it is taken: the best-ranked of the lab
 ;; are among them, and a round costs the same with 20 tasks waiting or
-;; 2,000 (docs/allocation.md).  Global, as the offer rounds are.
+;; 2,000 (docs/allocation.md).  The depth asked for now is kept.
 (define offer-depth 4)
-(define *depth* offer-depth)
 
 (define (offer-round)
-  (let ((me (local-aspace-uid))
-        (depth *depth*))
-    (set! *waiters-here?* #f)       ; before asking: a note after it stands
-    (set! *new-waiters* #f)
-    (offer-subjects! (and *waiters-seen* 'nobody) 3)
+  (let* ((me (local-aspace-uid))
+         (o (the-offering))
+         (depth (offering-depth o)))
+    (offering-waiters-here?-set! o #f)  ; before asking: a note after it stands
+    (offering-new-waiters-set! o #f)
+    (offer-subjects! (and (offering-waiters-seen o) 'nobody) 3)
     (let* ((answers (guard (e (#t '()))
                       (who-waits me depth)))
            (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                                (append-map cadr answers))))
-      (set! *waiters-seen* (pair? waiting))
-      (if (pair? waiting) (set! *waiters-here?* #t))
+      (offering-waiters-seen-set! o (pair? waiting))
+      (if (pair? waiting) (offering-waiters-here?-set! o #t))
       (offer-to me waiting)
-      (cond ((not (free-here?)) (set! *depth* offer-depth))
+      (cond ((not (free-here?)) (offering-depth-set! o offer-depth))
             ((any (lambda (a) (>= (length (cadr a)) depth)) answers)
-             (set! *depth* (* 2 depth))
-             (if (not *new-waiters*) (offer-round)))))))
+             (offering-depth-set! o (* 2 depth))
+             (if (not (offering-new-waiters o)) (offer-round)))))))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
@@ -202,7 +221,8 @@
           (remote-apply (uid->aspace poser) receive-offer
                         (wanting-id (car waiting)) me)))
       (if (and (ask-again-before? (cdr waiting)) (free-here?))
-          (with-lock *offer-lock* (lambda () (set! *offer-again* #t)))
+          (let ((o (the-offering)))
+            (with-lock (offering-lock o) (lambda () (offering-again?-set! o #t))))
           (offer-to me (cdr waiting))))))
 
 ;; The subjects this address space subscribes to: a poser matches them
@@ -213,7 +233,7 @@
 ;;> offers itself at once to the tasks that wait for it, which may have
 ;;> waited for it while it was away, or before it came.
 (define (offer-on-joining!)
-  (set! *waiters-here?* #t)
+  (offering-waiters-here?-set! (the-offering) #t)
   (if (and (robot-here?) (free-here?)) (robot-freed!)))
 
 ;; Whether no subject here is held exclusively.

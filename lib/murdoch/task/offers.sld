@@ -3,7 +3,8 @@
 ;;> round), and receive-offer is what a waiting task's poser answers.
 
 (define-library (murdoch task offers)
-  (export receive-offer offered-to-others note-waiters! robot-freed! offer-on-joining!)
+  (export open-offering! receive-offer offered-to-others note-waiters! robot-freed!
+          offer-on-joining!)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (only (murdoch pubsub) request subscription-statuses offer-subjects!)

@@ -1,10 +1,9 @@
 ;;;; pose-task (thesis §4.2, appendix A.7 new-task.scm).
 ;;
-;; pose-task asks the lab who is capable (request-exclusive for a
-;; component that needs a resource to itself, request otherwise), ranks
-;; each component's candidates by its metric, gives each, in priority
-;; order, the best not already chosen, frees every unused promise, and
-;; runs the team.  Beyond the thesis: docs/allocation.md.
+;; It asks the lab who is capable (request-exclusive, or request for a
+;; shared component), ranks candidates by each component's metric, gives
+;; each in priority order the best not chosen, frees every unused
+;; promise, and runs the team.  Beyond the thesis: docs/allocation.md.
 
 ;;; pose-task
 
@@ -44,10 +43,19 @@
 (define (component-type layout)
   (if (null? (car layout)) 'non-exclusive 'exclusive))
 
-;; The poses made here, counted, and those negotiating.  Global: a
-;; rival's call (receive-rival) finds them by name.
-(define *poses* 0)
-(define *negotiating* '())
+;; The node's poses part: the poses made here, counted, and those
+;; negotiating, which a rival's call (receive-rival) finds by name; its
+;; lock is over both.
+(define-record-type poses
+  (make-poses count negotiating lock)
+  poses?
+  (count poses-count poses-count-set!)
+  (negotiating poses-negotiating poses-negotiating-set!)
+  (lock poses-lock))
+
+(define-syntax the-poses (syntax-rules () ((_) (node-poses *node*))))
+
+(define (open-poses!) (node-poses-set! (this-node) (make-poses 0 '() (make-mutex 'poses))))
 
 ;; A pose negotiating here: its name, rank, and its rivals' ranks.
 (define-record-type negotiation
@@ -57,10 +65,7 @@
   (rank negotiation-rank)
   (rivals negotiation-rivals negotiation-rivals-set!))
 
-;; Global, as the poses are: over *poses* and *negotiating*.
-(define *poses-lock* (make-mutex 'poses))
-
-(define (with-poses thunk) (with-lock *poses-lock* thunk))
+(define (with-poses thunk) (with-lock (poses-lock (the-poses)) thunk))
 
 ;;> A key of this address space's own for a task named \var{task-name},
 ;;> NAME@UID/N: a started task's id and its reservations' name, so the
@@ -86,7 +91,9 @@
     (and (<= to (string-length s)) (string=? lab-key-mark (substring s from to)))))
 
 (define (numbered-key task-name mark)
-  (let ((n (with-poses (lambda () (set! *poses* (+ *poses* 1)) *poses*))))
+  (let ((n (with-poses (lambda ()
+                        (poses-count-set! (the-poses) (+ (poses-count (the-poses)) 1))
+                        (poses-count (the-poses))))))
     (string->symbol (string-append (symbol->string task-name) "@"
                                    (symbol->string (local-aspace-uid)) "/" mark
                                    (number->string n)))))

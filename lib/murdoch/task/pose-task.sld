@@ -4,7 +4,7 @@
 ;;> new-task.scm had them.
 
 (define-library (murdoch task pose-task)
-  (export pose-task negotiate negotiated-winners negotiated-types negotiated-name
+  (export open-poses! pose-task negotiate negotiated-winners negotiated-types negotiated-name
           winner-uid winner-promise check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
           pose-task-backoff pose-task-excluded pose-task-reservation receive-rival pose-negotiations
@@ -20,7 +20,7 @@
           (only (chibi ast) procedure-code procedure-vars opcode? thread-interrupt!)
           (only (chibi) call-with-output-string)
           (only (chibi process) current-process-id) (murdoch sys) (murdoch code)
-          (only (murdoch lab) lab-default)
+          (only (murdoch lab) lab-default *node* this-node node-poses node-poses-set!)
           (murdoch remote) (murdoch pubsub) (murdoch task assign)
           (murdoch task progress) (murdoch task metric) (murdoch task takers)
           (murdoch task team) (only (murdoch task running) run-posed-component))

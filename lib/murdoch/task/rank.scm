@@ -46,7 +46,7 @@
      (else (bad "no such option; the options are wait, hold, priority and deadline")))))
 
 ;; Refuses a task that would wait when this address space has
-;; max-waiting tasks waiting or about to.  Under *tasks-lock*.
+;; max-waiting tasks waiting or about to.  Under (tasks-lock).
 (define (check-waiting-room turn)
   (if (and turn (turn-wait? turn)
            (>= (count (lambda (t) (and (task-turn t) (turn-wait? (task-turn t))
@@ -114,16 +114,28 @@
   (let ((cc (assq c (waiter-capables w))))
     (and cc (cdr cc))))
 
-;; The tasks waiting here, best rank first, under *tasks-lock*.  Global,
-;; as the posed tasks are: a process is one poser.
-(define *waiters* '())
+;; The node's line part: the tasks waiting here, best rank first, under
+;; (tasks-lock); the posers known to have tasks waiting, and when the lab
+;; was last asked for them; the lab's waiting tasks as last asked (below).
+(define-record-type line
+  (make-line waiters posers posers-asked lab-waiting)
+  line?
+  (waiters line-waiters line-waiters-set!)
+  (posers line-posers line-posers-set!)
+  (posers-asked line-posers-asked line-posers-asked-set!)
+  (lab-waiting line-lab-waiting line-lab-waiting-set!))
 
-(define (waiters) *waiters*)
+(define-syntax the-line (syntax-rules () ((_) (node-line *node*))))
+
+(define (open-line!) (node-line-set! (this-node) (make-line '() #f #f #f)))
+
+(define (waiters) (line-waiters (the-line)))
 (define (add-waiter! w)
   (let-values (((before after)
-                (break (lambda (x) (rank<? (waiter-rank w) (waiter-rank x))) *waiters*)))
-    (set! *waiters* (append before (cons w after)))))
-(define (drop-waiter! w) (set! *waiters* (remove (lambda (x) (eq? x w)) *waiters*)))
+                (break (lambda (x) (rank<? (waiter-rank w) (waiter-rank x))) (waiters))))
+    (line-waiters-set! (the-line) (append before (cons w after)))))
+(define (drop-waiter! w)
+  (line-waiters-set! (the-line) (remove (lambda (x) (eq? x w)) (waiters))))
 
 ;; A piece of news is (posed), (cancel), (give-way UID) or (offer REPLY
 ;; UID): its kind, then what it says, read by name.
@@ -134,9 +146,9 @@
 (define (give-way-uid n) (cadr n))
 
 (define (tell-waiter! w news)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
-      (cond ((memq w *waiters*)
+      (cond ((memq w (line-waiters (the-line)))
              (waiter-news-set! w (cons news (waiter-news w)))
              (mailbox-put! (waiter-bell w) #t))
             ((offer? news) (answer-offers! (list news) #f))))))
@@ -145,7 +157,7 @@
 ;; monotonic second until has passed.
 (define (take-news! w until)
   (mailbox-take (waiter-bell w) until (lambda () #f))
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (let ((news (reverse (waiter-news w))))
         (waiter-news-set! w '())
@@ -186,7 +198,7 @@
                 (let ((held (held-uids w)))
                   (and (or (null? holding) (not (car holding)) (pair? held))
                        (list (waiter-rank w) held))))
-              (with-lock *tasks-lock* waiters)))
+              (with-lock (tasks-lock) waiters)))
 
 ;; A task that waits at poser, as its entry of waiting-ranks says.
 (define-record-type waiting-there
@@ -211,17 +223,17 @@
 ;; which it does every look-period, so that a poser it missed (one that
 ;; joined later) is found: asking every address space each round cost
 ;; the robots most of their CPU (docs/speed.md).  #f until it has asked
-;; the lab.  Global: one address space, one view of the lab's posers.
-(define *posers* #f)
-(define *posers-asked* #f)              ; when the lab was last asked
+;; the lab.
 
 ;;> Notes that poser \var{uid} has tasks waiting.
 (define (know-poser! uid)
-  (if (and *posers* (not (memq uid *posers*))) (set! *posers* (cons uid *posers*))))
+  (let ((posers (line-posers (the-line))))
+    (if (and posers (not (memq uid posers)))
+        (line-posers-set! (the-line) (cons uid posers)))))
 
 (define (ask-lab-due?)
-  (or (not *posers*)
-      (> (- (monotonic-seconds) *posers-asked*) (look-period))))
+  (or (not (line-posers (the-line)))
+      (> (- (monotonic-seconds) (line-posers-asked (the-line))) (look-period))))
 
 ;;> What request of waiting-tasks answers, \var{proc} applied to
 ;;> \var{args} by each poser with tasks waiting, ((UID VALUE) ...), asked
@@ -229,16 +241,18 @@
 (define (ask-posers proc . args)
   (if (ask-lab-due?)
       (let ((answers (apply request 'waiting-tasks proc args)))
-        (set! *posers* (delete-duplicates (append (map car answers) (or *posers* '()))))
-        (set! *posers-asked* (monotonic-seconds))
+        (line-posers-set! (the-line)
+                          (delete-duplicates (append (map car answers)
+                                                     (or (line-posers (the-line)) '()))))
+        (line-posers-asked-set! (the-line) (monotonic-seconds))
         answers)
       (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
-                  (apply remote-apply-all (filter-map live-aspace *posers*) proc args))))
+                  (apply remote-apply-all (filter-map live-aspace (line-posers (the-line)))
+                         proc args))))
 
 ;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
-;; . WAITING-THERES), WHEN a monotonic-seconds.  Under *tasks-lock*; global,
-;; as the lab's waiting tasks are the same for all this poser's.
-(define *lab-waiting* #f)
+;; . WAITING-THERES), WHEN a monotonic-seconds, under (tasks-lock): the
+;; same for all this poser's tasks.
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
 ;; asked of the lab at most once a heartbeat for every 100 tasks it
@@ -248,15 +262,15 @@
 ;; list, and who holds what is asked afresh (lab-holders).
 (define (waiting-at-others)
   (let* ((now (monotonic-seconds))
-         (cached (with-lock *tasks-lock* (lambda () *lab-waiting*)))
+         (cached (with-lock (tasks-lock) (lambda () (line-lab-waiting (the-line)))))
          (all (if (and cached
                        (< (- now (car cached))
                           (* (setting 'heartbeat)
                              (max 1 (/ (length (cdr cached)) 100)))))
                   (cdr cached)
                   (let ((fresh (waiting-elsewhere)))
-                    (with-lock *tasks-lock*
-                      (lambda () (set! *lab-waiting* (cons now fresh))))
+                    (with-lock (tasks-lock)
+                      (lambda () (line-lab-waiting-set! (the-line) (cons now fresh))))
                     fresh)))
          (me (local-aspace-uid)))
     (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)))
@@ -283,7 +297,7 @@
   (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
         (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
                     (cadr subjects+limit))))
-    (let loop ((ws (with-lock *tasks-lock* waiters)) (n 0) (out '()))
+    (let loop ((ws (with-lock (tasks-lock) waiters)) (n 0) (out '()))
       (cond ((or (null? ws) (and limit (>= n limit))) (reverse out))
             ((wants? (car ws) uid subjects)
              (loop (cdr ws) (+ n 1)
@@ -321,7 +335,7 @@
 ;;> one line.
 (define (waiting-entries)
   (map (lambda (w) (cons (waiter-rank w) (waiting-entry w)))
-       (with-lock *tasks-lock* waiters)))
+       (with-lock (tasks-lock) waiters)))
 
 ;; w as (tasks) lists it: (posed ID STATE WHY PLACE PRIORITY HELD WANTS).
 (define (waiting-entry w)

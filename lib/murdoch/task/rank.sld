@@ -3,7 +3,7 @@
 ;;> place in it, and the waiter record of a task waiting here.
 
 (define-library (murdoch task rank)
-  (export make-turn turn? turn-wait? turn-hold? turn-priority turn-deadline
+  (export open-line! make-turn turn? turn-wait? turn-hold? turn-priority turn-deadline
           turn-posed read-turn check-waiting-room turn-rank rank<? better-rank
           look-period
           make-waiter waiter? waiter-task waiter-components waiter-rank

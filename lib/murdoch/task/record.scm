@@ -39,23 +39,32 @@
   (state component-state component-state-set!)
   (attempts component-attempts component-attempts-set!)) ; ((UID . OUTCOME) ...)
 
-;; The tasks started here, newest first: those not over, and at most
-;; tasks-kept of those over.  Global: peers' calls find them by name.  The
-;; lock guards these lists and the tasks' and waiters' fields.
-(define *posed* '())
-(define *tasks-lock* (make-mutex 'tasks))
+;; The node's posed part: the tasks started here, newest first, those not
+;; over and at most tasks-kept of those over; peers' calls find them by
+;; name.  Its lock guards these lists and the tasks' and waiters' fields.
+(define-record-type posed
+  (make-posed list lock)
+  posed?
+  (list posed-list posed-list-set!)
+  (lock posed-lock))
 
-(define (posed-tasks) *posed*)
+(define-syntax the-posed (syntax-rules () ((_) (node-posed *node*))))
+
+(define (open-posed!) (node-posed-set! (this-node) (make-posed '() (make-mutex 'tasks))))
+
+(define (tasks-lock) (posed-lock (the-posed)))
+
+(define (posed-tasks) (posed-list (the-posed)))
 
 (define (over? t) (memq (task-state t) '(done failed cancelled deadline)))
 
-;; Under *tasks-lock*.
-(define (add-posed! t) (set! *posed* (cons t *posed*)))
+;; Under (tasks-lock).
+(define (add-posed! t) (posed-list-set! (the-posed) (cons t (posed-list (the-posed)))))
 
-;; Forgets the tasks over but the newest kept of them.  Under *tasks-lock*.
+;; Forgets the tasks over but the newest kept of them.  Under (tasks-lock).
 (define (forget-over! kept)
-  (let loop ((ts *posed*) (n 0) (out '()))
-    (cond ((null? ts) (set! *posed* (reverse out)))
+  (let loop ((ts (posed-list (the-posed))) (n 0) (out '()))
+    (cond ((null? ts) (posed-list-set! (the-posed) (reverse out)))
           ((not (over? (car ts))) (loop (cdr ts) n (cons (car ts) out)))
           ((< n kept) (loop (cdr ts) (+ n 1) (cons (car ts) out)))
           (else (loop (cdr ts) n out)))))

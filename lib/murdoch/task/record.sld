@@ -10,11 +10,12 @@
           make-component component? component-index component-capabilities
           component-metric component-proc component-restartable? component-state
           component-state-set! component-attempts component-attempts-set!
-          *tasks-lock* posed-tasks add-posed! over? forget-over! fail-component!
+          tasks-lock open-posed! posed-tasks add-posed! over? forget-over! fail-component!
           component-result check-task-record
           status-index status-state status-attempts
           step-status? step-status-index step-status-entries
           listed-posed? listed-id listed-state listed-place listed-why
           listed-priority listed-held listed-wants listed-index listed-poser)
-  (import (scheme base) (scheme cxr) (srfi 1) (srfi 18))
+  (import (scheme base) (scheme cxr) (srfi 1) (srfi 18)
+          (only (murdoch lab) *node* this-node node-posed node-posed-set!))
   (include "record.scm"))

@@ -20,17 +20,17 @@
    (lambda ()
      (with-poses
       (lambda ()
-        (set! *negotiating* (cons (make-negotiation name (own-rank name) '())
-                                  *negotiating*)))))
+        (poses-negotiating-set! (the-poses) (cons (make-negotiation name (own-rank name) '())
+                                  (poses-negotiating (the-poses)))))))
    thunk
    (lambda ()
-     (with-poses (lambda () (set! *negotiating* (without-name name)))))))
+     (with-poses (lambda () (poses-negotiating-set! (the-poses) (without-name name)))))))
 
 ;; The negotiations here, but name's; and name's.  Under the poses' lock.
 (define (without-name name)
-  (remove (lambda (n) (eq? (negotiation-name n) name)) *negotiating*))
+  (remove (lambda (n) (eq? (negotiation-name n) name)) (poses-negotiating (the-poses))))
 (define (negotiation-named name)
-  (find (lambda (n) (eq? (negotiation-name n) name)) *negotiating*))
+  (find (lambda (n) (eq? (negotiation-name n) name)) (poses-negotiating (the-poses))))
 
 ;;> What a pose that wants robots held by pose \var{name} calls where
 ;;> \var{name} was posed, with its \var{rank} (priority name): answers #t
@@ -54,7 +54,7 @@
    (lambda ()
      (map (lambda (n)
             (cons* (negotiation-name n) (negotiation-rank n) (negotiation-rivals n)))
-          *negotiating*))))
+          (poses-negotiating (the-poses))))))
 
 ;; The ranks of the rivals that outrank pose name.
 (define (outranking-rivals name)
@@ -72,7 +72,7 @@
      (let ((n (negotiation-named name)))
        (and (not (any (lambda (rank) (outranks? rank (negotiation-rank n)))
                       (negotiation-rivals n)))
-            (begin (set! *negotiating* (without-name name)) #t))))))
+            (begin (poses-negotiating-set! (the-poses) (without-name name)) #t))))))
 
 ;; Whether a rival that outranks pose name is still negotiating where it
 ;; was posed.  Rivals that are done are forgotten, so that they no longer
@@ -103,12 +103,10 @@
   (filter-map (lambda (answer) (and (eq? (cadr answer) #t) (car answer)))
               (guard (e (#t '())) (request 'lab-tasks thunk))))
 
-;; After a try that found too few robots: whether another may do better.
-;; It may when other poses hold robots it could use, and those poses are
-;; told of this one's rank; or when such a robot is free now that was no
-;; candidate in the try: its holder let it go in between, as a pose that
-;; gives way does a moment after it is told (a try then found it held and
-;; this look found it free, and the pose gave up with the robots free).
+;; After a try that found too few robots: whether another may do better,
+;; when other poses hold robots it could use and are told of this one's
+;; rank, or when such a robot is free now that was no candidate in the
+;; try (its holder, told to give way, let it go in between).
 (define (contended! task)
   (let* ((statuses (capable-statuses (pose-layouts task) (pose-type-list task)))
          (holders (rival-holders (pose-name task) statuses)))

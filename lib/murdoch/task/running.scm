@@ -16,9 +16,19 @@
   (over? running-over? running-over?-set!)
   (cancelled? running-cancelled? running-cancelled?-set!)) ; by its poser
 
-;; Global: the poser's calls (component-heartbeat! ...) find them by name.
-(define *running* '())
-(define *running-lock* (make-mutex 'running))
+;; The node's runs part: the components running here, which the poser's
+;; calls (component-heartbeat! ...) find by name, and those ended here
+;; (below); one lock over both.
+(define-record-type runs
+  (make-runs running ended lock)
+  runs?
+  (running runs-running runs-running-set!)
+  (ended runs-ended runs-ended-set!)
+  (lock runs-lock))
+
+(define-syntax the-runs (syntax-rules () ((_) (node-runs *node*))))
+
+(define (open-runs!) (node-runs-set! (this-node) (make-runs '() '() (make-mutex 'running))))
 
 ;;> Runs component \var{k} of task \var{id} here, for \var{poser}, which
 ;;> sends a heartbeat every \var{period} seconds: work is (PROC ARG ...).
@@ -47,7 +57,9 @@
          (outcome unfinished))
     (running-over?-set! r #f)
     (running-cancelled?-set! r #f)
-    (with-lock *running-lock* (lambda () (set! *running* (cons r *running*))))
+    (let ((runs (the-runs)))
+      (with-lock (runs-lock runs)
+        (lambda () (runs-running-set! runs (cons r (runs-running runs))))))
     (watch! r)
     (dynamic-wind
      (lambda () #f)
@@ -104,10 +116,10 @@
   (guard (e (#t #f)) (stop-base)))      ; when this address space has a robot
 
 (define (find-running id k)
-  (with-lock *running-lock*
+  (with-lock (runs-lock (the-runs))
     (lambda ()
       (find (lambda (r) (and (eq? (running-id r) id) (= (running-index r) k)))
-            *running*))))
+            (runs-running (the-runs))))))
 
 ;;> A heartbeat from the poser of component \var{k} of task \var{id}:
 ;;> answers whether it runs here.
@@ -140,12 +152,12 @@
           (else (error "no such component here" id k)))))
 
 (define (find-ending id k)
-  (with-lock *running-lock*
+  (with-lock (runs-lock (the-runs))
     (lambda ()
       (find (lambda (e)
               (let ((r (ending-running e)))
                 (and (eq? (running-id r) id) (= (running-index r) k))))
-            *ended*))))
+            (runs-ended (the-runs))))))
 
 ;;> Stops component \var{k} of task \var{id} here, as cancel-task asks.
 (define (stop-component! id k)
@@ -158,18 +170,13 @@
 ;;> (ID INDEX POSER) for each component running here.
 (define (components-running)
   (map (lambda (r) (list (running-id r) (running-index r) (running-poser r)))
-       (with-lock *running-lock* (lambda () *running*))))
+       (with-lock (runs-lock (the-runs)) (lambda () (runs-running (the-runs))))))
 
-;;; The components ended here
-;;
-;; The last kept-ended of them, newest first, each an ending.  A component
-;; leaves the running list and joins this one at once, under the lock: a
-;; report that reads the running list first, then this one, finds every
-;; component in one or the other.
+;;; The components ended here: the last kept-ended, newest first.  A
+;;; component leaves the running list and joins this one under one lock,
+;;; so a report reading both finds it in one or the other.
 
 (define kept-ended 16)
-;; Global, as the running list is: a poser's report reads both.
-(define *ended* '())
 
 (define-record-type ending
   (make-ending running at end outcome)
@@ -185,12 +192,13 @@
                                      (not (eq? (car (end-of outcome)) 'done)))
                                 '(cancelled)
                                 (end-of outcome))
-                            outcome)))
-    (with-lock *running-lock*
+                            outcome))
+        (runs (the-runs)))
+    (with-lock (runs-lock runs)
       (lambda ()
-        (set! *running* (remove (lambda (x) (eq? x r)) *running*))
-        (set! *ended* (let ((all (cons entry *ended*)))
-                        (if (> (length all) kept-ended) (take all kept-ended) all)))))))
+        (runs-running-set! runs (remove (lambda (x) (eq? x r)) (runs-running runs)))
+        (runs-ended-set! runs (let ((all (cons entry (runs-ended runs))))
+                                (if (> (length all) kept-ended) (take all kept-ended) all)))))))
 
 ;; How a component ended: (done), (lost WHY), (failed WHY); note-ended!
 ;; makes it (cancelled) when its poser cancelled it.
@@ -209,7 +217,7 @@
            (let ((r (ending-running e)))
              (list (running-id r) (running-index r) (running-poser r)
                    (- now (running-started r)) (- now (ending-at e)) (ending-end e))))
-         (with-lock *running-lock* (lambda () *ended*)))))
+         (with-lock (runs-lock (the-runs)) (lambda () (runs-ended (the-runs)))))))
 
 ;;> The task id of \var{e}, an entry of components-ended.
 (define (ended-id e) (car e))

@@ -8,11 +8,12 @@
 ;;> components-ended list them all, for the status and the live view.
 
 (define-library (murdoch task running)
-  (export run-component run-posed-component component-heartbeat! stop-component!
+  (export open-runs! run-component run-posed-component component-heartbeat! stop-component!
           await-component
           components-running components-ended ended-id ended-index ended-started
           ended-ended ended-end orphan-periods lost-periods)
   (import (scheme base) (srfi 1) (srfi 18) (murdoch sys) (murdoch code) (murdoch wire)
-          (murdoch robot) (only (murdoch lab) setting)
+          (murdoch robot)
+          (only (murdoch lab) setting *node* this-node node-runs node-runs-set!)
           (only (murdoch remote) hand-over-connection! release-call!))
   (include "running.scm"))

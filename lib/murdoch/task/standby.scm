@@ -38,17 +38,15 @@
          (begin (set-team! h team-id state) #t))))
 
 (define (set-team! h team-id state)
-  (with-lock *handed-lock*
+  (with-lock (handing-lock (the-handing))
     (lambda ()
       (handed-teams-set! h (cons (list team-id state)
                                  (remove (lambda (x) (eq? (car x) team-id))
                                          (handed-teams h)))))))
 
 ;; The team-keeper of a detached task's steps: (keep-team ID TEAM-ID) the
-;; state its coordinator, or the standby that took over, holds of the
-;; team, or #f; (keep-team ID TEAM-ID STATE) holds it, and gives it to
-;; the standby.  A standby that does not answer is found lost by
-;; keep-watch, and the next is given every team as it is then.
+;; team's state held here, or #f; (keep-team ID TEAM-ID STATE) holds it
+;; and gives it to the standby, or to the next once keep-watch finds it lost.
 (define (keep-team id team-id . state)
   (let ((h (handed-by-id id)))
     (cond ((not h) #f)

@@ -1,9 +1,8 @@
 ;;;; Tasks of several steps (thesis ch. 6: pose-task with MOVER's
 ;;;; synchronization)
 ;;
-;; A step starts when every component of the step before is done (a
-;; barrier), its procedures applied to that step's results.  A component
-;; may ask for a robot of an earlier step, so a team keeps its members
+;; A step starts when the step before is done, its procedures applied to
+;; that step's results; a component may ask for an earlier step's robot
 ;; (team.scm).  A step with a failed component stops the task.
 
 (define-record-type step

@@ -1,11 +1,7 @@
-;;;; Why a task found not enough takers.
-;;
-;; pose-task answers the thesis's not-enough-takers; a person at a REPL
-;; then wants to know who could have taken each component and why none
-;; did.  Asked once the negotiation has given up, so it costs nothing on
-;; the way to a winner: each component's subjects are requested afresh,
-;; each capable robot answering the holders of its exclusive subjects,
-;; and the lab file says who should have answered.
+;;;; Why a task found not enough takers: who could have taken each
+;;;; component and why none did, asked afresh once the negotiation has
+;;;; given up, each capable robot answering the holders of its exclusive
+;;;; subjects, and the lab file saying who should have answered.
 
 ;;> Writes to \var{port} why task \var{task-name} found no takers: for
 ;;> each of \var{layouts} (a component's (EXCLUSIVE SHARED) subjects), the

@@ -48,7 +48,7 @@
 
 ;;> Seconds a component may run before its caller gives up on it, when
 ;;> on-list is not given a timeout; it stops on its robot at its next
-;;> command (abandon.scm).
+;;> command (code/abandon.scm).
 (define task-timeout (make-parameter (lab-default 'task-timeout)))
 (sandbox-parameter! task-timeout)
 
@@ -84,7 +84,7 @@
                  uids procs)))))
 
 ;; The threads' results, in order; left early (Ctrl-C), the threads are
-;; interrupted too and each gives up its component (abandon.scm).
+;; interrupted too and each gives up its component (code/abandon.scm).
 (define (join-or-interrupt threads)
   (undo-on-raise (lambda () (for-each thread-interrupt! threads))
                  (lambda () (map thread-join! threads))))
@@ -100,7 +100,7 @@
     result))
 
 ;; A component this address space won runs in a thread of its own, so
-;; seconds bound it as they bound one elsewhere (abandon.scm).
+;; seconds bound it as they bound one elsewhere (code/abandon.scm).
 (define (apply-here-by proc seconds)
   (let* ((outcome #f)
          (runner (make-logged-thread
@@ -127,18 +127,13 @@
 ;;; Synchronization inside a team, MOVER's way
 ;;
 ;; Members wait at named barriers and pass values by uid through the
-;; team's coordinator, held where the task is coordinated, under the
-;; team's id.  A member reaches it by its address, (ID UID KEPT?); when
-;; UID is lost, or holds the team no more, the member of a team that is
-;; kept (a detached task's, taken over) asks the lab who holds ID now
-;; (the lab-tasks subject, which the members holding a detached task
-;; subscribe to), and calls again there.
-;; So any call may count twice: an arrival counts once however often it
-;; comes, a letter carries its sender's key and is kept once, a member
-;; takes each key once, and a letter stays with the coordinator until the
-;; member's next receive says that it came.  A coordinator that is kept
-;; (make-coordinator's keep) keeps an arrival or a letter before its
-;; member hears that it counted.
+;; team's coordinator, held under the team's id where the task is
+;; coordinated, and reached by its address, (ID UID KEPT?).  A member of
+;; a kept team (a detached task's) whose UID is lost asks the lab-tasks
+;; subject who holds ID now and calls again there, so any call may count
+;; twice: an arrival counts once, a letter carries its sender's key and
+;; is kept and taken once, and stays until the member's next receive
+;; says it came.  A kept coordinator keeps each before its member hears.
 
 ;; What a member of a team keeps, in the thread running its procedure.
 (define-record-type teammate
@@ -288,13 +283,23 @@
   (live? held-team-live?)
   (proc held-team-proc))
 
-;; Global: the teams held here, found by id from members' calls.
-(define *teams* '())
-(define *teams-lock* (make-mutex 'teams))
+;; The node's teams part: the teams held here, found by id from members'
+;; calls.
+(define-record-type held-teams
+  (make-held-teams list lock)
+  held-teams?
+  (list held-teams-list held-teams-list-set!)
+  (lock held-teams-lock))
+
+(define-syntax the-teams (syntax-rules () ((_) (node-teams *node*))))
+
+(define (open-teams!) (node-teams-set! (this-node) (make-held-teams '() (make-mutex 'teams))))
 
 (define (find-held-team id)
-  (with-lock *teams-lock*
-    (lambda () (find (lambda (c) (eq? (address-id (held-team-address c)) id)) *teams*))))
+  (with-lock (held-teams-lock (the-teams))
+    (lambda ()
+      (find (lambda (c) (eq? (address-id (held-team-address c)) id))
+            (held-teams-list (the-teams))))))
 
 ;;> Whether this address space holds team \var{id} and acts for it.
 (define (team-held? id)
@@ -320,17 +325,21 @@
   (let ((c (make-held-team (list id (local-aspace-uid) (and keep #t)) live?
                            (coordinator-proc team-of live? keep
                                              (or (and keep (keep)) '(() ()))))))
-    (with-lock *teams-lock*
+    (with-lock (held-teams-lock (the-teams))
       (lambda ()
-        (set! *teams* (cons c (remove (lambda (x) (eq? (address-id (held-team-address x)) id))
-                                      *teams*)))))
+        (held-teams-list-set!
+         (the-teams)
+         (cons c (remove (lambda (x) (eq? (address-id (held-team-address x)) id))
+                         (held-teams-list (the-teams)))))))
     (held-team-address c)))
 
 ;;> Forgets the coordinator at \var{address}, made here by make-coordinator.
 (define (release-coordinator! address)
-  (with-lock *teams-lock*
+  (with-lock (held-teams-lock (the-teams))
     (lambda ()
-      (set! *teams* (remove (lambda (c) (eq? (held-team-address c) address)) *teams*)))))
+      (held-teams-list-set! (the-teams)
+                            (remove (lambda (c) (eq? (held-team-address c) address))
+                                    (held-teams-list (the-teams)))))))
 
 ;; The coordinator's calls, its state (ARRIVED LETTERS) to begin with:
 ;; ARRIVED the (NAME . UID) come to a barrier, LETTERS those not known

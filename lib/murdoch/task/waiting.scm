@@ -34,7 +34,7 @@
   (waiter-excluded-set! w (pose-task-excluded))
   (waiter-news-set! w '())
   (waiter-bell-set! w (make-mailbox))
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (task-waiter-set! (waiter-task w) w)
       (add-waiter! w)
@@ -42,33 +42,51 @@
       (subscribe 'waiting-tasks)))
   (note-lab! (waiter-rank w)))
 
+;; The node's looking part: a poser's one line of tasks, and what its
+;; notes to the lab, its tries and its one looking thread share.
+(define-record-type looking
+  (make-looking noting? note-again try-lock looker? bell takers free-seen)
+  looking?
+  (noting? looking-noting? looking-noting?-set!)    ; a publication goes
+  (note-again looking-note-again looking-note-again-set!) ; best rank since, or #f
+  (try-lock looking-try-lock)
+  (looker? looking-looker? looking-looker?-set!)    ; the looking thread runs
+  (bell looking-bell)                   ; rung by a task that wants a look
+  (takers looking-takers looking-takers-set!)
+  (free-seen looking-free-seen looking-free-seen-set!))
+
+(define-syntax the-looking (syntax-rules () ((_) (node-looking *node*))))
+
+(define (open-looking!)
+  (node-looking-set! (this-node)
+                     (make-looking #f #f (make-mutex 'tries) #f (make-mailbox) #f '())))
+
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
-;; their ranks.  Global: a process is one poser, with one line of tasks.
-(define *noting* #f)                    ; a publication goes
-(define *note-again* #f)                ; the best rank waiting since, or #f
-
+;; their ranks.
 (define (note-lab! rank)
-  (when (with-lock *tasks-lock*
+  (when (with-lock (tasks-lock)
           (lambda ()
-            (if *noting*
-                (begin (set! *note-again* (better-rank rank *note-again*)) #f)
-                (begin (set! *noting* #t) #t))))
+            (let ((l (the-looking)))
+              (if (looking-noting? l)
+                  (begin (looking-note-again-set! l (better-rank rank (looking-note-again l)))
+                         #f)
+                  (begin (looking-noting?-set! l #t) #t)))))
     (let loop ((rank rank))
       (guard (e (#t (log-warn "telling the lab a task waits: " (error-message e))))
         (publish 'all note-waiters! (local-aspace-uid) rank))
-      (let ((again (with-lock *tasks-lock*
+      (let ((again (with-lock (tasks-lock)
                      (lambda ()
-                       (let ((again *note-again*))
-                         (set! *note-again* #f)
-                         (if (not again) (set! *noting* #f))
+                       (let ((again (looking-note-again (the-looking))))
+                         (looking-note-again-set! (the-looking) #f)
+                         (if (not again) (looking-noting?-set! (the-looking) #f))
                          again)))))
         (if again (loop again))))))
 
 ;; The offers w had not answered are declined: a robot waits for no task
 ;; that no longer waits.
 (define (delist! w)
-  (with-lock *tasks-lock*
+  (with-lock (tasks-lock)
     (lambda ()
       (task-waiter-set! (waiter-task w) #f)
       (drop-waiter! w)
@@ -135,11 +153,10 @@
 ;; to the others are left alone, and so are all but those offered to w,
 ;; the uids offered, when w can take robots one at a time (it holds, or
 ;; needs one): a robot may be kept for this poser on its way to offer
-;; itself to another of its tasks.  Global: one poser a process.
-(define *try-lock* (make-mutex 'tries))
+;; itself to another of its tasks.
 
 (define (try-in-turn w try offered)
-  (with-lock *try-lock*
+  (with-lock (looking-try-lock (the-looking))
     (lambda ()
       (waiter-offered-set! w offered)
       (let ((excluded (append (offered-to-others w) (not-offered w offered)
@@ -187,27 +204,23 @@
 
 ;;; The poser's look, for all its waiting tasks at once
 
-;; Global: one poser a process, so one looking thread.
-(define *looker* #f)                    ; the poser's looking thread runs
-(define *look-bell* (make-mailbox))     ; rung by a task that wants a look
-
-;; Under *tasks-lock*, as a task starts to wait.
+;; Under (tasks-lock), as a task starts to wait.
 (define (start-looker!)
-  (when (not *looker*)
-    (set! *looker* #t)
+  (when (not (looking-looker? (the-looking)))
+    (looking-looker?-set! (the-looking) #t)
     (thread-start! (make-logged-thread looker 'looks))))
 
-(define (want-look!) (mailbox-put! *look-bell* #t))
+(define (want-look!) (mailbox-put! (looking-bell (the-looking)) #t))
 
 ;; Looks when a waiting task asks, a second after the last look at the
 ;; soonest, and every ten heartbeats or a third of the lease in any case,
 ;; until no task waits here.
 (define (looker)
-  (mailbox-take *look-bell* (next-look #f) (lambda () #f))
-  (mailbox-empty! *look-bell*)
-  (let ((ws (with-lock *tasks-lock*
+  (mailbox-take (looking-bell (the-looking)) (next-look #f) (lambda () #f))
+  (mailbox-empty! (looking-bell (the-looking)))
+  (let ((ws (with-lock (tasks-lock)
               (lambda ()
-                (if (null? (waiters)) (set! *looker* #f))
+                (if (null? (waiters)) (looking-looker?-set! (the-looking) #f))
                 (waiters))))
         (start (monotonic-seconds)))
     (when (pair? ws)
@@ -249,18 +262,16 @@
 ;; of the n tasks waiting in the lab (docs/allocation.md).  Who is capable
 ;; and free, and why a task waits, may so be n/100 heartbeats old; who
 ;; is offered a robot is decided by the robot's round, never by this.
-;; Global: one poser, one look at a time.
-(define *takers* #f)                    ; (WHEN (LAYOUT . EXPLANATION) ...)
-
+;; The last are kept as (WHEN (LAYOUT . EXPLANATION) ...).
 (define (takers-of layouts n)
-  (let ((now (monotonic-seconds)))
-    (if (and *takers*
-             (< (- now (car *takers*))
-                (* (setting 'heartbeat) (max 1 (/ n 100))))
-             (every (lambda (l) (assoc l (cdr *takers*))) layouts))
-        (values (cdr *takers*) #f)
+  (let ((now (monotonic-seconds))
+        (last (looking-takers (the-looking))))
+    (if (and last
+             (< (- now (car last)) (* (setting 'heartbeat) (max 1 (/ n 100))))
+             (every (lambda (l) (assoc l (cdr last))) layouts))
+        (values (cdr last) #f)
         (let ((lines (map cons layouts (explain-components layouts))))
-          (set! *takers* (cons now lines))
+          (looking-takers-set! (the-looking) (cons now lines))
           (values lines #t)))))
 
 ;; The line a look tells of explanation e for component number i, trimmed,
@@ -341,16 +352,16 @@
 ;; is asked to offer itself (again), best rank first, rather than taken by
 ;; a try out of turn.  A robot just freed is offering itself already: a
 ;; look that reminded every robot it found free, with hundreds of tasks
-;; waiting, kept them all answering reminders.  Global, as the look is.
-(define *free-seen* '())                ; the free robots of the last look
+;; waiting, kept them all answering reminders.  The free robots of the
+;; last look are kept.
 
 (define (remind-free! free)
   (for-each (lambda (uid)
               (guard (e (#t (log-warn "reminding " uid ": " (error-message e))))
                 (parameterize ((remote-timeout 1))
                   (remote-apply (uid->aspace uid) note-waiters! (local-aspace-uid)))))
-            (filter (lambda (uid) (memq uid *free-seen*)) free))
-  (set! *free-seen* free))
+            (filter (lambda (uid) (memq uid (looking-free-seen (the-looking)))) free))
+  (looking-free-seen-set! (the-looking) free))
 
 (define (trimmed line)
   (let loop ((s line))
@@ -370,7 +381,7 @@
   (let ((place (guard (e (#t (waiter-position w)))
                  (place-in-line w (if (pair? line) (car line) (line-of (lab-waiting))))))
         (t (waiter-task w)))
-    (with-lock *tasks-lock*
+    (with-lock (tasks-lock)
       (lambda ()
         (waiter-position-set! w place)
         (if (and (pair? (waiter-why w)) (memq (task-state t) '(negotiating waiting holding)))
@@ -390,6 +401,6 @@
 ;; Whether a better-ranked task of the lab waits: w, just posed, has not
 ;; looked at which robots it may use.
 (define (behind-others? w)
-  (or (rank<? (waiter-rank (car (with-lock *tasks-lock* waiters))) (waiter-rank w))
+  (or (rank<? (waiter-rank (car (with-lock (tasks-lock) waiters))) (waiter-rank w))
       (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
            (guard (e (#t '())) (waiting-at-others)))))

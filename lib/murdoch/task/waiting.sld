@@ -3,7 +3,7 @@
 ;;> until it wins its robots, its deadline passes or it is cancelled.
 
 (define-library (murdoch task waiting)
-  (export negotiate-turn move-up!)
+  (export open-looking! negotiate-turn move-up!)
   (import (scheme base) (scheme char) (scheme cxr) (srfi 1) (srfi 18) (srfi 132)
           (murdoch sys) (murdoch code) (murdoch wire) (murdoch lab) (murdoch remote)
           (murdoch task progress) (murdoch task pose-task)

@@ -1,9 +1,9 @@
 ;;;; The live view's table of tasks, part of (murdoch view): who holds what
-;;;; for which task, from the robots' reports of subjects held (NAME@POSER/N),
+;;;; for which task, from the robots' reports of subjects held and
 ;;;; components running and ended.  A component seen on another robot was
-;;;; reassigned; subjects held with none are a negotiation's reservation.  A
-;;;; task's state is its poser's word, else its components'.  A component is
-;;;; lost when its robot restarted or missed away-polls looks.
+;;;; reassigned, subjects held with none are a reservation, a component is
+;;;; lost when its robot restarted or missed away-polls looks, and a task's
+;;;; state is its poser's word, else its components'.
 
 (define-record-type task-entry
   (make-task-entry key name poser state components)
