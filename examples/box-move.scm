@@ -544,27 +544,43 @@
              (begin (note-turn! own)
                     (list own (if view (cadr view) '())))))))
 
-;; How many degrees left the box must turn to head for the path.
+;; How many degrees left the box must turn to head for the path: for its
+;; aim point, but at most max-approach off the path's own way there, so
+;; that a box far aside of its path is never steered toward a face its
+;; pushers are not at (seed 42: a lone pusher left it 620 mm aside, the
+;; pair turned it 45 degrees off its leg toward the path and past).
+(define max-approach 30)
 (define (turn-error box)
-  (wrap (- (heading-to box (aim-point box)) (place-axis box))))
+  (let* ((legs (nearest-legs box))
+         (s (leg-position box (car legs) (cadr legs)))
+         (aim (along-path legs (+ s lookahead)))
+         (way (heading-to (along-path legs s) aim)))
+    (wrap (- (+ way (clip (wrap (- (heading-to box aim) way)) max-approach))
+             (place-axis box)))))
 
 ;; Where on the rear face this pusher pushes from, mm left of its middle:
-;; its own place until it is alone; then where lone-offset says, kept
+;; its own place until it is alone; then the clear spot nearest lone-want, kept
 ;; until that has moved by more than 80 mm, for a pusher that slides far
 ;; along a face it pushes drags the box round the wrong way: it comes up
 ;; afresh to each new spot (approach!).  Before it is alone a spare may
 ;; come to the other half, and a lone pusher that slid toward the middle
 ;; as it pushed turned the box 45 degrees the wrong way in 5 s while the
 ;; spare waited for the lost pusher's body to clear its place (generated
-;; seed 13).
+;; seed 13).  A pusher whose own place a body holds pushes from the spot
+;; of its own half nearest it that is clear, out to where half of it is
+;; behind the face: seed 42's box turned until the lost pusher's body lay
+;; behind its middle, holding both places, and no one pushed it on.
 (define lone-at #f)
 (define (push-offset view side)
-  (if (not (alone?))
-      (begin (set! lone-at #f) (* side pusher-offset))
-      (let ((want (lone-offset (car view) (cadr view) side)))
-        (cond ((not lone-at) (set! lone-at (* side pusher-offset)))
-              ((> (abs (- want lone-at)) 80) (set! lone-at want)))
-        lone-at)))
+  (let ((own (* side pusher-offset)) (box (car view)) (bodies (cadr view)))
+    (cond ((alone?)
+           (let ((want (or (clear-offset box bodies side (lone-want box) pusher-offset) own)))
+             (cond ((not lone-at) (set! lone-at own))
+                   ((> (abs (- want lone-at)) 80) (set! lone-at want)))
+             lone-at))
+          (else
+           (set! lone-at #f)
+           (or (clear-offset box bodies side own (+ box-half (/ body-radius 2)) side) own)))))
 
 ;; Whether this pusher has heard nothing from a partner for 10 s (long
 ;; enough for a spare to be found and the watcher to know where the lost
@@ -670,19 +686,23 @@
 ;; push clears).
 (define (spare-spoke?) (< (coming-age) 2))
 
-;; Where a pusher alone pushes, mm left of the middle of the rear face:
-;; 10 mm aside a degree the box must turn, to the right of the middle to
-;; turn it left, anywhere along the face; or the spot nearest that, its own
+;; Where a pusher alone would push, mm left of the middle of the rear
+;; face: 10 mm aside a degree the box must turn, to the right of the middle
+;; to turn it left.
+(define (lone-want box) (clip (* -10 (turn-error box)) pusher-offset))
+
+;; The spot nearest want, mm left of the middle of the rear face, its own
 ;; side first, that is clear of the lost pushers' bodies as a place must be
-;; (staging), else its own place.
-(define (lone-offset box bodies side)
+;; (staging), at most reach from the middle and, given half, on that side
+;; of it (+1 left, -1 right); #f when there is none.
+(define (clear-offset box bodies side want reach . half)
   (let* ((axis (place-axis box))
-         (want (clip (* -10 (turn-error box)) pusher-offset))
          (clear? (lambda (o)
-                   (and (<= (abs o) pusher-offset)
+                   (and (<= (abs o) reach)
+                        (or (null? half) (>= (* o (car half)) 0))
                         (clear-of? bodies (list (behind-at box axis o)) -40)))))
     (let loop ((k 0))
-      (cond ((> k (* 2 pusher-offset)) (* side pusher-offset))
+      (cond ((> k (* 2 reach)) #f)
             ((find clear? (list (+ want (* side k)) (- want (* side k)))))
             (else (loop (+ k 20)))))))
 
@@ -949,12 +969,9 @@
 ;; The box's axis nearest to heading d: a square box has four.
 (define (box-axis box d) (+ d (square-wrap (- (list-ref box 2) d))))
 
-;; The point of the path the box steers for: lookahead mm along the path
-;; past the point of it nearest the box, or the goal.
+;; How far along the path, past the point of it nearest the box, the
+;; point the box steers for lies, mm (turn-error).
 (define lookahead 700)
-(define (aim-point box)
-  (let ((legs (nearest-legs box)))
-    (along-path legs (+ (leg-position box (car legs) (cadr legs)) lookahead))))
 
 ;; How far along the leg from a to b the point of it nearest p is, mm.
 (define (leg-position p a b)

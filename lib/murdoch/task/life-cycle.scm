@@ -303,9 +303,12 @@
                   (call-there a answer (task-id t) (component-index c)
                                      (local-aspace-uid) (* patience period) work))))
     (thread-start! runner)
-    (let watch ((heard (monotonic-seconds)))
-      (let ((got (mailbox-take answer (+ (monotonic-seconds) period)
-                               (lambda () #f))))
+    ;; A beat goes a period after the last one went, not after its answer
+    ;; came: the robot stops a component orphan-periods after the last it
+    ;; heard, and on a loaded machine an answer may take most of a period.
+    (let watch ((heard (monotonic-seconds)) (due (+ (monotonic-seconds) period)))
+      (let ((got (mailbox-take answer due (lambda () #f)))
+            (next (max (+ due period) (monotonic-seconds))))
         (cond
          (got (outcome-of got))
          ;; Its call is not given up: that would stop the component,
@@ -313,13 +316,13 @@
          ((let-go? t) '(let-go))
          ((begin (task-acted-set! t (utc-seconds))
                  (heartbeat a (task-id t) (component-index c) period))
-          (watch (monotonic-seconds)))
+          (watch (monotonic-seconds) next))
          ((>= (- (monotonic-seconds) heard) (* (lost-periods) patience period))
           (thread-interrupt! runner)    ; its call is given up
           (list 'lost (string-append (symbol->string uid) " silent for "
                                      (number->string (* (lost-periods) patience))
                                      " heartbeats")))
-         (else (watch heard)))))))
+         (else (watch heard next)))))))
 
 ;; A thunk that runs work on a inside run-component, and puts (value V)
 ;; or (raised E) in the mailbox answer.
