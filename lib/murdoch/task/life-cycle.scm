@@ -307,8 +307,8 @@
     ;; came: the robot stops a component orphan-periods after the last it
     ;; heard, and on a loaded machine an answer may take most of a period.
     (let watch ((heard (monotonic-seconds)) (due (+ (monotonic-seconds) period)))
-      (let ((got (mailbox-take answer due (lambda () #f)))
-            (next (max (+ due period) (monotonic-seconds))))
+      (let* ((got (mailbox-take answer due (lambda () #f)))
+             (next (max (+ due period) (monotonic-seconds))))
         (cond
          (got (outcome-of got))
          ;; Its call is not given up: that would stop the component,
