@@ -179,7 +179,7 @@
                        (begin (offering-again?-set! o #t) #f)
                        (begin (offering-round?-set! o #t) #t)))))
       ;; At once, not in the round's thread, which may start late.
-      (offer-subjects! 'nobody 3)
+      (if (heard-of-waiters? o) (offer-subjects! 'nobody 3))
       (thread-start! (make-logged-thread offer-rounds 'offers)))))
 
 ;; The robot is kept for the poser it was last offered to until the
@@ -217,7 +217,7 @@
   (let* ((me (local-aspace-uid))
          (o (the-offering))
          (depth (offering-depth o))
-         (keep? (or (offering-waiters-seen o) (offering-waiters-here? o))))
+         (keep? (heard-of-waiters? o)))
     (offering-waiters-here?-set! o #f)  ; before asking: a note after it stands
     (offering-new-waiters-set! o #f)
     (offer-subjects! (and keep? 'nobody) 3)
@@ -244,6 +244,12 @@
     (if horizon
         (take-while (lambda (e) (not (rank<? horizon (wanting-rank e)))) waiting)
         waiting)))
+
+;; Whether tasks waited at the robot's last round or one was noted since:
+;; not merely that it joined (offer-on-joining!), or a robot freed in a
+;; lab where no task waits would refuse every negotiation while it asks.
+(define (heard-of-waiters? o)
+  (and (or (offering-waiters-seen o) (offering-new-waiters o)) #t))
 
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
