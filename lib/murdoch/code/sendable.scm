@@ -368,6 +368,11 @@
     (define (maker-of key) (maker (hash-table-cell makers key #f) key))
     (lambda (source names) (maker-of (cons source names)))))
 
+;; A place of tagged-places: (PAIR IN-CAR? . DEPTH), read without calls.
+(define-syntax place-pair (syntax-rules () ((_ place) (car place))))
+(define-syntax place-in-car? (syntax-rules () ((_ place) (cadr place))))
+(define-syntax place-depth (syntax-rules () ((_ place) (cddr place))))
+
 ;;> Returns a procedure that rebuilds values encoded by \scheme{encode},
 ;;> resolving globals and sources in \var{env} and proxies by \var{proxy};
 ;;> in place, so the value must be fresh from a frame.
@@ -375,18 +380,22 @@
   (let ((compile (make-closure-compiler env)))
     (define (dec x depth)
       (cond
-       ((pair? x) (check-depth (+ depth 1) "a received value")
-                  (dec-elements! x (+ depth 1))
+       ((pair? x) (fill-places! (tagged-places x depth (limits-depth (the-limits))))
                   x)
        ((vector? x) (dec-tagged x depth))
        (else x)))
-    ;; By iteration down the cdrs; no let or or (see known-encoding).
-    (define (dec-elements! p depth)
-      (if (pair? (car p))
-          (set-car! p (dec (car p) depth))
-          (if (vector? (car p)) (set-car! p (dec (car p) depth))))
-      (cond ((pair? (cdr p)) (dec-elements! (cdr p) depth))
-            ((vector? (cdr p)) (set-cdr! p (dec (cdr p) depth)))))
+    ;; The walk down the pairs is C's (plain.c); its places, here.
+    (define (fill-places! places)
+      (cond ((pair? places) (fill-place! (car places))
+                            (fill-places! (cdr places)))
+            ((eq? places #f) (check-depth (+ 1 (limits-depth (the-limits)))
+                                          "a received value"))))
+    (define (fill-place! place)
+      (if (place-in-car? place)
+          (set-car! (place-pair place)
+                    (dec-tagged (car (place-pair place)) (place-depth place)))
+          (set-cdr! (place-pair place)
+                    (dec-tagged (cdr (place-pair place)) (place-depth place)))))
     (define (dec-tagged v depth)
       (check-depth (+ depth 1) "a received value")
       (dec-tag (vector-ref v 0) v depth))
@@ -409,4 +418,4 @@
        ((eq? tag 'murdoch:eof) (eof-object))
        (else (error "unknown tag in a received value" v))))
     (define (global-ref name) (procedure-in (env-cell env name) name))
-    (lambda (x) (if (plain? x) x (dec x 0)))))
+    (lambda (x) (dec x 0))))
