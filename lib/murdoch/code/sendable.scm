@@ -368,10 +368,11 @@
     (define (maker-of key) (maker (hash-table-cell makers key #f) key))
     (lambda (source names) (maker-of (cons source names)))))
 
-;; A place of tagged-places: (PAIR IN-CAR? . DEPTH), read without calls.
+;; A place of tagged-places: (PAIR IN-CAR? . DEPTH), read without calls
+;; (cadr is a procedure in Chibi, car an opcode).
 (define-syntax place-pair (syntax-rules () ((_ place) (car place))))
-(define-syntax place-in-car? (syntax-rules () ((_ place) (cadr place))))
-(define-syntax place-depth (syntax-rules () ((_ place) (cddr place))))
+(define-syntax place-in-car? (syntax-rules () ((_ place) (car (cdr place)))))
+(define-syntax place-depth (syntax-rules () ((_ place) (cdr (cdr place)))))
 
 ;;> Returns a procedure that rebuilds values encoded by \scheme{encode},
 ;;> resolving globals and sources in \var{env} and proxies by \var{proxy};

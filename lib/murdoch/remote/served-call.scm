@@ -157,10 +157,13 @@
       (serve-call r (served-call-of message uid answer))
       (serve-notice (reading-serving r) uid message)))
 
-;; The served call message asks for, by the places of wire/frame.scm's table.
+;; The served call message asks for, by the places of wire/frame.scm's
+;; table: (KIND ID PROC ARGS); car and cdr, opcodes, where list-ref is a
+;; call (docs/speed.md).
 (define (served-call-of message uid answer)
-  (make-served-call uid (message-id message) (car message) (list-ref message 2)
-                    (list-ref message 3) answer))
+  (make-served-call uid (message-id message) (car message)
+                    (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
+                    answer))
 
 ;; Serves a frame that needs no answer: an answer or an abandon (by cond).
 (define (serve-notice s uid message)

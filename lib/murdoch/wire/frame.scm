@@ -84,7 +84,7 @@
       (protocol-fail "datagram" "not a datagram")))
 
 ;;> The id of \var{message} (all kinds but hello, welcome, datagram, beacon).
-(define (message-id message) (cadr message))
+(define (message-id message) (car (cdr message))) ; cadr is a call
 
 ;;> The field named \var{name} of \var{message}, a checked message, as
 ;;> the table names it.
