@@ -342,9 +342,13 @@
 ;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
 
+;; procedure? is a call in Chibi (init-7.scm); closure? and opcode? are opcodes.
+(define-syntax closure-or-opcode?
+  (syntax-rules () ((_ x) (if (closure? x) #t (opcode? x)))))
+
 ;; The procedure in cell, the env-cell of global name (no let: see known-encoding).
 (define (procedure-in cell name)
-  (if (and cell (procedure? (cdr cell)))
+  (if (and cell (closure-or-opcode? (cdr cell)))
       (cdr cell)
       (error "no procedure of this name here" name)))
 
