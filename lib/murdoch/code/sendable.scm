@@ -174,10 +174,15 @@
                     (make-value-limits (setting 'max-depth)
                                        (quotient (setting 'max-frame) 2))))
 
-(define (check-depth depth what)
-  (if (> depth (limits-depth (the-limits)))
-      (send-fail (what-string what) " nests deeper than the lab's max-depth, "
-                 (number->string (limits-depth (the-limits))))))
+;; A macro: the test is on every level of every value sent or received,
+;; the raise seldom (docs/speed.md).
+(define-syntax check-depth
+  (syntax-rules ()
+    ((_ depth what) (if (> depth (limits-depth (the-limits))) (too-deep what)))))
+
+(define (too-deep what)
+  (send-fail (what-string what) " nests deeper than the lab's max-depth, "
+             (number->string (limits-depth (the-limits)))))
 
 ;; (map f ls) by iteration, ls maybe improper: f gets its tail too.
 (define (map-elements f ls)
@@ -372,12 +377,6 @@
     (define (maker-of key) (maker (hash-table-cell makers key #f) key))
     (lambda (source names) (maker-of (cons source names)))))
 
-;; A place of tagged-places: (PAIR IN-CAR? . DEPTH), read without calls
-;; (cadr is a procedure in Chibi, car an opcode).
-(define-syntax place-pair (syntax-rules () ((_ place) (car place))))
-(define-syntax place-in-car? (syntax-rules () ((_ place) (car (cdr place)))))
-(define-syntax place-depth (syntax-rules () ((_ place) (cdr (cdr place)))))
-
 ;;> Returns a procedure that rebuilds values encoded by \scheme{encode},
 ;;> resolving globals and sources in \var{env} and proxies by \var{proxy};
 ;;> in place, so the value must be fresh from a frame.
@@ -389,18 +388,19 @@
                   x)
        ((vector? x) (dec-tagged x depth))
        (else x)))
-    ;; The walk down the pairs is C's (plain.c); its places, here.
+    ;; The walk down the pairs is C's (plain.c); its places, here, each
+    ;; a pair and (+ (* 2 depth) 1) for its car, (* 2 depth) for its cdr.
     (define (fill-places! places)
-      (cond ((pair? places) (fill-place! (car places))
-                            (fill-places! (cdr places)))
-            ((eq? places #f) (check-depth (+ 1 (limits-depth (the-limits)))
-                                          "a received value"))))
-    (define (fill-place! place)
-      (if (place-in-car? place)
-          (set-car! (place-pair place)
-                    (dec-tagged (car (place-pair place)) (place-depth place)))
-          (set-cdr! (place-pair place)
-                    (dec-tagged (cdr (place-pair place)) (place-depth place)))))
+      (cond ((vector? places) (fill-from! places 0))
+            ((eq? places 'too-deep) (too-deep "a received value"))))
+    (define (fill-from! places i)
+      (if (< i (vector-length places))
+          (begin (fill-place! (vector-ref places i) (vector-ref places (+ i 1)))
+                 (fill-from! places (+ i 2)))))
+    (define (fill-place! p code)
+      (if (eq? 1 (remainder code 2))   ; odd? is a call
+          (set-car! p (dec-tagged (car p) (quotient code 2)))
+          (set-cdr! p (dec-tagged (cdr p) (quotient code 2)))))
     (define (dec-tagged v depth)
       (check-depth (+ depth 1) "a received value")
       (dec-tag (vector-ref v 0) v depth))

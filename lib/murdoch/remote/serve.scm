@@ -118,7 +118,7 @@
              (take-polled! s rest))))
 
 (define (await-whole! s)
-  (cond ((positive? (poller-buffered (serving-fd s)))
+  (cond ((> (poller-buffered (serving-fd s)) 0) ; positive? is a call
          (if (serving-deadline s)
              #f
              (begin (serving-deadline-set! s (+ (monotonic-seconds)
