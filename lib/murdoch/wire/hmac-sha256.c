@@ -14,7 +14,7 @@
  *  of those two states.  Chibi's threads are green threads on one OS
  *  thread, and a call into C is not interrupted by them, so one set of
  *  states serves every call; every frame of a process is under one key.
- *  OpenSSL 3's EVP_MAC, which this file used before, spent about 2,500
+ *  OpenSSL 3's EVP_MAC, which this file used before, spent about 2,000
  *  instructions a MAC on its dispatch around the hash (docs/speed.md,
  *  "The receivers' share", sixth session).
  *
