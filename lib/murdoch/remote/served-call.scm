@@ -119,7 +119,7 @@
 ;; taken by lock! (docs/speed.md); the reader's handlers let go after a raise.
 (define (answer! s g message last?)
   (lock! (greeting-write-lock g))
-  (write-answer! s g (frame-text (greeting-text g) message))
+  (write-answer! s g message)
   (if (flush-now? s last?) (flush! s g))
   (unlock! (greeting-write-lock g)))
 
@@ -127,10 +127,12 @@
 (define (flush-now? s last?)
   (if (reader? s) (and last? (null? (serving-frames s))) #t))
 
-;; A caller that left makes this raise, and the connection end.
-(define (write-answer! s g frame)
-  (greeting-sent-set! g (+ 1 (greeting-sent g)))
-  (write-frame! (serving-out s) frame (greeting-caller-nonce g) (greeting-sent g)))
+;; A caller that left makes this raise, and the connection end; a message
+;; too large raises before its count is taken.
+(define (write-answer! s g message)
+  (write-message! (serving-out s) (greeting-text g) message
+                  (greeting-caller-nonce g) (+ 1 (greeting-sent g)))
+  (greeting-sent-set! g (+ 1 (greeting-sent g))))
 
 ;; The caller holds the write lock.
 (define (flush! s g)

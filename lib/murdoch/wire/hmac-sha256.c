@@ -231,6 +231,28 @@ static sexp hmac_sha256_write (sexp ctx, sexp self, sexp key, const char *tp,
   return SEXP_VOID;
 }
 
+/* (hmac-sha256-write-text! key text-port parts port max): as
+ * hmac-sha256-write! of the text written to text-port, a string output
+ * port emptied by reset-output-string! (netstring-scan.c) before it,
+ * taken from the port's buffer: get-output-string made four objects a
+ * frame (docs/speed.md, "The receivers' share", sixth session).  #t once
+ * written; the symbol too-large, writing nothing, when the frame would
+ * be over max bytes; #f, writing nothing, when the text outgrew the
+ * port's buffer, for the caller to take by get-output-string. */
+static sexp hmac_sha256_write_text (sexp ctx, sexp self, sexp key, sexp text_port,
+                                    sexp parts, sexp port, long max) {
+  sexp res;
+  if (!sexp_oportp(text_port) || !sexp_pairp(sexp_port_cookie(text_port))
+      || sexp_filenop(sexp_port_fd(text_port)))
+    return sexp_xtype_exception(ctx, self, "not a string output port", text_port);
+  if (sexp_cdr(sexp_port_cookie(text_port)) != SEXP_NULL) return SEXP_FALSE;
+  if (64 + (long)sexp_port_offset(text_port) > max)
+    return sexp_intern(ctx, "too-large", -1);
+  res = hmac_sha256_write(ctx, self, key, sexp_port_buf(text_port),
+                          sexp_port_offset(text_port), parts, port);
+  return res == SEXP_VOID ? SEXP_TRUE : res;
+}
+
 /* (hmac-sha256-open key bytes end parts): the text that follows the 64
  * hex digits of a MAC in the first end bytes of bytes (of size bytes at
  * data), as a string, when the MAC is that under key of the parts

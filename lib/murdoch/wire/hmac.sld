@@ -6,13 +6,19 @@
 ;;> of the list \var{parts} then \var{text}, followed by \var{text}.
 ;;> \procedure{(hmac-sha256-write! key text parts port)} Writes the
 ;;> netstring of \var{text} signed, making no string of it.
+;;> \procedure{(hmac-sha256-write-text! key text-port parts port max)}
+;;> The same for the text written to the string port \var{text-port} since
+;;> it was emptied, taken from its buffer: #t, or writing nothing, the
+;;> symbol too-large past \var{max} bytes and #f when the text outgrew
+;;> the buffer.
 ;;> \procedure{(hmac-sha256-open key bytes end parts)} The text of the
 ;;> signed message in the first \var{end} bytes of \var{bytes}, or #f when
 ;;> its MAC is not that of \var{parts} then the text.
 ;;> C: hmac.stub and hmac-sha256.c (docs/speed.md says why not Scheme).
 
 (define-library (murdoch wire hmac)
-  (export hmac-sha256 hmac-sha256-sign hmac-sha256-write! hmac-sha256-open)
+  (export hmac-sha256 hmac-sha256-sign hmac-sha256-write! hmac-sha256-write-text!
+          hmac-sha256-open)
   (import (scheme base))
   (include-shared "hmac")
   (begin
