@@ -167,7 +167,7 @@
   (within-max-frame (string-append (car parts) (fixnum->decimal id) (cdr parts))))
 
 (define (write-frame! out text nonce count)
-  (hmac-sha256-write! (wire-key (the-wire)) text (list nonce ":" count ":") out))
+  (hmac-sha256-write! (wire-key (the-wire)) text (cons nonce count) out))
 
 ;;> Writes \var{message}'s frame to \var{out} by way of \var{text-port}, as
 ;;> write-frame! of its frame-text, making no string of the text but when
@@ -177,7 +177,7 @@
   (write-simple message text-port)
   (written-text out text-port nonce count
                 (hmac-sha256-write-text! (wire-key (the-wire)) text-port
-                                         (list nonce ":" count ":") out
+                                         (cons nonce count) out
                                          (wire-max-frame (the-wire)))))
 
 (define (written-text out text-port nonce count written)
@@ -205,7 +205,7 @@
 (define (open-frame payload nonce count)
   (parse-message
    (authentic-text payload (bytevector-length payload)
-                  (list nonce ":" count ":"))))
+                  (cons nonce count))))
 
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
 (define (max-frame) (wire-max-frame (the-wire)))

@@ -120,8 +120,14 @@ static int hmac_begin (sexp key) {
 
 /* Hashes the parts of a Scheme list: the empty list when all are bytes,
  * text or fixnums; else the pair of the first that is not, or the list's
- * end that is not the empty list. */
+ * end that is not the empty list.  A frame's (NONCE . COUNT), COUNT a
+ * fixnum, stands for the parts NONCE ":" COUNT ":" (wire/frame.scm): a
+ * pair a frame, where the list took four. */
 static sexp hash_parts (sexp ls) {
+  if (sexp_pairp(ls) && sexp_fixnump(sexp_cdr(ls)))
+    return hash_part(sexp_car(ls)) && SHA256_Update(&mac_state, ":", 1)
+      && hash_part(sexp_cdr(ls)) && SHA256_Update(&mac_state, ":", 1)
+      ? SEXP_NULL : ls;
   for ( ; sexp_pairp(ls); ls = sexp_cdr(ls))
     if (!hash_part(sexp_car(ls)))
       return ls;

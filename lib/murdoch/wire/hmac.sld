@@ -2,6 +2,8 @@
 ;;> HMAC-SHA256 under \var{key} of the \var{part}s one after another, as
 ;;> lowercase hex.  Key and parts are bytevectors or strings (UTF-8); a
 ;;> part may be a fixnum, standing for its decimal digits.
+;;> Where \var{parts} is a list below, a frame's pair (NONCE . COUNT), COUNT
+;;> a fixnum, stands for the list (NONCE ":" COUNT ":").
 ;;> \procedure{(hmac-sha256-sign key text parts)} The MAC under \var{key}
 ;;> of the list \var{parts} then \var{text}, followed by \var{text}.
 ;;> \procedure{(hmac-sha256-write! key text parts port)} Writes the
