@@ -174,8 +174,7 @@
                     (make-value-limits (setting 'max-depth)
                                        (quotient (setting 'max-frame) 2))))
 
-;; A macro: the test is on every level of every value sent or received,
-;; the raise seldom (docs/speed.md).
+;; A macro, run on every level of every value (docs/speed.md).
 (define-syntax check-depth
   (syntax-rules ()
     ((_ depth what) (if (> depth (limits-depth (the-limits))) (too-deep what)))))
@@ -347,7 +346,6 @@
 ;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
 
-;; procedure? is a call in Chibi (init-7.scm); closure? and opcode? are opcodes.
 (define-syntax closure-or-opcode?
   (syntax-rules () ((_ x) (if (closure? x) #t (opcode? x)))))
 

@@ -159,9 +159,8 @@
       (serve-call r (served-call-of message uid answer))
       (serve-notice (reading-serving r) uid message)))
 
-;; The served call message asks for, by the places of wire/frame.scm's
-;; table: (KIND ID PROC ARGS); car and cdr, opcodes, where list-ref is a
-;; call (docs/speed.md).
+;; The served call message asks for: (KIND ID PROC ARGS), wire/frame.scm's
+;; table (by car and cdr: docs/speed.md).
 (define (served-call-of message uid answer)
   (make-served-call uid (message-id message) (car message)
                     (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
