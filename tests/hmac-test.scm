@@ -118,6 +118,13 @@
   (open-all (signed "caf\xe9;" "n:") "n:"))
 (test "not with other parts" #f
   (open-all (signed "(hello)" "n:" 7 ":") "n:" 8 ":"))
+(test "a frame's (NONCE . COUNT) is the parts NONCE \":\" COUNT \":\""
+    (hmac-sha256-sign key "(hello)" '("n" ":" 7 ":"))
+  (hmac-sha256-sign key "(hello)" '("n" . 7)))
+(test "and opens what they signed" "(hello)"
+  (hmac-sha256-open key (signed "(hello)" "n" ":" 7 ":") 71 '("n" . 7)))
+(test "not with another count" #f
+  (hmac-sha256-open key (signed "(hello)" "n" ":" 7 ":") 71 '("n" . 8)))
 (test "not with a byte of the text changed" #f
   (let ((b (signed "(hello)" "n:")))
     (bytevector-u8-set! b 65 (char->integer #\j))

@@ -62,6 +62,17 @@
 (test "the lab's delivery is in force" (if (null? delivery) 'broadcast 'multicast)
   (delivery-mode))
 
+;; First, while no robot here has been freed since it joined: a robot
+;; freed asks the posers whether tasks wait for it, and in a lab where
+;; none has waited it refuses no request meanwhile (task/offers.scm).
+(test-group "robots freed for the first time promise again at once"
+  (test "a, b and c promise, are freed, and promise again" '(3 3 3)
+    (map (lambda (i)
+           (let ((promises (request-exclusive '((foo) ()) 'freed-first (lambda () #t))))
+             (for-each (lambda (p) ((cadr p) #f)) promises)
+             (length promises)))
+         (iota 3))))
+
 (test-group "subscribe and unsubscribe"
   (test "every address space has all and its uid" #t
     (every (lambda (u) (and (memq 'all (at u subscriptions))

@@ -4,7 +4,7 @@
 (define-library (murdoch wire)
   (export open-connection socket-port make-message message-id message-field check-message
           check-datagram start-wire! frame-text message-without-id spliced-text
-          write-frame! send-frame! read-frame open-frame max-frame frame-fail
+          write-frame! write-message! send-frame! read-frame open-frame max-frame frame-fail
           protocol-fault? fault-message log-fault datagram-bytes
           open-datagram-text datagram-head datagram-from? hmac-sha256
           open-multicast-socket read-netstring write-netstring remote-error

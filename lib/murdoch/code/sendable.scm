@@ -174,10 +174,14 @@
                     (make-value-limits (setting 'max-depth)
                                        (quotient (setting 'max-frame) 2))))
 
-(define (check-depth depth what)
-  (if (> depth (limits-depth (the-limits)))
-      (send-fail (what-string what) " nests deeper than the lab's max-depth, "
-                 (number->string (limits-depth (the-limits))))))
+;; A macro, run on every level of every value (docs/speed.md).
+(define-syntax check-depth
+  (syntax-rules ()
+    ((_ depth what) (if (> depth (limits-depth (the-limits))) (too-deep what)))))
+
+(define (too-deep what)
+  (send-fail (what-string what) " nests deeper than the lab's max-depth, "
+             (number->string (limits-depth (the-limits)))))
 
 ;; (map f ls) by iteration, ls maybe improper: f gets its tail too.
 (define (map-elements f ls)
@@ -342,9 +346,12 @@
 ;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
 
+(define-syntax closure-or-opcode?
+  (syntax-rules () ((_ x) (if (closure? x) #t (opcode? x)))))
+
 ;; The procedure in cell, the env-cell of global name (no let: see known-encoding).
 (define (procedure-in cell name)
-  (if (and cell (procedure? (cdr cell)))
+  (if (and cell (closure-or-opcode? (cdr cell)))
       (cdr cell)
       (error "no procedure of this name here" name)))
 
@@ -375,18 +382,23 @@
   (let ((compile (make-closure-compiler env)))
     (define (dec x depth)
       (cond
-       ((pair? x) (check-depth (+ depth 1) "a received value")
-                  (dec-elements! x (+ depth 1))
+       ((pair? x) (fill-places! (tagged-places x depth (limits-depth (the-limits))))
                   x)
        ((vector? x) (dec-tagged x depth))
        (else x)))
-    ;; By iteration down the cdrs; no let or or (see known-encoding).
-    (define (dec-elements! p depth)
-      (if (pair? (car p))
-          (set-car! p (dec (car p) depth))
-          (if (vector? (car p)) (set-car! p (dec (car p) depth))))
-      (cond ((pair? (cdr p)) (dec-elements! (cdr p) depth))
-            ((vector? (cdr p)) (set-cdr! p (dec (cdr p) depth)))))
+    ;; The walk down the pairs is C's (plain.c); its places, here, each
+    ;; a pair and (+ (* 2 depth) 1) for its car, (* 2 depth) for its cdr.
+    (define (fill-places! places)
+      (cond ((vector? places) (fill-from! places 0))
+            ((eq? places 'too-deep) (too-deep "a received value"))))
+    (define (fill-from! places i)
+      (if (< i (vector-length places))
+          (begin (fill-place! (vector-ref places i) (vector-ref places (+ i 1)))
+                 (fill-from! places (+ i 2)))))
+    (define (fill-place! p code)
+      (if (eq? 1 (remainder code 2))   ; odd? is a call
+          (set-car! p (dec-tagged (car p) (quotient code 2)))
+          (set-cdr! p (dec-tagged (cdr p) (quotient code 2)))))
     (define (dec-tagged v depth)
       (check-depth (+ depth 1) "a received value")
       (dec-tag (vector-ref v 0) v depth))
@@ -409,4 +421,4 @@
        ((eq? tag 'murdoch:eof) (eof-object))
        (else (error "unknown tag in a received value" v))))
     (define (global-ref name) (procedure-in (env-cell env name) name))
-    (lambda (x) (if (plain? x) x (dec x 0)))))
+    (lambda (x) (dec x 0))))

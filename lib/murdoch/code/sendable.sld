@@ -12,7 +12,7 @@
           (rename (only (chibi) equal?) (equal? chibi-equal?))
           (only (chibi) er-macro-transformer make-syntactic-closure
                 strip-syntactic-closures
-                make-exception exception? exception-kind)
+                make-exception exception? exception-kind closure?)
           (chibi ast)
           (srfi 1) (srfi 18) (srfi 69) (only (murdoch sys) define-lean-record-type)
           (murdoch lab))

@@ -207,7 +207,7 @@
         (let loop ()
           (let ((fds (poller-ready)))
             (if (null? fds)
-                (port-wait! *poller-port* 3600)
+                (port-wait! *poller-port* 3600.)
                 (for-each take! fds)))
           (loop))))))
 

@@ -118,7 +118,7 @@
              (take-polled! s rest))))
 
 (define (await-whole! s)
-  (cond ((positive? (poller-buffered (serving-fd s)))
+  (cond ((> (poller-buffered (serving-fd s)) 0) ; positive? is a call
          (if (serving-deadline s)
              #f
              (begin (serving-deadline-set! s (+ (monotonic-seconds)
@@ -156,7 +156,7 @@
       (first-frame! s (serving-frames s))
       (begin
         (await-whole! s)
-        (port-wait! (serving-in s) 3600)
+        (port-wait! (serving-in s) 3600.) ; inexact: no flonum made a wait
         (serving-frames-set! s (poller-frames! (serving-fd s) (max-frame)))
         (next-served-frame s))))
 

@@ -119,7 +119,7 @@
 ;; taken by lock! (docs/speed.md); the reader's handlers let go after a raise.
 (define (answer! s g message last?)
   (lock! (greeting-write-lock g))
-  (write-answer! s g (frame-text (greeting-text g) message))
+  (write-answer! s g message)
   (if (flush-now? s last?) (flush! s g))
   (unlock! (greeting-write-lock g)))
 
@@ -127,10 +127,12 @@
 (define (flush-now? s last?)
   (if (reader? s) (and last? (null? (serving-frames s))) #t))
 
-;; A caller that left makes this raise, and the connection end.
-(define (write-answer! s g frame)
-  (greeting-sent-set! g (+ 1 (greeting-sent g)))
-  (write-frame! (serving-out s) frame (greeting-caller-nonce g) (greeting-sent g)))
+;; A caller that left makes this raise, and the connection end; a message
+;; too large raises before its count is taken.
+(define (write-answer! s g message)
+  (write-message! (serving-out s) (greeting-text g) message
+                  (greeting-caller-nonce g) (+ 1 (greeting-sent g)))
+  (greeting-sent-set! g (+ 1 (greeting-sent g))))
 
 ;; The caller holds the write lock.
 (define (flush! s g)
@@ -157,10 +159,12 @@
       (serve-call r (served-call-of message uid answer))
       (serve-notice (reading-serving r) uid message)))
 
-;; The served call message asks for, by the places of wire/frame.scm's table.
+;; The served call message asks for: (KIND ID PROC ARGS), wire/frame.scm's
+;; table (by car and cdr: docs/speed.md).
 (define (served-call-of message uid answer)
-  (make-served-call uid (message-id message) (car message) (list-ref message 2)
-                    (list-ref message 3) answer))
+  (make-served-call uid (message-id message) (car message)
+                    (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
+                    answer))
 
 ;; Serves a frame that needs no answer: an answer or an abandon (by cond).
 (define (serve-notice s uid message)

@@ -84,7 +84,7 @@
       (protocol-fail "datagram" "not a datagram")))
 
 ;;> The id of \var{message} (all kinds but hello, welcome, datagram, beacon).
-(define (message-id message) (cadr message))
+(define (message-id message) (car (cdr message))) ; cadr is a call
 
 ;;> The field named \var{name} of \var{message}, a checked message, as
 ;;> the table names it.
@@ -129,9 +129,12 @@
 ;; The receiver would close the connection, failing calls unrelated to this one.
 (define (within-max-frame text)
   (if (> (+ 64 (string-size text)) (wire-max-frame (the-wire)))
-      (error (string-append "the message is larger than the lab's max-frame, "
-                            (number->string (max-frame)) " bytes")))
+      (too-large))
   text)
+
+(define (too-large)
+  (error (string-append "the message is larger than the lab's max-frame, "
+                        (number->string (max-frame)) " bytes")))
 
 ;;> The text of the message (\var{kind} ID FIELD ...) but its id, for
 ;;> \scheme{spliced-text}: a call to many peers is written once.
@@ -164,10 +167,27 @@
   (within-max-frame (string-append (car parts) (fixnum->decimal id) (cdr parts))))
 
 (define (write-frame! out text nonce count)
-  (hmac-sha256-write! (wire-key (the-wire)) text (list nonce ":" count ":") out))
+  (hmac-sha256-write! (wire-key (the-wire)) text (cons nonce count) out))
+
+;;> Writes \var{message}'s frame to \var{out} by way of \var{text-port}, as
+;;> write-frame! of its frame-text, making no string of the text but when
+;;> it outgrows the port's buffer (docs/speed.md).
+(define (write-message! out text-port message nonce count)
+  (reset-output-string! text-port)
+  (write-simple message text-port)
+  (written-text out text-port nonce count
+                (hmac-sha256-write-text! (wire-key (the-wire)) text-port
+                                         (cons nonce count) out
+                                         (wire-max-frame (the-wire)))))
+
+(define (written-text out text-port nonce count written)
+  (cond ((eq? written 'too-large) (too-large))
+        ((eq? written #f)
+         (write-frame! out (within-max-frame (get-output-string text-port))
+                       nonce count))))
 
 (define (send-frame! out text-port nonce count message)
-  (write-frame! out (frame-text text-port message) nonce count)
+  (write-message! out text-port message nonce count)
   (flush-output-port out))
 
 ;; A frame that breaks the protocol raises; its connection closes.
@@ -185,7 +205,7 @@
 (define (open-frame payload nonce count)
   (parse-message
    (authentic-text payload (bytevector-length payload)
-                  (list nonce ":" count ":"))))
+                  (cons nonce count))))
 
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
 (define (max-frame) (wire-max-frame (the-wire)))

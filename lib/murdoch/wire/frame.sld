@@ -5,7 +5,7 @@
 (define-library (murdoch wire frame)
   (export message-kinds make-message message-id message-field check-message check-datagram
           start-wire! frame-text message-without-id spliced-text write-frame!
-          send-frame! read-frame
+          write-message! send-frame! read-frame
           open-frame max-frame
           frame-fail parse-message protocol-fault? fault-message log-fault
           datagram-bytes open-datagram-text datagram-head datagram-from?)

@@ -4,36 +4,42 @@
  *  Every frame of the remote layer is MAC'd once when sent and once when
  *  received.  Over Chibi's SHA-256 that cost 40 us a frame, nearly all of
  *  it Scheme building the byte strings HMAC hashes; here it is about a
- *  microsecond.  The hash, the HMAC and the constant-time comparison are
- *  libcrypto's (a well-kept library, not ours to get wrong); this file only
- *  feeds it the parts of a frame and builds Scheme strings of the result.
+ *  microsecond.  The hash and the constant-time comparison are
+ *  libcrypto's (a well-kept library, not ours to get wrong); this file
+ *  feeds it the pads and the parts of a frame, and builds Scheme strings
+ *  of the result.
  *
- *  The HMAC is OpenSSL 3's EVP_MAC, not the HMAC_CTX calls it deprecates.
- *  One context serves every call: Chibi's threads are green threads on one
- *  OS thread, and a call into C is not interrupted by them.  The context
- *  keeps the key it was last given, hashed into its inner and outer pads,
- *  and a call under the same key (every frame of a process is under one)
- *  starts from those.  Signing a 200-byte frame cost 2.6 us of CPU over
- *  our own SHA-256 in C, 1.7 us by HMAC_CTX keyed afresh each call, and
- *  costs 1.0 us so; a 64 KB message 290 us over our SHA-256, 47 us here.
+ *  The HMAC (RFC 2104) is built here on libcrypto's SHA-256: the key's
+ *  inner and outer pads are hashed once, and each MAC starts from a copy
+ *  of those two states.  Chibi's threads are green threads on one OS
+ *  thread, and a call into C is not interrupted by them, so one set of
+ *  states serves every call; every frame of a process is under one key.
+ *  OpenSSL 3's EVP_MAC, which this file used before, spent about 2,000
+ *  instructions a MAC on its dispatch around the hash (docs/speed.md,
+ *  "The receivers' share", sixth session).
  *
  *  The key and the parts come unchecked, and are looked at here: each may
  *  be of more than one type, which chibi-ffi's checks cannot say.
  */
 
 #include <chibi/eval.h>
-#include <openssl/core_names.h>
+/* SHA256_Init and its kin are deprecated in OpenSSL 3 for EVP, whose
+ * dispatch is what this file avoids; they remain in libcrypto. */
+#define OPENSSL_SUPPRESS_DEPRECATED
 #include <openssl/crypto.h>
-#include <openssl/evp.h>
+#include <openssl/sha.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define MAC_SIZE 32                     /* SHA-256's */
+#define MAC_SIZE 32                     /* SHA-256's digest */
+#define BLOCK_SIZE 64                   /* and block */
 
-static EVP_MAC_CTX *mac_context;
-/* A copy of the key mac_context was last keyed with, of keyed_length
- * bytes; NULL and -1 when there is none. */
+/* The states after the inner and the outer pad of the key last given,
+ * and the MAC being made. */
+static SHA256_CTX inner_start, outer_start, mac_state;
+/* A copy of the key the pads were made of, of keyed_length bytes; NULL
+ * and -1 when there is none. */
 static unsigned char *keyed;
 static long keyed_length = -1;
 
@@ -59,13 +65,13 @@ static int hash_part (sexp part) {
   char digits[32];
   if (sexp_fixnump(part)) {
     n = snprintf(digits, sizeof digits, "%ld", (long)sexp_unbox_fixnum(part));
-    return EVP_MAC_update(mac_context, (const unsigned char *)digits, n);
+    return SHA256_Update(&mac_state, digits, n);
   }
   if (!bytes_of(part, &p, &n)) return 0;
-  return EVP_MAC_update(mac_context, p, n);
+  return SHA256_Update(&mac_state, p, n);
 }
 
-/* Forgets the key mac_context was keyed with. */
+/* Forgets the key the pads were made of. */
 static void forget_key (void) {
   if (keyed) {
     OPENSSL_cleanse(keyed, keyed_length);
@@ -75,36 +81,58 @@ static void forget_key (void) {
   keyed_length = -1;
 }
 
+/* The states after the pads of key, of kn bytes: RFC 2104's K0, the key
+ * hashed when longer than a block, then zeros, xored with 0x36 and 0x5c. */
+static int make_pads (const unsigned char *kp, size_t kn) {
+  unsigned char block[BLOCK_SIZE];
+  size_t i;
+  int ok;
+  memset(block, 0, sizeof block);
+  if (kn > BLOCK_SIZE) SHA256(kp, kn, block);
+  else memcpy(block, kp, kn);
+  for (i = 0; i < BLOCK_SIZE; i++) block[i] ^= 0x36;
+  ok = SHA256_Init(&inner_start) && SHA256_Update(&inner_start, block, BLOCK_SIZE);
+  for (i = 0; i < BLOCK_SIZE; i++) block[i] ^= 0x36 ^ 0x5c;
+  ok = ok && SHA256_Init(&outer_start) && SHA256_Update(&outer_start, block, BLOCK_SIZE);
+  OPENSSL_cleanse(block, sizeof block);
+  return ok;
+}
+
 /* Begins HMAC under key; 0 when the key is neither bytes nor text, or
  * libcrypto fails.  The key's bytes are compared, not the object, so a
- * bytevector changed in place is keyed afresh. */
+ * bytevector changed in place is keyed afresh; by memcmp, as both are
+ * this process's own key. */
 static int hmac_begin (sexp key) {
   const unsigned char *kp;
   size_t kn;
   if (!bytes_of(key, &kp, &kn)) return 0;
-  if (keyed && kn == (size_t)keyed_length && CRYPTO_memcmp(kp, keyed, kn) == 0)
-    return EVP_MAC_init(mac_context, NULL, 0, NULL);
-  forget_key();
-  /* kp is never NULL, even for an empty key: NULL would mean the last. */
-  if (!EVP_MAC_init(mac_context, kp, kn, NULL)) return 0;
-  if ((keyed = malloc(kn ? kn : 1))) {  /* else keyed afresh next time */
-    memcpy(keyed, kp, kn);
-    keyed_length = kn;
+  if (!(keyed && kn == (size_t)keyed_length && memcmp(kp, keyed, kn) == 0)) {
+    forget_key();
+    if (!make_pads(kp, kn)) return 0;
+    if ((keyed = malloc(kn ? kn : 1))) { /* else keyed afresh next time */
+      memcpy(keyed, kp, kn);
+      keyed_length = kn;
+    }
   }
+  mac_state = inner_start;
   return 1;
 }
 
 /* Hashes the parts of a Scheme list: the empty list when all are bytes,
  * text or fixnums; else the pair of the first that is not, or the list's
- * end that is not the empty list. */
+ * end that is not the empty list.  A frame's (NONCE . COUNT), COUNT a
+ * fixnum, stands for the parts NONCE ":" COUNT ":" (wire/frame.scm): a
+ * pair a frame, where the list took four. */
 static sexp hash_parts (sexp ls) {
+  if (sexp_pairp(ls) && sexp_fixnump(sexp_cdr(ls)))
+    return hash_part(sexp_car(ls)) && SHA256_Update(&mac_state, ":", 1)
+      && hash_part(sexp_cdr(ls)) && SHA256_Update(&mac_state, ":", 1)
+      ? SEXP_NULL : ls;
   for ( ; sexp_pairp(ls); ls = sexp_cdr(ls))
     if (!hash_part(sexp_car(ls)))
       return ls;
   return ls;
 }
-
-static EVP_MAC_CTX *new_mac_context (void);
 
 /* Begins HMAC under key and hashes the parts: SEXP_VOID, or the type
  * exception that names the key or the first part that is neither bytes,
@@ -113,8 +141,6 @@ static sexp hmac_begin_parts (sexp ctx, sexp self, sexp key, sexp parts) {
   const unsigned char *p;
   size_t n;
   sexp bad;
-  if (!mac_context && !(mac_context = new_mac_context()))
-    return sexp_user_exception(ctx, self, "libcrypto: no HMAC-SHA256", SEXP_NULL);
   if (!hmac_begin(key))
     return bytes_of(key, &p, &n)
       ? sexp_user_exception(ctx, self, "libcrypto: HMAC failed", key)
@@ -130,9 +156,11 @@ static sexp hmac_begin_parts (sexp ctx, sexp self, sexp key, sexp parts) {
  * in text; 0 when libcrypto fails. */
 static int hmac_end (char text[2 * MAC_SIZE]) {
   static const char hex[] = "0123456789abcdef";
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  size_t n = 0, i;
-  if (!EVP_MAC_final(mac_context, digest, &n, sizeof digest) || n != MAC_SIZE)
+  unsigned char digest[MAC_SIZE];
+  SHA256_CTX outer = outer_start;
+  size_t i;
+  if (!SHA256_Final(digest, &mac_state)
+      || !SHA256_Update(&outer, digest, MAC_SIZE) || !SHA256_Final(digest, &outer))
     return 0;
   for (i = 0; i < MAC_SIZE; i++) {
     text[2*i] = hex[digest[i] >> 4];
@@ -163,7 +191,7 @@ static sexp mac_of_text (sexp ctx, sexp self, sexp key, sexp parts,
                          const char *tp, long tn, char mac[64]) {
   sexp res = hmac_begin_parts(ctx, self, key, parts);
   if (res != SEXP_VOID) return res;
-  if (!EVP_MAC_update(mac_context, (const unsigned char *)tp, tn)
+  if (!SHA256_Update(&mac_state, tp, tn)
       || !hmac_end(mac))
     return libcrypto_failed(ctx, self);
   return SEXP_VOID;
@@ -209,6 +237,28 @@ static sexp hmac_sha256_write (sexp ctx, sexp self, sexp key, const char *tp,
   return SEXP_VOID;
 }
 
+/* (hmac-sha256-write-text! key text-port parts port max): as
+ * hmac-sha256-write! of the text written to text-port, a string output
+ * port emptied by reset-output-string! (netstring-scan.c) before it,
+ * taken from the port's buffer: get-output-string made four objects a
+ * frame (docs/speed.md, "The receivers' share", sixth session).  #t once
+ * written; the symbol too-large, writing nothing, when the frame would
+ * be over max bytes; #f, writing nothing, when the text outgrew the
+ * port's buffer, for the caller to take by get-output-string. */
+static sexp hmac_sha256_write_text (sexp ctx, sexp self, sexp key, sexp text_port,
+                                    sexp parts, sexp port, long max) {
+  sexp res;
+  if (!sexp_oportp(text_port) || !sexp_pairp(sexp_port_cookie(text_port))
+      || sexp_filenop(sexp_port_fd(text_port)))
+    return sexp_xtype_exception(ctx, self, "not a string output port", text_port);
+  if (sexp_cdr(sexp_port_cookie(text_port)) != SEXP_NULL) return SEXP_FALSE;
+  if (64 + (long)sexp_port_offset(text_port) > max)
+    return sexp_intern(ctx, "too-large", -1);
+  res = hmac_sha256_write(ctx, self, key, sexp_port_buf(text_port),
+                          sexp_port_offset(text_port), parts, port);
+  return res == SEXP_VOID ? SEXP_TRUE : res;
+}
+
 /* (hmac-sha256-open key bytes end parts): the text that follows the 64
  * hex digits of a MAC in the first end bytes of bytes (of size bytes at
  * data), as a string, when the MAC is that under key of the parts
@@ -225,26 +275,9 @@ static sexp hmac_sha256_open (sexp ctx, sexp self, sexp key, const char *data,
   if (end < 64) return SEXP_FALSE;
   res = hmac_begin_parts(ctx, self, key, parts);
   if (res != SEXP_VOID) return res;
-  if (!EVP_MAC_update(mac_context, (const unsigned char *)data + 64, end - 64)
+  if (!SHA256_Update(&mac_state, data + 64, end - 64)
       || !hmac_end(mac))
     return libcrypto_failed(ctx, self);
   if (CRYPTO_memcmp(mac, data, 64) != 0) return SEXP_FALSE;
   return sexp_c_string(ctx, data + 64, end - 64);
-}
-
-/* A context for HMAC over SHA-256, not yet keyed; NULL when libcrypto has
- * none. */
-static EVP_MAC_CTX *new_mac_context (void) {
-  EVP_MAC *mac = EVP_MAC_fetch(NULL, "HMAC", NULL);
-  EVP_MAC_CTX *c = mac ? EVP_MAC_CTX_new(mac) : NULL;
-  OSSL_PARAM params[] = {
-    OSSL_PARAM_construct_utf8_string(OSSL_MAC_PARAM_DIGEST, "SHA256", 0),
-    OSSL_PARAM_construct_end()
-  };
-  EVP_MAC_free(mac);                    /* the context holds its own */
-  if (c && !EVP_MAC_CTX_set_params(c, params)) {
-    EVP_MAC_CTX_free(c);
-    c = NULL;
-  }
-  return c;
 }
