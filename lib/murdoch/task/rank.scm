@@ -131,14 +131,17 @@
 
 (define (waiters) (line-waiters (the-line)))
 (define (add-waiter! w)
+  (line-waiters-set! (the-line) (in-rank-order w (waiters) waiter-rank)))
+
+;;> \var{ls}, best rank first by \var{rank-of}, with \var{x} after its equals.
+(define (in-rank-order x ls rank-of)
   (let-values (((before after)
-                (break (lambda (x) (rank<? (waiter-rank w) (waiter-rank x))) (waiters))))
-    (line-waiters-set! (the-line) (append before (cons w after)))))
+                (break (lambda (y) (rank<? (rank-of x) (rank-of y))) ls)))
+    (append before (cons x after))))
 (define (drop-waiter! w)
   (line-waiters-set! (the-line) (remove (lambda (x) (eq? x w)) (waiters))))
 
-;; A piece of news is (first), try at once, (cancel), (give-way UID) or (offer REPLY
-;; UID): its kind, then what it says, read by name.
+;; News, read by name: (first), try at once; (cancel); (give-way UID); (offer REPLY UID).
 (define (news-kind n) (car n))
 (define (offer? n) (eq? (news-kind n) 'offer))
 (define (offer-reply n) (cadr n))

@@ -13,7 +13,7 @@
           waiter-capables-set! waiter-offered waiter-offered-set! waiter-position waiter-position-set!
           waiter-why waiter-why-set! waiter-never waiter-never-set!
           waiter-excluded waiter-excluded-set! waiter-news waiter-news-set!
-          waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter!
+          waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter! in-rank-order
           news-kind offer? offer-reply offer-uid give-way-uid tell-waiter!
           take-news! answer-offers! held-index held-winner held-type held-uid
           held-uids place-in-line line-of waiting-ranks waiting-there?

@@ -180,12 +180,10 @@
     (lambda ()
       (let ((l (the-looking)))
         (if (looking-trying? l)
-            (let-values (((before after)
-                          (break (lambda (x) (rank<? (waiter-rank (car turn))
-                                                     (waiter-rank (car x))))
-                                 (looking-try-turns l))))
-              (looking-try-turns-set! l (append before (cons turn after)))
-              #f)
+            (begin (looking-try-turns-set!
+                    l (in-rank-order turn (looking-try-turns l)
+                                     (lambda (t) (waiter-rank (car t)))))
+                   #f)
             (begin (looking-trying?-set! l #t) #t))))))
 
 ;; A turn still queued leaves the queue; one that was given the try
