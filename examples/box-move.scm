@@ -197,7 +197,8 @@
   (turn-to! (heading-to (reckon) (car box-path)))
   (local-aspace-uid))
 
-;; Tells the pushers where the box is, and where the bodies of lost pushers
+;; Tells the pushers where the box is, when it saw it (its own clock, the
+;; simulator's, as every robot's), and where the bodies of lost pushers
 ;; lie (their last word of where they were), until the box has arrived;
 ;; keeps the box in view.
 (define (watch previous)
@@ -210,7 +211,7 @@
       (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
-                                      (team-send! uid (list 'box box bodies))))
+                                      (team-send! uid (list 'box box bodies now))))
                     (step-team)))
       (thread-sleep! 0.15)
       (let* ((heard (all-heard)) (box (or box last))
@@ -431,7 +432,7 @@
         (let ((m (cdr heard)))
           (cond ((and (pair? m) (eq? (car m) 'box))
                  (set! view-at now)
-                 (note-turn! (cadr m))
+                 (note-turn! (cadr m) (list-ref m 3))
                  (latest (cdr m)))
                 ((eq? m 'here) (set! partner-here now) (latest last))
                 ((and (pair? m) (eq? (car m) 'coming))
@@ -541,7 +542,7 @@
       view
       (let ((own (see-box)))
         (and own
-             (begin (note-turn! own)
+             (begin (note-turn! own now)
                     (list own (if view (cadr view) '())))))))
 
 ;; How many degrees left the box must turn to head for the path: for its
@@ -652,30 +653,47 @@
 ;; A pusher's share of push-speed in a pair: both push less the further
 ;; the box is turned off its way (forward at a third from 30 degrees off),
 ;; so that it turns more than it goes; and one pushes more and the other
-;; less by how far the box must turn, up to 20 degrees, less what it will
-;; turn of that within turn-lead seconds at the rate it turns now, so that
-;; it comes round at a few degrees a second without swinging past the
-;; path: a box swung fast leaves the pushers behind their places, and on a
-;; slow machine the views come later and it swings further before they see it.
+;; less, by the difference of speed that turns the box, held between two
+;; pushers pusher-offset either side of its middle, at the rate wanted:
+;; pair-gain a second of how far it must turn, up to pair-rate, plus
+;; rate-feedback of what the rate it turns now falls short of that.  Two
+;; pushers hold the box to the speeds they drive at, so a pair turns it at
+;; nearly the rate their speeds say; steered by how far it must turn less
+;; what it would turn in 1.5 s at the rate last seen, a pair of generated
+;; seed 160 or 38 turned its box at 30 degrees a second to and fro, some
+;; 10 degrees either side, each half second or so that the views came,
+;; knocking its pushers off their places (seeds 38, 149: the spare off
+;; the face for a third of the last third).  The slower pushes at no less
+;; than 0.3 of its speed, to keep up with its place.
 (define turn-lead 1.5)
 (define max-turn-rate 8)                ; degrees a second, for a pusher alone
+(define pair-gain 0.5)                  ; per second
+(define pair-rate 12)                   ; degrees a second
+(define rate-feedback 0.5)
 (define (pair-share box side)
   (let* ((err (turn-error box))
-         (ahead (- (clip err 20) (* turn-lead turn-rate))))
-    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1) (* 0.05 side ahead)) 0.3 1.6)))
+         (want (clip (* pair-gain err) pair-rate))
+         (rate (+ want (* rate-feedback (- want turn-rate)))))
+    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1)
+             (/ (* side rate degrees pusher-offset) push-speed))
+          0.3 1.6)))
 
 ;; How fast the box turns, degrees a second, left positive, from the
-;; sightings it pushes by (fresh), at least 0.3 s apart on this robot's
-;; clock.
+;; sightings it pushes by (fresh), at least rate-span seconds apart by the
+;; clock they were seen at (the watcher's, or this robot's for its own: one
+;; clock, the simulator's), not by when a view arrived: a view a round
+;; late, or two in one round, made a rate of twice or half the true one;
+;; a sighting older than the last is passed over.
 (define turn-rate 0)
+(define rate-span 0.5)
 (define rate-from #f)                   ; (SECONDS HEADING)
-(define (note-turn! box)
+(define (note-turn! box seen-at)
   (let ((h (list-ref box 2)))
-    (cond ((not rate-from) (set! rate-from (list now h)))
-          ((>= (- now (car rate-from)) 0.3)
+    (cond ((not rate-from) (set! rate-from (list seen-at h)))
+          ((>= (- seen-at (car rate-from)) rate-span)
            (set! turn-rate
-                 (/ (square-wrap (- h (cadr rate-from))) (- now (car rate-from))))
-           (set! rate-from (list now h))))))
+                 (/ (square-wrap (- h (cadr rate-from))) (- seen-at (car rate-from))))
+           (set! rate-from (list seen-at h))))))
 
 ;; Whether a spare said lately (within 2 s) that it has a way to its place.
 (define (spare-on-its-way?)
