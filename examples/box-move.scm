@@ -406,11 +406,12 @@
         (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
 ;; How far aside of its place a pusher at the face may stand and still push
-;; from there: 200 mm, 75 mm alone; 100 mm while its partner says it is on
+;; from there: 200 mm; 75 mm from a spot of its own (push-offset: alone,
+;; or clearing a lost partner's body); 100 mm while its partner says it is on
 ;; its way to its place, for one further aside stands in the way into the
 ;; partner's place, 340 mm off, and holds there waiting for it.
 (define (aside-slack)
-  (cond ((alone?) 75) ((spare-on-its-way?) 100) (else 200)))
+  (cond (lone-at 75) ((spare-on-its-way?) 100) (else 200)))
 
 ;; What the pusher hears, on its own clock: when its partner last said it
 ;; was at the face ('here), and when it last said how far it still had to
@@ -418,6 +419,7 @@
 (define partner-here -100)
 (define partner-coming -100)
 (define partner-coming-mm #f)
+(define spare-way-at -100)              ; when a spare last said it had a way
 (define view-at -100)
 
 ;; How lately, in seconds, the partner said it was at the face, or coming.
@@ -437,6 +439,7 @@
                 ((eq? m 'here) (set! partner-here now) (latest last))
                 ((and (pair? m) (eq? (car m) 'coming))
                  (set! partner-coming now)
+                 (if (< (cadr m) 1e8) (set! spare-way-at now))
                  (set! partner-coming-mm (cadr m))
                  (latest last))
                 (else (latest last)))))))
@@ -571,6 +574,16 @@
 ;; of its own half nearest it that is clear, out to where half of it is
 ;; behind the face: seed 42's box turned until the lost pusher's body lay
 ;; behind its middle, holding both places, and no one pushed it on.
+;; A pusher that pushed in a pair and has lost its partner, with no spare
+;; saying it has a way to its place (the lost one's body holds it), pushes
+;; until one has from the spot nearest the middle of the face that is
+;; clear of the bodies and has a staging point, chosen once: from its own
+;; place, beside the body, its push turned the box about the body's corner
+;; away from its side, 20 to 35 degrees the wrong way in the 300 mm that
+;; clear the body (generated seeds 38 and 160, the outside pusher lost
+;; before a bend to the inside; the pair then had to turn the box 60 to 100
+;; degrees at the bend and passed its goal wide).  A spare, which has not
+;; pushed in a pair, never takes that spot: its place is the lost one's.
 (define lone-at #f)
 (define (push-offset view side)
   (let ((own (* side pusher-offset)) (box (car view)) (bodies (cadr view)))
@@ -579,6 +592,11 @@
              (cond ((not lone-at) (set! lone-at own))
                    ((> (abs (- want lone-at)) 80) (set! lone-at want)))
              lone-at))
+          ((and (pair? bodies) paired-at (not (paired?)) (>= (- now spare-way-at) 1))
+           (if (not lone-at)
+               (let ((o (clear-offset box bodies side 0 (+ box-half (/ body-radius 2)))))
+                 (set! lone-at (if (and o (staging box (place-axis box) o bodies)) o own))))
+           lone-at)
           (else
            (set! lone-at #f)
            (or (clear-offset box bodies side own (+ box-half (/ body-radius 2)) side) own)))))
@@ -594,8 +612,9 @@
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
 ;; pushes harder (pair-share).  A pusher alone (its partner has not said
-;; lately that it is at the face) pushes from its own place, which turns
-;; the box away from its side, until it is alone (push-offset); it holds
+;; lately that it is at the face) pushes from the spot push-offset gives
+;; (its own place, or one nearer the middle while it clears a lost
+;; partner's body), slanted in as lone-push! says; it holds
 ;; while the box turns faster than max-turn-rate, and once a spare has a
 ;; way to the other place, leaving that free.  Before a spare speaks it
 ;; pushes on only until the box has left the lost partner's body behind,
@@ -610,10 +629,11 @@
     (if (paired?) (set! paired-at box))
     (if (or (paired?) (alone?) (= share 0))
         (push-at! box (place-axis box) offset share)
-        (lone-push! box side share))))
+        (lone-push! box offset share))))
 
 ;; Pushes at share of push-speed from where this pusher stands at the face,
-;; heading lone-slant degrees off the box's axis toward its middle, and only
+;; offset mm left of its middle, heading off the box's axis toward the
+;; middle by lone-slant degrees at a place's offset (less nearer it), and only
 ;; while it heads so (within 6 degrees), else turning there first.  A push
 ;; off the middle turns the box away from the pusher's side; the pusher,
 ;; pressed to the face, turns with the box and lags it, heading out, and the
@@ -622,9 +642,9 @@
 ;; pushed, headed 13 to 19 degrees out and turned the box 6 degrees a
 ;; second the wrong way.  Slanted in, that slide turns the box back.
 (define lone-slant 10)
-(define (lone-push! box side share)
+(define (lone-push! box offset share)
   (let* ((axis (place-axis box))
-         (want (- axis (* side lone-slant)))
+         (want (- axis (clip (* lone-slant (/ offset pusher-offset)) lone-slant)))
          (turn (wrap (- want (list-ref (reckon) 2)))))
     (drive! (if (< (abs turn) 6) (* push-speed (slowing box) share) 0)
             (clip (* 2 turn) 40))))
@@ -668,15 +688,15 @@
 (define turn-lead 1.5)
 (define max-turn-rate 8)                ; degrees a second, for a pusher alone
 (define pair-gain 0.5)                  ; per second
-(define pair-rate 12)                   ; degrees a second
+(define pair-rate 20)                   ; degrees a second
 (define rate-feedback 0.5)
 (define (pair-share box side)
   (let* ((err (turn-error box))
          (want (clip (* pair-gain err) pair-rate))
          (rate (+ want (* rate-feedback (- want turn-rate)))))
-    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1)
+    (clip (- (clip (- 1 (/ (abs err) 45)) 0.25 1)
              (/ (* side rate degrees pusher-offset) push-speed))
-          0.3 1.6)))
+          0.1 1.6)))
 
 ;; How fast the box turns, degrees a second, left positive, from the
 ;; sightings it pushes by (fresh), at least rate-span seconds apart by the
