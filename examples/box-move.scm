@@ -673,7 +673,7 @@
       (< (* side (- (clip (turn-error box) 20) (* turn-lead turn-rate))) -3)))
 
 ;; A pusher's share of push-speed in a pair: both push less the further
-;; the box is turned off its way (forward at a third from 30 degrees off),
+;; the box is turned off its way (forward at a quarter from 34 degrees off),
 ;; so that it turns more than it goes; and one pushes more and the other
 ;; less, by the difference of speed that turns the box, held between two
 ;; pushers pusher-offset either side of its middle, at the rate wanted:
@@ -684,10 +684,11 @@
 ;; what it would turn in 1.5 s at the rate last seen, a pair of generated
 ;; seed 160 or 38 turned its box at 30 degrees a second to and fro, some
 ;; 10 degrees either side, each half second or so that the views came,
-;; knocking its pushers off their places (seeds 38, 149: the spare off
-;; the face for a third of the last third).  The slower pushes at no less
-;; than 0.3 of its speed, to keep up with its place.
-(define turn-lead 1.5)
+;; knocking its pushers off their places (seed 38's spare was off the
+;; face for half the last third).  The slower pushes at no less
+;; than 0.1 of its speed: held at 0.3, a pair with its box 100 degrees off
+;; turned it at 7 degrees a second and drifted 600 mm past a bend.
+(define turn-lead 1.5)                  ; seconds ahead, for a pusher alone (lone-push?)
 (define max-turn-rate 8)                ; degrees a second, for a pusher alone
 (define pair-gain 0.5)                  ; per second
 (define pair-rate 20)                   ; degrees a second
