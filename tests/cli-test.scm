@@ -2,7 +2,7 @@
 ;;; line with the usage, exit 2, and no stack trace.
 ;;; tests/run: long
 (import (scheme base) (scheme write) (scheme file) (srfi 1) (chibi test)
-        (only (chibi process) system)
+        (only (chibi process) system current-process-id)
         (only (chibi filesystem) delete-file-hierarchy open-input-file-descriptor)
         (only (chibi net) make-listener-socket get-address-info)
         (chibi json) (murdoch testing harness))
@@ -121,6 +121,33 @@
                                                         (number->string (+ base 148))
                                                         "/")))))
       (stop-process! pid))))
+
+;; Every base claimed by an existing folder, each claim's asker as given.
+(define (claim-every-base! claims asker)
+  (system "sh" "-c"
+          (string-append
+           "e=$(cut -f1 /proc/sys/net/ipv4/ip_local_port_range); mkdir -p \"$0\";"
+           " i=0; while [ $i -lt $(( (e - 10200) / 200 )) ]; do"
+           "  b=$(( 10000 + i * 200 )); rm -rf \"$0/$b\"; mkdir \"$0/$b\";"
+           "  echo \"$0\" > \"$0/$b/pid\"; echo \"$1\" > \"$0/$b/asker\"; i=$((i + 1)); done")
+          claims asker))
+
+;; free-port-base's exit status with claims as its claims folder.
+(define (free-port-base-status claims)
+  (let ((status (system "sh" "-c" "MURDOCH_PORT_CLAIMS=\"$0\" \"$1\" \"$0\" >/dev/null 2>&1"
+                        claims (tool-path "tools/free-port-base"))))
+    (quotient (if (pair? status) (cadr status) status) 256)))
+
+(test-group "a port base held by a folder is free once its asker has ended"
+  ;; A run killed before it removed its folder held its base for ever,
+  ;; until no base was left for any lab on the machine.
+  (let ((claims (string-append dir "/claims")))
+    (claim-every-base! claims (number->string (current-process-id)))
+    (test "a live asker's claims stand: no base is free" 1
+      (free-port-base-status claims))
+    (claim-every-base! claims "999999999")
+    (test "an ended asker's claims are free again" 0
+      (free-port-base-status claims))))
 
 (test-group "before anything is built"
   ;; A copy of bin/ and tools/chibi with no Chibi beside it or on PATH,

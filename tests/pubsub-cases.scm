@@ -207,6 +207,21 @@
     (test "each address space asks the first component's first" '(1 2 3)
       (at 'a (lab-proc 'asked-order)))))
 
+(test-group "a component not addressed here comes without its code"
+  ;; only-here is the tester's own: it travels by name, and no other
+  ;; address space has it (remote/served-call.scm, screen-calls!).
+  (eval '(define (only-here) 'ran) (lab-environment))
+  (let ((components (list (list 'exclusive '((wheel) ()) (lab-proc 'only-here) '())
+                          (list 'non-exclusive '(() (bar)) (lab-proc 'only-here) '()))))
+    (test "d, with neither subject, answers both without decoding" '(((#f d) ()) ((#f d) ()))
+      (at 'd receive-components components 'screened 'tester))
+    (test "b, with wheel, decodes the first, and cannot" 'raised
+      (guard (e ((remote-error? e) 'raised))
+        (at 'b receive-components components 'screened 'tester)))
+    (test "a, with bar, decodes the second, and cannot" 'raised
+      (guard (e ((remote-error? e) 'raised))
+        (at 'a receive-components components 'screened 'tester)))))
+
 (test-group "request-non-exclusive"
   (let* ((r1 (request-non-exclusive 'foo 'reader1 (lambda () 'read1)))
          (r2 (request-non-exclusive 'foo 'reader2 (lambda () 'read2))))

@@ -12,7 +12,7 @@
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
           remote-protocol-error? encap release-proxy! start-aspace!
           hand-over-connection! release-call! var-ref var-set! display-remote undo-on-raise
-          with-lock)
+          with-lock screen-calls!)
   (import (scheme base) (scheme write) (murdoch sys) (murdoch wire) (murdoch lab)
           (murdoch code) (murdoch remote aspace) (murdoch remote worker)
           (murdoch remote call) (murdoch remote serve) (murdoch remote group)

@@ -34,12 +34,36 @@
          (if (not (and (list? c) (= 4 (length c))))
              (error "receive-components: a component is (type layout proc askings)" c))
          (apply (lambda (type layout proc askings)
-                  (let ((answer (if (eq? type 'exclusive)
-                                    (receive-request-exclusive layout task-name uid proc '())
-                                    (receive-request (cadr layout) uid proc '()))))
+                  (let ((answer (cond ((not proc) (list #f (local-aspace-uid)))
+                                      ((eq? type 'exclusive)
+                                       (receive-request-exclusive layout task-name uid proc '()))
+                                      (else (receive-request (cadr layout) uid proc '())))))
                     (list answer (if (evaluated? answer) (map ask-here askings) '()))))
                 c))
        components))
+
+;; A component not addressed here, as most of a negotiation's are in most
+;; of a lab, comes without its code, which is then not decoded (docs/speed.md).
+(define (screen-components args)
+  (if (and (list? args) (= 3 (length args)) (list? (car args)))
+      (cons (map screened-component (car args)) (cdr args))
+      args))
+
+(define (screened-component c)
+  (if (unaddressed-component? c) (list (car c) (cadr c) #f '()) c))
+
+(define (unaddressed-component? c)
+  (and (list? c) (= 4 (length c)) (layout? (cadr c))
+       (not (if (eq? (car c) 'exclusive)
+                (and (subscribed-to-all? (car (cadr c))) (subscribed-to-all? (cadr (cadr c))))
+                (addressed-here? (cadr (cadr c)))))))
+
+(define (layout? x)
+  (and (list? x) (= 2 (length x)) (every symbols? x)))
+
+(define (symbols? x) (and (list? x) (every symbol? x)))
+
+(screen-calls! receive-components screen-components)
 
 ;; An asking is user code: one raising costs only its answer (docs/speed.md).
 (define (ask-here proc)

@@ -5,7 +5,7 @@
   (export start-serving! hand-over-connection! release-call!
           new-serving! read-as-reader reader? read-calls serve-call
           make-served-call served-call-caller served-call-id reply!
-          serving-read-on serving-read-on-set!)
+          serving-read-on serving-read-on-set! screen-calls!)
   (import (scheme base) (srfi 1) (srfi 18)
           (only (chibi filesystem) open-input-file-descriptor open-output-file-descriptor)
           (only (chibi) port-fileno)

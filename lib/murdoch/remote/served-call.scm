@@ -174,20 +174,39 @@
 
 ;; The application run c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
-  (sandboxed-thunk (served-procedure c) (served-arguments c)))
+  (decoded-thunk (served-procedure c) c))
+
+(define (decoded-thunk proc c)
+  (sandboxed-thunk proc (served-arguments c proc)))
 
 (define (sandboxed-thunk proc args)
   (lambda () (call-in-sandbox proc args)))
 
 ;; What c's application answers, encoded (no thunk: docs/speed.md).
 (define (encoded-result c)
-  (encode (call-in-sandbox (served-procedure c) (served-arguments c))
-          (lab-environment) "the result"))
+  (encoded-application (served-procedure c) c))
+
+(define (encoded-application proc c)
+  (encode (call-in-sandbox proc (served-arguments c proc)) (lab-environment) "the result"))
 
 (define (served-procedure c)
   (checked-procedure (decode-value (served-call-proc-code c))))
 
-(define (served-arguments c) (decode-value (served-call-args-code c)))
+(define (served-arguments c proc)
+  (decode-value (screened (served-call-args-code c) proc)))
+
+;; Global: each layer adds its own as it loads (screen-calls!).
+(define *screens* '())
+
+;;> Passes the arguments of a call of \var{proc}, as read, through \var{screen}, which
+;;> leaves out the code this address space will not run, before they are decoded.
+;;> Arguments it does not know, it answers as they are.
+(define (screen-calls! proc screen)
+  (set! *screens* (cons (cons proc screen) *screens*)))
+
+(define (screened args-code proc)
+  (let ((entry (assq proc *screens*)))
+    (if entry ((cdr entry) args-code) args-code)))
 
 (define (checked-procedure proc)
   (if (procedure? proc) proc (error "not a procedure" proc)))

@@ -59,7 +59,7 @@
 (define folders-made 0)
 
 ;;> A port base B, free from B to B + 199, held while this process lives
-;;> or \var{folder} exists.
+;;> and \var{folder}, if given, exists.
 (define (free-port-base . folder)
   (string->number (command-output (cons (tool-path "tools/free-port-base") folder))))
 
