@@ -197,7 +197,8 @@
   (turn-to! (heading-to (reckon) (car box-path)))
   (local-aspace-uid))
 
-;; Tells the pushers where the box is, and where the bodies of lost pushers
+;; Tells the pushers where the box is, when it saw it (its own clock, the
+;; simulator's, as every robot's), and where the bodies of lost pushers
 ;; lie (their last word of where they were), until the box has arrived;
 ;; keeps the box in view.
 (define (watch previous)
@@ -210,7 +211,7 @@
       (keep-in-view (or box last))
       (if box
           (for-each (lambda (uid) (if (not (eq? uid (local-aspace-uid)))
-                                      (team-send! uid (list 'box box bodies))))
+                                      (team-send! uid (list 'box box bodies now))))
                     (step-team)))
       (thread-sleep! 0.15)
       (let* ((heard (all-heard)) (box (or box last))
@@ -405,11 +406,14 @@
         (and (< -120 (car off) 30) (< (abs (cadr off)) 70) (< turn 20)))))
 
 ;; How far aside of its place a pusher at the face may stand and still push
-;; from there: 200 mm, 75 mm alone; 100 mm while its partner says it is on
+;; from there: 200 mm; 75 mm from a spot of its own (push-offset: alone,
+;; or clearing a lost partner's body); 50 mm while its partner says it is on
 ;; its way to its place, for one further aside stands in the way into the
-;; partner's place, 340 mm off, and holds there waiting for it.
+;; partner's place, 340 mm off, and holds there waiting for it (140 mm
+;; aside, generated seed 13; 93 mm, back from a spot nearer the middle
+;; where it cleared the lost one's body, seed 149, for 48 s).
 (define (aside-slack)
-  (cond ((alone?) 75) ((spare-on-its-way?) 100) (else 200)))
+  (cond (lone-at 75) ((spare-on-its-way?) 50) (else 200)))
 
 ;; What the pusher hears, on its own clock: when its partner last said it
 ;; was at the face ('here), and when it last said how far it still had to
@@ -417,6 +421,7 @@
 (define partner-here -100)
 (define partner-coming -100)
 (define partner-coming-mm #f)
+(define spare-way-at -100)              ; when a spare last said it had a way
 (define view-at -100)
 
 ;; How lately, in seconds, the partner said it was at the face, or coming.
@@ -431,11 +436,12 @@
         (let ((m (cdr heard)))
           (cond ((and (pair? m) (eq? (car m) 'box))
                  (set! view-at now)
-                 (note-turn! (cadr m))
+                 (note-turn! (cadr m) (list-ref m 3))
                  (latest (cdr m)))
                 ((eq? m 'here) (set! partner-here now) (latest last))
                 ((and (pair? m) (eq? (car m) 'coming))
                  (set! partner-coming now)
+                 (if (< (cadr m) 1e8) (set! spare-way-at now))
                  (set! partner-coming-mm (cadr m))
                  (latest last))
                 (else (latest last)))))))
@@ -541,7 +547,7 @@
       view
       (let ((own (see-box)))
         (and own
-             (begin (note-turn! own)
+             (begin (note-turn! own now)
                     (list own (if view (cadr view) '())))))))
 
 ;; How many degrees left the box must turn to head for the path: for its
@@ -570,6 +576,16 @@
 ;; of its own half nearest it that is clear, out to where half of it is
 ;; behind the face: seed 42's box turned until the lost pusher's body lay
 ;; behind its middle, holding both places, and no one pushed it on.
+;; A pusher that pushed in a pair and has lost its partner, with no spare
+;; saying it has a way to its place (the lost one's body holds it), pushes
+;; until one has from the spot nearest the middle of the face that is
+;; clear of the bodies and has a staging point, chosen once: from its own
+;; place, beside the body, its push turned the box about the body's corner
+;; away from its side, 20 to 35 degrees the wrong way in the 300 mm that
+;; clear the body (generated seeds 38 and 160, the outside pusher lost
+;; before a bend to the inside; the pair then had to turn the box 60 to 100
+;; degrees at the bend and passed its goal wide).  A spare, which has not
+;; pushed in a pair, never takes that spot: its place is the lost one's.
 (define lone-at #f)
 (define (push-offset view side)
   (let ((own (* side pusher-offset)) (box (car view)) (bodies (cadr view)))
@@ -578,6 +594,11 @@
              (cond ((not lone-at) (set! lone-at own))
                    ((> (abs (- want lone-at)) 80) (set! lone-at want)))
              lone-at))
+          ((and (pair? bodies) paired-at (not (paired?)) (>= (- now spare-way-at) 1))
+           (if (not lone-at)
+               (let ((o (clear-offset box bodies side 0 (+ box-half (/ body-radius 2)))))
+                 (set! lone-at (if (and o (staging box (place-axis box) o bodies)) o own))))
+           lone-at)
           (else
            (set! lone-at #f)
            (or (clear-offset box bodies side own (+ box-half (/ body-radius 2)) side) own)))))
@@ -593,8 +614,9 @@
 ;; Two pushers stand pusher-offset to either side of the middle, and the
 ;; box turns toward the path when the one on the far side of the turn
 ;; pushes harder (pair-share).  A pusher alone (its partner has not said
-;; lately that it is at the face) pushes from its own place, which turns
-;; the box away from its side, until it is alone (push-offset); it holds
+;; lately that it is at the face) pushes from the spot push-offset gives
+;; (its own place, or one nearer the middle while it clears a lost
+;; partner's body), slanted in as lone-push! says; it holds
 ;; while the box turns faster than max-turn-rate, and once a spare has a
 ;; way to the other place, leaving that free.  Before a spare speaks it
 ;; pushes on only until the box has left the lost partner's body behind,
@@ -609,10 +631,11 @@
     (if (paired?) (set! paired-at box))
     (if (or (paired?) (alone?) (= share 0))
         (push-at! box (place-axis box) offset share)
-        (lone-push! box side share))))
+        (lone-push! box offset share))))
 
 ;; Pushes at share of push-speed from where this pusher stands at the face,
-;; heading lone-slant degrees off the box's axis toward its middle, and only
+;; offset mm left of its middle, heading off the box's axis toward the
+;; middle by lone-slant degrees at a place's offset (less nearer it), and only
 ;; while it heads so (within 6 degrees), else turning there first.  A push
 ;; off the middle turns the box away from the pusher's side; the pusher,
 ;; pressed to the face, turns with the box and lags it, heading out, and the
@@ -621,9 +644,9 @@
 ;; pushed, headed 13 to 19 degrees out and turned the box 6 degrees a
 ;; second the wrong way.  Slanted in, that slide turns the box back.
 (define lone-slant 10)
-(define (lone-push! box side share)
+(define (lone-push! box offset share)
   (let* ((axis (place-axis box))
-         (want (- axis (* side lone-slant)))
+         (want (- axis (clip (* lone-slant (/ offset pusher-offset)) lone-slant)))
          (turn (wrap (- want (list-ref (reckon) 2)))))
     (drive! (if (< (abs turn) 6) (* push-speed (slowing box) share) 0)
             (clip (* 2 turn) 40))))
@@ -650,32 +673,50 @@
       (< (* side (- (clip (turn-error box) 20) (* turn-lead turn-rate))) -3)))
 
 ;; A pusher's share of push-speed in a pair: both push less the further
-;; the box is turned off its way (forward at a third from 30 degrees off),
+;; the box is turned off its way (forward at a quarter from 34 degrees off),
 ;; so that it turns more than it goes; and one pushes more and the other
-;; less by how far the box must turn, up to 20 degrees, less what it will
-;; turn of that within turn-lead seconds at the rate it turns now, so that
-;; it comes round at a few degrees a second without swinging past the
-;; path: a box swung fast leaves the pushers behind their places, and on a
-;; slow machine the views come later and it swings further before they see it.
-(define turn-lead 1.5)
+;; less, by the difference of speed that turns the box, held between two
+;; pushers pusher-offset either side of its middle, at the rate wanted:
+;; pair-gain a second of how far it must turn, up to pair-rate, plus
+;; rate-feedback of what the rate it turns now falls short of that.  Two
+;; pushers hold the box to the speeds they drive at, so a pair turns it at
+;; nearly the rate their speeds say; steered by how far it must turn less
+;; what it would turn in 1.5 s at the rate last seen, a pair of generated
+;; seed 160 or 38 turned its box at 30 degrees a second to and fro, some
+;; 10 degrees either side, each half second or so that the views came,
+;; knocking its pushers off their places (seed 38's spare was off the
+;; face for half the last third).  The slower pushes at no less
+;; than 0.1 of its speed: held at 0.3, a pair with its box 100 degrees off
+;; turned it at 7 degrees a second and drifted 600 mm past a bend.
+(define turn-lead 1.5)                  ; seconds ahead, for a pusher alone (lone-push?)
 (define max-turn-rate 8)                ; degrees a second, for a pusher alone
+(define pair-gain 0.5)                  ; per second
+(define pair-rate 20)                   ; degrees a second
+(define rate-feedback 0.5)
 (define (pair-share box side)
   (let* ((err (turn-error box))
-         (ahead (- (clip err 20) (* turn-lead turn-rate))))
-    (clip (- (clip (- 1 (/ (abs err) 45)) 0.33 1) (* 0.05 side ahead)) 0.3 1.6)))
+         (want (clip (* pair-gain err) pair-rate))
+         (rate (+ want (* rate-feedback (- want turn-rate)))))
+    (clip (- (clip (- 1 (/ (abs err) 45)) 0.25 1)
+             (/ (* side rate degrees pusher-offset) push-speed))
+          0.1 1.6)))
 
 ;; How fast the box turns, degrees a second, left positive, from the
-;; sightings it pushes by (fresh), at least 0.3 s apart on this robot's
-;; clock.
+;; sightings it pushes by (fresh), at least rate-span seconds apart by the
+;; clock they were seen at (the watcher's, or this robot's for its own: one
+;; clock, the simulator's), not by when a view arrived: a view a round
+;; late, or two in one round, made a rate of twice or half the true one;
+;; a sighting older than the last is passed over.
 (define turn-rate 0)
+(define rate-span 0.5)
 (define rate-from #f)                   ; (SECONDS HEADING)
-(define (note-turn! box)
+(define (note-turn! box seen-at)
   (let ((h (list-ref box 2)))
-    (cond ((not rate-from) (set! rate-from (list now h)))
-          ((>= (- now (car rate-from)) 0.3)
+    (cond ((not rate-from) (set! rate-from (list seen-at h)))
+          ((>= (- seen-at (car rate-from)) rate-span)
            (set! turn-rate
-                 (/ (square-wrap (- h (cadr rate-from))) (- now (car rate-from))))
-           (set! rate-from (list now h))))))
+                 (/ (square-wrap (- h (cadr rate-from))) (- seen-at (car rate-from))))
+           (set! rate-from (list seen-at h))))))
 
 ;; Whether a spare said lately (within 2 s) that it has a way to its place.
 (define (spare-on-its-way?)
