@@ -260,6 +260,10 @@
 (define (heard-of-waiters? o)
   (and (or (offering-waiters-seen o) (offering-new-waiters o)) #t))
 
+;; How many of run a poser's answer n went through: a peer's word, checked.
+(define (went-through n run)
+  (if (exact-integer? n) (max 1 (min n (length run))) 1))
+
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
     (let* ((poser (wanting-poser (car waiting)))
@@ -268,7 +272,7 @@
       (let* ((n (guard (e (#t 1))
                   (parameterize ((remote-timeout (+ (offer-seconds) 1)))
                     (remote-apply (uid->aspace poser) receive-offer (map wanting-id run) me))))
-             (left (list-tail waiting (max 1 (min n (length run))))))
+             (left (list-tail waiting (went-through n run))))
         (if (and (ask-again-before? left) (free-here?))
             (let ((o (the-offering)))
               (with-lock (offering-lock o) (lambda () (offering-again?-set! o #t))))
