@@ -26,12 +26,19 @@
 
 ;;; The poser's side
 
-;;> What a freed robot \var{uid} calls where task \var{id} waits: the
-;;> task tries again at once; answers whether it started, #f when it is
-;;> no longer waiting here, the robots it is offered already could take
-;;> every component this one could, or it did not answer within
-;;> offer-seconds.
-(define (receive-offer id uid)
+;;> What a freed robot \var{uid} calls where the tasks \var{ids} wait,
+;;> best first: the first that may use it tries again at once.  Answers
+;;> how many of ids it went through, to the one that tried, or all when
+;;> each waits here no more or was offered robots already that could
+;;> take every component this one could: one call for a poser's declines.
+(define (receive-offer ids uid)
+  (let loop ((ids ids) (n 1))
+    (cond ((null? ids) (- n 1))
+          ((offer-to-waiter! (car ids) uid) n)
+          (else (loop (cdr ids) (+ n 1))))))
+
+;; Offers robot uid to task id: #f if declined at once, else after its try.
+(define (offer-to-waiter! id uid)
   (let* ((reply (make-mailbox))
          (offer (cons uid id))
          (w (with-lock (tasks-lock)
@@ -45,7 +52,8 @@
           (lambda () #f)
           (lambda ()
             (tell-waiter! w (list 'offer reply uid))
-            (mailbox-take reply (+ (monotonic-seconds) (offer-seconds)) (lambda () #f)))
+            (mailbox-take reply (+ (monotonic-seconds) (offer-seconds)) (lambda () #f))
+            #t)
           (lambda ()
             (with-lock (tasks-lock)
               (lambda ()
@@ -252,18 +260,23 @@
 (define (heard-of-waiters? o)
   (and (or (offering-waiters-seen o) (offering-new-waiters o)) #t))
 
+;; How many of run a poser's answer n went through: a peer's word, checked.
+(define (went-through n run)
+  (if (exact-integer? n) (max 1 (min n (length run))) 1))
+
 (define (offer-to me waiting)
   (when (and (pair? waiting) (free-here?))
-    (let ((poser (wanting-poser (car waiting))))
+    (let* ((poser (wanting-poser (car waiting)))
+           (run (take-while (lambda (e) (eq? (wanting-poser e) poser)) waiting)))
       (offer-subjects! poser (+ (offer-seconds) 1))
-      (guard (e (#t #f))
-        (parameterize ((remote-timeout (+ (offer-seconds) 1)))
-          (remote-apply (uid->aspace poser) receive-offer
-                        (wanting-id (car waiting)) me)))
-      (if (and (ask-again-before? (cdr waiting)) (free-here?))
-          (let ((o (the-offering)))
-            (with-lock (offering-lock o) (lambda () (offering-again?-set! o #t))))
-          (offer-to me (cdr waiting))))))
+      (let* ((n (guard (e (#t 1))
+                  (parameterize ((remote-timeout (+ (offer-seconds) 1)))
+                    (remote-apply (uid->aspace poser) receive-offer (map wanting-id run) me))))
+             (left (list-tail waiting (went-through n run))))
+        (if (and (ask-again-before? left) (free-here?))
+            (let ((o (the-offering)))
+              (with-lock (offering-lock o) (lambda () (offering-again?-set! o #t))))
+            (offer-to me left))))))
 
 ;; The subjects this address space subscribes to: a poser matches them
 ;; against its waiting tasks' capabilities, for a robot it has not seen.
