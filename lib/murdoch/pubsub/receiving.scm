@@ -2,6 +2,7 @@
 ;;;; each address space, (#t UID VALUE) or (#f UID), and the reservations.
 
 (define (evaluated? answer) (car answer))
+(define (not-evaluated) (list #f (local-aspace-uid)))
 (define (evaluation answer) (cdr answer)) ; (UID VALUE)
 (define (component-answer entry) (car entry))
 (define (component-asked entry) (cadr entry))
@@ -16,7 +17,7 @@
 (define (receive-request topic uid proc args)
   (if (addressed-here? topic)
       (list #t (local-aspace-uid) (apply proc args))
-      (list #f (local-aspace-uid))))
+      (not-evaluated)))
 
 ;;> Reserves and promises, if addressed here and free: (#t uid promise) or (#f uid).
 (define (receive-request-exclusive topiclist task-name uid proc args)
@@ -34,7 +35,7 @@
          (if (not (and (list? c) (= 4 (length c))))
              (error "receive-components: a component is (type layout proc askings)" c))
          (apply (lambda (type layout proc askings)
-                  (let ((answer (cond ((not proc) (list #f (local-aspace-uid)))
+                  (let ((answer (cond ((not proc) (not-evaluated))
                                       ((eq? type 'exclusive)
                                        (receive-request-exclusive layout task-name uid proc '()))
                                       (else (receive-request (cadr layout) uid proc '())))))
@@ -55,7 +56,7 @@
 (define (unaddressed-component? c)
   (and (list? c) (= 4 (length c)) (layout? (cadr c))
        (not (if (eq? (car c) 'exclusive)
-                (and (subscribed-to-all? (car (cadr c))) (subscribed-to-all? (cadr (cadr c))))
+                (subscribed-to-layout? (car (cadr c)) (cadr (cadr c)))
                 (addressed-here? (cadr (cadr c)))))))
 
 (define (layout? x)
@@ -119,9 +120,12 @@
   (or (null? subjects)
       (and (find-subscription (car subjects)) (subscribed-to-all? (cdr subjects)))))
 
+(define (subscribed-to-layout? exclusive non-exclusive)
+  (and (subscribed-to-all? exclusive) (subscribed-to-all? non-exclusive)))
+
 (define (reserve! exclusive non-exclusive task uid)
   (and
-   (subscribed-to-all? exclusive) (subscribed-to-all? non-exclusive)
+   (subscribed-to-layout? exclusive non-exclusive)
    (with-subscriptions
      (lambda ()
        (let ((ex (and (not (and (pair? exclusive) (offered-elsewhere? uid)))
@@ -211,7 +215,7 @@
 
 (define (promise-for r proc args)
   (if (not r)
-      (list #f (local-aspace-uid))
+      (not-evaluated)
       (list #t (local-aspace-uid)
             (letrec ((promise
                       (encap
