@@ -109,7 +109,9 @@
          (fits? (lambda (uid c)
                   (let ((capable (looked-capable w c)))
                     (or (not capable) (memq uid capable))))))
-    (= (most-matched open offered fits?) (most-matched open (cons uid offered) fits?))))
+    (if (null? offered)
+        (not (any (lambda (c) (fits? uid c)) open))
+        (= (most-matched open offered fits?) (most-matched open (cons uid offered) fits?)))))
 
 ;; The most of components cs that uids, one a component, can take: a
 ;; task has a few components, and is offered a few robots at once.
