@@ -68,16 +68,19 @@
 ;; every 50 ms at what those that hold robots while they wait hold, each
 ;; change told to the bench, which notes it as (TIME ID UID ...): the
 ;; judge asks whether a better-ranked task could have used a robot that
-;; went elsewhere, which the starts and ends alone do not say.
+;; went elsewhere, which the starts and ends alone do not say.  The ids
+;; as ranks name them are made once a task: made every 50 ms, for hundreds
+;; of tasks, they were CPU of the poser's that the bench charged the lab.
 (define posed '())
+(define ids '())                        ; (TASK-ID-STRING . ID)
 (define watching #t)
 (define (posed! id task)
   (if (null? posed) (thread-start! (make-thread watch-holdings)))
+  (set! ids (cons (cons (symbol->string (task-id task)) id) ids))
   (set! posed (cons (cons id task) posed)))
 (define (watch-holdings)
   (let loop ((last '()))                ; (ID UID ...) of each task holding
-    (let* ((ids (map (lambda (p) (cons (symbol->string (task-id (cdr p))) (car p))) posed))
-           (now (filter-map (lambda (e)
+    (let* ((now (filter-map (lambda (e)
                               (let ((id (assoc (list-ref (car e) 2) ids)))
                                 (and id (cons (cdr id) (cadr e)))))
                             (waiting-ranks #t)))
