@@ -579,14 +579,23 @@
 ;; behind its middle, holding both places, and no one pushed it on.
 ;; A pusher that pushed in a pair and has lost its partner, with no spare
 ;; saying it has a way to its place (the lost one's body holds it), pushes
-;; until one has from the spot nearest the middle of the face that is
-;; clear of the bodies and has a staging point, chosen once: from its own
-;; place, beside the body, its push turned the box about the body's corner
-;; away from its side, 20 to 35 degrees the wrong way in the 300 mm that
-;; clear the body (generated seeds 38 and 160, the outside pusher lost
-;; before a bend to the inside; the pair then had to turn the box 60 to 100
-;; degrees at the bend and passed its goal wide).  A spare, which has not
-;; pushed in a pair, never takes that spot: its place is the lost one's.
+;; until one has from the spot of its own half nearest lone-want (the
+;; middle, when the box must turn toward the other half) that is clear of
+;; the bodies and has a staging point, chosen afresh when that has moved by
+;; more than 80 mm: from its own place, beside the body, its push turned
+;; the box about the body's corner away from its side, 20 to 35 degrees the
+;; wrong way in the 300 mm that clear the body (generated seeds 38 and 160,
+;; the outside pusher lost before a bend to the inside; the pair then had
+;; to turn the box 60 to 100 degrees at the bend and passed its goal wide).
+;; Chosen once, nearest the middle, the spot still let the box turn 20 to
+;; 34 degrees the wrong way (seeds 160, 149).  Not on the other half: there
+;; the spare comes, and seed 149's lone pusher went round to it and stood
+;; in the spare's way.  A spare, which has not pushed in a pair, never
+;; takes that spot: its place is the lost one's.  A pusher whose own place
+;; a body holds takes a spot that leaves its partner's place free (the
+;; width of a robot from it): seed 149's spare, the body at its place,
+;; chose a spot 50 mm from the middle of a 410 mm box, where the lone
+;; pusher's edge stood in its way in, and each held for the other.
 (define lone-at #f)
 (define (push-offset view side)
   (let ((own (* side pusher-offset)) (box (car view)) (bodies (cadr view)))
@@ -596,13 +605,16 @@
                    ((> (abs (- want lone-at)) 80) (set! lone-at want)))
              lone-at))
           ((and (pair? bodies) paired-at (not (paired?)) (>= (- now spare-way-at) 1))
-           (if (not lone-at)
-               (let ((o (clear-offset box bodies side 0 (+ box-half (/ body-radius 2)))))
-                 (set! lone-at (if (and o (staging box (place-axis box) o bodies)) o own))))
-           lone-at)
+           (let ((o (clear-offset box bodies side (lone-want box) (+ box-half (/ body-radius 2)) side)))
+             (if (and o (or (not lone-at) (> (abs (- o lone-at)) 80))
+                      (staging box (place-axis box) o bodies))
+                 (set! lone-at o))
+             (or lone-at (begin (set! lone-at own) own))))
           (else
            (set! lone-at #f)
-           (or (clear-offset box bodies side own (+ box-half (/ body-radius 2)) side) own)))))
+           (or (clear-offset box (cons (behind-at box (place-axis box) (- own)) bodies)
+                             side own (+ box-half (/ body-radius 2)) side)
+               own)))))
 
 ;; Whether this pusher has heard nothing from a partner for 10 s (long
 ;; enough for a spare to be found and the watcher to know where the lost
