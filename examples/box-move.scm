@@ -491,6 +491,7 @@
             (let ((offset (push-offset seen side)))
               (cond ((at-place? box offset (and at-face? (aside-slack)))
                      (team-send! (partner) 'here)
+                     (set! backing #f)
                      (steer! seen side offset)
                      (loop (latest view) #t said))
                     (else
@@ -578,14 +579,23 @@
 ;; behind its middle, holding both places, and no one pushed it on.
 ;; A pusher that pushed in a pair and has lost its partner, with no spare
 ;; saying it has a way to its place (the lost one's body holds it), pushes
-;; until one has from the spot nearest the middle of the face that is
-;; clear of the bodies and has a staging point, chosen once: from its own
-;; place, beside the body, its push turned the box about the body's corner
-;; away from its side, 20 to 35 degrees the wrong way in the 300 mm that
-;; clear the body (generated seeds 38 and 160, the outside pusher lost
-;; before a bend to the inside; the pair then had to turn the box 60 to 100
-;; degrees at the bend and passed its goal wide).  A spare, which has not
-;; pushed in a pair, never takes that spot: its place is the lost one's.
+;; until one has from the spot of its own half nearest lone-want (the
+;; middle, when the box must turn toward the other half) that is clear of
+;; the bodies and has a staging point, chosen afresh when that has moved by
+;; more than 80 mm: from its own place, beside the body, its push turned
+;; the box about the body's corner away from its side, 20 to 35 degrees the
+;; wrong way in the 300 mm that clear the body (generated seeds 38 and 160,
+;; the outside pusher lost before a bend to the inside; the pair then had
+;; to turn the box 60 to 100 degrees at the bend and passed its goal wide).
+;; Chosen once, nearest the middle, the spot still let the box turn 20 to
+;; 34 degrees the wrong way (seeds 160, 149).  Not on the other half: there
+;; the spare comes, and seed 149's lone pusher went round to it and stood
+;; in the spare's way.  A spare, which has not pushed in a pair, never
+;; takes that spot: its place is the lost one's.  A pusher whose own place
+;; a body holds takes a spot that leaves its partner's place free (the
+;; width of a robot from it): seed 149's spare, the body at its place,
+;; chose a spot 50 mm from the middle of a 410 mm box, where the lone
+;; pusher's edge stood in its way in, and each held for the other.
 (define lone-at #f)
 (define (push-offset view side)
   (let ((own (* side pusher-offset)) (box (car view)) (bodies (cadr view)))
@@ -595,13 +605,16 @@
                    ((> (abs (- want lone-at)) 80) (set! lone-at want)))
              lone-at))
           ((and (pair? bodies) paired-at (not (paired?)) (>= (- now spare-way-at) 1))
-           (if (not lone-at)
-               (let ((o (clear-offset box bodies side 0 (+ box-half (/ body-radius 2)))))
-                 (set! lone-at (if (and o (staging box (place-axis box) o bodies)) o own))))
-           lone-at)
+           (let ((o (clear-offset box bodies side (lone-want box) (+ box-half (/ body-radius 2)) side)))
+             (if (and o (or (not lone-at) (> (abs (- o lone-at)) 80))
+                      (staging box (place-axis box) o bodies))
+                 (set! lone-at o))
+             (or lone-at (begin (set! lone-at own) own))))
           (else
            (set! lone-at #f)
-           (or (clear-offset box bodies side own (+ box-half (/ body-radius 2)) side) own)))))
+           (or (clear-offset box (cons (behind-at box (place-axis box) (- own)) bodies)
+                             side own (+ box-half (/ body-radius 2)) side)
+               own)))))
 
 ;; Whether this pusher has heard nothing from a partner for 10 s (long
 ;; enough for a spare to be found and the watcher to know where the lost
@@ -795,10 +808,18 @@
 ;; and stage-reach: the spare of generated seed 13, its fault drawn,
 ;; stopped 52 mm past its staging point, 502 mm from its place, where it
 ;; neither docked (within 500 mm) nor planned a way on, and stood for 60 s.
+;; Along the axis into the place it slows to 40 mm/s as it nears it (not
+;; 120), and at the face but 70 mm or more aside it backs off straight
+;; along the axis to 300 mm behind the place and comes in again, never
+;; pressing on: a pusher put off its place by its partner's coming pressed
+;; on into the face's corner at 110 to 120 mm/s for 5 to 12 s, alone and
+;; unsteered, and turned the box at 6 to 8 degrees a second past its last
+;; leg's heading (generated seeds 160 and 13, the outside pusher lost).
 (define stage-back 450)
 (define stage-out 450)                  ; a staging point beside the place
 (define stage-reach 150)
 (define docking #f)             ; the staging point reached, while docking
+(define backing #f)
 (define waypoint #f)
 
 (define planned-at -100)
@@ -814,14 +835,21 @@
            (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
           ((and (eq? docking 'behind) (in-corridor? off 2))
            (set! held "it does not come into its place along the box's axis")
-           (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
+           (set! backing (if backing
+                             (< (car off) 300)
+                             (and (< (car off) 80) (>= (abs (cadr off)) 70))))
+           (if backing
+               (drive-along! axis (car off) 0 -120)
+               (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 40 300))))
           ((and (eq? docking 'beside) (< (distance (reckon) place) (+ stage-out stage-reach)))
            (set! held "it does not come into its place along the box's face")
+           (set! backing #f)
            (if (> (distance (reckon) place) 40)
                (drive-to! place)
                (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
           (else
            (set! docking #f)
+           (set! backing #f)
            (if (or (not waypoint) (>= (- now planned-at) 0.8))
                (begin (set! planned-at now)
                       (set! waypoint (and stage (plan-way (car stage) box (cadr view))))))
