@@ -491,7 +491,6 @@
             (let ((offset (push-offset seen side)))
               (cond ((at-place? box offset (and at-face? (aside-slack)))
                      (team-send! (partner) 'here)
-                     (set! backing #f)
                      (steer! seen side offset)
                      (loop (latest view) #t said))
                     (else
@@ -808,18 +807,10 @@
 ;; and stage-reach: the spare of generated seed 13, its fault drawn,
 ;; stopped 52 mm past its staging point, 502 mm from its place, where it
 ;; neither docked (within 500 mm) nor planned a way on, and stood for 60 s.
-;; Along the axis into the place it slows to 40 mm/s as it nears it (not
-;; 120), and at the face but 70 mm or more aside it backs off straight
-;; along the axis to 300 mm behind the place and comes in again, never
-;; pressing on: a pusher put off its place by its partner's coming pressed
-;; on into the face's corner at 110 to 120 mm/s for 5 to 12 s, alone and
-;; unsteered, and turned the box at 6 to 8 degrees a second past its last
-;; leg's heading (generated seeds 160 and 13, the outside pusher lost).
 (define stage-back 450)
 (define stage-out 450)                  ; a staging point beside the place
 (define stage-reach 150)
 (define docking #f)             ; the staging point reached, while docking
-(define backing #f)
 (define waypoint #f)
 
 (define planned-at -100)
@@ -835,21 +826,14 @@
            (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
           ((and (eq? docking 'behind) (in-corridor? off 2))
            (set! held "it does not come into its place along the box's axis")
-           (set! backing (if backing
-                             (< (car off) 300)
-                             (and (< (car off) 80) (>= (abs (cadr off)) 70))))
-           (if backing
-               (drive-along! axis (car off) 0 -120)
-               (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 40 300))))
+           (drive-along! axis (car off) (cadr off) (clip (* 1.5 (car off)) 120 300)))
           ((and (eq? docking 'beside) (< (distance (reckon) place) (+ stage-out stage-reach)))
            (set! held "it does not come into its place along the box's face")
-           (set! backing #f)
            (if (> (distance (reckon) place) 40)
                (drive-to! place)
                (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
           (else
            (set! docking #f)
-           (set! backing #f)
            (if (or (not waypoint) (>= (- now planned-at) 0.8))
                (begin (set! planned-at now)
                       (set! waypoint (and stage (plan-way (car stage) box (cadr view))))))
