@@ -174,20 +174,14 @@
 
 ;; The application run c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
-  (decoded-thunk (served-procedure c) c))
-
-(define (decoded-thunk proc c)
-  (sandboxed-thunk proc (served-arguments c proc)))
-
-(define (sandboxed-thunk proc args)
-  (lambda () (call-in-sandbox proc args)))
+  (let* ((proc (served-procedure c))
+         (args (served-arguments c proc)))
+    (lambda () (call-in-sandbox proc args))))
 
 ;; What c's application answers, encoded (no thunk: docs/speed.md).
 (define (encoded-result c)
-  (encoded-application (served-procedure c) c))
-
-(define (encoded-application proc c)
-  (encode (call-in-sandbox proc (served-arguments c proc)) (lab-environment) "the result"))
+  (let ((proc (served-procedure c)))
+    (encode (call-in-sandbox proc (served-arguments c proc)) (lab-environment) "the result")))
 
 (define (served-procedure c)
   (checked-procedure (decode-value (served-call-proc-code c))))
