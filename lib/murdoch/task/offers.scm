@@ -202,14 +202,15 @@
       (thread-start! (make-logged-thread offer-rounds 'offers)))))
 
 ;; The robot is kept for the poser it was last offered to until the
-;; rounds end, so that no task takes it between two rounds.
+;; rounds end, so that no task takes it between two rounds.  A robot taken
+;; meanwhile ends them: its next freeing starts a round.
 (define (offer-rounds)
   (guard (e (#t (log-warn "offering this robot: " (error-message e))))
     (offer-round))
   (if (let ((o (the-offering)))
         (with-lock (offering-lock o)
           (lambda ()
-            (let ((again (offering-again? o)))
+            (let ((again (and (offering-again? o) (free-here?))))
               (offering-again?-set! o #f)
               (when (not again)
                 (offer-subjects! #f)
