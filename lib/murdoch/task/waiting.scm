@@ -28,6 +28,7 @@
     (lambda ()
       (task-waiter-set! (waiter-task w) w)
       (add-waiter! w)
+      (known-capable! w)
       (start-looker!)
       (subscribe 'waiting-tasks)))
   (note-lab! (waiter-rank w)))
@@ -236,10 +237,12 @@
 
 ;;; The poser's look, for all its waiting tasks at once
 
-;; Under (tasks-lock), as a task starts to wait.
+;; Under (tasks-lock), as a task starts to wait: the first look comes at
+;; once, so that the tasks posed after it know their robots (known-capable!).
 (define (start-looker!)
   (when (not (looking-looker? (the-looking)))
     (looking-looker?-set! (the-looking) #t)
+    (want-look!)
     (thread-start! (make-logged-thread looker 'looks))))
 
 (define (want-look!) (mailbox-put! (looking-bell (the-looking)) #t))
@@ -329,12 +332,7 @@
 (define (look! w lines holders line told)
   (waiter-looked-set! w (monotonic-seconds))
   (let* ((cs (waiter-components w))
-         (capable (map (lambda (line)
-                         (let ((all (explanation-capable line)))
-                           (if (null? (waiter-excluded w))
-                               all
-                               (remove (lambda (uid) (memq uid (waiter-excluded w))) all))))
-                       lines))
+         (capable (capable-lists w lines))
          (never (cond
                  ((any null? capable)
                   (string-append "no live robot of the lab is capable of it:"
@@ -360,6 +358,30 @@
                                 (held-uids w)))
                     "")
                 ", " (waiter-position w) " in line")))))
+
+;; The uids of each of lines, w's components' explanations, that w may
+;; use: all but those it excludes.
+(define (capable-lists w lines)
+  (map (lambda (line)
+         (let ((all (explanation-capable line)))
+           (if (null? (waiter-excluded w))
+               all
+               (remove (lambda (uid) (memq uid (waiter-excluded w))) all))))
+       lines))
+
+;; A task that starts to wait takes the robots capable of its components
+;; from its poser's last look, when that asked about all their layouts
+;; and found some for each: its first try asks them, not the whole lab,
+;; and a robot's round passes it by when it cannot serve it.  Its own
+;; look still tells it its place.  Under (tasks-lock).
+(define (known-capable! w)
+  (let* ((last (looking-takers (the-looking)))
+         (lines (and last (map (lambda (l) (cond ((assoc l (cdr last)) => cdr) (else #f)))
+                               (waiter-layouts w))))
+         (capable (and lines (every values lines) (capable-lists w lines))))
+    (when (and capable (every pair? capable))
+      (waiter-capable-set! w (union-of capable))
+      (waiter-capables-set! w (map cons (waiter-components w) capable)))))
 
 ;; Whether fewer robots are capable of the exclusive components of cs,
 ;; capable the uids capable of each, than they are: never when each has
