@@ -147,9 +147,14 @@
 
 ;;> Starts \var{args} logging to \var{log-file}; answers the pid.
 (define (start-process! args log-file)
-  (let ((pid (fork)))
+  (let* ((parent (current-process-id))
+         (pid (fork)))
     (cond
      ((zero? pid)
+      ;; A test or bench killed, by a person or a time limit, leaves no
+      ;; lab behind: its children die with it.
+      (set-parent-death-signal! signal/term)
+      (if (not (= (parent-process-id) parent)) (exit 1))
       (execute "/bin/sh"
                (append (list "/bin/sh" "-c"
                              "unset MURDOCH_PORT_BASE; exec \"$@\" >>\"$0\" 2>&1"
