@@ -249,9 +249,12 @@
                                                      (line-posers (the-line)))))
         (line-posers-asked-set! (the-line) (monotonic-seconds))
         answers)
-      (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
-                  (apply remote-apply-all (filter-map live-aspace (line-posers (the-line)))
-                         proc args))))
+      (apply ask-these-posers (line-posers (the-line)) proc args)))
+
+;;> The same, asked of the posers \var{posers} alone.
+(define (ask-these-posers posers proc . args)
+  (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
+              (apply remote-apply-all (filter-map live-aspace posers) proc args)))
 
 ;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
 ;; . WAITING-THERES), WHEN a monotonic-seconds, under (tasks-lock): the
