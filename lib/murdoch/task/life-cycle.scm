@@ -427,12 +427,12 @@
 (define (tasks)
   (let* ((posed (with-lock (tasks-lock) posed-tasks))
          (line (and (any task-waiter posed)
-                    (line-of (guard (e (#t '())) (lab-waiting))))))
+                    (line-ranks-now))))
     (append (map (lambda (t) (posed-entry t line)) posed)
             (map (lambda (r) (cons 'running r)) (components-running)))))
 
 ;; t as (tasks) lists it; a waiting task as waiting-entry has it, with
-;; its place in line, the ranks of the lab's waiting tasks (line-of).
+;; its place in line, line the lab's line (line-ranks-now).
 (define (posed-entry t line)
   (let ((w (task-waiter t)))
     (if w

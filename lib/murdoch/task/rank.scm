@@ -116,14 +116,15 @@
 
 ;; The node's line part: the tasks waiting here, best rank first, under
 ;; (tasks-lock); the posers known to have tasks waiting, and when the lab
-;; was last asked for them; the lab's waiting tasks as last asked (below).
+;; was last asked for them; the other posers' waiting tasks as last asked
+;; (others-waiting, below).
 (define-record-type line
-  (make-line waiters posers posers-asked lab-waiting)
+  (make-line waiters posers posers-asked others)
   line?
   (waiters line-waiters line-waiters-set!)
   (posers line-posers line-posers-set!)
   (posers-asked line-posers-asked line-posers-asked-set!)
-  (lab-waiting line-lab-waiting line-lab-waiting-set!))
+  (others line-others line-others-set!))
 
 (define-syntax the-line (syntax-rules () ((_) (node-line *node*))))
 
@@ -175,22 +176,41 @@
 
 (define (held-uids w) (map held-uid (waiter-held w)))
 
-;; w's place in the lab's line, line being the ranks of every task of
-;; the lab that waits, as line-of orders them: 1 + how many rank before
-;; it.  One order for the whole lab, 1 to n, whatever robots each may
-;; use; found by halving, as a look numbers all of its poser's tasks.
+;;> The lab's line, as place-in-line reads it: the ranks of the other
+;;> posers' waiting tasks, in order, as waiting-at-others last asked for
+;;> them, and of this poser's own, as its waiters keep them.  Neither is
+;;> sorted at a look: a sort of the lab's 2,000 at every look of every
+;;> poser made the most calls a poser made (docs/allocation.md).
+(define-record-type line-ranks
+  (make-line-ranks others own)
+  line-ranks?
+  (others line-ranks-others)
+  (own line-ranks-own))
+
+(define (line-ranks-now)
+  (make-line-ranks (guard (e (#t (vector))) (others-waiting-line (others-waiting)))
+                   (list->vector (map waiter-rank (with-lock (tasks-lock) waiters)))))
+
+(define (line-ranks-length line)
+  (+ (vector-length (line-ranks-others line)) (vector-length (line-ranks-own line))))
+
+;; w's place in the lab's line, line as line-ranks-now makes it: 1 + how
+;; many rank before it.  One order for the whole lab, 1 to n, whatever
+;; robots each may use.
 (define (place-in-line w line)
-  (let loop ((lo 0) (hi (vector-length line)))
+  (+ 1
+     (ranked-before (line-ranks-others line) (waiter-rank w))
+     (ranked-before (line-ranks-own line) (waiter-rank w))))
+
+;; How many of ranks, a vector in rank order, go before rank: by halving.
+(define (ranked-before ranks rank)
+  (let loop ((lo 0) (hi (vector-length ranks)))
     (if (= lo hi)
-        (+ lo 1)
+        lo
         (let ((mid (quotient (+ lo hi) 2)))
-          (if (rank<? (vector-ref line mid) (waiter-rank w))
+          (if (rank<? (vector-ref ranks mid) rank)
               (loop (+ mid 1) hi)
               (loop lo mid))))))
-
-;; The ranks of others, waiting-theres, best first.
-(define (line-of others)
-  (list->vector (list-sort rank<? (map waiting-there-rank others))))
 
 ;;> The (RANK HELD) of each task waiting here: its rank, and the uids of
 ;;> the robots it holds; only of those that hold one if \var{holding} is
@@ -256,9 +276,15 @@
   (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
               (apply remote-apply-all (filter-map live-aspace posers) proc args)))
 
-;; The lab's waiting tasks as lab-waiting last asked for them: (WHEN
-;; . WAITING-THERES), WHEN a monotonic-seconds, under (tasks-lock): the
-;; same for all this poser's tasks.
+;; The other posers' waiting tasks as others-waiting last asked for them,
+;; under (tasks-lock): when, a monotonic-seconds, the waiting-theres, and
+;; their ranks in order, sorted once an ask.
+(define-record-type others-waiting
+  (make-others-waiting asked entries line)
+  others-waiting?
+  (asked others-waiting-asked)
+  (entries others-waiting-entries)
+  (line others-waiting-line))
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
 ;; asked of the lab at most once a heartbeat for every 100 tasks it
@@ -266,27 +292,24 @@
 ;; A place may so be W/100 heartbeats old for tasks posed elsewhere; who
 ;; is offered a robot is decided by the robot's own round, never by this
 ;; list, and who holds what is asked afresh (lab-holders).
-(define (waiting-at-others)
-  (let* ((now (monotonic-seconds))
-         (cached (with-lock (tasks-lock) (lambda () (line-lab-waiting (the-line)))))
-         (all (if (and cached
-                       (< (- now (car cached))
-                          (* (setting 'heartbeat)
-                             (max 1 (/ (length (cdr cached)) 100)))))
-                  (cdr cached)
-                  (let ((fresh (waiting-elsewhere)))
-                    (with-lock (tasks-lock)
-                      (lambda () (line-lab-waiting-set! (the-line) (cons now fresh))))
-                    fresh)))
-         (me (local-aspace-uid)))
-    (remove (lambda (o) (eq? (waiting-there-poser o) me)) all)))
+(define (others-waiting)
+  (let ((cached (with-lock (tasks-lock) (lambda () (line-others (the-line))))))
+    (if (and cached
+             (< (- (monotonic-seconds) (others-waiting-asked cached))
+                (* (setting 'heartbeat)
+                   (max 1 (/ (vector-length (others-waiting-line cached)) 100)))))
+        cached
+        (let* ((asked (monotonic-seconds))
+               (me (local-aspace-uid))
+               (entries (remove (lambda (o) (eq? (waiting-there-poser o) me))
+                                (waiting-elsewhere)))
+               (fresh (make-others-waiting asked entries
+                                           (list->vector
+                                            (list-sort rank<? (map waiting-there-rank entries))))))
+          (with-lock (tasks-lock) (lambda () (line-others-set! (the-line) fresh)))
+          fresh))))
 
-;; Every task of the lab that waits: the other posers' as
-;; waiting-at-others has them, this poser's as they are now.
-(define (lab-waiting)
-  (append (waiting-at-others)
-          (map (lambda (e) (apply make-waiting-there (local-aspace-uid) e))
-               (waiting-ranks))))
+(define (waiting-at-others) (others-waiting-entries (others-waiting)))
 
 ;; Every task of the lab that waits holding robots, asked afresh: no more
 ;; of them than robots.

@@ -16,9 +16,9 @@
           waiter-bell waiter-bell-set! waiters add-waiter! drop-waiter! in-rank-order
           news-kind offer? offer-reply offer-uid give-way-uid tell-waiter!
           take-news! answer-offers! held-index held-winner held-type held-uid
-          held-uids place-in-line line-of waiting-ranks waiting-there?
+          held-uids place-in-line line-ranks-now line-ranks-length waiting-ranks waiting-there?
           waiting-there-poser waiting-there-rank
-          waiting-there-held waiting-elsewhere waiting-at-others lab-waiting lab-holders
+          waiting-there-held waiting-elsewhere waiting-at-others lab-holders
           know-poser! ask-posers ask-these-posers wants? waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id)

@@ -266,14 +266,14 @@
 
 ;; Looks at the lab for the waiting tasks ws: one request for the takers
 ;; of all their components, one for the tasks that hold robots, and the
-;; lab's line as lab-waiting has it, whatever the number of tasks.  What
+;; lab's line (line-ranks-now), whatever the number of tasks.  What
 ;; each task is told is made once a look for each of the layouts and
 ;; numbers its components have, and the holders that rank after each task
 ;; are found by going down both lists together (docs/allocation.md).
 (define (look-all! ws)
-  (let*-values (((line) (line-of (guard (e (#t '())) (lab-waiting))))
+  (let*-values (((line) (line-ranks-now))
                 ((lines fresh?) (takers-of (delete-duplicates (append-map waiter-layouts ws))
-                                           (vector-length line))))
+                                           (line-ranks-length line))))
     ;; Those that hold robots, no more than the robots, best first: each
     ;; task asks those of them that rank after it to give way.
     (let ((holders (list-sort (lambda (a b)
@@ -429,11 +429,11 @@
 ;; Brings w's place in the lab's line, its state and its components'
 ;; states up to date: holding while it holds a robot, each component it
 ;; holds a robot for (holding UID), the others (waiting PLACE WHY).
-;; line is the ranks of the lab's waiting tasks (line-of), asked for when
+;; line is the lab's line (line-ranks-now), asked for when
 ;; not given.
 (define (move-up! w . line)
   (let ((place (guard (e (#t (waiter-position w)))
-                 (place-in-line w (if (pair? line) (car line) (line-of (lab-waiting))))))
+                 (place-in-line w (if (pair? line) (car line) (line-ranks-now)))))
         (t (waiter-task w)))
     (with-lock (tasks-lock)
       (lambda ()
