@@ -26,6 +26,7 @@
 ;; call e) once its output is flushed; any other goes to (other-failure e).
 (define (read-calls s read-on answer-error other-failure)
   (let ((r (make-reading s #f)))
+    (serving-reading-set! s r)
     (let again ()
       (guard (e ((reading-call r)
                  => (lambda (c)
@@ -52,7 +53,7 @@
   (run-in-worker thunk))
 
 (define (serve-apply r s c)
-  (inline-apply-begins! s (served-call-id c))
+  (inline-apply-begins! s)
   ;; Answered while the call is r's; a value too large gets the error.
   (reply! c 'value (encoded-result c))
   (reading-call-set! r #f)
