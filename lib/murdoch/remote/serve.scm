@@ -75,14 +75,15 @@
         (server-servings-set! (the-server) (cons s (server-servings (the-server))))))
     s))
 
+(define-syntax reader?
+  (syntax-rules () ((_ s) (eq? (current-thread) (serving-thread s)))))
+
 ;; Runs a reader's loop; the connection ends with it, unless handed on.
 (define (read-as-reader s thunk)
   (guard (e (#t (let-go-of-writes! s)
                 (log-fault (serving-peer s) e)))
     (thunk))
   (if (reader? s) (end-serving! s)))
-
-(define (reader? s) (eq? (current-thread) (serving-thread s)))
 
 ;; Once: the janitor and the reader may both end it.  The poller lets go of
 ;; the descriptor first, as a closed number may be another connection's next.

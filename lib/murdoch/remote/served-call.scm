@@ -12,7 +12,8 @@
   (answer served-call-answer))          ; (answer C KIND VALUE)
 
 ;;> Answers served call \var{c}: \var{kind} ack, value or error, and its \var{value}.
-(define (reply! c kind value) ((served-call-answer c) c kind value))
+(define-syntax reply!
+  (syntax-rules () ((_ c kind value) ((served-call-answer c) c kind value))))
 
 ;; A thread reading s's calls, and the call it runs until answered.
 (define-record-type reading
