@@ -183,8 +183,8 @@
           (thread-specific-set! (current-thread) new)
           new))))
 
-(define (flush-if-open port)
-  (if (port-open? port) (flush-output-port port)))
+(define-syntax flush-if-open
+  (syntax-rules () ((_ port) (if (port-open? port) (flush-output-port port)))))
 
 ;; Global: each layer adds its own as it loads (sandbox-parameter!).
 (define *parameters* '())

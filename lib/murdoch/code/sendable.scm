@@ -345,6 +345,7 @@
 ;; Makers kept by source, as compiling is decoding's dear part; emptied at
 ;; max-makers, as a peer could send sources without end (docs/speed.md).
 (define max-makers 4096)
+(define max-cells 64)
 
 (define-syntax closure-or-opcode?
   (syntax-rules () ((_ x) (if (closure? x) #t (opcode? x)))))
@@ -379,7 +380,8 @@
 ;;> resolving globals and sources in \var{env} and proxies by \var{proxy};
 ;;> in place, so the value must be fresh from a frame.
 (define (make-decoder env proxy)
-  (let ((compile (make-closure-compiler env)))
+  (let ((compile (make-closure-compiler env))
+        (cells '()))                    ; (NAME . CELL): the lab's code defines all before a call
     (define (dec x depth)
       (cond
        ((pair? x) (fill-places! (tagged-places x depth (limits-depth (the-limits))))
@@ -420,5 +422,11 @@
        ((eq? tag 'murdoch:void) void-value)
        ((eq? tag 'murdoch:eof) (eof-object))
        (else (error "unknown tag in a received value" v))))
-    (define (global-ref name) (procedure-in (env-cell env name) name))
+    (define (global-ref name) (procedure-in (cell-of name (assq name cells)) name))
+    (define (cell-of name entry)
+      (if entry (cdr entry) (new-cell! name (env-cell env name))))
+    (define (new-cell! name cell)
+      (if cell
+          (set! cells (cons (cons name cell) (if (< (length cells) max-cells) cells '()))))
+      cell)
     (lambda (x) (dec x 0))))

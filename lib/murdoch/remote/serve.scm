@@ -21,7 +21,8 @@
   (greeting serving-greeting serving-greeting-set!) ; after the hello
   (deadline serving-deadline serving-deadline-set!)
   (busy-since serving-busy-since serving-busy-since-set!) ; of an inline apply
-  (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...)
+  (reading serving-reading serving-reading-set!) ; the reader's (served-call.scm)
+  (applying serving-applying serving-applying-set!) ; ((ID . THREAD) ...) handed on
   (read-on serving-read-on serving-read-on-set!)) ; a reader's loop
 
 ;; The connections served and the lab's limits on them.
@@ -64,6 +65,7 @@
   (let ((s (make-serving peer host (current-thread) in out)))
     (serving-deadline-set! s #f)
     (serving-busy-since-set! s #f)
+    (serving-reading-set! s #f)
     (serving-applying-set! s '())
     (serving-fd-set! s #f)
     (serving-frames-set! s '())
@@ -73,14 +75,15 @@
         (server-servings-set! (the-server) (cons s (server-servings (the-server))))))
     s))
 
+(define-syntax reader?
+  (syntax-rules () ((_ s) (eq? (current-thread) (serving-thread s)))))
+
 ;; Runs a reader's loop; the connection ends with it, unless handed on.
 (define (read-as-reader s thunk)
   (guard (e (#t (let-go-of-writes! s)
                 (log-fault (serving-peer s) e)))
     (thunk))
   (if (reader? s) (end-serving! s)))
-
-(define (reader? s) (eq? (current-thread) (serving-thread s)))
 
 ;; Once: the janitor and the reader may both end it.  The poller lets go of
 ;; the descriptor first, as a closed number may be another connection's next.
@@ -224,10 +227,16 @@
     (let ((t (make-guarded-thread
               (lambda () (read-as-reader s (serving-read-on s)))
               'connection)))
+      (keep-applying! s (reading-call (serving-reading s)))
       (serving-busy-since-set! s #f)
       (serving-thread-set! s t)
       (thread-start! t)))
   (unlock! (server-lock (the-server))))
+
+(define (keep-applying! s c)
+  (if c
+      (serving-applying-set! s (cons (cons (served-call-id c) (serving-thread s))
+                                     (serving-applying s)))))
 
 ;;> Run by an apply that runs long, a task's component say: its connection
 ;;> gets a new reader now, so the caller's next calls do not wait.
@@ -239,23 +248,20 @@
     (unlock! (server-lock (the-server)))
     (if s (take-over! s))))
 
-;; Marks the reader's inline apply of call id, during which a caller giving
-;; up finds the thread; ending answers whether it is still the reader.
-(define (inline-apply-begins! s id)
-  (lock! (server-lock (the-server)))
-  (serving-applying-set! s (cons (cons id (current-thread))
-                                 (serving-applying s)))
+;; The reader's inline apply, marked for the janitor without the lock (only a
+;; reader starts one: docs/speed.md); its call listed for abandon-call! once handed on.
+(define (inline-apply-begins! s)
   (serving-busy-since-set! s (monotonic-seconds))
-  (unlock! (server-lock (the-server)))
   (janitor-wanted!))
 
-(define (inline-apply-ends! s)
+(define (inline-apply-ends! s)          ; whether still the reader
   (lock! (server-lock (the-server)))
-  (serving-applying-set! s (without-thread (serving-applying s) (current-thread)))
   (apply-ended! s (reader? s)))
 
 (define (apply-ended! s still)
-  (if still (serving-busy-since-set! s #f))
+  (if still
+      (serving-busy-since-set! s #f)
+      (serving-applying-set! s (without-thread (serving-applying s) (current-thread))))
   (unlock! (server-lock (the-server)))
   (if (abandoned?) (forget-abandoned! (current-thread)))
   still)

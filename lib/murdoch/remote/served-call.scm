@@ -12,7 +12,8 @@
   (answer served-call-answer))          ; (answer C KIND VALUE)
 
 ;;> Answers served call \var{c}: \var{kind} ack, value or error, and its \var{value}.
-(define (reply! c kind value) ((served-call-answer c) c kind value))
+(define-syntax reply!
+  (syntax-rules () ((_ c kind value) ((served-call-answer c) c kind value))))
 
 ;; A thread reading s's calls, and the call it runs until answered.
 (define-record-type reading
@@ -26,6 +27,7 @@
 ;; call e) once its output is flushed; any other goes to (other-failure e).
 (define (read-calls s read-on answer-error other-failure)
   (let ((r (make-reading s #f)))
+    (serving-reading-set! s r)
     (let again ()
       (guard (e ((reading-call r)
                  => (lambda (c)
@@ -52,7 +54,7 @@
   (run-in-worker thunk))
 
 (define (serve-apply r s c)
-  (inline-apply-begins! s (served-call-id c))
+  (inline-apply-begins! s)
   ;; Answered while the call is r's; a value too large gets the error.
   (reply! c 'value (encoded-result c))
   (reading-call-set! r #f)

@@ -23,17 +23,19 @@
   (vector-set! p 3 parent)
   p)
 
-;;> srfi 18's mutex-lock! and mutex-unlock!, no timeout or condition variable, no garbage.
-(define (lock! m)
-  (if lock-order-checked? (taking! m))
-  (if (%mutex-lock! m #f #t)            ; no or, no not (docs/speed.md)
-      #t
-      (begin (thread-yield!) (mutex-lock! m)))   ; as srfi 18's, once it failed
-  (if lock-order-checked? (took! m)))
+;;> srfi 18's mutex-lock! and mutex-unlock! as macros (\var{m} without effects): no timeout, no garbage.
+(define-syntax lock!
+  (syntax-rules ()
+    ((_ m) (begin (if lock-order-checked? (taking! m))
+                  (if (%mutex-lock! m #f #t)            ; no or, no not (docs/speed.md)
+                      #t
+                      (begin (thread-yield!) (mutex-lock! m))) ; as srfi 18's, once it failed
+                  (if lock-order-checked? (took! m))))))
 
-(define (unlock! m)
-  (if lock-order-checked? (released! m))
-  (%mutex-unlock! m #f #f))
+(define-syntax unlock!
+  (syntax-rules ()
+    ((_ m) (begin (if lock-order-checked? (released! m))
+                  (%mutex-unlock! m #f #f)))))
 
 ;;> \var{value}, once \var{m} is unlocked: no let (docs/speed.md).
 (define (unlocked m value)

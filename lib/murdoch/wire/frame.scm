@@ -58,7 +58,8 @@
          (cons (car k) (cons (length (cdr k)) (map cadr (cdr k)))))
        message-kinds))
 
-(define (checks-of kind) (checks-in (assq kind kind-checks) kind))
+(define-syntax checks-of
+  (syntax-rules () ((_ kind) (checks-in (assq kind kind-checks) kind))))
 
 ;; No cond =>, whose let makes a closure (docs/speed.md).
 (define (checks-in entry kind)
