@@ -446,9 +446,10 @@
                  (latest last))
                 (else (latest last)))))))
 
-;; Each round a pusher at the box tells its partner it is there, and a
-;; spare on its way how far it has to come.  A spare pushes only once it
-;; is at the face; until then the other pushes alone (steer!).
+;; Each round a pusher at the box tells its partner it is there, and one
+;; on its way how far it has to come (1e9 when it has no way: neither a
+;; planned one nor a staging point it docks from).  A spare pushes only
+;; once it is at the face; until then the other pushes alone (steer!).
 (define (push previous)
   (team-barrier 'push 120)
   (sonar-start)
@@ -495,7 +496,7 @@
                      (loop (latest view) #t said))
                     (else
                      (team-send! (partner)
-                                 (list 'coming (if waypoint
+                                 (list 'coming (if (or waypoint docking)
                                                    (distance (reckon) (place-of box side))
                                                    1e9)))
                      (approach! seen offset)
