@@ -812,12 +812,12 @@
 ;; Along the axis it never presses on into the face off its place: within
 ;; 30 mm of its place's line it stands and turns to the axis, and, 70 mm
 ;; or more aside, backs off to 200 mm behind and comes in again, turning
-;; toward the place's line as if to a point 380 mm ahead (seed 160's pusher,
-;; turning by drive-along!'s 0.15 degrees a mm, came in 70 to 100 mm aside
-;; again and again).  Put off
-;; its place by its partner's coming, one pressed on into the face's corner
-;; at 120 mm/s for 5 to 12 s, unsteered, and turned the box 6 to 8 degrees
-;; a second past its last leg (generated seeds 160 and 13, faults drawn).
+;; toward the place's line as if to a point 380 mm ahead (seed 160's
+;; pusher, turning by drive-along!'s 0.15 degrees a mm, came in 70 to 100
+;; mm aside again and again).  Put off its place by its partner's coming,
+;; one pressed on into the face's corner at 120 mm/s for 5 to 12 s,
+;; unsteered, and turned the box 6 to 8 degrees a second past its last
+;; leg (generated seeds 160 and 13, faults drawn).
 (define stage-back 450)
 (define stage-out 450)                  ; a staging point beside the place
 (define stage-reach 150)
