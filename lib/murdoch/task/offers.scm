@@ -116,12 +116,9 @@
     (not (augment! uid taken fits?))))
 
 ;; Whether robot uid can take one of the components that taken, by index,
-;; gives the robots taking them, moving those robots on to others of
-;; theirs as needed (an augmenting path, in matching's terms); if so, it
-;; does.  Offered robots added one at a time this way take the most
-;; components they can, and the last adds one just when it can add any:
-;; polynomial, where trying every assignment took millions of calls a
-;; minute at a poser with 250 tasks waiting.
+;; gives the robots taking them, moving those on as needed (an augmenting
+;; path); if so, it does.  Robots added one at a time so take the most
+;; components they can, in polynomial time (docs/allocation.md).
 (define (augment! uid taken fits?)
   (let ((seen (make-vector (vector-length taken) #f)))
     (let take ((uid uid))
@@ -165,13 +162,10 @@
   (if (and (robot-here?) (free-here?)) (offer-robot!))
   #t)
 
-;; The posers the robot's next round asks who waits: all it knows (#t)
-;; after a freeing, a joining or a note that named none, else those that
-;; noted since its last round.  While it stayed free the others' answers
-;; stand: a poser whose task starts to wait notes, and one whose look finds
-;; the robot free twice reminds it.  A free robot asked every poser at each
-;; of the notes that came while the posers posed, eight calls a note, and
-;; the lab's CPU went to that (docs/allocation.md).  This is noted.
+;; The posers the robot's next round asks (noted): all it knows (#t) after
+;; a freeing, a joining or a note naming none, else those that noted since
+;; its last round, as the others' answers stand while it stayed free; they
+;; note or remind it when that changes (docs/allocation.md).
 (define (note-poser! o poser)
   (with-lock (offering-lock o)
     (lambda ()

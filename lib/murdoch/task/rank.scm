@@ -176,11 +176,9 @@
 
 (define (held-uids w) (map held-uid (waiter-held w)))
 
-;;> The lab's line, as place-in-line reads it: the ranks of the other
-;;> posers' waiting tasks, in order, as waiting-at-others last asked for
-;;> them, and of this poser's own, as its waiters keep them.  Neither is
-;;> sorted at a look: a sort of the lab's 2,000 at every look of every
-;;> poser made the most calls a poser made (docs/allocation.md).
+;;> The lab's line, as place-in-line reads it: the other posers' ranks in
+;;> order, as waiting-at-others last asked for them, and this poser's own,
+;;> as its waiters keep them; neither sorted at a look (docs/allocation.md).
 (define-record-type line-ranks
   (make-line-ranks others own)
   line-ranks?
@@ -276,9 +274,8 @@
   (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
               (apply remote-apply-all (filter-map live-aspace posers) proc args)))
 
-;; The other posers' waiting tasks as others-waiting last asked for them,
-;; under (tasks-lock): when, a monotonic-seconds, the waiting-theres, and
-;; their ranks in order, sorted once an ask.
+;; The other posers' waiting tasks as last asked, under (tasks-lock): when
+;; (monotonic-seconds), the waiting-theres, and their ranks sorted once.
 (define-record-type others-waiting
   (make-others-waiting asked entries line)
   others-waiting?

@@ -369,11 +369,10 @@
                (remove (lambda (uid) (memq uid (waiter-excluded w))) all))))
        lines))
 
-;; A task that starts to wait takes the robots capable of its components
-;; from its poser's last look, when that asked about all their layouts
-;; and found some for each: its first try asks them, not the whole lab,
-;; and a robot's round passes it by when it cannot serve it.  Its own
-;; look still tells it its place.  Under (tasks-lock).
+;; A task that starts to wait takes its capable robots from its poser's
+;; last look, when that found some for each of its layouts: its first try
+;; asks them, not the whole lab, and robots that cannot serve it pass it
+;; by.  Under (tasks-lock).
 (define (known-capable! w)
   (let* ((last (looking-takers (the-looking)))
          (lines (and last (map (lambda (l) (cond ((assoc l (cdr last)) => cdr) (else #f)))
