@@ -209,8 +209,7 @@
 ;; open-subscriber!): starts an offer round, or asks the running one for
 ;; another, of every poser.
 (define (robot-freed!)
-  (let ((o (the-offering)))
-    (with-lock (offering-lock o) (lambda () (offering-noted-set! o #t))))
+  (note-poser! (the-offering) #f)
   (offer-robot!))
 
 ;; A running round keeps the robot as it is: a runner-up of the poser's

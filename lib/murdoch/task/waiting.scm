@@ -345,8 +345,7 @@
       (waiter-never-set! w never)
       (tell-waiter! w '(looked)))
      (else
-      (waiter-capable-set! w (union-of capable))
-      (waiter-capables-set! w (map cons cs capable))
+      (capable-set! w capable)
       (waiter-why-set! w (map told lines (iota (length lines) 1)))
       (ask-way! w lines holders)
       (if (blocked-on-itself? w) (tell-waiter! w '(looked)))
@@ -359,8 +358,7 @@
                     "")
                 ", " (waiter-position w) " in line")))))
 
-;; The uids of each of lines, w's components' explanations, that w may
-;; use: all but those it excludes.
+;; The uids of each of lines, w's components' explanations, w may use.
 (define (capable-lists w lines)
   (map (lambda (line)
          (let ((all (explanation-capable line)))
@@ -378,9 +376,12 @@
          (lines (and last (map (lambda (l) (cond ((assoc l (cdr last)) => cdr) (else #f)))
                                (waiter-layouts w))))
          (capable (and lines (every values lines) (capable-lists w lines))))
-    (when (and capable (every pair? capable))
-      (waiter-capable-set! w (union-of capable))
-      (waiter-capables-set! w (map cons (waiter-components w) capable)))))
+    (if (and capable (every pair? capable)) (capable-set! w capable))))
+
+;; w's capable robots, capable those of each of its components.
+(define (capable-set! w capable)
+  (waiter-capable-set! w (union-of capable))
+  (waiter-capables-set! w (map cons (waiter-components w) capable)))
 
 ;; Whether fewer robots are capable of the exclusive components of cs,
 ;; capable the uids capable of each, than they are: never when each has
