@@ -198,8 +198,7 @@
          (pid (fork)))
     (cond
      ((zero? pid)
-      (set-parent-death-signal! signal/kill)
-      (if (not (= (parent-process-id) loader)) (exit 1))
+      (die-with-parent! loader signal/kill)
       (close-port in)
       (close-port out)
       (redirect! 0 "/dev/null" open/read)

@@ -6,7 +6,7 @@
           run-cancel)
   (import (scheme base) (scheme read) (scheme write) (scheme eval) (scheme file)
           (scheme process-context) (srfi 1)
-          (only (chibi process) execute current-process-id parent-process-id fork waitpid
+          (only (chibi process) execute current-process-id fork waitpid
                 wait/no-hang set-signal-action! signal/interrupt signal/quit signal/kill
                 signal/term)
           (only (chibi filesystem) open-pipe open open/read open/write open/append
@@ -16,7 +16,7 @@
           (only (srfi 27) random-source-pseudo-randomize! default-random-source)
           (only (scheme time) current-second)
           (only (srfi 151) bitwise-and bitwise-ior arithmetic-shift)
-          (only (murdoch sys) set-process-name! set-parent-death-signal!) (murdoch lab)
+          (only (murdoch sys) set-process-name! die-with-parent!) (murdoch lab)
           (murdoch cli command) (only (murdoch cli hints) eval-with-hints)
           (only (murdoch remote) remote-timeout)
           (only (murdoch code) make-lab-environment check-lab-code at-form-line)

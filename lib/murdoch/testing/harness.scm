@@ -153,8 +153,7 @@
      ((zero? pid)
       ;; A test or bench killed, by a person or a time limit, leaves no
       ;; lab behind: its children die with it.
-      (set-parent-death-signal! signal/term)
-      (if (not (= (parent-process-id) parent)) (exit 1))
+      (die-with-parent! parent signal/term)
       (execute "/bin/sh"
                (append (list "/bin/sh" "-c"
                              "unset MURDOCH_PORT_BASE; exec \"$@\" >>\"$0\" 2>&1"

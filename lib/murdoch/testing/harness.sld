@@ -18,7 +18,7 @@
           (only (chibi ast) unsetenv errno integer->error-string)
           (murdoch lab) (only (murdoch wire) open-connection)
           (only (murdoch remote) remote-error? remote-error-message)
-          (only (murdoch sys) set-parent-death-signal!)
+          (only (murdoch sys) die-with-parent!)
           (only (chibi test) test-failure-count)
           (only (chibi filesystem) delete-file-hierarchy current-directory directory-files
                 file-directory?
