@@ -71,6 +71,11 @@
   (if (> (abs (wrap (- heading (list-ref (reckon) 2)))) 2)
       (rotate 'to heading)))
 
+;; Turns toward heading within the round, at most 40 degrees a second:
+;; not turn-to!'s rotation, which the round would wait for.
+(define (turn-toward! heading)
+  (drive! 0 (clip (* 2 (wrap (- heading (list-ref (reckon) 2)))) 40)))
+
 ;; The box as this robot sees it, (X Y HEADING) in the room, or #f.
 (define (see-box)
   (let ((seen (fiducials)))
@@ -835,14 +840,14 @@
         (set! docking (cdr stage)))
     (cond ((and (eq? docking 'behind) (in-corridor? off 2) (blocked-ahead? box axis place))
            (set! held "something stands in its way into its place")
-           (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
+           (turn-toward! axis))
           ((and (eq? docking 'behind) (in-corridor? off 2))
            (set! held "it does not come into its place along the box's axis")
            (set! backing (if backing
                              (< (car off) 200)
                              (and (< (car off) 30) (>= (abs (cadr off)) 70))))
            (cond (backing (drive-along! axis (car off) 0 -120))
-                 ((< (car off) 30) (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40)))
+                 ((< (car off) 30) (turn-toward! axis))
                  (else (drive-along! axis (car off) (* (cadr off) (max 1 (/ 380 (max 100 (car off)))))
                                      (clip (* 1.5 (car off)) 120 300)))))
           ((and (eq? docking 'beside) (< (distance (reckon) place) (+ stage-out stage-reach)))
@@ -850,7 +855,7 @@
            (set! backing #f)
            (if (> (distance (reckon) place) 40)
                (drive-to! place)
-               (drive! 0 (clip (* 2 (wrap (- axis (list-ref (reckon) 2)))) 40))))
+               (turn-toward! axis)))
           (else
            (set! docking #f)
            (set! backing #f)
