@@ -18,6 +18,7 @@
   (received connection-received connection-received-set!)
   (nonce connection-nonce connection-nonce-set!) ; the callee's
   (sent connection-sent connection-sent-set!)
+  (flushed connection-flushed connection-flushed-set!) ; sent when last flushed
   (next-id connection-next-id connection-next-id-set!)
   (stage connection-stage connection-stage-set!) ; of the send under the lock
   (open? connection-open? connection-open?-set!))
@@ -116,6 +117,7 @@
       (connection-received-set! c 0)
       (connection-nonce-set! c #f)
       (connection-sent-set! c 0)
+      (connection-flushed-set! c 0)
       (connection-next-id-set! c 0)
       (connection-stage-set! c 'sent)
       (connection-open?-set! c #t)
@@ -301,8 +303,10 @@
   (unlocked (connection-write-lock c) (connection-next-id c)))
 
 ;; Sends message as c's next frame under c's write lock, with p (or #f)
-;; in c's table.  A failed write closes c to calls; an unsendable message
-;; leaves it be; either way p is taken out and the peer noted unreachable.
+;; in c's table, then flushes: message a count is the flush of the frames
+;; to that count, which threads ready to run may add theirs to first.  A
+;; failed write or flush closes c to calls; an unsendable message leaves it
+;; be; either way p is taken out and the peer noted unreachable.
 ;; One wind point and one closure for the undo, no let (docs/speed.md).
 (define (send-counted! c message p)
   (lock! (connection-write-lock c))
@@ -316,28 +320,39 @@
 (define (write-counted! c message p)
   (if (not (connection-open? c))
       (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
-  (write-frame-text! c (if (string? message)
-                           message
-                           (frame-text (connection-text c) message))
-                     p))
+  (cond ((exact-integer? message) (flush-to! c message))
+        ((string? message) (write-frame-text! c message p))
+        (else (write-frame-text! c (frame-text (connection-text c) message) p))))
 
 (define (write-frame-text! c text p)
   (if p (hash-table-set! (connection-pending c) (pending-call-id p) p))
   (connection-sent-set! c (+ 1 (connection-sent c)))
   (connection-stage-set! c 'writing)
   (write-frame! (connection-out c) text (connection-nonce c) (connection-sent c))
-  (flush-output-port (connection-out c))
+  (connection-stage-set! c 'written))
+
+(define (flush-to! c count)
+  (when (< (connection-flushed c) count)
+    (connection-stage-set! c 'writing)
+    (flush-output-port (connection-out c))
+    (connection-flushed-set! c (connection-sent c)))
   (connection-stage-set! c 'sent))
 
 (define (after-send! c p)
-  (when (not (eq? (connection-stage c) 'sent))
+  (when (not (memq (connection-stage c) '(written sent)))
     (if (eq? (connection-stage c) 'writing) (connection-open?-set! c #f))
     (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
-  (unlock-after-send! c p (eq? (connection-stage c) 'sent)))
+  (unlock-after-send! c p (connection-stage c) (connection-sent c)))
 
-(define (unlock-after-send! c p sent?)
+;; A frame written is flushed after the threads ready to run have had a
+;; turn, their frames going out in the same write (docs/speed.md).
+(define (unlock-after-send! c p stage count)
   (unlock! (connection-write-lock c))
-  (if (and p (not sent?)) (note-unreachable! (connection-uid c))))
+  (cond ((eq? stage 'written)
+         (if (others-runnable?) (thread-yield!))
+         (send-counted! c count p))
+        ((eq? stage 'sent))
+        (p (note-unreachable! (connection-uid c)))))
 
 ;;> Sends a's datagram call id its answer (answer ID KIND VALUE), unacknowledged.
 (define (send-datagram-answer! a id kind value)
