@@ -345,12 +345,13 @@
   (unlock-after-send! c p (connection-stage c) (connection-sent c)))
 
 ;; A frame written is flushed after the threads ready to run have had a
-;; turn, their frames going out in the same write (docs/speed.md).
+;; turn, their frames going out in the same write (docs/speed.md); the
+;; count flushed only grows, so it is read without the lock.
 (define (unlock-after-send! c p stage count)
   (unlock! (connection-write-lock c))
   (cond ((eq? stage 'written)
          (if (others-runnable?) (thread-yield!))
-         (send-counted! c count p))
+         (if (< (connection-flushed c) count) (send-counted! c count p)))
         ((eq? stage 'sent))
         (p (note-unreachable! (connection-uid c)))))
 
