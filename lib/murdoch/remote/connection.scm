@@ -344,13 +344,14 @@
     (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
   (unlock-after-send! c p (connection-stage c) (connection-sent c)))
 
-;; A frame written is flushed after the threads ready to run have had a
-;; turn, their frames going out in the same write (docs/speed.md); the
-;; count flushed only grows, so it is read without the lock.
+;; A frame written while other calls on c wait is flushed after the threads
+;; ready to run have had a turn, their frames going out in the same write
+;; (docs/speed.md); the count flushed only grows, so it is read unlocked.
 (define (unlock-after-send! c p stage count)
   (unlock! (connection-write-lock c))
   (cond ((eq? stage 'written)
-         (if (others-runnable?) (thread-yield!))
+         (if (and (> (hash-table-size (connection-pending c)) 1) (others-runnable?))
+             (thread-yield!))
          (if (< (connection-flushed c) count) (send-counted! c count p)))
         ((eq? stage 'sent))
         (p (note-unreachable! (connection-uid c)))))
