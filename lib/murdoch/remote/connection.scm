@@ -344,13 +344,16 @@
     (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
   (unlock-after-send! c p (connection-stage c) (connection-sent c)))
 
-;; A frame written while other calls on c wait is flushed after the threads
-;; ready to run have had a turn, their frames going out in the same write
-;; (docs/speed.md); the count flushed only grows, so it is read unlocked.
+;; A frame written while the peer has more calls to work on than wait here
+;; unflushed is flushed after the threads ready to run have had a turn,
+;; theirs going out in the same write; else at once, lest the two ends take
+;; turns (docs/speed.md).  The counts are read unlocked, flushed only grows.
 (define (unlock-after-send! c p stage count)
   (unlock! (connection-write-lock c))
   (cond ((eq? stage 'written)
-         (if (and (> (hash-table-size (connection-pending c)) 1) (others-runnable?))
+         (if (and (< (* 2 (- count (connection-flushed c)))
+                     (hash-table-size (connection-pending c)))
+                  (others-runnable?))
              (thread-yield!))
          (if (< (connection-flushed c) count) (send-counted! c count p)))
         ((eq? stage 'sent))
