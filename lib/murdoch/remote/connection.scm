@@ -39,10 +39,9 @@
   (gathering-put! (pending-call-gathering p) p answer
                   pending-call-answer pending-call-answer-set!))
 
-;; The node's connections part: one connection to each peer, made by the
-;; first call to it, from any thread; and a lock for each uid being
-;; connected to, so that a peer that does not answer holds up only the
-;; calls to it.
+;; The node's connections part: one connection to each peer, made by the first
+;; call to it from any thread, and a lock for each uid being connected to, so
+;; that a peer that does not answer holds up only the calls to it.
 (define-record-type connections
   (make-connections table connecting lock)
   connections?
@@ -58,9 +57,8 @@
                          (make-connections (make-hash-table eq?) (make-hash-table eq?)
                                            (make-mutex 'connections))))
 
-;; The open connection to a, made and greeted by the deadline if there is
-;; none.  No let or or, whose closures every call to every peer would make
-;; (docs/speed.md).
+;; The open connection to a, made and greeted by the deadline if there is none.
+;; No let or or: closures every call to every peer would make (docs/speed.md).
 (define (connection-to a deadline)
   (live-or-new (live-connection-to (aspace-uid a)) a deadline))
 
@@ -139,9 +137,8 @@
 
 ;;; The poller
 
-;; Global, as the process has one poller: the watched connections by
-;; descriptor, a vector the poller reads without a lock (a vector-set! is
-;; whole), replaced by a larger one under the connections' lock.
+;; Global, one poller's: connections by descriptor, read without a lock (a
+;; vector-set! is whole), replaced by a larger one under the connections' lock.
 (define *watched* (make-vector 64 #f))
 (define *poller-port* #f)               ; on the epoll descriptor
 
@@ -302,12 +299,10 @@
   (connection-next-id-set! c (+ 1 (connection-next-id c)))
   (unlocked (connection-write-lock c) (connection-next-id c)))
 
-;; Sends message as c's next frame under c's write lock, with p (or #f)
-;; in c's table, then flushes: message a count is the flush of the frames
-;; to that count, which threads ready to run may add theirs to first.  A
-;; failed write or flush closes c to calls; an unsendable message leaves it
-;; be; either way p is taken out and the peer noted unreachable.
-;; One wind point and one closure for the undo, no let (docs/speed.md).
+;; Sends message as c's next frame under c's write lock, p (or #f) in c's
+;; table; a count flushes the frames to it.  A failed write or flush closes c
+;; to calls, an unsendable message leaves it be; either way p is taken out,
+;; the peer noted unreachable.  One wind point, one undo closure, no let.
 (define (send-counted! c message p)
   (lock! (connection-write-lock c))
   (connection-stage-set! c 'before)
@@ -329,7 +324,14 @@
   (connection-sent-set! c (+ 1 (connection-sent c)))
   (connection-stage-set! c 'writing)
   (write-frame! (connection-out c) text (connection-nonce c) (connection-sent c))
-  (connection-stage-set! c 'written))
+  (if (coalesce? c) (connection-stage-set! c 'written) (flush-to! c (connection-sent c))))
+
+;; Whether frames written wait for other senders' (docs/speed.md): while the
+;; peer has more calls than wait here unflushed, and another thread can run.
+(define (coalesce? c)
+  (and (< (* 2 (- (connection-sent c) (connection-flushed c)))
+          (hash-table-size (connection-pending c)))
+       (others-runnable?)))
 
 (define (flush-to! c count)
   (when (< (connection-flushed c) count)
@@ -344,17 +346,11 @@
     (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
   (unlock-after-send! c p (connection-stage c) (connection-sent c)))
 
-;; A frame written while the peer has more calls to work on than wait here
-;; unflushed is flushed after the threads ready to run have had a turn,
-;; theirs going out in the same write; else at once, lest the two ends take
-;; turns (docs/speed.md).  The counts are read unlocked, flushed only grows.
+;; Frames written wait a turn of the others; flushed only grows: read unlocked.
 (define (unlock-after-send! c p stage count)
   (unlock! (connection-write-lock c))
   (cond ((eq? stage 'written)
-         (if (and (< (* 2 (- count (connection-flushed c)))
-                     (hash-table-size (connection-pending c)))
-                  (others-runnable?))
-             (thread-yield!))
+         (thread-yield!)
          (if (< (connection-flushed c) count) (send-counted! c count p)))
         ((eq? stage 'sent))
         (p (note-unreachable! (connection-uid c)))))
