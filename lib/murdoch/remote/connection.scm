@@ -18,6 +18,7 @@
   (received connection-received connection-received-set!)
   (nonce connection-nonce connection-nonce-set!) ; the callee's
   (sent connection-sent connection-sent-set!)
+  (flushed connection-flushed connection-flushed-set!) ; sent when last flushed
   (next-id connection-next-id connection-next-id-set!)
   (stage connection-stage connection-stage-set!) ; of the send under the lock
   (open? connection-open? connection-open?-set!))
@@ -38,10 +39,9 @@
   (gathering-put! (pending-call-gathering p) p answer
                   pending-call-answer pending-call-answer-set!))
 
-;; The node's connections part: one connection to each peer, made by the
-;; first call to it, from any thread; and a lock for each uid being
-;; connected to, so that a peer that does not answer holds up only the
-;; calls to it.
+;; The node's connections part: one connection to each peer, made by the first
+;; call to it from any thread, and a lock for each uid being connected to, so
+;; that a peer that does not answer holds up only the calls to it.
 (define-record-type connections
   (make-connections table connecting lock)
   connections?
@@ -57,9 +57,8 @@
                          (make-connections (make-hash-table eq?) (make-hash-table eq?)
                                            (make-mutex 'connections))))
 
-;; The open connection to a, made and greeted by the deadline if there is
-;; none.  No let or or, whose closures every call to every peer would make
-;; (docs/speed.md).
+;; The open connection to a, made and greeted by the deadline if there is none.
+;; No let or or: closures every call to every peer would make (docs/speed.md).
 (define (connection-to a deadline)
   (live-or-new (live-connection-to (aspace-uid a)) a deadline))
 
@@ -116,6 +115,7 @@
       (connection-received-set! c 0)
       (connection-nonce-set! c #f)
       (connection-sent-set! c 0)
+      (connection-flushed-set! c 0)
       (connection-next-id-set! c 0)
       (connection-stage-set! c 'sent)
       (connection-open?-set! c #t)
@@ -137,9 +137,8 @@
 
 ;;; The poller
 
-;; Global, as the process has one poller: the watched connections by
-;; descriptor, a vector the poller reads without a lock (a vector-set! is
-;; whole), replaced by a larger one under the connections' lock.
+;; Global, one poller's: connections by descriptor, read without a lock (a
+;; vector-set! is whole), replaced by a larger one under the connections' lock.
 (define *watched* (make-vector 64 #f))
 (define *poller-port* #f)               ; on the epoll descriptor
 
@@ -300,10 +299,10 @@
   (connection-next-id-set! c (+ 1 (connection-next-id c)))
   (unlocked (connection-write-lock c) (connection-next-id c)))
 
-;; Sends message as c's next frame under c's write lock, with p (or #f)
-;; in c's table.  A failed write closes c to calls; an unsendable message
-;; leaves it be; either way p is taken out and the peer noted unreachable.
-;; One wind point and one closure for the undo, no let (docs/speed.md).
+;; Sends message as c's next frame under c's write lock, p (or #f) in c's
+;; table; a count flushes the frames to it.  A failed write or flush closes c
+;; to calls, an unsendable message leaves it be; either way p is taken out,
+;; the peer noted unreachable.  One wind point, one undo closure, no let.
 (define (send-counted! c message p)
   (lock! (connection-write-lock c))
   (connection-stage-set! c 'before)
@@ -316,28 +315,45 @@
 (define (write-counted! c message p)
   (if (not (connection-open? c))
       (remote-error 'unreachable (connection-uid c) 'send "connection lost"))
-  (write-frame-text! c (if (string? message)
-                           message
-                           (frame-text (connection-text c) message))
-                     p))
+  (cond ((exact-integer? message) (flush-to! c message))
+        ((string? message) (write-frame-text! c message p))
+        (else (write-frame-text! c (frame-text (connection-text c) message) p))))
 
 (define (write-frame-text! c text p)
   (if p (hash-table-set! (connection-pending c) (pending-call-id p) p))
   (connection-sent-set! c (+ 1 (connection-sent c)))
   (connection-stage-set! c 'writing)
   (write-frame! (connection-out c) text (connection-nonce c) (connection-sent c))
-  (flush-output-port (connection-out c))
+  (if (coalesce? c) (connection-stage-set! c 'written) (flush-to! c (connection-sent c))))
+
+;; Whether frames written wait for other senders' (docs/speed.md): while the
+;; peer has more calls than wait here unflushed, and another thread can run.
+(define (coalesce? c)
+  (and (< (* 2 (- (connection-sent c) (connection-flushed c)))
+          (hash-table-size (connection-pending c)))
+       (others-runnable?)))
+
+(define (flush-to! c count)
+  (when (< (connection-flushed c) count)
+    (connection-stage-set! c 'writing)
+    (flush-output-port (connection-out c))
+    (connection-flushed-set! c (connection-sent c)))
   (connection-stage-set! c 'sent))
 
 (define (after-send! c p)
-  (when (not (eq? (connection-stage c) 'sent))
+  (when (not (memq (connection-stage c) '(written sent)))
     (if (eq? (connection-stage c) 'writing) (connection-open?-set! c #f))
     (if p (hash-table-delete! (connection-pending c) (pending-call-id p))))
-  (unlock-after-send! c p (eq? (connection-stage c) 'sent)))
+  (unlock-after-send! c p (connection-stage c) (connection-sent c)))
 
-(define (unlock-after-send! c p sent?)
+;; Frames written wait a turn of the others; flushed only grows: read unlocked.
+(define (unlock-after-send! c p stage count)
   (unlock! (connection-write-lock c))
-  (if (and p (not sent?)) (note-unreachable! (connection-uid c))))
+  (cond ((eq? stage 'written)
+         (thread-yield!)
+         (if (< (connection-flushed c) count) (send-counted! c count p)))
+        ((eq? stage 'sent))
+        (p (note-unreachable! (connection-uid c)))))
 
 ;;> Sends a's datagram call id its answer (answer ID KIND VALUE), unacknowledged.
 (define (send-datagram-answer! a id kind value)

@@ -566,6 +566,12 @@ static int installed (sexp ctx) {
   return sexp_opcodep(s) && sexp_opcode_func(s) == (sexp_proc1)poll_scheduler;
 }
 
+/* (others-runnable?): whether another thread waits in the run queue, so
+ * that a thread yielding now would let it run before going on. */
+static sexp others_runnablep (sexp ctx, sexp self, sexp_sint_t n) {
+  return sexp_make_boolean(sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_FRONT)));
+}
+
 static sexp poll_scheduler_installedp (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_boolean(installed(ctx));
 }
@@ -876,6 +882,7 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
     return SEXP_ABI_ERROR;
   sexp_define_foreign(ctx, env, "poll-scheduler-installed?", 0,
                       poll_scheduler_installedp);
+  sexp_define_foreign(ctx, env, "others-runnable?", 0, others_runnablep);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
   sexp_define_foreign(ctx, env, "wall-microseconds", 0, wall_microseconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);
