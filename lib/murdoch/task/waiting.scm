@@ -303,11 +303,19 @@
         (last (looking-takers (the-looking))))
     (if (and last
              (< (- now (car last)) (* (setting 'heartbeat) (max 1 (/ n 100))))
-             (every (lambda (l) (assoc l (cdr last))) layouts))
+             (last-explanations layouts))
         (values (cdr last) #f)
         (let ((lines (map cons layouts (explain-components layouts))))
           (looking-takers-set! (the-looking) (cons now lines))
           (values lines #t)))))
+
+;; The last look's explanation of each of layouts; #f before a look, or
+;; when it did not ask about one of them.
+(define (last-explanations layouts)
+  (let ((last (looking-takers (the-looking))))
+    (and last
+         (let ((found (map (lambda (l) (assoc l (cdr last))) layouts)))
+           (and (every values found) (map cdr found))))))
 
 ;; The line a look tells of explanation e for component number i, trimmed,
 ;; made once a look for each.
@@ -372,10 +380,8 @@
 ;; asks them, not the whole lab, and robots that cannot serve it pass it
 ;; by.  Under (tasks-lock).
 (define (known-capable! w)
-  (let* ((last (looking-takers (the-looking)))
-         (lines (and last (map (lambda (l) (cond ((assoc l (cdr last)) => cdr) (else #f)))
-                               (waiter-layouts w))))
-         (capable (and lines (every values lines) (capable-lists w lines))))
+  (let* ((lines (last-explanations (waiter-layouts w)))
+         (capable (and lines (capable-lists w lines))))
     (if (and capable (every pair? capable)) (capable-set! w capable))))
 
 ;; w's capable robots, capable those of each of its components.
