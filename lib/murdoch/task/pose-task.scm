@@ -29,6 +29,10 @@
 ;;> robot renegotiates without it (life-cycle.scm).
 (define pose-task-excluded (make-parameter '()))
 
+;; Whether a negotiation that found too few takers asks the whole lab
+;; why and writes it (explain-no-takers): a waiting task's tries do not.
+(define pose-task-explain (make-parameter #t))
+
 ;; The reservation name a negotiation holds its robots under, or #f for
 ;; a new one: a started task's id, so its reservations name the task.
 (define pose-task-reservation (make-parameter #f))
@@ -199,7 +203,8 @@
            (back-off! n outcome)
            (negotiate-by-tries task (+ n 1)))
           (else
-           (explain-no-takers (pose-name task) (pose-layouts task) (current-error-port))
+           (if (pose-task-explain)
+               (explain-no-takers (pose-name task) (pose-layouts task) (current-error-port)))
            'not-enough-takers))))
 
 ;; One round: (winners type-list name), not-enough-takers, or outranked;

@@ -229,10 +229,11 @@
   (let ((look (+ (monotonic-seconds) (look-period))))
     (if deadline (min deadline look) look)))
 
-;; A try that answers at once and writes no explanation: the waiter
-;; gives its own.
+;; A try that answers at once and neither asks the lab why it found too
+;; few takers nor writes it: the waiter's look explains.
 (define (quiet-try try)
-  (parameterize ((pose-task-retries 0) (current-error-port (open-output-string)))
+  (parameterize ((pose-task-retries 0) (pose-task-explain #f)
+                 (current-error-port (open-output-string)))
     (try)))
 
 ;;; The poser's look, for all its waiting tasks at once
