@@ -202,6 +202,12 @@
         payload
         (open-frame payload nonce count))))
 
+;; The text after the MAC in bytes, once the MAC is that of parts and the text.
+(define-syntax authentic-text
+  (syntax-rules ()
+    ((_ bytes end parts)
+     (mac-checked (hmac-sha256-open (wire-key (the-wire)) bytes end parts)))))
+
 ;;> The message of the count'th frame, \var{payload}, from the side whose nonce is given.
 (define (open-frame payload nonce count)
   (parse-message
@@ -210,10 +216,6 @@
 
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
 (define (max-frame) (wire-max-frame (the-wire)))
-
-;; The text after the MAC in bytes, once the MAC is that of parts and the text.
-(define (authentic-text bytes end parts)
-  (mac-checked (hmac-sha256-open (wire-key (the-wire)) bytes end parts)))
 
 ;; No or, whose let makes a closure (docs/speed.md).
 (define (mac-checked text) (if text text (frame-fail "bad MAC")))
