@@ -40,6 +40,15 @@
                     (if (reader? s) (again))))
         (read-on r)))))
 
+(define-syntax serve-apply
+  (syntax-rules ()
+    ((_ r s c)
+     (begin (inline-apply-begins! s)
+            ;; Answered while the call is r's; a value too large gets the error.
+            (reply! c 'value (encoded-result c))
+            (reading-call-set! r #f)
+            (inline-apply-ends! s)))))
+
 ;; Runs call c: a run is acknowledged once decoded, and runs in a worker;
 ;; an apply runs here until the janitor hands the connection on.
 (define (serve-call r c)
@@ -52,13 +61,6 @@
   (reading-call-set! r #f)
   (reply! c 'ack #t)
   (run-in-worker thunk))
-
-(define (serve-apply r s c)
-  (inline-apply-begins! s)
-  ;; Answered while the call is r's; a value too large gets the error.
-  (reply! c 'value (encoded-result c))
-  (reading-call-set! r #f)
-  (inline-apply-ends! s))
 
 ;; What a connection knows after hello: the caller, the nonces, the counts.
 (define-record-type greeting
@@ -99,6 +101,23 @@
                 (reply! c 'error (error-message-naming e))
                 (flush-if-idle! s (serving-greeting s)))
               raise))
+
+;; The served call message asks for: (KIND ID PROC ARGS), wire/frame.scm's
+;; table (by car and cdr: docs/speed.md).
+(define-syntax served-call-of
+  (syntax-rules ()
+    ((_ message uid answer)
+     (make-served-call uid (message-id message) (car message)
+                       (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
+                       answer))))
+
+;; Serves one frame from uid: a call, answered by answer, or a notice.
+(define-syntax serve-frame
+  (syntax-rules ()
+    ((_ r uid answer message)
+     (if (memq (car message) '(run apply))
+         (serve-call r (served-call-of message uid answer))
+         (serve-notice (reading-serving r) uid message)))))
 
 ;; No unless, nor not below: each a call to Chibi's not (docs/speed.md).
 (define (serve-read! s r message)
@@ -158,21 +177,6 @@
   (let ((g (serving-greeting s)))
     (if (and g (eq? (mutex-state (greeting-write-lock g)) (current-thread)))
         (unlock! (greeting-write-lock g)))))
-
-;; The served call message asks for: (KIND ID PROC ARGS), wire/frame.scm's
-;; table (by car and cdr: docs/speed.md).
-(define-syntax served-call-of
-  (syntax-rules ()
-    ((_ message uid answer)
-     (make-served-call uid (message-id message) (car message)
-                       (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
-                       answer))))
-
-;; Serves one frame from uid: a call, answered by answer, or a notice.
-(define (serve-frame r uid answer message)
-  (if (memq (car message) '(run apply))
-      (serve-call r (served-call-of message uid answer))
-      (serve-notice (reading-serving r) uid message)))
 
 ;; Serves a frame that needs no answer: an answer or an abandon (by cond).
 (define (serve-notice s uid message)
