@@ -28,8 +28,7 @@
   (peers-lock membership-peers-lock)    ; over peers, unreachable and live
   (live membership-live membership-live-set!)) ; the live set, #f once changed
 
-;; No procedure, nor or, whose let is a call (docs/speed.md): read by
-;; every call served.
+;; Read by every call served: no procedure, nor or (docs/speed.md).
 (define-syntax joined
   (syntax-rules ()
     ((_) (if (and *node* (node-membership *node*))
