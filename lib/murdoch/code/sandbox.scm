@@ -200,6 +200,20 @@
 (define (call-in-sandbox proc args)
   (sandboxed (thread-call-ports) (thread-parameters) proc args))
 
+(define-syntax flush-ports
+  (syntax-rules ()
+    ((_ p) (begin (flush-if-open (call-ports-out p)) (flush-if-open (call-ports-err p))))))
+
+;; fresh-bindings is C (call-bindings.c).
+(define-syntax call-bindings
+  (syntax-rules ()
+    ((_ p outer)
+     (fresh-bindings *parameters*
+                     (cons (cons current-input-port (call-ports-in p))
+                           (cons (cons current-output-port (call-ports-out p))
+                                 (cons (cons current-error-port (call-ports-err p))
+                                       outer)))))))
+
 (define (sandboxed p outer proc args)
   (thread-parameters-set! (call-bindings p outer))
   (left-sandbox p outer (apply proc args)))
@@ -208,19 +222,6 @@
   (thread-parameters-set! outer)
   (flush-ports p)
   value)
-
-(define (call-bindings p outer)
-  (fresh-bindings *parameters*
-                  (cons (cons current-input-port (call-ports-in p))
-                        (cons (cons current-output-port (call-ports-out p))
-                              (cons (cons current-error-port (call-ports-err p))
-                                    outer)))))
-
-;; fresh-bindings is C (call-bindings.c).
-
-(define (flush-ports p)
-  (flush-if-open (call-ports-out p))
-  (flush-if-open (call-ports-err p)))
 
 ;;> Flushes the ports of this thread's calls, for the handler of one that raised.
 (define (flush-call-ports!)

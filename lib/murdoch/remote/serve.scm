@@ -45,6 +45,14 @@
 ;; on one port.
 (define-syntax the-server (syntax-rules () ((_) (node-server *node*))))
 
+(define-syntax janitor-wanted!
+  (syntax-rules ()
+    ((_) (if (server-janitor-resting? (the-server))
+             (begin (lock! (server-janitor-mutex (the-server)))
+                    (server-janitor-resting?-set! (the-server) #f)
+                    (condition-variable-signal! (server-janitor-wake (the-server)))
+                    (unlock! (server-janitor-mutex (the-server))))))))
+
 (define janitor-seconds 0.1)
 (define takeover-seconds 0.1)
 
@@ -99,6 +107,10 @@
     (guard (e (#t #f)) (close-input-port (serving-in s)))
     (guard (e (#t #f)) (close-output-port (serving-out s)))))
 
+;; The message of s's next frame, checked to be one a caller may send.
+(define-syntax open-served
+  (syntax-rules () ((_ s bytes) (open-counted s (serving-greeting s) bytes))))
+
 ;;; Frames as the poller reads them
 
 ;; The frames, eof or fault the poller read from s: hello, answers and
@@ -145,8 +157,8 @@
 
 ;; The next message of s for its reader, or an eof object; a frame begun
 ;; has frame-timeout to come whole.  No let to answer-call (docs/speed.md).
-(define (read-served s)
-  (opened s (next-served-frame s)))
+(define-syntax read-served
+  (syntax-rules () ((_ s) (opened s (next-served-frame s)))))
 
 (define (opened s x)
   (cond ((pair? x) x)                   ; opened and checked by the poller
@@ -166,10 +178,6 @@
 (define (first-frame! s frames)
   (serving-frames-set! s (cdr frames))
   (car frames))
-
-;; The message of s's next frame, checked to be one a caller may send.
-(define (open-served s bytes)
-  (open-counted s (serving-greeting s) bytes))
 
 (define (open-counted s g bytes)
   (greeting-count-set! g (+ 1 (greeting-count g)))
@@ -208,13 +216,6 @@
            (unlock! m))
           (else (unlock-waiting! m (server-janitor-wake (the-server)))))))
 
-(define (janitor-wanted!)
-  (when (server-janitor-resting? (the-server))
-    (lock! (server-janitor-mutex (the-server)))
-    (server-janitor-resting?-set! (the-server) #f)
-    (condition-variable-signal! (server-janitor-wake (the-server)))
-    (unlock! (server-janitor-mutex (the-server)))))
-
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
             " closed: no whole frame within frame-timeout")
@@ -250,13 +251,13 @@
 
 ;; The reader's inline apply, marked for the janitor without the lock (only a
 ;; reader starts one: docs/speed.md); its call listed for abandon-call! once handed on.
-(define (inline-apply-begins! s)
-  (serving-busy-since-set! s (monotonic-seconds))
-  (janitor-wanted!))
+(define-syntax inline-apply-begins!
+  (syntax-rules ()
+    ((_ s) (begin (serving-busy-since-set! s (monotonic-seconds)) (janitor-wanted!)))))
 
-(define (inline-apply-ends! s)          ; whether still the reader
-  (lock! (server-lock (the-server)))
-  (apply-ended! s (reader? s)))
+(define-syntax inline-apply-ends!       ; whether still the reader
+  (syntax-rules ()
+    ((_ s) (begin (lock! (server-lock (the-server))) (apply-ended! s (reader? s))))))
 
 (define (apply-ended! s still)
   (if still

@@ -40,6 +40,15 @@
                     (if (reader? s) (again))))
         (read-on r)))))
 
+(define-syntax serve-apply
+  (syntax-rules ()
+    ((_ r s c)
+     (begin (inline-apply-begins! s)
+            ;; Answered while the call is r's; a value too large gets the error.
+            (reply! c 'value (encoded-result c))
+            (reading-call-set! r #f)
+            (inline-apply-ends! s)))))
+
 ;; Runs call c: a run is acknowledged once decoded, and runs in a worker;
 ;; an apply runs here until the janitor hands the connection on.
 (define (serve-call r c)
@@ -52,13 +61,6 @@
   (reading-call-set! r #f)
   (reply! c 'ack #t)
   (run-in-worker thunk))
-
-(define (serve-apply r s c)
-  (inline-apply-begins! s)
-  ;; Answered while the call is r's; a value too large gets the error.
-  (reply! c 'value (encoded-result c))
-  (reading-call-set! r #f)
-  (inline-apply-ends! s))
 
 ;; What a connection knows after hello: the caller, the nonces, the counts.
 (define-record-type greeting
@@ -89,6 +91,9 @@
     (send-frame! (serving-out s) (greeting-text g) caller-nonce 0
                  (make-message 'welcome (local-aspace-uid) (greeting-nonce g)))))
 
+(define-syntax read-on
+  (syntax-rules () ((_ s r) (serve-read! s r (read-served s)))))
+
 (define (serve-greeted s)
   (read-calls s (lambda (r) (read-on s r))
               (lambda (c e)
@@ -97,8 +102,22 @@
                 (flush-if-idle! s (serving-greeting s)))
               raise))
 
-(define (read-on s r)
-  (serve-read! s r (read-served s)))
+;; The served call message asks for: (KIND ID PROC ARGS), wire/frame.scm's
+;; table (by car and cdr: docs/speed.md).
+(define-syntax served-call-of
+  (syntax-rules ()
+    ((_ message uid answer)
+     (make-served-call uid (message-id message) (car message)
+                       (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
+                       answer))))
+
+;; Serves one frame from uid: a call, answered by answer, or a notice.
+(define-syntax serve-frame
+  (syntax-rules ()
+    ((_ r uid answer message)
+     (if (memq (car message) '(run apply))
+         (serve-call r (served-call-of message uid answer))
+         (serve-notice (reading-serving r) uid message)))))
 
 ;; No unless, nor not below: each a call to Chibi's not (docs/speed.md).
 (define (serve-read! s r message)
@@ -115,6 +134,26 @@
       (answer! s (serving-greeting s) (make-message kind (served-call-id c) value)
                #t)))
 
+;; No or, whose let makes a closure (docs/speed.md).
+(define-syntax flush-now?
+  (syntax-rules ()
+    ((_ s last?) (if (reader? s) (and last? (null? (serving-frames s))) #t))))
+
+;; A caller that left makes this raise, and the connection end; a message
+;; too large raises before its count is taken.
+(define-syntax write-answer!
+  (syntax-rules ()
+    ((_ s g message)
+     (begin (write-message! (serving-out s) (greeting-text g) message
+                            (greeting-caller-nonce g) (+ 1 (greeting-sent g)))
+            (greeting-sent-set! g (+ 1 (greeting-sent g)))))))
+
+;; The caller holds the write lock.
+(define-syntax flush!
+  (syntax-rules ()
+    ((_ s g) (begin (flush-output-port (serving-out s))
+                    (greeting-flushed-set! g (greeting-sent g))))))
+
 ;; The reader's answers wait in the buffer until it has read every call
 ;; that arrived, for one write.  A value or error with no call behind it is
 ;; flushed under the lock; an ack waits for flush-if-idle!.  The lock is
@@ -124,22 +163,6 @@
   (write-answer! s g message)
   (if (flush-now? s last?) (flush! s g))
   (unlock! (greeting-write-lock g)))
-
-;; No or, whose let makes a closure (docs/speed.md).
-(define (flush-now? s last?)
-  (if (reader? s) (and last? (null? (serving-frames s))) #t))
-
-;; A caller that left makes this raise, and the connection end; a message
-;; too large raises before its count is taken.
-(define (write-answer! s g message)
-  (write-message! (serving-out s) (greeting-text g) message
-                  (greeting-caller-nonce g) (+ 1 (greeting-sent g)))
-  (greeting-sent-set! g (+ 1 (greeting-sent g))))
-
-;; The caller holds the write lock.
-(define (flush! s g)
-  (flush-output-port (serving-out s))
-  (greeting-flushed-set! g (greeting-sent g)))
 
 ;; Nothing to flush after a frame that had no answer; under the write lock.
 (define (flush-if-idle! s g)
@@ -155,24 +178,19 @@
     (if (and g (eq? (mutex-state (greeting-write-lock g)) (current-thread)))
         (unlock! (greeting-write-lock g)))))
 
-;; Serves one frame from uid: a call, answered by answer, or a notice.
-(define (serve-frame r uid answer message)
-  (if (memq (car message) '(run apply))
-      (serve-call r (served-call-of message uid answer))
-      (serve-notice (reading-serving r) uid message)))
-
-;; The served call message asks for: (KIND ID PROC ARGS), wire/frame.scm's
-;; table (by car and cdr: docs/speed.md).
-(define (served-call-of message uid answer)
-  (make-served-call uid (message-id message) (car message)
-                    (car (cdr (cdr message))) (car (cdr (cdr (cdr message))))
-                    answer))
-
 ;; Serves a frame that needs no answer: an answer or an abandon (by cond).
 (define (serve-notice s uid message)
   (if (eq? (car message) 'answer)
       (take-datagram-answer! uid message)
       (abandon-call! s (message-id message))))
+
+(define-syntax served-procedure
+  (syntax-rules ()
+    ((_ c) (checked-procedure (decode-value (served-call-proc-code c))))))
+
+(define-syntax served-arguments
+  (syntax-rules ()
+    ((_ c proc) (decode-value (screened (served-call-args-code c) proc)))))
 
 ;; The application run c asks for, as a thunk that runs it in the sandbox.
 (define (decode-call c)
@@ -180,16 +198,12 @@
          (args (served-arguments c proc)))
     (lambda () (call-in-sandbox proc args))))
 
-;; What c's application answers, encoded (no thunk: docs/speed.md).
+;; What c's application answers, encoded (no thunk, nor let: docs/speed.md).
 (define (encoded-result c)
-  (let ((proc (served-procedure c)))
-    (encode (call-in-sandbox proc (served-arguments c proc)) (lab-environment) "the result")))
+  (encoded-application c (served-procedure c)))
 
-(define (served-procedure c)
-  (checked-procedure (decode-value (served-call-proc-code c))))
-
-(define (served-arguments c proc)
-  (decode-value (screened (served-call-args-code c) proc)))
+(define (encoded-application c proc)
+  (encode (call-in-sandbox proc (served-arguments c proc)) (lab-environment) "the result"))
 
 ;; Global: each layer adds its own as it loads (screen-calls!).
 (define *screens* '())

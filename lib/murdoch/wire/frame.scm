@@ -28,9 +28,11 @@
 
 ;;; The message kinds
 
+(define answer-kinds '(ack value error))
+(define call-kinds '(run apply))
 (define (anything? x) #t)
-(define (answer-kind? x) (memq x '(ack value error)))
-(define (call-kind? x) (memq x '(run apply)))
+(define (answer-kind? x) (memq x answer-kinds))
+(define (call-kind? x) (memq x call-kinds))
 
 ;; Every message: its kind, then its fields, each with its check (the
 ;; datagram has no kind word).
@@ -52,10 +54,16 @@
 
 ;; Each kind's field count and checks, from the table once, since every
 ;; message made and every frame read is checked (docs/speed.md): (KIND
-;; COUNT CHECK ...).
+;; COUNT CHECK ...), each check as fields-pass? (plain-read.c) takes it.
+(define check-codes
+  `((,anything? . 0) (,exact-integer? . 1) (,symbol? . 2) (,string? . 3) (,list? . 4)
+    (,pair? . 5) (,answer-kind? . ,answer-kinds) (,call-kind? . ,call-kinds)))
+
 (define kind-checks
   (map (lambda (k)
-         (cons (car k) (cons (length (cdr k)) (map cadr (cdr k)))))
+         (cons (car k) (cons (length (cdr k))
+                             (map (lambda (f) (cdr (assq (cadr f) check-codes)))
+                                  (cdr k)))))
        message-kinds))
 
 (define-syntax checks-of
@@ -95,13 +103,6 @@
     (cond ((null? fields) (error "no such field in a message" (car message) name))
           ((eq? (caar fields) name) (car values))
           (else (loop (cdr fields) (cdr values))))))
-
-;; No or, whose let makes a closure (docs/speed.md).
-(define (fields-pass? values checks)
-  (cond ((null? checks) (null? values))
-        ((pair? values) (and ((car checks) (car values))
-                             (fields-pass? (cdr values) (cdr checks))))
-        (else #f)))
 
 ;;; Frames
 
@@ -202,6 +203,12 @@
         payload
         (open-frame payload nonce count))))
 
+;; The text after the MAC in bytes, once the MAC is that of parts and the text.
+(define-syntax authentic-text
+  (syntax-rules ()
+    ((_ bytes end parts)
+     (mac-checked (hmac-sha256-open (wire-key (the-wire)) bytes end parts)))))
+
 ;;> The message of the count'th frame, \var{payload}, from the side whose nonce is given.
 (define (open-frame payload nonce count)
   (parse-message
@@ -210,10 +217,6 @@
 
 ;;> The lab's max-frame: the most bytes a netstring's payload may hold.
 (define (max-frame) (wire-max-frame (the-wire)))
-
-;; The text after the MAC in bytes, once the MAC is that of parts and the text.
-(define (authentic-text bytes end parts)
-  (mac-checked (hmac-sha256-open (wire-key (the-wire)) bytes end parts)))
 
 ;; No or, whose let makes a closure (docs/speed.md).
 (define (mac-checked text) (if text text (frame-fail "bad MAC")))

@@ -4,7 +4,7 @@
 
 (define-library (murdoch wire netstring)
   (export read-netstring write-netstring buffered-byte-count
-          reset-output-string! nests-within? plain-message fixnum->decimal
+          reset-output-string! nests-within? plain-message fields-pass? fixnum->decimal
           netstring-error? netstring-error-message)
   (import (scheme base) (only (chibi) string-size)
           (murdoch wire remote-error))

@@ -242,3 +242,43 @@ static sexp plain_message (sexp ctx, const char *text, long size, long limit,
   if (res == other || sexp_exceptionp(res)) return res;
   return s.p == s.end ? res : other;    /* as parse-message refuses more */
 }
+
+/* Whether x is a proper list, as list? says: a cycle is not one. */
+static int proper_list (sexp x) {
+  sexp slow = x;
+  while (sexp_pairp(x) && sexp_pairp(sexp_cdr(x))) {
+    x = sexp_cddr(x);
+    slow = sexp_cdr(slow);
+    if (x == slow) return 0;
+  }
+  return sexp_nullp(sexp_pairp(x) ? sexp_cdr(x) : x);
+}
+
+/* Whether x passes check, a field's check from frame.scm's check-codes:
+ * 0 anything, 1 an exact integer, 2 a symbol, 3 a string, 4 a list, 5 a
+ * pair, or a list of the symbols x may be. */
+static int field_passes (sexp check, sexp x) {
+  if (sexp_pairp(check)) {
+    for (; sexp_pairp(check); check = sexp_cdr(check))
+      if (sexp_car(check) == x) return 1;
+    return 0;
+  }
+  switch (sexp_unbox_fixnum(check)) {
+  case 0: return 1;
+  case 1: return sexp_exact_integerp(x);
+  case 2: return sexp_symbolp(x);
+  case 3: return sexp_stringp(x);
+  case 4: return proper_list(x);
+  case 5: return sexp_pairp(x);
+  default: return 0;
+  }
+}
+
+/* (fields-pass? values checks): whether values holds one field for each
+ * of checks, each passing it (frame.scm's check-message). */
+static sexp fields_pass (sexp ctx, sexp values, sexp checks) {
+  for (; sexp_pairp(checks); checks = sexp_cdr(checks), values = sexp_cdr(values))
+    if (!sexp_pairp(values) || !field_passes(sexp_car(checks), sexp_car(values)))
+      return SEXP_FALSE;
+  return sexp_make_boolean(sexp_nullp(values));
+}
