@@ -7,7 +7,8 @@
   (export open-poses! pose-task negotiate negotiated-winners negotiated-types negotiated-name
           winner-uid winner-promise check-task pose-task-progress task-timeout
           pose-task-assignment pose-task-priority pose-task-retries
-          pose-task-backoff pose-task-excluded pose-task-reservation pose-task-explain receive-rival pose-negotiations
+          pose-task-backoff pose-task-excluded pose-task-reservation pose-task-explain
+          receive-rival pose-negotiations
           reservation-aspace-uid task-key task-key-parts lab-task-key lab-task-key?
           location-metric-maker load-metric-maker load-metric reverse-metric
           metric-by metric-by-asking metric-within compose-metrics
