@@ -7,7 +7,7 @@
 ;; robot's offer rounds (a process drives at most one robot); each field
 ;; is described where it is used.
 (define-record-type offering
-  (make-offering offers round? again? lock waiters-here? new-waiters noted waiters-seen depth)
+  (make-offering offers round? again? lock waiters-here? new-waiters waiters-seen depth)
   offering?
   (offers offering-offers offering-offers-set!)
   (round? offering-round? offering-round?-set!)    ; an offer round runs here
@@ -15,7 +15,6 @@
   (lock offering-lock)
   (waiters-here? offering-waiters-here? offering-waiters-here?-set!)
   (new-waiters offering-new-waiters offering-new-waiters-set!)
-  (noted offering-noted offering-noted-set!)
   (waiters-seen offering-waiters-seen offering-waiters-seen-set!)
   (depth offering-depth offering-depth-set!))
 
@@ -23,7 +22,7 @@
 
 (define (open-offering!)
   (node-offering-set! (this-node)
-                      (make-offering '() #f #f (make-mutex 'offers) #f #f #t #f offer-depth)))
+                      (make-offering '() #f #f (make-mutex 'offers) #f #f #f offer-depth)))
 
 ;;; The poser's side
 
@@ -156,37 +155,16 @@
     (offering-waiters-here?-set! o #t)
     (offering-new-waiters-set! o (if (and (= 2 (length poser+rank)) (not (eq? new #t)))
                                      (better-rank (cadr poser+rank) new)
-                                     #t))
-    (note-poser! o (and (pair? poser+rank) (car poser+rank))))
+                                     #t)))
   (if (pair? poser+rank) (know-poser! (car poser+rank)))
   (if (and (robot-here?) (free-here?)) (offer-robot!))
   #t)
 
-;; The posers the robot's next round asks (noted): all it knows (#t) after
-;; a freeing, a joining or a note naming none, else those that noted since
-;; its last round, as the others' answers stand while it stayed free; they
-;; note or remind it when that changes (docs/allocation.md).
-(define (note-poser! o poser)
-  (with-lock (offering-lock o)
-    (lambda ()
-      (let ((noted (offering-noted o)))
-        (cond ((not poser) (offering-noted-set! o #t))
-              ((not (or (eq? noted #t) (memq poser noted)))
-               (offering-noted-set! o (cons poser noted))))))))
-
-(define (take-noted! o)
-  (with-lock (offering-lock o)
-    (lambda ()
-      (let ((noted (offering-noted o)))
-        (offering-noted-set! o '())
-        noted))))
-
-;; Each poser's (UID (WANTING ...)) for this robot, best offer-depth first,
-;; of the posers posers (noted).
-(define (who-waits me depth posers)
-  (if (eq? posers #t)
-      (ask-posers waiting-for me (subjects-here) depth)
-      (ask-these-posers posers waiting-for me (subjects-here) depth)))
+;; Each poser's (UID (WANTING ...)) for this robot, best depth first, of
+;; every poser it knows: one whose note has not come yet may have a task
+;; waiting before those of the poser that noted (docs/allocation.md).
+(define (who-waits me depth)
+  (ask-posers waiting-for me (subjects-here) depth))
 
 ;; Whether a task started to wait, or was reminded of, since this robot's
 ;; offer round asked who waits: the round's list may lack a better-ranked
@@ -207,10 +185,8 @@
 
 ;; Runs on every freeing of exclusive subjects here (the hook given to
 ;; open-subscriber!): starts an offer round, or asks the running one for
-;; another, of every poser.
-(define (robot-freed!)
-  (note-poser! (the-offering) #f)
-  (offer-robot!))
+;; another.
+(define (robot-freed!) (offer-robot!))
 
 ;; A running round keeps the robot as it is: a runner-up of the poser's
 ;; negotiation is freed while the robot waits for its answer, and the
@@ -232,7 +208,7 @@
 ;; meanwhile ends them: its next freeing starts a round.
 (define (offer-rounds)
   (guard (e (#t (log-warn "offering this robot: " (error-message e))))
-    (offer-round (take-noted! (the-offering))))
+    (offer-round))
   (if (let ((o (the-offering)))
         (with-lock (offering-lock o)
           (lambda ()
@@ -250,8 +226,7 @@
 ;; noted since, nobody may, so that no task takes it before the
 ;; best-ranked has been offered it.
 ;; In a lab where no task waits it refuses nobody, as in the thesis.
-;; waiters-seen says whether tasks waited at its last round that asked
-;; every poser; one that asked some leaves it, and waiters-here?, as they were.
+;; waiters-seen says whether tasks waited at its last round.
 
 ;; Each poser answers its best offer-depth tasks that may use the robot,
 ;; and the robot asks for twice as many when every one declined it, in
@@ -260,25 +235,25 @@
 ;; 2,000 (docs/allocation.md).  The depth asked for now is kept.
 (define offer-depth 4)
 
-(define (offer-round posers)
+(define (offer-round)
   (let* ((me (local-aspace-uid))
          (o (the-offering))
          (depth (offering-depth o))
          (keep? (heard-of-waiters? o)))
-    (if (eq? posers #t) (offering-waiters-here?-set! o #f)) ; a note after it stands
+    (offering-waiters-here?-set! o #f)  ; a note after it stands
     (offering-new-waiters-set! o #f)
     (offer-subjects! (and keep? 'nobody) 3)
     (let* ((answers (guard (e (#t '()))
-                      (who-waits me depth posers)))
+                      (who-waits me depth)))
            (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                                (append-map cadr answers))))
-      (if (eq? posers #t) (offering-waiters-seen-set! o (pair? waiting)))
+      (offering-waiters-seen-set! o (pair? waiting))
       (if (pair? waiting) (offering-waiters-here?-set! o #t))
       (offer-to me (within-horizon waiting answers depth))
       (cond ((not (free-here?)) (offering-depth-set! o offer-depth))
             ((any (lambda (a) (>= (length (cadr a)) depth)) answers)
              (offering-depth-set! o (* 2 depth))
-             (if (not (offering-new-waiters o)) (offer-round posers)))))))
+             (if (not (offering-new-waiters o)) (offer-round)))))))
 
 ;; The entries of waiting that rank no later than the last of any poser's
 ;; answer of depth entries: that poser may have better ones past it.

@@ -19,7 +19,7 @@
           held-uids place-in-line line-ranks-now line-ranks-length waiting-ranks waiting-there?
           waiting-there-poser waiting-there-rank
           waiting-there-held waiting-elsewhere waiting-at-others lab-holders
-          know-poser! ask-posers ask-these-posers wants? waiting-entries waiting-entry
+          know-poser! ask-posers wants? waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132) (murdoch sys)
