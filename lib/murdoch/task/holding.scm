@@ -19,13 +19,17 @@
 ;; negotiated alone, without the robots held or given way on, those with
 ;; the fewest capable robots first (a component that accepts two kinds
 ;; took the one robot of the kind its neighbour alone accepts), then in
-;; priority order.  Answers (winners type-list) once every component has
-;; a robot.
+;; priority order, and without the robots offered that a largest
+;; matching of them gives to the others (offered-matching).  Answers
+;; (winners type-list) once every component has a robot.
 (define (hold-try w priorities)
-  (let ((t (waiter-task w)) (cs (waiter-components w)))
+  (let* ((t (waiter-task w)) (cs (waiter-components w))
+         (order (fewest-capable-first w cs priorities))
+         (m (offered-matching w order)))
     (for-each
      (lambda (c)
-       (let ((excluded (append (held-uids w) (waiter-yielded w) (pose-task-excluded))))
+       (let ((excluded (append (held-uids w) (waiter-yielded w) (pose-task-excluded)
+                               (matched-to-others m c))))
          (if (and (not (assv (component-index c) (waiter-held w)))
                   (may-win? w c excluded))
              (let ((team (parameterize ((pose-task-excluded excluded))
@@ -37,15 +41,28 @@
                                                    (car (negotiated-winners team))
                                                    (car (negotiated-types team)))
                                              (waiter-held w))))))))
-     (map cdr (list-sort (lambda (a b)
-                           (let ((na (capable-count w (cdr a))) (nb (capable-count w (cdr b))))
-                             (or (< na nb) (and (= na nb) (> (car a) (car b))))))
-                         (map cons priorities cs))))
+     order)
     (let ((held (map (lambda (c) (assv (component-index c) (waiter-held w))) cs)))
       (cond ((every pair? held)
              (waiter-held-set! w '())
              (list (map held-winner held) (map held-type held)))
             (else 'not-enough-takers)))))
+
+;; w's components cs, the fewest capable robots first, then by priority.
+(define (fewest-capable-first w cs priorities)
+  (map cdr (list-sort (lambda (a b)
+                        (let ((na (capable-count w (cdr a))) (nb (capable-count w (cdr b))))
+                          (or (< na nb) (and (= na nb) (> (car a) (car b))))))
+                      (map cons priorities cs))))
+
+;; The robots offered to w's try, not held nor excluded, matched to its
+;; open components in order: as offered-enough? counted on (docs/allocation.md).
+(define (offered-matching w order)
+  (let ((m (open-matching w order))
+        (out (append (held-uids w) (waiter-yielded w) (pose-task-excluded))))
+    (for-each (lambda (uid) (if (not (memq uid out)) (match! m uid)))
+              (waiter-offered w))
+    m))
 
 ;; How many robots w's last look found capable of c; before it, as many
 ;; as the lab has.

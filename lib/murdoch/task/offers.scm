@@ -101,34 +101,12 @@
 (define (offered-enough? w uid)
   (let* ((id (task-id (waiter-task w)))
          (held (held-uids w))
-         (offered (filter-map (lambda (o) (and (eq? (cdr o) id) (not (memq (car o) held))
-                                               (car o)))
-                              (offering-offers (the-offering))))
-         (open (list->vector
-                (remove (lambda (c) (assv (component-index c) (waiter-held w)))
-                        (waiter-components w))))
-         (fits? (lambda (uid i)
-                  (let ((capable (looked-capable w (vector-ref open i))))
-                    (or (not capable) (memq uid capable)))))
-         (taken (make-vector (vector-length open) #f)))
-    (for-each (lambda (o) (augment! o taken fits?)) offered)
-    (not (augment! uid taken fits?))))
-
-;; Whether robot uid can take one of the components that taken, by index,
-;; gives the robots taking them, moving those on as needed (an augmenting
-;; path); if so, it does.  Robots added one at a time so take the most
-;; components they can, in polynomial time (docs/allocation.md).
-(define (augment! uid taken fits?)
-  (let ((seen (make-vector (vector-length taken) #f)))
-    (let take ((uid uid))
-      (let loop ((i 0))
-        (cond ((= i (vector-length taken)) #f)
-              ((and (not (vector-ref seen i)) (fits? uid i))
-               (vector-set! seen i #t)
-               (if (or (not (vector-ref taken i)) (take (vector-ref taken i)))
-                   (begin (vector-set! taken i uid) #t)
-                   (loop (+ i 1))))
-              (else (loop (+ i 1))))))))
+         (m (open-matching w (waiter-components w))))
+    (for-each (lambda (o)
+                (if (and (eq? (cdr o) id) (not (memq (car o) held)))
+                    (match! m (car o))))
+              (offering-offers (the-offering)))
+    (not (match! m uid))))
 
 ;; The offers being answered here, (UID . ID): the robot UID keeps itself
 ;; for this poser while task ID tries, and the poser's other waiting

@@ -114,6 +114,51 @@
   (let ((cc (assq c (waiter-capables w))))
     (and cc (cdr cc))))
 
+;; Of robots to w's components open, one each; taken is by open's index.
+(define-record-type matching
+  (make-matching waiter open taken)
+  matching?
+  (waiter matching-waiter)
+  (open matching-open)
+  (taken matching-taken))
+
+;;> An empty matching of robots to those of components \var{cs} of
+;;> waiting task \var{w} not held, which match! grows, giving each robot
+;;> to the first it fits.
+(define (open-matching w cs)
+  (let ((open (list->vector (remove (lambda (c) (assv (component-index c) (waiter-held w)))
+                                    cs))))
+    (make-matching w open (make-vector (vector-length open) #f))))
+
+;;> Whether robot \var{uid} can take one more of \var{m}'s components
+;;> (by the last look), moving those taken on along an augmenting path;
+;;> if so, it does: robots added so take the most (docs/allocation.md).
+(define (match! m uid)
+  (let* ((open (matching-open m))
+         (taken (matching-taken m))
+         (seen (make-vector (vector-length open) #f))
+         (fits? (lambda (uid i)
+                  (let ((capable (looked-capable (matching-waiter m) (vector-ref open i))))
+                    (or (not capable) (memq uid capable))))))
+    (let take ((uid uid))
+      (let loop ((i 0))
+        (cond ((= i (vector-length open)) #f)
+              ((and (not (vector-ref seen i)) (fits? uid i))
+               (vector-set! seen i #t)
+               (if (or (not (vector-ref taken i)) (take (vector-ref taken i)))
+                   (begin (vector-set! taken i uid) #t)
+                   (loop (+ i 1))))
+              (else (loop (+ i 1))))))))
+
+;;> The uids \var{m} gives to the components but \var{c}.
+(define (matched-to-others m c)
+  (let loop ((i 0) (out '()))
+    (cond ((= i (vector-length (matching-open m))) out)
+          ((and (vector-ref (matching-taken m) i)
+                (not (eq? c (vector-ref (matching-open m) i))))
+           (loop (+ i 1) (cons (vector-ref (matching-taken m) i) out)))
+          (else (loop (+ i 1) out)))))
+
 ;; The node's line part: the tasks waiting here, best rank first, under
 ;; (tasks-lock); the posers known to have tasks waiting, and when the lab
 ;; was last asked for them; the other posers' waiting tasks as last asked
