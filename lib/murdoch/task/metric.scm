@@ -45,18 +45,18 @@
              entry))
        keys))
 
+(define-syntax key-better?             ; a macro: a call a comparison (docs/speed.md)
+  (syntax-rules ()
+    ((_ key a b) (if (measure-key? key) (< a (- b (measure-key-tolerance key))) (key a b)))))
+
 ;; Whether values as are better than bs by the first key that does not
 ;; tie them.  Ties are judged pair by pair, so not transitive.
 (define (keys-better? keys as bs)
   (and (pair? keys)
        (cond ((key-better? (car keys) (car as) (car bs)) #t)
-             ((or (null? (cdr keys)) (key-better? (car keys) (car bs) (car as))) #f)
+             ((null? (cdr keys)) #f)
+             ((key-better? (car keys) (car bs) (car as)) #f)
              (else (keys-better? (cdr keys) (cdr as) (cdr bs))))))
-
-(define (key-better? key a b)
-  (if (measure-key? key)
-      (< a (- b (measure-key-tolerance key)))
-      (key a b)))
 
 ;;> A metric that prefers the candidate with the smaller
 ;;> \scheme{(measure uid)}: a number for a candidate's uid.
@@ -146,10 +146,17 @@
 ;; Each candidate as (values . entry), each measure asked of every
 ;; candidate once; asked holds answers already had (request-components).
 (define (measured-response response keys . asked)
-  (apply map
-         (lambda (entry . values) (cons values entry))
-         response
-         (key-columns response keys (and (pair? asked) (car asked)))))
+  (with-values response (key-columns response keys (and (pair? asked) (car asked)))))
+
+;; Not (apply map ...), a dozen calls a candidate (docs/speed.md).
+(define (with-values response columns)
+  (if (null? response)
+      '()
+      (cons (cons (firsts columns) (car response))
+            (with-values (cdr response) (rests columns)))))
+
+(define (firsts ls) (if (null? ls) '() (cons (caar ls) (firsts (cdr ls)))))
+(define (rests ls) (if (null? ls) '() (cons (cdar ls) (rests (cdr ls)))))
 
 (define (key-columns response keys asked)
   (let loop ((keys keys) (k 0))
@@ -159,13 +166,12 @@
                             (measure-key-measure (car keys)))))
           (cond ((not measure) (cons response (loop (cdr keys) k)))
                 ((and asked (asking? measure))
-                 (cons (measured-told (map car response)
+                 (cons (measured-told response
                                       (map-guarded (lambda (e) (asked-score measure asked e k))
                                                    response unscored))
                        (loop (cdr keys) (+ k 1))))
                 (else
-                 (cons (measured-told (map car response)
-                                      (measure-all measure (map car response)))
+                 (cons (measured-told response (measure-all measure (map car response)))
                        (loop (cdr keys) k))))))))
 
 ;; Candidate entry's score by an asking measure from its k-th answer.
@@ -177,8 +183,8 @@
                  (and (pair? (cdr answer)) (asked-value answer))))
         +inf.0)))
 
-(define (measured-told uids measures)
-  (progress "  measured " (map list uids measures))
+(define (measured-told response measures)
+  (progress "  measured " (map list (map car response) measures))
   measures)
 
 ;; The procedures a candidate is asked for the measures among keys.
