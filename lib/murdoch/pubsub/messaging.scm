@@ -161,11 +161,10 @@
 
 ;;; Sending
 
-;; Macros: read for every component of every row (docs/speed.md).
 (define-syntax evaluated? (syntax-rules () ((_ answer) (car answer)))) ; (#t UID VALUE)
 (define-syntax evaluation (syntax-rules () ((_ answer) (cdr answer)))) ; (UID VALUE)
 (define-syntax component-answer (syntax-rules () ((_ entry) (car entry)))) ; (ANSWER ASKED)
-(define-syntax component-asked (syntax-rules () ((_ entry) (cadr entry))))
+(define-syntax component-asked (syntax-rules () ((_ entry) (cadr entry)))) ; macros: docs/speed.md
 
 ;; Sends a message to the lab: a result for each address space reached; a
 ;; uid goes to that address space alone, as metrics ask point to point.

@@ -150,8 +150,7 @@
 (define (started-uid x)
   (if (pending-call? x) (pending-call-uid x) (result-uid x)))
 
-;;> Applies each of \var{procs} to \var{args}, all at once: a proxy where it
-;;> was made, any other procedure here; a result each, in their order.
+;;> Applies each of \var{procs} to \var{args} at once, a proxy where it was made: a result each.
 (define (apply-each procs args)
   (check-not-abandoned "apply-each")
   (let* ((deadline (+ (monotonic-seconds) (current-timeout)))
@@ -166,8 +165,7 @@
                         x))
                   started)))
 
-;; p's call sent where p was made, (pending-call . call), or its result here.
-(define (start-apply p args deadline g)
+(define (start-apply p args deadline g) ; (pending-call . call), or p's result
   (if (eq? (maker-uid p) (local-aspace-uid))
       (make-result (local-aspace-uid) #t (apply p args))
       (let ((c (new-call 'apply p args)))

@@ -148,8 +148,7 @@
 (define (measured-response response keys . asked)
   (with-values response (key-columns response keys (and (pair? asked) (car asked)))))
 
-;; Not (apply map ...), a dozen calls a candidate (docs/speed.md).
-(define (with-values response columns)
+(define (with-values response columns)  ; not (apply map ...): docs/speed.md
   (if (null? response)
       '()
       (cons (cons (firsts columns) (car response))

@@ -295,9 +295,8 @@
   (progress "  " outcome "; every reservation freed")
   outcome)
 
-;; Applies to #f each promise that did not win its component, all at
-;; once: the exact entry, not its robot, since a robot may have promised
-;; two components.
+;; Applies to #f, all at once, each promise that did not win its component:
+;; the exact entry, not its robot, since a robot may have promised two.
 (define (release-runners-up responses type-list winners)
   (let ((entries (append-map (lambda (response type)
                                (if (eq? type 'exclusive)
@@ -306,8 +305,7 @@
                              responses type-list)))
     (for-each forget-promise! entries (apply-each (map winner-promise entries) '(#f)))))
 
-;; Forgets entry's promise here once r, its application, says it is freed.
-(define (forget-promise! entry r)
+(define (forget-promise! entry r)       ; once r, its application, freed it
   (let ((why (cond ((not (result-ok? r)) (result-value r))
                    ((proxy-procedure-ref (winner-promise entry))
                     (release-proxy! (winner-promise entry))
