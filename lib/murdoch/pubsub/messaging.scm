@@ -280,13 +280,13 @@
               (tell-failure (if (eq? (car c) 'exclusive) 'request-exclusive 'request) row))
             components))
 
-(define (row-of? value n)
-  (and (list? value) (= (length value) n) (entries? value)))
+(define (row-of? value n) (and (list? value) (entries-of? value n)))
 
-(define (entries? value)
-  (or (null? value)
-      (and (list? (car value)) (= (length (car value)) 2) (pair? (caar value))
-           (entries? (cdr value)))))
+(define (entries-of? value n)           ; n entries (ANSWER ASKED), without length
+  (if (null? value)
+      (eq? n 0)
+      (and (pair? (car value)) (pair? (caar value)) (pair? (cdar value))
+           (null? (cddr (car value))) (entries-of? (cdr value) (- n 1)))))
 
 ;; Conses each entry of a row from component i on, if evaluated, on its columns.
 (define (take-entries! entries uid i answers asked)

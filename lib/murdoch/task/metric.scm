@@ -175,12 +175,19 @@
 
 ;; Candidate entry's score by an asking measure from its k-th answer.
 (define (asked-score measure asked entry k)
-  (let ((answers (assq (car entry) asked)))
-    (if (and answers (> (length answers) (+ k 1)) (list? (list-ref answers (+ k 1))))
-        (let ((answer (list-ref answers (+ k 1))))
-          (score measure (asked-ok? answer)
-                 (and (pair? (cdr answer)) (asked-value answer))))
-        +inf.0)))
+  (answer-score measure (nth-pair (assq (car entry) asked) (+ k 1))))
+
+(define (nth-pair ls i) (and (list? ls) (tail-at ls i))) ; the i-th's, or #f
+
+(define (tail-at ls i)                  ; not length and list-ref: a call a step
+  (cond ((not (pair? ls)) #f)
+        ((eq? i 0) ls)
+        (else (tail-at (cdr ls) (- i 1)))))
+
+(define (answer-score measure p)
+  (if (and p (list? (car p)))
+      (score measure (asked-ok? (car p)) (and (pair? (cdar p)) (asked-value (car p))))
+      +inf.0))
 
 (define (measured-told response measures)
   (progress "  measured " (map list (map car response) measures))
