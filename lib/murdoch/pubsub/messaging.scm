@@ -288,8 +288,7 @@
       (and (pair? (car value)) (pair? (caar value)) (pair? (cdar value))
            (null? (cddr (car value))) (entries-of? (cdr value) (- n 1)))))
 
-;; Conses each entry of a row from component i on, if evaluated, on its columns.
-(define (take-entries! entries uid i answers asked)
+(define (take-entries! entries uid i answers asked) ; each evaluated on its column
   (when (pair? entries)
     (when (evaluated? (component-answer (car entries)))
       (vector-set! answers i (cons (evaluation (component-answer (car entries)))

@@ -150,9 +150,9 @@
 (define (started-uid x)
   (if (pending-call? x) (pending-call-uid x) (result-uid x)))
 
-;;> Applies each of \var{procs} to \var{args} at once, a proxy where it was made: a result each.
+;;> Applies each of \var{procs} to \var{args} at once, a proxy where it
+;;> was made; a result each, a call that raised or stopped a failure.
 (define (apply-each procs args)
-  (check-not-abandoned "apply-each")
   (let* ((deadline (+ (monotonic-seconds) (current-timeout)))
          (g (make-gathering))
          (started (capture-each maker-uid (lambda (p) (start-apply p args deadline g))
@@ -161,15 +161,17 @@
     (capture-each (lambda (x) (if (pair? x) (pending-call-uid (car x)) (result-uid x)))
                   (lambda (x)
                     (if (pair? x)
-                        (make-result (pending-call-uid (car x)) #t (answer-value (car x) (cdr x)))
+                        (make-result (pending-call-uid (car x)) #t
+                                     (answer-value (car x) (cdr x)))
                         x))
                   started)))
 
 (define (start-apply p args deadline g) ; (pending-call . call), or p's result
   (if (eq? (maker-uid p) (local-aspace-uid))
       (make-result (local-aspace-uid) #t (apply p args))
-      (let ((c (new-call 'apply p args)))
-        (cons (start-call (uid->aspace (maker-uid p)) (call-tail c) deadline g) c))))
+      (begin (check-not-abandoned (caller-name 'apply))
+             (let ((c (new-call 'apply p args)))
+               (cons (start-call (uid->aspace (maker-uid p)) (call-tail c) deadline g) c)))))
 
 (define (maker-uid p)
   (let ((ref (proxy-procedure-ref p)))
