@@ -6,7 +6,7 @@
           local-aspace-uid aspace-started-at uid->aspace known-uids live-uids
           live-aspace remote-run! remote-apply remote-timeout
           remote-apply-all remote-run-all! outcome-uid
-          outcome-ok? outcome-value call-all broadcast-apply broadcast-run!
+          outcome-ok? outcome-value call-all apply-each broadcast-apply broadcast-run!
           make-result result-uid result-ok? result-value delivery-mode
           remote-error? remote-error-uid remote-error-message
           remote-timeout-error? remote-unreachable-error? remote-raised-error?

@@ -161,6 +161,11 @@
 
 ;;; Sending
 
+(define-syntax evaluated? (syntax-rules () ((_ answer) (car answer)))) ; (#t UID VALUE)
+(define-syntax evaluation (syntax-rules () ((_ answer) (cdr answer)))) ; (UID VALUE)
+(define-syntax component-answer (syntax-rules () ((_ entry) (car entry)))) ; (ANSWER ASKED)
+(define-syntax component-asked (syntax-rules () ((_ entry) (cadr entry)))) ; macros: docs/speed.md
+
 ;; Sends a message to the lab: a result for each address space reached; a
 ;; uid goes to that address space alone, as metrics ask point to point.
 (define (deliver kind topic proc . args)
@@ -237,15 +242,10 @@
 ;;> asked) for each, response as request-exclusive or request gives,
 ;;> asked ((uid answer ...) ...), each answer (#t value) or (#f message).
 (define (request-components task-name components)
-  (let* ((n (length components))
-         (rows (checked-rows (audience-apply receive-components components task-name
-                                             (local-aspace-uid))
-                             n)))
-    (map (lambda (c i)
-           (list (column-answers (if (eq? (car c) 'exclusive) 'request-exclusive 'request)
-                                 rows i)
-                 (column-asked rows i)))
-         components (iota n))))
+  (let ((n (length components)))
+    (component-columns components n
+                       (audience-apply receive-components components task-name
+                                       (local-aspace-uid)))))
 
 ;;> The uids that request-components asks, or #f, the thesis's whole
 ;;> lab.  Only an address space subscribed to a component's subjects
@@ -260,43 +260,42 @@
         (call-all (filter-map live-aspace (delete-duplicates uids)) 'apply proc args)
         (apply broadcast-apply proc args))))
 
-;; rows with one not of n entries made a failure, checked once (docs/speed.md).
-(define (checked-rows rows n)
-  (cond ((null? rows) '())
-        ((or (not (result-ok? (car rows))) (row-of? (result-value (car rows)) n))
-         (cons (car rows) (checked-rows (cdr rows) n)))
-        (else (cons (make-result (result-uid (car rows)) #f
-                                 "a malformed answer to request-components")
-                    (checked-rows (cdr rows) n)))))
+;; Every component's (response asked), in one pass; a row not of n entries fails.
+(define (component-columns components n rows)
+  (let ((answers (make-vector n '())) (asked (make-vector n '())))
+    (for-each (lambda (row) (take-row! components n row answers asked)) rows)
+    (map (lambda (i) (list (reverse (vector-ref answers i)) (reverse (vector-ref asked i))))
+         (iota n))))
 
-(define (row-of? value n)
-  (and (list? value) (= (length value) n) (entries? value)))
+(define (take-row! components n row answers asked)
+  (cond ((not (result-ok? row)) (tell-failures components row))
+        ((row-of? (result-value row) n)
+         (take-entries! (result-value row) (result-uid row) 0 answers asked))
+        (else (tell-failures components
+                             (make-result (result-uid row) #f
+                                          "a malformed answer to request-components")))))
 
-(define (entries? value)
-  (or (null? value)
-      (and (list? (car value)) (= (length (car value)) 2) (pair? (caar value))
-           (entries? (cdr value)))))
+(define (tell-failures components row)
+  (for-each (lambda (c)
+              (tell-failure (if (eq? (car c) 'exclusive) 'request-exclusive 'request) row))
+            components))
 
-;; Component i's answers, as request-exclusive's or request's.
-(define (column-answers what rows i)
-  (cond ((null? rows) '())
-        ((not (result-ok? (car rows)))
-         (tell-failure what (car rows))
-         (column-answers what (cdr rows) i))
-        ((evaluated? (row-answer (car rows) i))
-         (cons (evaluation (row-answer (car rows) i)) (column-answers what (cdr rows) i)))
-        (else (column-answers what (cdr rows) i))))
+(define (row-of? value n) (and (list? value) (entries-of? value n)))
 
-;; Component i's askings' answers, (uid answer ...) for each evaluator.
-(define (column-asked rows i)
-  (cond ((null? rows) '())
-        ((and (result-ok? (car rows)) (evaluated? (row-answer (car rows) i)))
-         (cons (cons (result-uid (car rows))
-                     (component-asked (list-ref (result-value (car rows)) i)))
-               (column-asked (cdr rows) i)))
-        (else (column-asked (cdr rows) i))))
+(define (entries-of? value n)           ; n entries (ANSWER ASKED), without length
+  (if (null? value)
+      (eq? n 0)
+      (and (pair? (car value)) (pair? (caar value)) (pair? (cdar value))
+           (null? (cddr (car value))) (entries-of? (cdr value) (- n 1)))))
 
-(define (row-answer row i) (component-answer (list-ref (result-value row) i)))
+(define (take-entries! entries uid i answers asked) ; each evaluated on its column
+  (when (pair? entries)
+    (when (evaluated? (component-answer (car entries)))
+      (vector-set! answers i (cons (evaluation (component-answer (car entries)))
+                                   (vector-ref answers i)))
+      (vector-set! asked i (cons (cons uid (component-asked (car entries)))
+                                 (vector-ref asked i))))
+    (take-entries! (cdr entries) uid (+ i 1) answers asked)))
 
 ;;> Who holds what: for each address space with a subscription matching
 ;;> \var{topic}, (uid ((subject status) ...)).

@@ -1,11 +1,7 @@
 ;;;; Receiving, part of (murdoch pubsub messaging): what the senders run in
 ;;;; each address space, (#t UID VALUE) or (#f UID), and the reservations.
 
-(define (evaluated? answer) (car answer))
 (define (not-evaluated) (list #f (local-aspace-uid)))
-(define (evaluation answer) (cdr answer)) ; (UID VALUE)
-(define (component-answer entry) (car entry))
-(define (component-asked entry) (cadr entry))
 
 ;;> Evaluates a publication if it is addressed here.
 (define (receive-publication topic uid proc args)

@@ -150,6 +150,33 @@
 (define (started-uid x)
   (if (pending-call? x) (pending-call-uid x) (result-uid x)))
 
+;;> Applies each of \var{procs} to \var{args} at once, a proxy where it
+;;> was made; a result each, a call that raised or stopped a failure.
+(define (apply-each procs args)
+  (let* ((deadline (+ (monotonic-seconds) (current-timeout)))
+         (g (make-gathering))
+         (started (capture-each maker-uid (lambda (p) (start-apply p args deadline g))
+                                procs)))
+    (await-answers g (filter-map (lambda (x) (and (pair? x) (car x))) started) deadline)
+    (capture-each (lambda (x) (if (pair? x) (pending-call-uid (car x)) (result-uid x)))
+                  (lambda (x)
+                    (if (pair? x)
+                        (make-result (pending-call-uid (car x)) #t
+                                     (answer-value (car x) (cdr x)))
+                        x))
+                  started)))
+
+(define (start-apply p args deadline g) ; (pending-call . call), or p's result
+  (if (eq? (maker-uid p) (local-aspace-uid))
+      (make-result (local-aspace-uid) #t (apply p args))
+      (begin (check-not-abandoned (caller-name 'apply))
+             (let ((c (new-call 'apply p args)))
+               (cons (start-call (uid->aspace (maker-uid p)) (call-tail c) deadline g) c)))))
+
+(define (maker-uid p)
+  (let ((ref (proxy-procedure-ref p)))
+    (if ref (proxy-ref-uid ref) (local-aspace-uid))))
+
 ;; A call to this address space is a remote call too, so an abandoned
 ;; thread stops at it (code/abandon.scm).
 (define (local-call kind proc args)

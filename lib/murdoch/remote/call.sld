@@ -5,7 +5,7 @@
   (export remote-run! remote-apply remote-apply-all remote-run-all!
           outcome-uid outcome-ok? outcome-value
           new-call call? call-kind call-proc call-args call-proc-code call-args-code
-          call-seconds call-all make-result result? result-uid result-ok? result-value
+          call-seconds call-all apply-each make-result result? result-uid result-ok? result-value
           encode-arguments send-all local-call capture
           capture-each await-answers answer-value no-answer datagram-others
           expect-answers! forget-answers!

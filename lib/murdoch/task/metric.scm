@@ -45,18 +45,18 @@
              entry))
        keys))
 
+(define-syntax key-better?             ; a macro: a call a comparison (docs/speed.md)
+  (syntax-rules ()
+    ((_ key a b) (if (measure-key? key) (< a (- b (measure-key-tolerance key))) (key a b)))))
+
 ;; Whether values as are better than bs by the first key that does not
 ;; tie them.  Ties are judged pair by pair, so not transitive.
 (define (keys-better? keys as bs)
   (and (pair? keys)
        (cond ((key-better? (car keys) (car as) (car bs)) #t)
-             ((or (null? (cdr keys)) (key-better? (car keys) (car bs) (car as))) #f)
+             ((null? (cdr keys)) #f)
+             ((key-better? (car keys) (car bs) (car as)) #f)
              (else (keys-better? (cdr keys) (cdr as) (cdr bs))))))
-
-(define (key-better? key a b)
-  (if (measure-key? key)
-      (< a (- b (measure-key-tolerance key)))
-      (key a b)))
 
 ;;> A metric that prefers the candidate with the smaller
 ;;> \scheme{(measure uid)}: a number for a candidate's uid.
@@ -146,10 +146,16 @@
 ;; Each candidate as (values . entry), each measure asked of every
 ;; candidate once; asked holds answers already had (request-components).
 (define (measured-response response keys . asked)
-  (apply map
-         (lambda (entry . values) (cons values entry))
-         response
-         (key-columns response keys (and (pair? asked) (car asked)))))
+  (with-values response (key-columns response keys (and (pair? asked) (car asked)))))
+
+(define (with-values response columns)  ; not (apply map ...): docs/speed.md
+  (if (null? response)
+      '()
+      (cons (cons (firsts columns) (car response))
+            (with-values (cdr response) (rests columns)))))
+
+(define (firsts ls) (if (null? ls) '() (cons (caar ls) (firsts (cdr ls)))))
+(define (rests ls) (if (null? ls) '() (cons (cdar ls) (rests (cdr ls)))))
 
 (define (key-columns response keys asked)
   (let loop ((keys keys) (k 0))
@@ -159,26 +165,32 @@
                             (measure-key-measure (car keys)))))
           (cond ((not measure) (cons response (loop (cdr keys) k)))
                 ((and asked (asking? measure))
-                 (cons (measured-told (map car response)
+                 (cons (measured-told response
                                       (map-guarded (lambda (e) (asked-score measure asked e k))
                                                    response unscored))
                        (loop (cdr keys) (+ k 1))))
                 (else
-                 (cons (measured-told (map car response)
-                                      (measure-all measure (map car response)))
+                 (cons (measured-told response (measure-all measure (map car response)))
                        (loop (cdr keys) k))))))))
 
 ;; Candidate entry's score by an asking measure from its k-th answer.
 (define (asked-score measure asked entry k)
-  (let ((answers (assq (car entry) asked)))
-    (if (and answers (> (length answers) (+ k 1)) (list? (list-ref answers (+ k 1))))
-        (let ((answer (list-ref answers (+ k 1))))
-          (score measure (asked-ok? answer)
-                 (and (pair? (cdr answer)) (asked-value answer))))
-        +inf.0)))
+  (answer-score measure (nth-pair (assq (car entry) asked) (+ k 1))))
 
-(define (measured-told uids measures)
-  (progress "  measured " (map list uids measures))
+(define (nth-pair ls i) (and (list? ls) (tail-at ls i))) ; the i-th's, or #f
+
+(define (tail-at ls i)                  ; not length and list-ref: a call a step
+  (cond ((not (pair? ls)) #f)
+        ((eq? i 0) ls)
+        (else (tail-at (cdr ls) (- i 1)))))
+
+(define (answer-score measure p)
+  (if (and p (list? (car p)))
+      (score measure (asked-ok? (car p)) (and (pair? (cdar p)) (asked-value (car p))))
+      +inf.0))
+
+(define (measured-told response measures)
+  (progress "  measured " (map list (map car response) measures))
   measures)
 
 ;; The procedures a candidate is asked for the measures among keys.

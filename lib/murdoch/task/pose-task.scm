@@ -295,16 +295,20 @@
   (progress "  " outcome "; every reservation freed")
   outcome)
 
-;; Applies to #f each promise that did not win its component: the exact
-;; entry, not its robot, since a robot may have promised two components.
+;; Applies to #f, all at once, each promise that did not win its component:
+;; the exact entry, not its robot, since a robot may have promised two.
 (define (release-runners-up responses type-list winners)
-  (for-each (lambda (response type)
-              (if (eq? type 'exclusive)
-                  (for-each (lambda (entry)
-                              (if (not (memq entry winners))
-                                  (guard (e (#t (log-warn "releasing " (winner-uid entry)
-                                                          ": " (error-message e))))
-                                    ((winner-promise entry) #f)
-                                    (release-proxy! (winner-promise entry)))))
-                            response)))
-            responses type-list))
+  (let ((entries (append-map (lambda (response type)
+                               (if (eq? type 'exclusive)
+                                   (remove (lambda (entry) (memq entry winners)) response)
+                                   '()))
+                             responses type-list)))
+    (for-each forget-promise! entries (apply-each (map winner-promise entries) '(#f)))))
+
+(define (forget-promise! entry r)       ; once r, its application, freed it
+  (let ((why (cond ((not (result-ok? r)) (result-value r))
+                   ((proxy-procedure-ref (winner-promise entry))
+                    (release-proxy! (winner-promise entry))
+                    #f)
+                   (else "not a promise"))))
+    (if why (log-warn "releasing " (winner-uid entry) ": " why))))
