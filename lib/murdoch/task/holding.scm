@@ -28,8 +28,7 @@
          (m (offered-matching w order)))
     (for-each
      (lambda (c)
-       (let ((excluded (append (held-uids w) (waiter-yielded w) (pose-task-excluded)
-                               (matched-to-others m c))))
+       (let ((excluded (append (left-out w) (matched-to-others m c))))
          (if (and (not (assv (component-index c) (waiter-held w)))
                   (may-win? w c excluded))
              (let ((team (parameterize ((pose-task-excluded excluded))
@@ -59,10 +58,14 @@
 ;; open components in order: as offered-enough? counted on (docs/allocation.md).
 (define (offered-matching w order)
   (let ((m (open-matching w order))
-        (out (append (held-uids w) (waiter-yielded w) (pose-task-excluded))))
+        (out (left-out w)))
     (for-each (lambda (uid) (if (not (memq uid out)) (match! m uid)))
               (waiter-offered w))
     m))
+
+;; The robots no negotiation of w's takes: held, given way on, or excluded.
+(define (left-out w)
+  (append (held-uids w) (waiter-yielded w) (pose-task-excluded)))
 
 ;; How many robots w's last look found capable of c; before it, as many
 ;; as the lab has.
