@@ -36,7 +36,7 @@
 ;; The node's looking part: a poser's one line of tasks, and what its
 ;; notes to the lab, its tries and its one looking thread share.
 (define-record-type looking
-  (make-looking noting? note-again trying? try-turns looker? bell takers free-seen)
+  (make-looking noting? note-again trying? try-turns looker? bell takers free-seen turn)
   looking?
   (noting? looking-noting? looking-noting?-set!)    ; a publication goes
   (note-again looking-note-again looking-note-again-set!) ; best rank since, or #f
@@ -45,13 +45,14 @@
   (looker? looking-looker? looking-looker?-set!)    ; the looking thread runs
   (bell looking-bell)                   ; rung by a task that wants a look
   (takers looking-takers looking-takers-set!)
-  (free-seen looking-free-seen looking-free-seen-set!))
+  (free-seen looking-free-seen looking-free-seen-set!)
+  (turn looking-turn looking-turn-set!))          ; where the next look's rest begins
 
 (define-syntax the-looking (syntax-rules () ((_) (node-looking *node*))))
 
 (define (open-looking!)
   (node-looking-set! (this-node)
-                     (make-looking #f #f #f '() #f (make-mailbox) #f '())))
+                     (make-looking #f #f #f '() #f (make-mailbox) #f '() 0)))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
@@ -261,17 +262,37 @@
         (start (monotonic-seconds)))
     (when (pair? ws)
       (guard (e (#t (log-warn "looking at the lab: " (error-message e))))
-        (look-all! ws))
+        (look-all! ws (told-now ws)))
       (thread-sleep! (max 0 (- (+ start 1) (monotonic-seconds))))
       (looker))))
 
-;; Looks at the lab for the waiting tasks ws: one request for the takers
-;; of all their components, one for the tasks that hold robots, and the
-;; lab's line (line-ranks-now), whatever the number of tasks.  What
-;; each task is told is made once a look for each of the layouts and
-;; numbers its components have, and the holders that rank after each task
-;; are found by going down both lists together (docs/allocation.md).
-(define (look-all! ws)
+;; A look tells the best look-width tasks waiting here, and as many of
+;; the rest in turn, so that it costs the same with 60 tasks waiting here
+;; or 600: each of the rest is told every (n - look-width) / look-width
+;; looks (docs/allocation.md).
+(define look-width 32)
+
+;; Of ws, best first, those this look tells, best first.
+(define (told-now ws)
+  (let ((n (length ws)))
+    (if (<= n (* 2 look-width))
+        ws
+        (let* ((rest (list-tail ws look-width))
+               (from (if (< (looking-turn (the-looking)) (- n look-width))
+                         (looking-turn (the-looking))
+                         0))
+               (slice (take (list-tail rest from) (min look-width (- n look-width from)))))
+          (looking-turn-set! (the-looking) (+ from look-width))
+          (append (take ws look-width) slice)))))
+
+;; Looks at the lab for the waiting tasks ws, and tells told, some of
+;; them (told-now): one request for the takers of all their components,
+;; one for the tasks that hold robots, and the lab's line
+;; (line-ranks-now), whatever the number of tasks.  What each task is
+;; told is made once a look for each of the layouts and numbers its
+;; components have, and the holders that rank after each task are found
+;; by going down both lists together (docs/allocation.md).
+(define (look-all! ws told)
   (let*-values (((line) (line-ranks-now))
                 ((lines fresh?) (takers-of (delete-duplicates (append-map waiter-layouts ws))
                                            (line-ranks-length line))))
@@ -280,7 +301,7 @@
     (let ((holders (list-sort (lambda (a b)
                                 (rank<? (waiting-there-rank a) (waiting-there-rank b)))
                               (guard (e (#t '())) (lab-holders))))
-          (told (told-lines)))
+          (lines-told (told-lines)))
       (if fresh?
           (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines)))))
       (fold (lambda (w holders)
@@ -288,9 +309,9 @@
                                          (rank<? (waiting-there-rank h) (waiter-rank w)))
                                        holders)))
                 (look! w (map (lambda (l) (cdr (assoc l lines))) (waiter-layouts w))
-                       after line told)
+                       after line lines-told)
                 after))
-            holders ws))))
+            holders told))))
 
 ;; The takers of each of layouts, ((LAYOUT . EXPLANATION) ...), and
 ;; whether they were asked afresh; else as the last look that asked the
