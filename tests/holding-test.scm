@@ -48,8 +48,10 @@
       (map (lambda (c) (matched-to-others m c)) (waiter-components w)))))
 
 (test-group "held components are left out, and a component known to no look fits any"
-  (let ((w (waiter-of '((ra) #t) 1)))
-    (test "only the second is open, and rc fits it" '(rc) (taken-after w '(rc)))))
+  (let* ((w (waiter-of '((ra) #t) 1))
+         (m (open-matching w (waiter-components w))))
+    (test "rc fits the second, the one open" #t (match! m 'rc))
+    (test "and rd adds nothing: one is open" #f (match! m 'rd))))
 
 (test-group "the order given is the order preferred"
   (let* ((w (waiter-of '((ra rb) (ra rb))))
@@ -101,5 +103,39 @@
                   (if (= n (most-matched capables uids))
                       bad
                       (cons (list capables uids n) bad))))))))
+
+(test-group "before a look, a robot matched by guess is kept from no component"
+  ;; Neither component is known to a look: ra goes to the first by guess,
+  ;; and the second's negotiation may still take it, where it may fit.
+  (let* ((w (waiter-of '(#t #t)))
+         (m (open-matching w (waiter-components w))))
+    (match! m 'ra)
+    (test "ra is left to both" '(() ())
+      (map (lambda (c) (matched-to-others m c)) (waiter-components w)))))
+
+(test-group "a robot is offered only for a component not held"
+  ;; Before its look, a task holding its arm component wants a robot
+  ;; subscribed to lift, not one subscribed to arm alone.
+  (let* ((cs (list (make-component 1 '((arm) ()) #f #f #f)
+                   (make-component 2 '((lift) ()) #f #f #f)))
+         (w (make-waiter #f cs 0)))
+    (waiter-capable-set! w #t)
+    (waiter-held-set! w (list (list 1 #f 'exclusive)))
+    (test "not an arm" #f (wants? w 'r1 '(arm)))
+    (test-assert "a lift" (wants? w 'r2 '(lift)))))
+
+(test-group "before a look, a robot whose subjects are known fits by them"
+  (let* ((cs (list (make-component 1 '((arm) ()) #f #f #f)
+                   (make-component 2 '((lift) ()) #f #f #f)))
+         (w (make-waiter #f cs 0))
+         (m (begin (waiter-held-set! w '()) (open-matching w cs))))
+    (note-subjects! 'lifter '(lift))
+    (note-subjects! 'camera '(camera))
+    (test "a robot that fits none adds nothing" #f (match! m 'camera))
+    (test "the lifter goes to the lift component" #t (match! m 'lifter))
+    (test "and is kept from the arm's negotiation only once a look knows it"
+      '(() ())
+      (map (lambda (c) (matched-to-others m c)) cs))
+    (test "an arm it never heard of still fits the arm" #t (match! m 'stranger))))
 
 (test-end)

@@ -75,6 +75,7 @@
   (let ((subjects (and (pair? subjects+limit) (car subjects+limit)))
         (limit (and (pair? subjects+limit) (pair? (cdr subjects+limit))
                     (cadr subjects+limit))))
+    (note-subjects! uid subjects)
     (with-lock (tasks-lock)
       (lambda ()
         (let loop ((ws (waiters)) (n 0) (out '()))
@@ -283,4 +284,3 @@
 ;; Whether no subject here is held exclusively.
 (define (free-here?)
   (every (lambda (s) (memq (cadr s) '(() shared))) (subscription-statuses '>)))
-

@@ -139,7 +139,9 @@
          (seen (make-vector (vector-length open) #f))
          (fits? (lambda (uid i)
                   (let ((capable (looked-capable (matching-waiter m) (vector-ref open i))))
-                    (or (not capable) (memq uid capable))))))
+                    (if capable
+                        (memq uid capable)
+                        (subjects-fit? uid (vector-ref open i)))))))
     (let take ((uid uid))
       (let loop ((i 0))
         (cond ((= i (vector-length open)) #f)
@@ -150,12 +152,40 @@
                    (loop (+ i 1))))
               (else (loop (+ i 1))))))))
 
-;;> The uids \var{m} gives to the components but \var{c}.
+;; Global: the subjects of each robot that asked who waits here, ((UID
+;; . SUBJECTS) ...), replaced whole: before a task's first look, a robot
+;; offered fits a component whose subjects it has, not any.  Offered
+;; robots that fitted none of a task in the burst were counted as enough,
+;; and the robots it needed declined (docs/allocation.md).
+(define *robot-subjects* '())
+
+;;> Notes that robot \var{uid} subscribes to \var{subjects}.
+(define (note-subjects! uid subjects)
+  (let ((known (assq uid *robot-subjects*)))
+    (if (and (list? subjects) (every symbol? subjects)   ; a peer's word, checked
+             (not (and known (equal? (cdr known) subjects))))
+        (set! *robot-subjects*
+              (cons (cons uid subjects)
+                    (remove (lambda (e) (eq? (car e) uid)) *robot-subjects*))))))
+
+;; Whether robot uid has every subject of component c; #t if not known.
+(define (subjects-fit? uid c)
+  (let ((known (assq uid *robot-subjects*)))
+    (or (not known) (has-subjects? (cdr known) c))))
+
+(define (has-subjects? subjects c)
+  (every (lambda (s) (memq s subjects))
+         (apply append (capability-layout (component-capabilities c)))))
+
+;;> The uids \var{m} gives to the components but \var{c}, where the last
+;;> look said they fit.  Before a look a robot goes to the first component
+;;> by guess, and a try that kept it from the one it fits took none.
 (define (matched-to-others m c)
   (let loop ((i 0) (out '()))
     (cond ((= i (vector-length (matching-open m))) out)
           ((and (vector-ref (matching-taken m) i)
-                (not (eq? c (vector-ref (matching-open m) i))))
+                (not (eq? c (vector-ref (matching-open m) i)))
+                (looked-capable (matching-waiter m) (vector-ref (matching-open m) i)))
            (loop (+ i 1) (cons (vector-ref (matching-taken m) i) out)))
           (else (loop (+ i 1) out)))))
 
@@ -371,11 +401,13 @@
                 (waiter-capables w)))
           (else (and subjects (serves? subjects w))))))
 
-;; Whether a robot subscribed to subjects could take a component of w.
+;; Whether a robot subscribed to subjects could take a component of w
+;; that w does not hold: one offered for a component held was declined by
+;; the try, and went to a worse-ranked task meanwhile.
 (define (serves? subjects w)
   (any (lambda (c)
-         (every (lambda (s) (memq s subjects))
-                (apply append (capability-layout (component-capabilities c)))))
+         (and (not (assv (component-index c) (waiter-held w)))
+              (has-subjects? subjects c)))
        (waiter-components w)))
 
 ;;> Each task waiting here, as (RANK . ENTRY), ENTRY as (tasks) lists it:

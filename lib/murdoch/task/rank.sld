@@ -10,7 +10,7 @@
           waiter-held waiter-held-set! waiter-looked waiter-looked-set!
           waiter-kept waiter-kept-set! waiter-yielded waiter-yielded-set!
           waiter-capable waiter-capable-set! waiter-capables looked-capable
-          open-matching match! matched-to-others
+          open-matching match! matched-to-others note-subjects!
           waiter-capables-set! waiter-offered waiter-offered-set! waiter-position waiter-position-set!
           waiter-why waiter-why-set! waiter-never waiter-never-set!
           waiter-excluded waiter-excluded-set! waiter-news waiter-news-set!
