@@ -459,10 +459,69 @@ static void unpark_home (sexp ctx, sexp self, sexp root) {
   parked_count = still;
 }
 
+/* Chibi's poll.  Chibi's scheduler polls every descriptor a thread has
+ * waited on, at each call: a thread's every wait and slice.  While a thread
+ * can run it is not asked to look again within LOOK_USECS of its last look;
+ * the descriptors are hidden from it, their count set to 0, for that call.
+ * Its array is threads.c's (Chibi 0.12), known by its type's name. */
+#ifndef LOOK_USECS
+#define LOOK_USECS 200
+#endif
+
+struct chibi_pollfds {
+  struct pollfd *fds;
+  nfds_t nfds, mfds;
+};
+
+static long long last_look;
+static sexp_tag_t pollfds_tag;
+
+static long long now_usecs (void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (long long)t.tv_sec * 1000000 + t.tv_nsec / 1000;
+}
+
+static struct chibi_pollfds *chibi_pollfds (sexp ctx) {
+  sexp p = sexp_global(ctx, SEXP_G_THREADS_POLL_FDS), type;
+  if (!sexp_pointerp(p)) return NULL;
+  if (!pollfds_tag) {
+    type = sexp_object_type(ctx, p);
+    if (!(sexp_typep(type) && sexp_stringp(sexp_type_name(type))
+          && strcmp(sexp_string_data(sexp_type_name(type)), "pollfds") == 0))
+      return NULL;
+    pollfds_tag = sexp_pointer_tag(p);
+  }
+  return sexp_pointer_tag(p) == pollfds_tag
+    ? (struct chibi_pollfds *)&p->value : NULL;
+}
+
+/* Whether Chibi's pick, called now, is a thread that can run: the front
+ * of the queue, or the current thread going on. */
+static int runnable_pick (sexp ctx) {
+  sexp front = sexp_global(ctx, SEXP_G_THREADS_FRONT);
+  if (sexp_pairp(front))
+    return !sexp_context_waitp(sexp_car(front));
+  return !sexp_context_waitp(ctx) && sexp_context_refuel(ctx) > 0;
+}
+
 /* Chibi's scheduler, then the twins out of the queue; see unqueue_twins. */
 static sexp chibi_next (sexp ctx, sexp chibi, sexp_sint_t n, sexp root,
                         int may_twin) {
-  sexp next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+  struct chibi_pollfds *fds = NULL;
+  nfds_t hidden = 0;
+  long long now = now_usecs();
+  sexp next;
+  if (now - last_look < LOOK_USECS && runnable_pick(ctx)
+      && (fds = chibi_pollfds(ctx)) != NULL) {
+    hidden = fds->nfds;
+    fds->nfds = 0;
+  } else {
+    last_look = now;
+  }
+  next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+  if (fds && fds->nfds == 0)
+    fds->nfds = hidden;
   if (may_twin && sexp_contextp(next))
     unqueue_twins(ctx, next);
   return next;
