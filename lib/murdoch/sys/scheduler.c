@@ -25,6 +25,7 @@
 
 #include <chibi/eval.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -34,6 +35,7 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <time.h>
+#include <unistd.h>
 
 #if ! SEXP_USE_GREEN_THREADS
 #error "(murdoch sys scheduler) needs a Chibi-Scheme built with green threads"
@@ -631,6 +633,44 @@ static sexp others_runnablep (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_boolean(sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_FRONT)));
 }
 
+/* (cpu-contended?): whether this process waited for a CPU, runnable, a
+ * quarter or more of the last window of CONTENDED_USECS or more, by the
+ * kernel's count (the second field of /proc/self/schedstat, in ns).  Read
+ * once a window; #f where the file cannot be read. */
+#ifndef CONTENDED_USECS
+#define CONTENDED_USECS 10000
+#endif
+
+static int schedstat_fd = -2;
+static long long window_wall, window_delay;
+static int contended;
+
+static long long run_delay_usecs (void) {
+  char buf[96];
+  ssize_t got;
+  char *p;
+  if (schedstat_fd == -2)
+    schedstat_fd = open("/proc/self/schedstat", O_RDONLY | O_CLOEXEC);
+  if (schedstat_fd < 0) return -1;
+  got = pread(schedstat_fd, buf, sizeof buf - 1, 0);
+  if (got <= 0) return -1;
+  buf[got] = 0;
+  p = strchr(buf, ' ');
+  return p ? strtoll(p + 1, NULL, 10) / 1000 : -1;
+}
+
+static sexp cpu_contendedp (sexp ctx, sexp self, sexp_sint_t n) {
+  long long now = now_usecs(), delay;
+  if (now - window_wall >= CONTENDED_USECS) {
+    delay = run_delay_usecs();
+    contended = delay >= 0 && window_wall > 0
+      && 4 * (delay - window_delay) >= now - window_wall;
+    window_wall = now;
+    window_delay = delay;
+  }
+  return sexp_make_boolean(contended);
+}
+
 static sexp poll_scheduler_installedp (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_boolean(installed(ctx));
 }
@@ -942,6 +982,7 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "poll-scheduler-installed?", 0,
                       poll_scheduler_installedp);
   sexp_define_foreign(ctx, env, "others-runnable?", 0, others_runnablep);
+  sexp_define_foreign(ctx, env, "cpu-contended?", 0, cpu_contendedp);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
   sexp_define_foreign(ctx, env, "wall-microseconds", 0, wall_microseconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);
