@@ -597,17 +597,19 @@ static sexp stack_guard_trippedp (sexp ctx, sexp self, sexp_sint_t n,
  * costs a few loads. */
 static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   sexp next;
-  int may_twin;
+  int may_twin, strangers;
   interrupt_raised(ctx);
   guard_stack(ctx);
   may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
   if (parked_count > 0)
     unpark_home(ctx, self, root);
-  if (homes.count > 0)
+  /* With root the only context homed, every context may run here. */
+  strangers = homes.count > 1 || (homes.count == 1 && homes.items[0] != root);
+  if (strangers)
     park_strangers(ctx, self, root);
   if (nothing_runnable(ctx))
     wait_for_wakeup(ctx);
-  next = homes.count > 0
+  next = strangers
     ? next_here(ctx, self, n, root, may_twin)
     : chibi_next(ctx, sexp_opcode_data(self), n, root, may_twin);
   if (sexp_context_refuel(ctx) <= 0)
