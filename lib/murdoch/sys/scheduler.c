@@ -635,15 +635,16 @@ static sexp others_runnablep (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_boolean(sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_FRONT)));
 }
 
-/* (cpu-contended?): whether this process waited for a CPU, runnable, a
- * quarter or more of the last window of CONTENDED_USECS or more, by the
+/* (cpu-contended?): whether this process waited for a CPU, runnable, an
+ * eighth or more of the last window of CONTENDED_USECS or more, by the
  * kernel's count (the second field of /proc/self/schedstat, in ns).  Read
  * once a window; #f where the file cannot be read. */
 #ifndef CONTENDED_USECS
 #define CONTENDED_USECS 10000
 #endif
 
-static int schedstat_fd = -2;
+static int schedstat_fd = -1;
+static pid_t schedstat_pid;             /* whose file it is: a fork's differs */
 static long long window_wall, window_delay;
 static int contended;
 
@@ -651,8 +652,12 @@ static long long run_delay_usecs (void) {
   char buf[96];
   ssize_t got;
   char *p;
-  if (schedstat_fd == -2)
+  /* A fork's inherited number is left open: it may be another's by now. */
+  if (schedstat_pid != getpid()) {
+    schedstat_pid = getpid();
     schedstat_fd = open("/proc/self/schedstat", O_RDONLY | O_CLOEXEC);
+    window_wall = 0;
+  }
   if (schedstat_fd < 0) return -1;
   got = pread(schedstat_fd, buf, sizeof buf - 1, 0);
   if (got <= 0) return -1;
@@ -666,7 +671,7 @@ static sexp cpu_contendedp (sexp ctx, sexp self, sexp_sint_t n) {
   if (now - window_wall >= CONTENDED_USECS) {
     delay = run_delay_usecs();
     contended = delay >= 0 && window_wall > 0
-      && 4 * (delay - window_delay) >= now - window_wall;
+      && 8 * (delay - window_delay) >= now - window_wall;
     window_wall = now;
     window_delay = delay;
   }
