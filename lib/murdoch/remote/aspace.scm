@@ -126,7 +126,9 @@
 (define remote-timeout (make-parameter #f))
 (sandbox-parameter! remote-timeout)
 
-(define (current-timeout) (or (remote-timeout) (membership-timeout (joined))))
+(define (current-timeout) (timeout-or-lab (remote-timeout)))
+
+(define (timeout-or-lab t) (if t t (membership-timeout (joined))))
 
 ;;; The environment received code runs in
 

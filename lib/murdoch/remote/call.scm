@@ -39,8 +39,23 @@
 (define (call-by a c deadline g)
   (finish-call (start-call a (call-tail c) deadline g) g deadline c))
 
-(define (call-tail c)
-  (message-without-id (call-kind c) (list (call-proc-code c) (call-args-code c))))
+(define (call-tail c) (tail-of c *last-tail*))
+
+;; Global: the last call's text but its id, #(KIND PROC-CODE ARGS-CODE TAIL),
+;; replaced whole; a call of the same encodings (eq?) is written from it.
+(define *last-tail* (vector #f #f #f #f))
+
+(define (tail-of c last)
+  (if (and (eq? (vector-ref last 1) (call-proc-code c))
+           (eq? (vector-ref last 2) (call-args-code c))
+           (eq? (vector-ref last 0) (call-kind c)))
+      (vector-ref last 3)
+      (new-tail! c (message-without-id (call-kind c)
+                                       (list (call-proc-code c) (call-args-code c))))))
+
+(define (new-tail! c tail)
+  (set! *last-tail* (vector (call-kind c) (call-proc-code c) (call-args-code c) tail))
+  tail)
 
 ;; A call sent to a, answered to gathering g; a peer out of reach is noted so.
 (define (start-call a tail deadline g)

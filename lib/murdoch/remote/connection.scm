@@ -326,12 +326,18 @@
   (write-frame! (connection-out c) text (connection-nonce c) (connection-sent c))
   (if (coalesce? c) (connection-stage-set! c 'written) (flush-to! c (connection-sent c))))
 
-;; Whether frames written wait for other senders' (docs/speed.md): while the
-;; peer has more calls than wait here unflushed, and another thread can run.
+;; Whether frames written wait for other senders' (docs/speed.md): while
+;; another thread can run, and the peer has more calls than wait here
+;; unflushed, or, with calls besides this one, the ends take turns at a CPU.
 (define (coalesce? c)
-  (and (< (* 2 (- (connection-sent c) (connection-flushed c)))
-          (hash-table-size (connection-pending c)))
-       (others-runnable?)))
+  (and (others-runnable?)
+       (few-unflushed? (- (connection-sent c) (connection-flushed c))
+                       (hash-table-size (connection-pending c)))))
+
+(define (few-unflushed? unflushed pending)
+  (if (< (* 2 unflushed) pending)
+      #t
+      (and (> pending 1) (cpu-contended?))))
 
 (define (flush-to! c count)
   (when (< (connection-flushed c) count)

@@ -25,6 +25,7 @@
 
 #include <chibi/eval.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -34,6 +35,7 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <time.h>
+#include <unistd.h>
 
 #if ! SEXP_USE_GREEN_THREADS
 #error "(murdoch sys scheduler) needs a Chibi-Scheme built with green threads"
@@ -459,10 +461,69 @@ static void unpark_home (sexp ctx, sexp self, sexp root) {
   parked_count = still;
 }
 
+/* Chibi's poll.  Chibi's scheduler polls every descriptor a thread has
+ * waited on, at each call: a thread's every wait and slice.  While a thread
+ * can run it is not asked to look again within LOOK_USECS of its last look;
+ * the descriptors are hidden from it, their count set to 0, for that call.
+ * Its array is threads.c's (Chibi 0.12), known by its type's name. */
+#ifndef LOOK_USECS
+#define LOOK_USECS 200
+#endif
+
+struct chibi_pollfds {
+  struct pollfd *fds;
+  nfds_t nfds, mfds;
+};
+
+static long long last_look;
+static sexp_tag_t pollfds_tag;
+
+static long long now_usecs (void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (long long)t.tv_sec * 1000000 + t.tv_nsec / 1000;
+}
+
+static struct chibi_pollfds *chibi_pollfds (sexp ctx) {
+  sexp p = sexp_global(ctx, SEXP_G_THREADS_POLL_FDS), type;
+  if (!sexp_pointerp(p)) return NULL;
+  if (!pollfds_tag) {
+    type = sexp_object_type(ctx, p);
+    if (!(sexp_typep(type) && sexp_stringp(sexp_type_name(type))
+          && strcmp(sexp_string_data(sexp_type_name(type)), "pollfds") == 0))
+      return NULL;
+    pollfds_tag = sexp_pointer_tag(p);
+  }
+  return sexp_pointer_tag(p) == pollfds_tag
+    ? (struct chibi_pollfds *)&p->value : NULL;
+}
+
+/* Whether Chibi's pick, called now, is a thread that can run: the front
+ * of the queue, or the current thread going on. */
+static int runnable_pick (sexp ctx) {
+  sexp front = sexp_global(ctx, SEXP_G_THREADS_FRONT);
+  if (sexp_pairp(front))
+    return !sexp_context_waitp(sexp_car(front));
+  return !sexp_context_waitp(ctx) && sexp_context_refuel(ctx) > 0;
+}
+
 /* Chibi's scheduler, then the twins out of the queue; see unqueue_twins. */
 static sexp chibi_next (sexp ctx, sexp chibi, sexp_sint_t n, sexp root,
                         int may_twin) {
-  sexp next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+  struct chibi_pollfds *fds = NULL;
+  nfds_t hidden = 0;
+  long long now = now_usecs();
+  sexp next;
+  if (now - last_look < LOOK_USECS && runnable_pick(ctx)
+      && (fds = chibi_pollfds(ctx)) != NULL) {
+    hidden = fds->nfds;
+    fds->nfds = 0;
+  } else {
+    last_look = now;
+  }
+  next = ((sexp_proc2)sexp_opcode_func(chibi))(ctx, chibi, n, root);
+  if (fds && fds->nfds == 0)
+    fds->nfds = hidden;
   if (may_twin && sexp_contextp(next))
     unqueue_twins(ctx, next);
   return next;
@@ -536,17 +597,19 @@ static sexp stack_guard_trippedp (sexp ctx, sexp self, sexp_sint_t n,
  * costs a few loads. */
 static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   sexp next;
-  int may_twin;
+  int may_twin, strangers;
   interrupt_raised(ctx);
   guard_stack(ctx);
   may_twin = sexp_context_waitp(ctx) && has_deadline(ctx);
   if (parked_count > 0)
     unpark_home(ctx, self, root);
-  if (homes.count > 0)
+  /* With root the only context homed, every context may run here. */
+  strangers = homes.count > 1 || (homes.count == 1 && homes.items[0] != root);
+  if (strangers)
     park_strangers(ctx, self, root);
   if (nothing_runnable(ctx))
     wait_for_wakeup(ctx);
-  next = homes.count > 0
+  next = strangers
     ? next_here(ctx, self, n, root, may_twin)
     : chibi_next(ctx, sexp_opcode_data(self), n, root, may_twin);
   if (sexp_context_refuel(ctx) <= 0)
@@ -570,6 +633,49 @@ static int installed (sexp ctx) {
  * that a thread yielding now would let it run before going on. */
 static sexp others_runnablep (sexp ctx, sexp self, sexp_sint_t n) {
   return sexp_make_boolean(sexp_pairp(sexp_global(ctx, SEXP_G_THREADS_FRONT)));
+}
+
+/* (cpu-contended?): whether this process waited for a CPU, runnable, an
+ * eighth or more of the last window of CONTENDED_USECS or more, by the
+ * kernel's count (the second field of /proc/self/schedstat, in ns).  Read
+ * once a window; #f where the file cannot be read. */
+#ifndef CONTENDED_USECS
+#define CONTENDED_USECS 10000
+#endif
+
+static int schedstat_fd = -1;
+static pid_t schedstat_pid;             /* whose file it is: a fork's differs */
+static long long window_wall, window_delay;
+static int contended;
+
+static long long run_delay_usecs (void) {
+  char buf[96];
+  ssize_t got;
+  char *p;
+  /* A fork's inherited number is left open: it may be another's by now. */
+  if (schedstat_pid != getpid()) {
+    schedstat_pid = getpid();
+    schedstat_fd = open("/proc/self/schedstat", O_RDONLY | O_CLOEXEC);
+    window_wall = 0;
+  }
+  if (schedstat_fd < 0) return -1;
+  got = pread(schedstat_fd, buf, sizeof buf - 1, 0);
+  if (got <= 0) return -1;
+  buf[got] = 0;
+  p = strchr(buf, ' ');
+  return p ? strtoll(p + 1, NULL, 10) / 1000 : -1;
+}
+
+static sexp cpu_contendedp (sexp ctx, sexp self, sexp_sint_t n) {
+  long long now = now_usecs(), delay;
+  if (now - window_wall >= CONTENDED_USECS) {
+    delay = run_delay_usecs();
+    contended = delay >= 0 && window_wall > 0
+      && 8 * (delay - window_delay) >= now - window_wall;
+    window_wall = now;
+    window_delay = delay;
+  }
+  return sexp_make_boolean(contended);
 }
 
 static sexp poll_scheduler_installedp (sexp ctx, sexp self, sexp_sint_t n) {
@@ -883,6 +989,7 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
   sexp_define_foreign(ctx, env, "poll-scheduler-installed?", 0,
                       poll_scheduler_installedp);
   sexp_define_foreign(ctx, env, "others-runnable?", 0, others_runnablep);
+  sexp_define_foreign(ctx, env, "cpu-contended?", 0, cpu_contendedp);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
   sexp_define_foreign(ctx, env, "wall-microseconds", 0, wall_microseconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);

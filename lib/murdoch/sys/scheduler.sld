@@ -4,6 +4,7 @@
 ;;> \procedure{(poll-scheduler-installed?)} #t once the wrapper is in place.
 ;;> \procedure{(stack-guard-tripped? thread)} Whether \var{thread} was stopped near Chibi's stack limit (once).
 ;;> \procedure{(others-runnable?)} Whether another thread could run now, were this one to yield.
+;;> \procedure{(cpu-contended?)} Whether this process waited an eighth of the last 10 ms for a CPU.
 ;;> \procedure{(monotonic-seconds)} Seconds on a clock that only goes forward.
 ;;> \procedure{(wall-microseconds)} Microseconds since 1970, for other hosts to compare.
 ;;> \procedure{(port-wait! port seconds)} Pauses this thread until \var{port} is ready (a hint) or time is up.
@@ -19,7 +20,7 @@
 ;;> errors say it).  Part of a frame waits in the buffer for the rest.
 
 (define-library (murdoch sys scheduler)
-  (export poll-scheduler-installed? others-runnable? monotonic-seconds wall-microseconds
+  (export poll-scheduler-installed? others-runnable? cpu-contended? monotonic-seconds wall-microseconds
           stack-guard-tripped?
           port-wait!
           poller-port poller-watch! poller-unwatch! poller-release!

@@ -262,7 +262,34 @@
   (wanted gathering-wanted gathering-wanted-set!))
 
 (define (make-gathering)
-  (%make-gathering (make-mutex 'gathering) (make-condition-variable) 0 #f))
+  (%make-gathering (lean-mutex 'gathering) (lean-condition-variable) 0 #f))
+
+;; srfi 18's mutex and condition variable, made as lean records are
+;; (sys/record.scm), their fields by their places in types.scm.
+(define mutex-type (type-of (make-mutex)))
+(define bare-mutex (make-constructor "make-mutex" mutex-type))
+(define condition-variable-type (type-of (make-condition-variable)))
+(define bare-condition-variable
+  (make-constructor "make-condition-variable" condition-variable-type))
+
+(define (lean-mutex name)
+  (filled-mutex (bare-mutex) name))
+
+(define (filled-mutex m name)
+  (slot-set! mutex-type m 0 name)
+  (slot-set! mutex-type m 1 #f)
+  (slot-set! mutex-type m 2 #f)
+  (slot-set! mutex-type m 3 #f)
+  m)
+
+(define (lean-condition-variable)
+  (filled-condition-variable (bare-condition-variable)))
+
+(define (filled-condition-variable cv)
+  (slot-set! condition-variable-type cv 0 #f)
+  (slot-set! condition-variable-type cv 1 #f)
+  (slot-set! condition-variable-type cv 2 #f)
+  cv)
 
 ;;> Gives \var{item} \var{value} by \scheme{(put item value)} unless \scheme{(get item)} has one.
 (define (gathering-put! g item value get put)

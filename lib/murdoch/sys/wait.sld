@@ -9,7 +9,7 @@
           make-mailbox mailbox-put! mailbox-take mailbox-empty!
           take-mailbox! take-all-mailboxes!
           make-gathering gathering-put! gathering-wait)
-  (import (scheme base) (only (chibi) %dk) (murdoch sys record) (only (meta) find-module module-env)
+  (import (scheme base) (only (chibi) %dk make-constructor slot-set!) (only (chibi ast) type-of) (murdoch sys record) (only (meta) find-module module-env)
           (only (scheme eval) eval) (only (scheme process-context) get-environment-variable)
           (only (scheme write) write) (only (scheme file) open-output-file)
           (only (chibi) call-with-output-string) (only (chibi process) current-process-id)
