@@ -266,7 +266,7 @@
 
 ;; srfi 18's mutex and condition variable, made as lean records are
 ;; (sys/record.scm), their fields by their places in types.scm.
-(define mutex-type (type-of (make-mutex)))
+(define mutex-type (type-of (make-mutex 'gathering)))
 (define bare-mutex (make-constructor "make-mutex" mutex-type))
 (define condition-variable-type (type-of (make-condition-variable)))
 (define bare-condition-variable
