@@ -434,3 +434,39 @@
 (define (answer-offers! offers took?)
   (for-each (lambda (offer) (mailbox-put! (offer-reply offer) took?)) offers))
 
+
+;;; Tries in turn
+
+;;> A try's turn at its poser: its waiter, the robots its negotiation may
+;;> ask (its claim), or #f for the whole lab, and the bell that lets it
+;;> in.  Tries that ask robots apart run at once; of two that may ask the
+;;> same robot, the better-ranked tries first (waiting.scm).
+(define-record-type try-turn
+  (make-try-turn waiter claim bell)
+  try-turn?
+  (waiter try-turn-waiter)
+  (claim try-turn-claim)
+  (bell try-turn-bell))
+
+;;> turns, waiting best first, with \var{turn} among them in rank order.
+(define (in-try-order turn turns)
+  (in-rank-order turn turns (lambda (t) (waiter-rank (try-turn-waiter t)))))
+
+;;> Of \var{waiting}, turns best first, those that may try beside
+;;> \var{running}: each clear of those running and of those that rank
+;;> before it, let in or not.  Answers the turns let in and those that
+;;> still wait, in order.
+(define (let-in waiting running)
+  (let loop ((ts waiting) (blocking running) (in '()) (out '()))
+    (cond ((null? ts) (values (reverse in) (reverse out)))
+          ((clear-of? (car ts) blocking)
+           (loop (cdr ts) (cons (car ts) blocking) (cons (car ts) in) out))
+          (else (loop (cdr ts) (cons (car ts) blocking) in (cons (car ts) out))))))
+
+;; Whether turn's claim shares no robot with any of turns'.
+(define (clear-of? turn turns)
+  (let ((claim (try-turn-claim turn)))
+    (every (lambda (t)
+             (let ((other (try-turn-claim t)))
+               (and claim other (not (any (lambda (uid) (memq uid other)) claim)))))
+           turns)))

@@ -22,7 +22,9 @@
           waiting-there-held waiting-elsewhere waiting-at-others lab-holders
           know-poser! ask-posers wants? waiting-entries waiting-entry
           wanting-rank
-          wanting-poser wanting-id)
+          wanting-poser wanting-id
+          make-try-turn try-turn? try-turn-waiter try-turn-claim try-turn-bell
+          in-try-order let-in)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132) (murdoch sys)
           (murdoch lab) (murdoch remote) (murdoch task pose-task)
           (only (murdoch pubsub) request capability-layout) (murdoch task record))

@@ -36,12 +36,12 @@
 ;; The node's looking part: a poser's one line of tasks, and what its
 ;; notes to the lab, its tries and its one looking thread share.
 (define-record-type looking
-  (make-looking noting? note-again trying? try-turns looker? bell takers free-seen turn)
+  (make-looking noting? note-again trying try-turns looker? bell takers free-seen turn)
   looking?
   (noting? looking-noting? looking-noting?-set!)    ; a publication goes
   (note-again looking-note-again looking-note-again-set!) ; best rank since, or #f
-  (trying? looking-trying? looking-trying?-set!)   ; a try runs here
-  (try-turns looking-try-turns looking-try-turns-set!) ; (WAITER . BELL) waiting, best first
+  (trying looking-trying looking-trying-set!)      ; the turns of the tries running here
+  (try-turns looking-try-turns looking-try-turns-set!) ; the turns waiting, best first
   (looker? looking-looker? looking-looker?-set!)    ; the looking thread runs
   (bell looking-bell)                   ; rung by a task that wants a look
   (takers looking-takers looking-takers-set!)
@@ -52,7 +52,7 @@
 
 (define (open-looking!)
   (node-looking-set! (this-node)
-                     (make-looking #f #f #f '() #f (make-mailbox) #f '() 0)))
+                     (make-looking #f #f '() '() #f (make-mailbox) #f '() 0)))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
@@ -143,74 +143,66 @@
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
-;; One try of w's, in turn with this poser's other waiting tasks' (two at
-;; once each reserved the robot offered to the other), best rank first.
-;; The robots offered to the others are left alone, and so are all but
-;; those offered to w, offered, when w can take robots one at a time (it
-;; holds, or needs one): a robot may be kept for this poser on its way to
-;; another of its tasks.
+;; One try of w's, in turn with this poser's other waiting tasks' that
+;; may ask the same robots (two at once each reserved the robot offered
+;; to the other), best rank first; tries that ask robots apart run at
+;; once.  The robots offered to the others are left alone, and so are all
+;; but those offered to w, offered, when w can take robots one at a time
+;; (it holds, or needs one): a robot may be kept for this poser on its
+;; way to another of its tasks.
 
 (define (try-in-turn w try offered)
-  (in-try-turn w
-    (lambda ()
-      (waiter-offered-set! w offered)
-      (let ((excluded (append (offered-to-others w) (not-offered w offered)
-                              (pose-task-excluded))))
-        (quiet-try (lambda ()
-                     (parameterize ((pose-task-excluded excluded)
-                                    (request-audience (audience w offered excluded)))
-                       (try w))))))))
+  (let ((claim (try-claim w offered)))
+    (in-try-turn (make-try-turn w claim (make-mailbox))
+      (lambda ()
+        (waiter-offered-set! w offered)
+        (let ((excluded (append (offered-to-others w) (not-offered w offered)
+                                (pose-task-excluded))))
+          (quiet-try (lambda ()
+                       (parameterize ((pose-task-excluded excluded)
+                                      (request-audience (audience claim excluded)))
+                         (try w)))))))))
 
-;; Runs thunk once no other try of this poser runs, those waiting let
-;; in best rank first.  A thread that leaves while it waits (cancelled,
-;; abandoned) leaves the queue, or passes on the turn it was given.
-(define (in-try-turn w thunk)
-  (let ((turn (cons w (make-mailbox))))
-    (dynamic-wind
-     (lambda () #f)
-     (lambda ()
-       (if (not (join-try-turns! turn))
-           (let wait ()
-             (if (not (mailbox-take (cdr turn) (+ (monotonic-seconds) 60) (lambda () #f)))
-                 (wait))))
-       (thunk))
-     (lambda () (leave-try-turns! turn)))))
+;; Runs thunk once no try of this poser that may ask the robots turn
+;; claims runs, nor waits with a better rank (let-in).  A thread that
+;; leaves while it waits (cancelled, abandoned) leaves the queue.
+(define (in-try-turn turn thunk)
+  (dynamic-wind
+   (lambda () (update-try-turns! (lambda (turns) (in-try-order turn turns))))
+   (lambda ()
+     (let wait ()
+       (if (not (mailbox-take (try-turn-bell turn) (+ (monotonic-seconds) 60) (lambda () #f)))
+           (wait)))
+     (thunk))
+   (lambda () (update-try-turns! (lambda (turns) (remove (lambda (t) (eq? t turn)) turns))
+                                 turn))))
 
-;; Whether turn may try at once; else it is queued by its waiter's rank.
-(define (join-try-turns! turn)
+;; Changes the turns waiting here by f, with the turn leaving, if given,
+;; no longer running, and lets in those that may try now.
+(define (update-try-turns! f . leaving)
   (with-lock (tasks-lock)
     (lambda ()
-      (let ((l (the-looking)))
-        (if (looking-trying? l)
-            (begin (looking-try-turns-set!
-                    l (in-rank-order turn (looking-try-turns l)
-                                     (lambda (t) (waiter-rank (car t)))))
-                   #f)
-            (begin (looking-trying?-set! l #t) #t))))))
+      (let* ((l (the-looking))
+             (running (remove (lambda (t) (memq t leaving)) (looking-trying l))))
+        (let-values (((in out) (let-in (f (looking-try-turns l)) running)))
+          (looking-trying-set! l (append in running))
+          (looking-try-turns-set! l out)
+          (for-each (lambda (t) (mailbox-put! (try-turn-bell t) #t)) in))))))
 
-;; A turn still queued leaves the queue; one that was given the try
-;; gives it to the next, or ends the trying.
-(define (leave-try-turns! turn)
-  (with-lock (tasks-lock)
-    (lambda ()
-      (let* ((l (the-looking)) (turns (looking-try-turns l)))
-        (cond ((memq turn turns)
-               (looking-try-turns-set! l (remove (lambda (x) (eq? x turn)) turns)))
-              ((null? turns) (looking-trying?-set! l #f))
-              (else (looking-try-turns-set! l (cdr turns))
-                    (mailbox-put! (cdar turns) #t)))))))
+;; The robots w's negotiation may ask: those offered alone when w takes
+;; them one at a time, else those offered and those its last look found
+;; capable; #f, the whole lab, before it has looked.  A task posed a
+;; moment before, offered a robot it could not use, asked the whole lab
+;; and took one freed for a better-ranked task, on its way to offer
+;; itself there.
+(define (try-claim w offered)
+  (cond ((and (pair? offered) (one-at-a-time? w)) offered)
+        ((list? (waiter-capable w)) (append offered (waiter-capable w)))
+        (else #f)))
 
-;; Whom w's negotiations ask, but those excluded: the robots offered
-;; alone when w takes them one at a time, else those offered and those
-;; its last look found capable; the whole lab before it has looked.  A
-;; task posed a moment before, offered a robot it could not use, asked
-;; the whole lab and took one freed for a better-ranked task, on its way
-;; to offer itself there.
-(define (audience w offered excluded)
-  (let ((asked (cond ((and (pair? offered) (one-at-a-time? w)) offered)
-                     ((list? (waiter-capable w)) (append offered (waiter-capable w)))
-                     (else #f))))
-    (and asked (remove (lambda (uid) (memq uid excluded)) asked))))
+;; Whom a negotiation of claim asks: all of it but those excluded.
+(define (audience claim excluded)
+  (and claim (remove (lambda (uid) (memq uid excluded)) claim)))
 
 (define (not-offered w offered)
   (if (and (pair? offered) (list? (waiter-capable w)) (one-at-a-time? w))
