@@ -28,6 +28,13 @@
 ;;;          the posers' CPU alone;
 ;;;   bench: sched-scale-cpu-per-start-growth X x, the second over the
 ;;;          first, beside sched-scale-log-growth, log 2000 / log 500.
+;;; And the floor of a freed robot's start, in the same run: a freed robot
+;;; asks the posers who waits, offers itself, is reserved and promised,
+;;; runs and tells this address space, at least five calls in a row.
+;;; Twice a second this one calls probe1, which calls probe2 four times,
+;;; two more address spaces of the lab, idle but for this:
+;;;   bench: sched-scale-floor-5-calls-p50, -p95 X ms, and
+;;;   bench: sched-scale-last-release-p95-over-floor X x.
 ;;; Sizes: MURDOCH_SCHED_SCALE_ROBOTS (64, a multiple of 4), _POSERS (8),
 ;;; _TASKS (2500), _BURST (500), _GAP (mean seconds between arrivals,
 ;;; 0.008); MURDOCH_SCHED_SEED (30).  MURDOCH_SCHED_SCALE_SAVE=FILE writes
@@ -74,6 +81,9 @@
                               (iota (length subjects) 1))
                          'wait #t 'hold #t 'priority priority))
   #t)
+;; Run on probe1: n calls to probe2 in a row.
+(define (probe-calls n)
+  (do ((i 0 (+ i 1))) ((= i n) #t) (remote-apply (uid->aspace 'probe2) (lambda () #t))))
 "))
 
 ;;; The tasks
@@ -120,13 +130,13 @@
      ;; them as orphans (docs/allocation.md).
      `((code "code.scm") (aging ,aging) (max-waiting ,n-tasks) (heartbeat 1)
        (max-connections-per-host ,(* 2 (+ n-robots n-posers 1)))
-       (aspace bench)
+       (aspace bench) (aspace probe1) (aspace probe2)
        ,@(map (lambda (uid) `(aspace ,uid)) posers)
        ,@(map (lambda (r) `(aspace ,(car r) (capabilities ,@(subjects-of (cdr r)))))
               robots))
      `(("code.scm" . ,lab-code))))
   (define uids (append posers (map car robots)))
-  (define pids (start-bench-lab! lab uids 60))
+  (define pids (take (start-bench-lab! lab (append uids '(probe1 probe2)) 60) (length uids)))
   (define posed-at (make-vector n-tasks #f))
   (define posed-by (make-vector n-tasks #f))
   (define n-posed 0)
@@ -144,6 +154,15 @@
               mine))
   (define samples '())
   (define sampling #t)
+  (define floor-calls '())
+  (define prober
+    (thread-start! (make-thread (lambda ()
+                                  (let loop ()
+                                    (let ((t (current-second)))
+                                      (remote-apply (uid->aspace 'probe1) (lab-proc 'probe-calls) 4)
+                                      (set! floor-calls (cons (- (current-second) t) floor-calls)))
+                                    (thread-sleep! 0.5)
+                                    (if sampling (loop)))))))
   (define sampler
     (thread-start! (make-thread (lambda ()
                                   (let loop ()
@@ -166,10 +185,11 @@
          (holdings (bench-told 'holdings t0)))
     (set! sampling #f)
     (thread-join! sampler)
+    (thread-join! prober)
     (stop-all-processes!)
     (remove-test-lab! lab)
     (list posed-at posed-by events holdings (reverse samples)
-          (count (lambda (r) (ok? (cadr r))) results))))
+          (count (lambda (r) (ok? (cadr r))) results) floor-calls)))
 
 (define (ok? result) (and (list? result) (every symbol? result)))
 
@@ -206,6 +226,8 @@
 (define events (list-ref recorded 2))
 (define holdings (list-ref recorded 3))
 (define samples (list-ref recorded 4))
+;; A run saved before the floor was measured has none.
+(define floor-calls (if (> (length recorded) 6) (list-ref recorded 6) '()))
 
 ;;; The figures
 
@@ -217,6 +239,13 @@
 (bench "sched-scale-robots" n-robots "")
 (bench "sched-scale-posers" n-posers "")
 (print-schedule-figures run "sched-scale")
+(when (pair? floor-calls)
+  (let ((floor-p95 (* 1000 (percentile floor-calls 0.95))))
+    (bench "sched-scale-floor-5-calls-p50" (round-to (* 1000 (percentile floor-calls 0.5)) 1) "ms")
+    (bench "sched-scale-floor-5-calls-p95" (round-to floor-p95 1) "ms")
+    (bench "sched-scale-last-release-p95-over-floor"
+           (round-to (/ (percentile (schedule-last-release-latencies run) 0.95) floor-p95) 2)
+           "x")))
 
 ;; The CPU per task started over the seconds whose queue, at their start
 ;; and end, was within a factor sqrt 2 of q, of the lab, or of its posers

@@ -12,7 +12,7 @@
 (define-library (bench schedule)
   (export bench-lab-code start-bench-lab! lab-proc bench-told seeded-reals below
           make-schedule-run schedule-completed! print-schedule-figures
-          schedule-spans schedule-makespan percentile round-to bench)
+          schedule-spans schedule-makespan schedule-last-release-latencies percentile round-to bench)
   (import (scheme base) (scheme write) (scheme inexact) (scheme eval) (scheme time)
           (srfi 1) (srfi 27) (srfi 132)
           (murdoch) (murdoch remote) (only (murdoch remote aspace) lab-environment)
@@ -513,10 +513,11 @@
                               (cons (* 1000 (- (cadr next) (car e))) out)
                               out))))))))
 
-    ;; From the last release among the robots a task starts on to its
-    ;; start, for a task posed before that release: what the turns add,
-    ;; without the time its other robots were held for it, which 'hold means.
-    (define (last-release-latencies run)
+    ;;> From the last release among the robots a task starts on to its
+    ;;> start, in ms, for each task posed before that release: what the
+    ;;> turns add, without the time its other robots were held for it,
+    ;;> which 'hold means.
+    (define (schedule-last-release-latencies run)
       (filter-map (lambda (t)
                     (let ((last (vector-ref (run-ready run) (car t))))
                       (and last (< (posed run t) last)
@@ -626,7 +627,7 @@
              (one-robot? (lambda (s) (= 1 (task-robots (list-ref tasks (list-ref s 2))))))
              (latencies (latencies-where run (lambda (s) #t)))
              (one-robot-latencies (latencies-where run one-robot?))
-             (last-release (last-release-latencies run)))
+             (last-release (schedule-last-release-latencies run)))
         (line "tasks" (length tasks) "")
         (line "completed" (run-completed run) "")
         (line "lost" (- (length tasks) (run-completed run)) "")
