@@ -98,13 +98,15 @@
 ;; components than without, counted by kind, not number, so that of two
 ;; robots freed together the second goes on at once.  A robot that w won,
 ;; holding, in the try its offer began is no longer one of them, though
-;; its offer is answered only when that try ends.  Under (tasks-lock).
+;; its offer is answered only when that try ends; nor is one that
+;; another task's try here may take first.  Under (tasks-lock).
 (define (offered-enough? w uid)
   (let* ((id (task-id (waiter-task w)))
          (held (held-uids w))
          (m (open-matching w (waiter-components w))))
     (for-each (lambda (o)
-                (if (and (eq? (cdr o) id) (not (memq (car o) held)))
+                (if (and (eq? (cdr o) id) (not (memq (car o) held))
+                         (not (claimed-by-others? w (car o))))
                     (match! m (car o))))
               (offering-offers (the-offering)))
     (not (match! m uid))))

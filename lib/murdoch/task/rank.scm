@@ -194,16 +194,18 @@
 ;; was last asked for them; the other posers' waiting tasks as last asked
 ;; (others-waiting, below).
 (define-record-type line
-  (make-line waiters posers posers-asked others)
+  (make-line waiters tries-running tries-waiting posers posers-asked others)
   line?
   (waiters line-waiters line-waiters-set!)
+  (tries-running line-tries-running line-tries-running-set!) ; their try-turns
+  (tries-waiting line-tries-waiting line-tries-waiting-set!) ; best first
   (posers line-posers line-posers-set!)
   (posers-asked line-posers-asked line-posers-asked-set!)
   (others line-others line-others-set!))
 
 (define-syntax the-line (syntax-rules () ((_) (node-line *node*))))
 
-(define (open-line!) (node-line-set! (this-node) (make-line '() '() #f #f)))
+(define (open-line!) (node-line-set! (this-node) (make-line '() '() '() '() #f #f)))
 
 (define (waiters) (line-waiters (the-line)))
 (define (add-waiter! w)
@@ -447,6 +449,23 @@
   (waiter try-turn-waiter)
   (claim try-turn-claim)
   (bell try-turn-bell))
+
+;;> The turns of the tries running here, and of those waiting, best
+;;> first, and their setter; under (tasks-lock).
+(define (tries-running) (line-tries-running (the-line)))
+(define (tries-waiting) (line-tries-waiting (the-line)))
+(define (tries-set! running waiting)
+  (line-tries-running-set! (the-line) running)
+  (line-tries-waiting-set! (the-line) waiting))
+
+;;> Whether a try of another task than \var{w}'s, running here or
+;;> waiting, may ask robot \var{uid}: it may take the robot offered to w
+;;> on its way.  Under (tasks-lock).
+(define (claimed-by-others? w uid)
+  (any (lambda (t)
+         (and (not (eq? (try-turn-waiter t) w))
+              (let ((claim (try-turn-claim t))) (or (not claim) (memq uid claim)))))
+       (append (tries-running) (tries-waiting))))
 
 ;;> turns, waiting best first, with \var{turn} among them in rank order.
 (define (in-try-order turn turns)

@@ -34,14 +34,12 @@
   (note-lab! (waiter-rank w)))
 
 ;; The node's looking part: a poser's one line of tasks, and what its
-;; notes to the lab, its tries and its one looking thread share.
+;; notes to the lab and its one looking thread share.
 (define-record-type looking
-  (make-looking noting? note-again trying try-turns looker? bell takers free-seen turn)
+  (make-looking noting? note-again looker? bell takers free-seen turn)
   looking?
   (noting? looking-noting? looking-noting?-set!)    ; a publication goes
   (note-again looking-note-again looking-note-again-set!) ; best rank since, or #f
-  (trying looking-trying looking-trying-set!)      ; the turns of the tries running here
-  (try-turns looking-try-turns looking-try-turns-set!) ; the turns waiting, best first
   (looker? looking-looker? looking-looker?-set!)    ; the looking thread runs
   (bell looking-bell)                   ; rung by a task that wants a look
   (takers looking-takers looking-takers-set!)
@@ -52,7 +50,7 @@
 
 (define (open-looking!)
   (node-looking-set! (this-node)
-                     (make-looking #f #f '() '() #f (make-mailbox) #f '() 0)))
+                     (make-looking #f #f #f (make-mailbox) #f '() 0)))
 
 ;; Tells the lab that a task of rank rank waits here: once for all the
 ;; tasks that start to wait while the publication goes, with the best of
@@ -182,11 +180,9 @@
 (define (update-try-turns! f . leaving)
   (with-lock (tasks-lock)
     (lambda ()
-      (let* ((l (the-looking))
-             (running (remove (lambda (t) (memq t leaving)) (looking-trying l))))
-        (let-values (((in out) (let-in (f (looking-try-turns l)) running)))
-          (looking-trying-set! l (append in running))
-          (looking-try-turns-set! l out)
+      (let ((running (remove (lambda (t) (memq t leaving)) (tries-running))))
+        (let-values (((in out) (let-in (f (tries-waiting)) running)))
+          (tries-set! (append in running) out)
           (for-each (lambda (t) (mailbox-put! (try-turn-bell t) #t)) in))))))
 
 ;; The robots w's negotiation may ask: those offered alone when w takes
