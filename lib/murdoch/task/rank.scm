@@ -362,13 +362,15 @@
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
 ;; asked of the lab at most once a heartbeat for every 100 tasks it
-;; waited last time, for all the tasks waiting here (docs/allocation.md).
+;; waited last time, for all the tasks waiting here (docs/allocation.md),
+;; and not before since, if given.
 ;; A place may so be W/100 heartbeats old for tasks posed elsewhere; who
 ;; is offered a robot is decided by the robot's own round, never by this
 ;; list, and who holds what is asked afresh (lab-holders).
-(define (others-waiting)
+(define (others-waiting . since)
   (let ((cached (with-lock (tasks-lock) (lambda () (line-others (the-line))))))
     (if (and cached
+             (or (null? since) (>= (others-waiting-asked cached) (car since)))
              (< (- (monotonic-seconds) (others-waiting-asked cached))
                 (* (setting 'heartbeat)
                    (max 1 (/ (vector-length (others-waiting-line cached)) 100)))))
@@ -383,7 +385,9 @@
           (with-lock (tasks-lock) (lambda () (line-others-set! (the-line) fresh)))
           fresh))))
 
-(define (waiting-at-others) (others-waiting-entries (others-waiting)))
+;;> The waiting tasks of the other posers, as waiting-elsewhere answers,
+;;> asked no earlier than monotonic second \var{since}.
+(define (waiting-at-others since) (others-waiting-entries (others-waiting since)))
 
 ;; Every task of the lab that waits holding robots, asked afresh: no more
 ;; of them than robots.

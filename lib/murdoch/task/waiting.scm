@@ -472,14 +472,18 @@
 ;; lab waits; from a thread of its own, as asking the posers may take
 ;; seconds, and w answers its offers meanwhile.
 (define (check-first! w)
-  (thread-start!
-   (make-logged-thread (lambda () (if (not (behind-others? w)) (tell-waiter! w '(first))))
-                       'first)))
+  (let ((posed (monotonic-seconds)))
+    (thread-start!
+     (make-logged-thread (lambda () (if (not (behind-others? w posed)) (tell-waiter! w '(first))))
+                         'first))))
 
 ;; Whether a better-ranked task of the lab waits, or w waits no more: w,
-;; just posed, has not looked at which robots it may use.
-(define (behind-others? w)
+;; just posed, has not looked at which robots it may use.  The other
+;; posers are asked after w was posed: in a burst, the answer of a second
+;; before lacked the tasks posed since, and a task that found itself best
+;; took the robots of one posed elsewhere before it.
+(define (behind-others? w posed)
   (or (let ((ws (with-lock (tasks-lock) waiters)))
         (or (not (memq w ws)) (rank<? (waiter-rank (car ws)) (waiter-rank w))))
       (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
-           (guard (e (#t '())) (waiting-at-others)))))
+           (guard (e (#t '())) (waiting-at-others posed)))))
