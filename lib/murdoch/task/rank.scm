@@ -362,11 +362,9 @@
 
 ;; The waiting tasks of the other posers, as waiting-elsewhere answers,
 ;; asked of the lab at most once a heartbeat for every 100 tasks it
-;; waited last time, for all the tasks waiting here (docs/allocation.md),
-;; and not before since, if given.
+;; waited last time, and not before since, if given (docs/allocation.md).
 ;; A place may so be W/100 heartbeats old for tasks posed elsewhere; who
-;; is offered a robot is decided by the robot's own round, never by this
-;; list, and who holds what is asked afresh (lab-holders).
+;; is offered a robot is decided by the robot's own round, never by this.
 (define (others-waiting . since)
   (let ((cached (with-lock (tasks-lock) (lambda () (line-others (the-line))))))
     (if (and cached
@@ -443,10 +441,8 @@
 
 ;;; Tries in turn
 
-;;> A try's turn at its poser: its waiter, the robots its negotiation may
-;;> ask (its claim), or #f for the whole lab, and the bell that lets it
-;;> in.  Tries that ask robots apart run at once; of two that may ask the
-;;> same robot, the better-ranked tries first (waiting.scm).
+;;> A try's turn at its poser: its waiter, the robots it may ask (its
+;;> claim), or #f for the whole lab, and the bell that lets it in.
 (define-record-type try-turn
   (make-try-turn waiter claim bell)
   try-turn?
@@ -462,9 +458,8 @@
   (line-tries-running-set! (the-line) running)
   (line-tries-waiting-set! (the-line) waiting))
 
-;;> Whether a try of another task than \var{w}'s, running here or
-;;> waiting, may ask robot \var{uid}: it may take the robot offered to w
-;;> on its way.  Under (tasks-lock).
+;;> Whether a try here of another task than \var{w}, running or waiting,
+;;> may ask robot \var{uid}, and so take it first.  Under (tasks-lock).
 (define (claimed-by-others? w uid)
   (any (lambda (t)
          (and (not (eq? (try-turn-waiter t) w))
@@ -476,9 +471,8 @@
   (in-rank-order turn turns (lambda (t) (waiter-rank (try-turn-waiter t)))))
 
 ;;> Of \var{waiting}, turns best first, those that may try beside
-;;> \var{running}: each clear of those running and of those that rank
-;;> before it, let in or not.  Answers the turns let in and those that
-;;> still wait, in order.
+;;> \var{running}: each clear of those running and of those before it.
+;;> Answers the turns let in and those that still wait, in order.
 (define (let-in waiting running)
   (let loop ((ts waiting) (blocking running) (in '()) (out '()))
     (cond ((null? ts) (values (reverse in) (reverse out)))

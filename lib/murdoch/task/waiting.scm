@@ -141,13 +141,10 @@
           (wait-turn w try
                      (take-news! w (next-look (turn-deadline (task-turn t))))))))))))
 
-;; One try of w's, in turn with this poser's other waiting tasks' that
-;; may ask the same robots (two at once each reserved the robot offered
-;; to the other), best rank first; tries that ask robots apart run at
-;; once.  The robots offered to the others are left alone, and so are all
-;; but those offered to w, offered, when w can take robots one at a time
-;; (it holds, or needs one): a robot may be kept for this poser on its
-;; way to another of its tasks.
+;; One try of w's, in turn with this poser's tries that may ask the same
+;; robots (docs/allocation.md).  It leaves alone the robots offered to
+;; the others, and all but offered when w takes robots one at a time: a
+;; robot may be kept for this poser on its way to another of its tasks.
 
 (define (try-in-turn w try offered)
   (let ((claim (try-claim w offered)))
@@ -161,9 +158,8 @@
                                       (request-audience (audience claim excluded)))
                          (try w)))))))))
 
-;; Runs thunk once no try of this poser that may ask the robots turn
-;; claims runs, nor waits with a better rank (let-in).  A thread that
-;; leaves while it waits (cancelled, abandoned) leaves the queue.
+;; Runs thunk once let-in lets turn in; a thread that leaves while it
+;; waits (cancelled, abandoned) leaves the queue.
 (define (in-try-turn turn thunk)
   (dynamic-wind
    (lambda () (update-try-turns! (lambda (turns) (in-try-order turn turns))))
@@ -187,10 +183,7 @@
 
 ;; The robots w's negotiation may ask: those offered alone when w takes
 ;; them one at a time, else those offered and those its last look found
-;; capable; #f, the whole lab, before it has looked.  A task posed a
-;; moment before, offered a robot it could not use, asked the whole lab
-;; and took one freed for a better-ranked task, on its way to offer
-;; itself there.
+;; capable; #f, the whole lab, before it has looked.
 (define (try-claim w offered)
   (cond ((and (pair? offered) (one-at-a-time? w)) offered)
         ((list? (waiter-capable w)) (append offered (waiter-capable w)))
@@ -479,9 +472,8 @@
 
 ;; Whether a better-ranked task of the lab waits, or w waits no more: w,
 ;; just posed, has not looked at which robots it may use.  The other
-;; posers are asked after w was posed: in a burst, the answer of a second
-;; before lacked the tasks posed since, and a task that found itself best
-;; took the robots of one posed elsewhere before it.
+;; posers are asked after w was posed: an older answer lacks the tasks
+;; posed elsewhere just before it.
 (define (behind-others? w posed)
   (or (let ((ws (with-lock (tasks-lock) waiters)))
         (or (not (memq w ws)) (rank<? (waiter-rank (car ws)) (waiter-rank w))))
