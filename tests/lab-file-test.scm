@@ -194,6 +194,21 @@
     (map (lambda (f) (lab? (read-lab (tool-path (string-append "examples/" f)))))
          '("tulane-lab.scm" "box-lab.scm" "box-lab-right.scm" "box-lab-alone.scm"))))
 
+(test-group "a file read again as it was is the same lab, and checked again"
+  (test 7 (setting "(lab x (timeout 7))" 'timeout))
+  (test 7 (lab-setting (read-lab file) 'timeout))
+  (test 8 (setting "(lab x (timeout 8))" 'timeout))
+  (call-with-output-file (string-append dir "/c.scm")
+    (lambda (out) (write-string "(define y 1)\n" out)))
+  (test #t (lab? (read-text "(lab x (code \"c.scm\"))")))
+  (delete-file (string-append dir "/c.scm"))
+  (test "a code file gone since" #t
+    (let ((message (guard (e ((error-object? e) (error-object-message e)))
+                     (read-lab file))))
+      (and (string? message) (text-contains? message "no such file c.scm"))))
+  (test "the same text at a line more" #t
+    (says? "\n(lab x (aspace a (capabilites sonar)))" "lab.scm:2:")))
+
 (test-end)
 (delete-file-hierarchy dir)
 (test-exit)

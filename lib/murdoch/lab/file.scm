@@ -80,7 +80,7 @@
 
 ;;> Reads the lab file at \var{path}; errors name the file, line and fault.
 (define (read-lab path)
-  (let* ((source (read-source path))
+  (let* ((source (lab-source path))
          (data (car source)))
     (parameterize ((clause-lines (cdr source)))
       (cond ((null? data)
@@ -96,6 +96,25 @@
              (lab-file-error path (car (car data))
                              "a lab file holds one (lab NAME CLAUSE ...) form"))
             (else (parse-lab path (car (car data))))))))
+
+(define *lab-source* #f)                ; (PATH TEXT . SOURCE): docs/speed.md
+
+(define (lab-source path)
+  (let ((text (guard (e ((file-error? e) #f)) (call-with-input-file path whole-text))))
+    (cond ((not text) (read-source path))
+          ((and *lab-source* (equal? path (car *lab-source*))
+                (string=? text (cadr *lab-source*)))
+           (cddr *lab-source*))
+          (else (let ((source (read-source-port path (open-input-string text))))
+                  (set! *lab-source* (cons path (cons text source)))
+                  source)))))
+
+(define (whole-text in)
+  (let loop ((parts '()))
+    (let ((s (read-string 65536 in)))
+      (if (eof-object? s)
+          (apply string-append (reverse parts))
+          (loop (cons s parts))))))
 
 (define (parse-lab path form)
   (let* ((clauses (cddr form))
