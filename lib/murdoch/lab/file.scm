@@ -97,16 +97,24 @@
                              "a lab file holds one (lab NAME CLAUSE ...) form"))
             (else (parse-lab path (car (car data))))))))
 
-(define *lab-source* #f)                ; (PATH TEXT . SOURCE): docs/speed.md
+;; The lab file this process read last, kept for its forks (docs/speed.md).
+(define-record-type lab-read
+  (make-lab-read path text source)
+  lab-read?
+  (path lab-read-path)
+  (text lab-read-text)
+  (source lab-read-source))
+
+(define *lab-read* #f)
 
 (define (lab-source path)
-  (let ((text (guard (e ((file-error? e) #f)) (call-with-input-file path whole-text))))
+  (let ((text (guard (e ((file-error? e) #f)) (call-with-input-file path whole-text)))
+        (last *lab-read*))
     (cond ((not text) (read-source path))
-          ((and *lab-source* (equal? path (car *lab-source*))
-                (string=? text (cadr *lab-source*)))
-           (cddr *lab-source*))
+          ((and last (equal? path (lab-read-path last)) (string=? text (lab-read-text last)))
+           (lab-read-source last))
           (else (let ((source (read-source-port path (open-input-string text))))
-                  (set! *lab-source* (cons path (cons text source)))
+                  (set! *lab-read* (make-lab-read path text source))
                   source)))))
 
 (define (whole-text in)
