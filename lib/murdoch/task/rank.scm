@@ -254,7 +254,7 @@
 (define (held-uids w) (map held-uid (waiter-held w)))
 
 ;;> The lab's line, as place-in-line reads it: the other posers' ranks in
-;;> order, as others-waiting last asked for them, and this poser's own,
+;;> order, as waiting-at-others last asked for them, and this poser's own,
 ;;> as its waiters keep them; neither sorted at a look (docs/allocation.md).
 (define-record-type line-ranks
   (make-line-ranks others own)
@@ -351,8 +351,8 @@
   (filter-map (lambda (o) (and (outcome-ok? o) (list (outcome-uid o) (outcome-value o))))
               (apply remote-apply-all (filter-map live-aspace posers) proc args)))
 
-;;> The other posers' waiting tasks as last asked: when (monotonic-seconds),
-;;> the waiting-theres, and their ranks sorted once.
+;; The other posers' waiting tasks as last asked, under (tasks-lock): when
+;; (monotonic-seconds), the waiting-theres, and their ranks sorted once.
 (define-record-type others-waiting
   (make-others-waiting asked entries line)
   others-waiting?
@@ -360,11 +360,11 @@
   (entries others-waiting-entries)
   (line others-waiting-line))
 
-;;> The waiting tasks of the other posers, as waiting-elsewhere answers,
-;;> asked of the lab at most once a heartbeat for every 100 tasks it
-;;> waited last time, and not before \var{since}, if given (docs/allocation.md).
-;;> A place may so be W/100 heartbeats old for tasks posed elsewhere; who
-;;> is offered a robot is decided by the robot's own round, never by this.
+;; The waiting tasks of the other posers, as waiting-elsewhere answers,
+;; asked of the lab at most once a heartbeat for every 100 tasks it
+;; waited last time, and not before since, if given (docs/allocation.md).
+;; A place may so be W/100 heartbeats old for tasks posed elsewhere; who
+;; is offered a robot is decided by the robot's own round, never by this.
 (define (others-waiting . since)
   (let ((cached (with-lock (tasks-lock) (lambda () (line-others (the-line))))))
     (if (and cached
@@ -383,6 +383,9 @@
           (with-lock (tasks-lock) (lambda () (line-others-set! (the-line) fresh)))
           fresh))))
 
+;;> The waiting tasks of the other posers, as waiting-elsewhere answers,
+;;> asked no earlier than monotonic second \var{since}.
+(define (waiting-at-others since) (others-waiting-entries (others-waiting since)))
 
 ;; Every task of the lab that waits holding robots, asked afresh: no more
 ;; of them than robots.

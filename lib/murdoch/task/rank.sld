@@ -19,8 +19,7 @@
           take-news! answer-offers! held-index held-winner held-type held-uid
           held-uids place-in-line line-ranks-now line-ranks-length waiting-ranks waiting-there?
           waiting-there-poser waiting-there-rank
-          waiting-there-held waiting-elsewhere lab-holders
-          make-others-waiting others-waiting others-waiting-asked others-waiting-entries
+          waiting-there-held waiting-elsewhere waiting-at-others lab-holders
           know-poser! ask-posers wants? waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id

@@ -467,28 +467,15 @@
 (define (check-first! w)
   (let ((posed (monotonic-seconds)))
     (thread-start!
-     (make-logged-thread (lambda () (if (first-in-lab? w posed 3) (tell-waiter! w '(first))))
+     (make-logged-thread (lambda () (if (not (behind-others? w posed)) (tell-waiter! w '(first))))
                          'first))))
 
-;; Whether w is the lab's best waiting task by an answer asked at most
-;; first-check-window seconds before now, asked at most tries times; else
-;; w waits for the free robots' offers.  An answer that took 2.4 s in a
-;; burst lacked a better task posed meanwhile, whose robot w then took.
-(define (first-in-lab? w since tries)
-  (let* ((now (monotonic-seconds))
-         (others (guard (e (#t (make-others-waiting now '() (vector))))
-                   (others-waiting since))))
-    (cond ((behind-others? w (others-waiting-entries others)) #f)
-          ((< (- (monotonic-seconds) (others-waiting-asked others)) first-check-window) #t)
-          (else (and (> tries 1) (first-in-lab? w (monotonic-seconds) (- tries 1)))))))
-
-(define first-check-window 0.1)
-
 ;; Whether a better-ranked task of the lab waits, or w waits no more: w,
-;; just posed, has not looked at which robots it may use; others, the
-;; other posers' waiting tasks, asked after it was posed: an older answer
-;; lacks the tasks posed elsewhere just before it.
-(define (behind-others? w others)
+;; just posed, has not looked at which robots it may use.  The other
+;; posers are asked after w was posed: an older answer lacks the tasks
+;; posed elsewhere just before it.
+(define (behind-others? w posed)
   (or (let ((ws (with-lock (tasks-lock) waiters)))
         (or (not (memq w ws)) (rank<? (waiter-rank (car ws)) (waiter-rank w))))
-      (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w))) others)))
+      (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
+           (guard (e (#t '())) (waiting-at-others posed)))))
