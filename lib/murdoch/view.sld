@@ -20,6 +20,7 @@
           (scheme file) (scheme eval) (scheme inexact) (scheme char) (srfi 1) (srfi 18)
           (chibi net) (chibi net http-server) (chibi net servlet)
           (only (chibi config) make-conf) (only (chibi process) current-process-id)
+          (only (chibi io) file->string)
           (only (chibi filesystem) create-directory* open open/write open/append
                 open/create open/exclusive open-output-file-descriptor)
           (only (srfi 151) bitwise-ior) (only (srfi 132) list-stable-sort) (chibi json)

@@ -108,7 +108,7 @@
 (define *lab-read* #f)
 
 (define (lab-source path)
-  (let ((text (guard (e ((file-error? e) #f)) (call-with-input-file path whole-text)))
+  (let ((text (guard (e ((file-error? e) #f)) (file->string path)))
         (last *lab-read*))
     (cond ((not text) (read-source path))
           ((and last (equal? path (lab-read-path last)) (string=? text (lab-read-text last)))
@@ -116,13 +116,6 @@
           (else (let ((source (read-source-port path (open-input-string text))))
                   (set! *lab-read* (make-lab-read path text source))
                   source)))))
-
-(define (whole-text in)
-  (let loop ((parts '()))
-    (let ((s (read-string 65536 in)))
-      (if (eof-object? s)
-          (apply string-append (reverse parts))
-          (loop (cons s parts))))))
 
 (define (parse-lab path form)
   (let* ((clauses (cddr form))

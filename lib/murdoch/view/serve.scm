@@ -6,15 +6,6 @@
     ("js" . "text/javascript; charset=UTF-8")
     ("css" . "text/css; charset=UTF-8")))
 
-(define (file-string path)
-  (call-with-input-file path
-    (lambda (in)
-      (let loop ((parts '()))
-        (let ((s (read-string 65536 in)))
-          (if (eof-object? s)
-              (apply string-append (reverse parts))
-              (loop (cons s parts))))))))
-
 (define (respond request status type body)
   (servlet-respond request status (if (= status 200) "OK" "Not Found")
                    `((Content-Type . ,type)
@@ -30,16 +21,16 @@
       (cond
        ((member path '("/" "/index.html"))
         (respond request 200 (cdr (assoc "html" content-types))
-                 (file-string (string-append web "/view.html"))))
+                 (file->string (string-append web "/view.html"))))
        ((member path '("/view.js" "/view.css"))
         (respond request 200
                  (cdr (assoc (if (equal? path "/view.js") "js" "css") content-types))
-                 (file-string (string-append web path))))
+                 (file->string (string-append web path))))
        ((equal? path "/info")
         (respond request 200 "application/json" (json-text (info))))
        ((equal? path "/trace")
         (respond request 200 "text/plain; charset=UTF-8"
-                 (if (file-exists? trace) (file-string trace) "")))
+                 (if (file-exists? trace) (file->string trace) "")))
        ((and feed (equal? path "/state"))
         (respond request 200 "application/json"
                  (let ((r (feed-recent feed))) (if (pair? r) (cdar r) "null"))))
