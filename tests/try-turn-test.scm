@@ -1,4 +1,4 @@
-;;; A poser's tries in turn (lib/murdoch/task/rank.scm, let-in): tries
+;;; A poser's tries in turn (lib/murdoch/task/try-turns.scm, let-in): tries
 ;;; that may ask the same robot never run together, a try for the whole
 ;;; lab runs alone, none waits that could run, none passes a better-ranked
 ;;; one that may ask its robots, and every one runs in the end.  Checked

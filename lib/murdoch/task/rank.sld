@@ -24,8 +24,8 @@
           wanting-rank
           wanting-poser wanting-id
           make-try-turn try-turn? try-turn-waiter try-turn-claim try-turn-bell
-          in-try-order let-in tries-running tries-waiting tries-set! claimed-by-others?)
+          in-try-order let-in join-try-turns! leave-try-turns! claimed-by-others?)
   (import (scheme base) (scheme cxr) (srfi 1) (srfi 18) (srfi 132) (murdoch sys)
           (murdoch lab) (murdoch remote) (murdoch task pose-task)
           (only (murdoch pubsub) request capability-layout) (murdoch task record))
-  (include "rank.scm"))
+  (include "rank.scm" "try-turns.scm"))

@@ -162,24 +162,13 @@
 ;; waits (cancelled, abandoned) leaves the queue.
 (define (in-try-turn turn thunk)
   (dynamic-wind
-   (lambda () (update-try-turns! (lambda (turns) (in-try-order turn turns))))
+   (lambda () (join-try-turns! turn))
    (lambda ()
      (let wait ()
        (if (not (mailbox-take (try-turn-bell turn) (+ (monotonic-seconds) 60) (lambda () #f)))
            (wait)))
      (thunk))
-   (lambda () (update-try-turns! (lambda (turns) (remove (lambda (t) (eq? t turn)) turns))
-                                 turn))))
-
-;; Changes the turns waiting here by f, with the turn leaving, if given,
-;; no longer running, and lets in those that may try now.
-(define (update-try-turns! f . leaving)
-  (with-lock (tasks-lock)
-    (lambda ()
-      (let ((running (remove (lambda (t) (memq t leaving)) (tries-running))))
-        (let-values (((in out) (let-in (f (tries-waiting)) running)))
-          (tries-set! (append in running) out)
-          (for-each (lambda (t) (mailbox-put! (try-turn-bell t) #t)) in))))))
+   (lambda () (leave-try-turns! turn))))
 
 ;; The robots w's negotiation may ask: those offered alone when w takes
 ;; them one at a time, else those offered and those its last look found
