@@ -353,7 +353,7 @@
 
 ;; The other posers' waiting tasks as last asked, under (tasks-lock): when
 ;; (monotonic-seconds), the waiting-theres, and their ranks sorted once.
-(define-record-type others-waiting
+(define-record-type others-waiting-answer   ; others-waiting is the procedure
   (make-others-waiting asked entries line)
   others-waiting?
   (asked others-waiting-asked)
