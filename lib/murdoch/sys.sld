@@ -6,7 +6,6 @@
   (export start-heap-guard! heap-on-huge-pages! utc-seconds set-log-name!
           stamp-log-lines! log-note log-warn condition-message set-process-name!
           die-with-parent! others-runnable? cpu-contended? monotonic-seconds wall-microseconds
-          alarm-on! apply-begins! apply-ends!
           stack-guard-tripped? port-wait! poller-port poller-watch!
           poller-unwatch! poller-release! poller-buffered poller-ready
           poller-frames! lock! unlock! unlocked unlock-waiting! cell-value with-lock

@@ -185,14 +185,13 @@
   (check-message (open-frame bytes (greeting-nonce g) (greeting-count g))
                  '(run apply answer abandon) "a call"))
 
-;; It looks at once when the alarm wakes it, an apply's takeover-seconds on.
 (define (janitor)
-  (rest-while-idle)
+  (thread-sleep! janitor-seconds)
   (let ((now (monotonic-seconds)))
     (for-each end-stalled! (serving-where serving-deadline now))
     (for-each take-over! (serving-where serving-busy-since
                                         (- now takeover-seconds))))
-  (thread-sleep! janitor-seconds)
+  (rest-while-idle)
   (janitor))
 
 (define (serving-where moment time)
@@ -203,9 +202,9 @@
 
 ;; The janitor rests while no frame is half read and no reader applies
 ;; (docs/speed.md).  It raises its flag before it looks and holds its
-;; mutex from the flag to the wait; a reader sets a frame's deadline before
-;; it reads the flag: so either the look sees it, or its wake-up finds the
-;; janitor waiting.  An apply sets the alarm, which wakes it if still running.
+;; mutex from the flag to the wait; a reader sets what it begins before it
+;; reads the flag: so either the look sees it, or its wake-up finds the
+;; janitor waiting.
 (define (rest-while-idle)
   (let ((m (server-janitor-mutex (the-server))))
     (lock! m)
@@ -215,8 +214,7 @@
                                  +inf.0))
            (server-janitor-resting?-set! (the-server) #f)
            (unlock! m))
-          (else (unlock-waiting! m (server-janitor-wake (the-server)))
-                (server-janitor-resting?-set! (the-server) #f)))))
+          (else (unlock-waiting! m (server-janitor-wake (the-server)))))))
 
 (define (end-stalled! s)
   (log-warn "connection with " (serving-peer s)
@@ -253,16 +251,13 @@
 
 ;; The reader's inline apply, marked for the janitor without the lock (only a
 ;; reader starts one: docs/speed.md); its call listed for abandon-call! once handed on.
-;; The alarm wakes a resting janitor takeover-seconds on, if an apply still runs.
 (define-syntax inline-apply-begins!
   (syntax-rules ()
-    ((_ s) (begin (serving-busy-since-set! s (monotonic-seconds))
-                  (apply-begins! takeover-seconds)))))
+    ((_ s) (begin (serving-busy-since-set! s (monotonic-seconds)) (janitor-wanted!)))))
 
 (define-syntax inline-apply-ends!       ; whether still the reader
   (syntax-rules ()
-    ((_ s) (begin (apply-ends!) (lock! (server-lock (the-server)))
-                  (apply-ended! s (reader? s))))))
+    ((_ s) (begin (lock! (server-lock (the-server))) (apply-ended! s (reader? s))))))
 
 (define (apply-ended! s still)
   (if still
@@ -348,5 +343,4 @@
              (make-listener-socket addr))))
       (if (zero? port) (local-aspace-port-set! (socket-port listener)))
       (spawn (lambda () (accept-loop listener addr)) 'accept)
-      (alarm-on! (server-janitor-wake (the-server)))
       (spawn janitor 'janitor))))

@@ -163,12 +163,6 @@ static int time_until (const struct timeval *deadline, struct timespec *ts) {
   return 1;
 }
 
-static struct timeval alarm_due;        /* the alarm's (below); zero: none */
-
-static int alarm_set (void) {
-  return alarm_due.tv_sec != 0 || alarm_due.tv_usec != 0;
-}
-
 /* Sleep until a blocked thread's descriptor is ready, the nearest deadline
  * passes or a signal arrives.  Signals are blocked by the caller and let in
  * only inside ppoll(), so one arriving after the caller's check cannot be
@@ -189,8 +183,6 @@ static enum wait_result wait_once (sexp ctx, const sigset_t *mask) {
    * that blocks is on it already, and its descriptor is polled once. */
   if (sexp_context_waitp(ctx) && !paused && !note_waiter(ctx, &n, &deadline))
     return WAIT_DONE;
-  if (alarm_set() && (!deadline || before(&alarm_due, deadline)))
-    deadline = &alarm_due;
   if (n == 0 && !deadline)
     return WAIT_DONE;
   if (deadline && !time_until(deadline, &timeout))
@@ -227,39 +219,6 @@ static void queue_cell (sexp ctx, sexp cell) {
   else
     sexp_global(ctx, SEXP_G_THREADS_FRONT) = cell;
   sexp_global(ctx, SEXP_G_THREADS_BACK) = cell;
-}
-
-/* The alarm.  A served call whose apply runs past takeover-seconds has
- * the janitor hand its connection on (remote/serve.scm); nearly all end in
- * microseconds.  A janitor woken for each, to sleep and look, woke a
- * process of a lab whose requests came tens of ms apart once more every
- * 0.1 s (docs/speed.md).  So the applies are counted here, and the thread
- * resting on the alarm's condition variable is woken at the first one's
- * due moment only if some apply is still running then. */
-static sexp alarm_event;                /* by address: the server keeps it */
-static long alarm_applies;
-/* Wakes the thread resting on the alarm's event once the due moment has
- * passed: as a signal would, at the back of the run queue; the current
- * thread, just paused, only goes on, since queued it would run twice (see
- * unqueue_twins). */
-static void ring_alarm (sexp ctx) {
-  sexp prev = SEXP_NULL, ls;
-  struct timeval now;
-  if (!alarm_set() || gettimeofday(&now, NULL) != 0 || before(&now, &alarm_due))
-    return;
-  alarm_due.tv_sec = alarm_due.tv_usec = 0;
-  for (ls = sexp_global(ctx, SEXP_G_THREADS_PAUSED); sexp_pairp(ls);
-       prev = ls, ls = sexp_cdr(ls))
-    if (sexp_context_event(sexp_car(ls)) == alarm_event) {
-      unlink_cell(ctx, SEXP_G_THREADS_PAUSED, prev, ls);
-      if (sexp_car(ls) != ctx) {
-        queue_cell(ctx, ls);
-      } else {
-        sexp_context_waitp(ctx) = 0;
-        sexp_context_timeoutp(ctx) = 0;
-      }
-      return;
-    }
 }
 
 /* Interrupts.  Chibi's thread-interrupt! -- the REPL's answer to Ctrl-C --
@@ -650,7 +609,6 @@ static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
     park_strangers(ctx, self, root);
   if (nothing_runnable(ctx))
     wait_for_wakeup(ctx);
-  ring_alarm(ctx);
   next = strangers
     ? next_here(ctx, self, n, root, may_twin)
     : chibi_next(ctx, sexp_opcode_data(self), n, root, may_twin);
@@ -664,35 +622,6 @@ static sexp poll_scheduler (sexp ctx, sexp self, sexp_sint_t n, sexp root) {
   if (sexp_contextp(next) && sexp_context_refuel(next) > 0)
     hand_over(next);
   return next;
-}
-
-/* (alarm-on! event): the alarm wakes the thread waiting on event. */
-static sexp alarm_on (sexp ctx, sexp self, sexp_sint_t n, sexp event) {
-  alarm_event = event;
-  return SEXP_VOID;
-}
-
-/* (apply-begins! seconds): an apply began; the alarm is due in seconds
- * unless it is due already. */
-static sexp apply_begins (sexp ctx, sexp self, sexp_sint_t n, sexp seconds) {
-  struct timeval now;
-  long long due;
-  if (!sexp_flonump(seconds))
-    return sexp_type_exception(ctx, self, SEXP_FLONUM, seconds);
-  alarm_applies++;
-  if (!alarm_set() && gettimeofday(&now, NULL) == 0) {
-    due = microseconds(&now) + (long long)(sexp_flonum_value(seconds) * 1e6);
-    alarm_due.tv_sec = due / 1000000;
-    alarm_due.tv_usec = due % 1000000;
-  }
-  return SEXP_VOID;
-}
-
-/* (apply-ends!): an apply ended; with none left the alarm is off. */
-static sexp apply_ends (sexp ctx, sexp self, sexp_sint_t n) {
-  if (alarm_applies > 0 && --alarm_applies == 0)
-    alarm_due.tv_sec = alarm_due.tv_usec = 0;
-  return SEXP_VOID;
 }
 
 static int installed (sexp ctx) {
@@ -1061,9 +990,6 @@ sexp sexp_init_library (sexp ctx, sexp self, sexp_sint_t n, sexp env,
                       poll_scheduler_installedp);
   sexp_define_foreign(ctx, env, "others-runnable?", 0, others_runnablep);
   sexp_define_foreign(ctx, env, "cpu-contended?", 0, cpu_contendedp);
-  sexp_define_foreign(ctx, env, "alarm-on!", 1, alarm_on);
-  sexp_define_foreign(ctx, env, "apply-begins!", 1, apply_begins);
-  sexp_define_foreign(ctx, env, "apply-ends!", 0, apply_ends);
   sexp_define_foreign(ctx, env, "monotonic-seconds", 0, monotonic_seconds);
   sexp_define_foreign(ctx, env, "wall-microseconds", 0, wall_microseconds);
   sexp_define_foreign(ctx, env, "stack-guard-tripped?", 1, stack_guard_trippedp);

@@ -7,9 +7,6 @@
 ;;> \procedure{(cpu-contended?)} Whether this process waited an eighth of the last 10 ms for a CPU.
 ;;> \procedure{(monotonic-seconds)} Seconds on a clock that only goes forward.
 ;;> \procedure{(wall-microseconds)} Microseconds since 1970, for other hosts to compare.
-;;> \procedure{(alarm-on! event)} The alarm wakes the thread waiting on \var{event}, a condition variable.
-;;> \procedure{(apply-begins! seconds)} An apply began: the alarm rings in \var{seconds}, unless set, if one still runs.
-;;> \procedure{(apply-ends!)} An apply ended; with none left the alarm is off.
 ;;> \procedure{(port-wait! port seconds)} Pauses this thread until \var{port} is ready (a hint) or time is up.
 ;;> \procedure{(poller-port)} An input port on the process's one epoll descriptor.
 ;;> \procedure{(poller-watch! port)} Watches \var{port}'s descriptor, with a buffer; answers it.
@@ -24,7 +21,6 @@
 
 (define-library (murdoch sys scheduler)
   (export poll-scheduler-installed? others-runnable? cpu-contended? monotonic-seconds wall-microseconds
-          alarm-on! apply-begins! apply-ends!
           stack-guard-tripped?
           port-wait!
           poller-port poller-watch! poller-unwatch! poller-release!
