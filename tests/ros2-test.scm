@@ -261,6 +261,32 @@
     (test "freed, it drives there" 'arrived
           (remote-apply (uid->aspace 'tb2) (lab-proc 'try-goto) 0 1000))))
 
+;; Where tb2's odometry says it is, within 20 mm of (x y).
+(define (tb2-near? x y)
+  (let ((p (remote-apply (uid->aspace 'tb2) (lab-proc 'pose-now))))
+    (< (sqrt (+ (square (- (car p) x)) (square (- (cadr p) y)))) 20)))
+
+(test-group "odometry that comes late: goto-xy still ends at its point"
+  (kill tb2-robot 1)                    ; SIGHUP: odometry 0.1 s of every second
+  (test "in bursts, a goto ends" 'arrived
+        (parameterize ((remote-timeout 60))
+          (remote-apply (uid->aspace 'tb2) (lab-proc 'try-goto) 1200 1000)))
+  (kill tb2-robot 1)                    ; steady again
+  (test-assert "at its point, not hunting round it" (tb2-near? 1200 1000))
+  ;; Stopped for 2 s while it drives, the robot then makes up the time at
+  ;; its last velocity, as a driver that went quiet and carried on.
+  (let ((go (make-thread
+             (lambda ()
+               (parameterize ((remote-timeout 60))
+                 (remote-apply (uid->aspace 'tb2) (lab-proc 'try-goto) -1200 1000))))))
+    (thread-start! go)
+    (thread-sleep! 4.5)
+    (kill tb2-robot 19)                 ; SIGSTOP
+    (thread-sleep! 2)
+    (kill tb2-robot 18)                 ; SIGCONT
+    (test "driven on blind for 2 s, a goto ends" 'arrived (thread-join! go))
+    (test-assert "at its point" (tb2-near? -1200 1000))))
+
 (test-group "odometry that stops: stalled, the robot lost, the component moves"
   (let ((t (start-task 'drive 1 (list '((mobile) ()))
                        (list (metric-by (lambda (uid) (if (eq? uid 'tb1) 0 1))))

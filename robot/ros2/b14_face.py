@@ -20,11 +20,10 @@ import math
 import os
 import signal
 import socket
-import threading
 import time
 
 import rclpy
-from rclpy.executors import MultiThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Pose, PoseArray, Twist, TwistStamped
@@ -103,20 +102,17 @@ class Face:
         node.create_subscription(TwistStamped if stamped else Twist, ns + "/cmd_vel",
                                  self.on_cmd_vel, QoSProfile(depth=10))
         self.count = 0
-        self.cmd_lock = threading.Lock()
         self.cmd = None                 # the newest cmd_vel not yet sent on
 
     def on_cmd_vel(self, m):
-        """Kept for the main loop to send on: a callback that waited for the
-        simulator would hold up the next, and they would queue."""
+        """Kept for the next period to send on: a callback that waited for
+        the simulator would hold up the next, and they would queue."""
         t = m.twist if isinstance(m, TwistStamped) else m
-        with self.cmd_lock:
-            self.cmd = ("base", "vel", "%.1f" % (t.linear.x * 1000.0),
-                        "%.2f" % math.degrees(t.angular.z))
+        self.cmd = ("base", "vel", "%.1f" % (t.linear.x * 1000.0),
+                    "%.2f" % math.degrees(t.angular.z))
 
     def publish(self):
-        with self.cmd_lock:
-            cmd, self.cmd = self.cmd, None
+        cmd, self.cmd = self.cmd, None
         asks = ([cmd] if cmd else []) + [("time",), ("base", "reckon")]
         answers = self.trip.ask_all(asks)
         # Stamped with the simulator's clock, which runs at its own speed:
@@ -184,9 +180,8 @@ def main():
         name, address = r.split("=", 1)
         host, port = address.rsplit(":", 1)
         faces.append(Face(node, name, host, int(port), args.cmd_vel == "stamped"))
-    executor = MultiThreadedExecutor(num_threads=2)
+    executor = SingleThreadedExecutor()
     executor.add_node(node)
-    threading.Thread(target=executor.spin, daemon=True).start()
     print("b14-face: ready", flush=True)
     period = 1.0 / ODOM_HZ
     next_at = time.monotonic()
@@ -194,7 +189,11 @@ def main():
         for f in faces:
             f.publish()
         next_at += period
-        time.sleep(max(0.0, next_at - time.monotonic()))
+        # cmd_vel's callbacks run here, on this one thread, until the next
+        # period: beside an executor's own threads this loop stalled for up
+        # to 4 s at a time (docs/ros2.md).
+        while next_at > time.monotonic():
+            executor.spin_once(timeout_sec=max(0.0, next_at - time.monotonic()))
 
 
 if __name__ == "__main__":

@@ -11,7 +11,8 @@ and drives the robot through ROS 2's standard messages:
 
     base      geometry_msgs/Twist or TwistStamped out on cmd_vel; the pose
               from nav_msgs/Odometry; translate, rotate and goto a closed
-              loop here on odometry, stalled when odometry does not move
+              loop here on odometry, held still while odometry is older
+              than odom-stale seconds, stalled when odometry does not move
               for stall seconds of the robot's clock (its odometry's
               stamps) or stops for odom-timeout seconds
     sonar     sensor_msgs/LaserScan folded into the B14's 16 sectors, or
@@ -57,6 +58,8 @@ MAX_FRAME_ERRORS = 16
 MAX_BACKLOG = 65536
 READ_SLICE = 16384
 TICK = 0.02                     # seconds between steps of the controller
+STEER_MM = 60                   # a goto steers while farther than this from its point
+REFACE_DEG = 45                 # ... and faces it again when it is this far off its bearing
 KEEP_ALIVE = 0.1                # seconds between repeats of an unchanged cmd_vel
 CMD_VEL_TYPES = {"twist": "geometry_msgs/msg/Twist",
                  "stamped": "geometry_msgs/msg/TwistStamped"}
@@ -225,6 +228,12 @@ class Robot:
             t = s
         self.publisher.publish(t)
 
+    def odom_age(self):
+        """Seconds since the newest odometry came, or None before any."""
+        with self.lock:
+            at = self.odom_at
+        return None if at is None else time.monotonic() - at
+
     def now_ms(self):
         """The robot's clock: its newest odometry's stamp, else this node's."""
         with self.lock:
@@ -273,6 +282,7 @@ class Base:
         self.goal = None
         self.turning = False                    # goto: still facing the goal
         self.progress = None                    # (robot's ms, pose) of the last progress
+        self.still = 0                          # ... and robot's ms since, that odometry covers
 
     def pose(self):
         with self.robot.lock:
@@ -298,7 +308,7 @@ class Base:
     def start(self, kind, goal=None):
         self.kind, self.goal, self.stalled = kind, goal, 0
         self.turning = kind == "goto"
-        self.progress = (self.robot.now_ms(), self.pose())
+        self.progress, self.still = (self.robot.now_ms(), self.pose()), 0
         if kind == "translate":
             x, y, th = self.pose()
             self.goal = (x, y, goal)
@@ -339,6 +349,10 @@ class Base:
             self.stop()
             self.stalled = 1
             return
+        if self.robot.odom_age() > a.odom_stale:
+            # Not blind: a loop on old odometry drives past its goal and
+            # hunts round it; held, the robot waits for the next.
+            return self.robot.drive(0, 0)
         if self.kind == "translate":
             x0, y0, d = self.goal
             left = abs(d) - math.hypot(x - x0, y - y0)
@@ -359,38 +373,46 @@ class Base:
         """As sim/world.c's goto: face the goal, then close in along the
         heading, steering only while farther than 60 mm (so near it, it
         does not chase the bearing round), so that a robot ends a goto
-        facing as the simulator's B14 does."""
+        facing as the simulator's B14 does.  Farther out and more than 45
+        degrees off its bearing (late odometry, a push), it faces the goal
+        again: closing in along a heading beside the goal would end it
+        there, its distance along the heading nil."""
         a = self.args
         gx, gy = self.goal
         dist = math.hypot(gx - x, gy - y)
         off = wrap180(math.degrees(math.atan2(gy - y, gx - x)) - th)
+        if dist > STEER_MM and abs(off) > REFACE_DEG:
+            self.turning = True         # past it, or off its line: face it again
         if self.turning and dist > 3 * a.arrive_mm and abs(off) > a.arrive_deg:
             return self.set(0, approach(off, 3, 1, a.turn_speed))
         self.turning = False
         along = dist * math.cos(math.radians(off))
         if abs(along) <= a.arrive_mm:
             return self.stop()
-        steer = max(-a.turn_speed, min(a.turn_speed, 3 * off)) if dist > 60 else 0
+        steer = max(-a.turn_speed, min(a.turn_speed, 3 * off)) if dist > STEER_MM else 0
         self.set(approach(along, 3, 5, a.speed), steer)
 
     def _stalled(self, x, y, th):
         """Why the base is blocked, else None: odometry silent for
         odom-timeout seconds here, or not moving for stall seconds of the
         robot's own clock while the base is told to (its clock, so that a
-        slow simulator or a loaded host is not taken for a blocked base)."""
-        with self.robot.lock:
-            at = self.robot.odom_at
-        silent = time.monotonic() - at if at is not None else None
+        slow simulator or a loaded host is not taken for a blocked base).
+        Only time its odometry covers counts: a gap in it longer than
+        odom-stale says nothing of whether the robot moved."""
+        silent = self.robot.odom_age()
         if silent is None or silent > self.args.odom_timeout:
             return "no odometry on %s for %.1f s" % (self.robot.odom_topic,
                                                      silent or self.args.odom_timeout)
         now = self.robot.now_ms()
-        t0, p0 = self.progress
+        t, p0 = self.progress
         if math.hypot(x - p0[0], y - p0[1]) > 5 or abs(wrap180(th - p0[2])) > 1:
-            self.progress = (now, (x, y, th))
+            self.progress, self.still = (now, (x, y, th)), 0
             return None
-        if now - t0 > 1000 * self.args.stall:
-            return "not moved for %.1f s at %.0f %.0f %.1f" % ((now - t0) / 1000, x, y, th)
+        if now - t <= 1000 * self.args.odom_stale:
+            self.still += now - t
+        self.progress = (now, p0)
+        if self.still > 1000 * self.args.stall:
+            return "not moved for %.1f s at %.0f %.0f %.1f" % (self.still / 1000, x, y, th)
         return None
 
 
@@ -770,6 +792,7 @@ def main():
     p.add_argument("--appear-timeout", type=float, default=20.0)
     p.add_argument("--stall", type=float, default=2.0)
     p.add_argument("--odom-timeout", type=float, default=5.0)
+    p.add_argument("--odom-stale", type=float, default=0.25)
     p.add_argument("--stall-timeout", type=float, default=10.0)
     p.add_argument("--max-frame", type=int, default=1024)
     p.add_argument("--speed", type=float, default=400.0)

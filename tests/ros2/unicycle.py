@@ -10,8 +10,10 @@ sensor_msgs/LaserScan on scan (the walls of the room, |x| and |y| up to
 HALF mm, measured from its centre), and, if given, sensor_msgs/BatteryState
 on battery_state.  SIGUSR1 stops its odometry for good, as a crashed
 driver would; SIGUSR2 jams its wheels, or frees them again: jammed, it
-does not move, and its odometry goes on saying so.  It says
-`unicycle: ready`.
+does not move, and its odometry goes on saying so.  SIGHUP makes its
+odometry come in bursts, or steady again: bursty, it holds its odometry back
+for 0.9 s of every second, as a driver on a congested link would, while
+the unicycle drives on.  It says `unicycle: ready`.
 """
 
 import argparse
@@ -55,7 +57,7 @@ def main():
     node = rclpy.create_node("unicycle", namespace=args.namespace)
     state = {"x": args.pose[0] / 1000, "y": args.pose[1] / 1000,
              "th": math.radians(args.pose[2]), "v": 0.0, "w": 0.0, "odom": True,
-             "jammed": False}
+             "jammed": False, "bursty": False}
     lock = threading.Lock()
 
     def on_cmd(m):
@@ -71,6 +73,7 @@ def main():
                if args.battery else None)
     signal.signal(signal.SIGUSR1, lambda *_: state.__setitem__("odom", False))
     signal.signal(signal.SIGUSR2, lambda *_: state.__setitem__("jammed", not state["jammed"]))
+    signal.signal(signal.SIGHUP, lambda *_: state.__setitem__("bursty", not state["bursty"]))
     threading.Thread(target=rclpy.spin, args=(node,), daemon=True).start()
     print("unicycle: ready", flush=True)
     dt, k, next_at = 0.02, 0, time.monotonic()
@@ -83,7 +86,7 @@ def main():
             state["y"] += state["v"] * math.sin(state["th"]) * dt
             x, y, th = state["x"], state["y"], state["th"]
         stamp = node.get_clock().now().to_msg()
-        if state["odom"]:
+        if state["odom"] and not (state["bursty"] and k % 50 < 45):
             o = Odometry()
             o.header.stamp = stamp
             o.pose.pose.position.x, o.pose.pose.position.y = x, y
