@@ -158,19 +158,18 @@
 
 ;;; The killer
 
-(define kills '())                      ; (uid . monotonic-seconds), newest first
+(define kills '())                      ; (uid . monotonic-seconds), newest first, any killer's
 (define lock (make-mutex))
 (define (locked thunk) (mutex-lock! lock) (let ((v (thunk))) (mutex-unlock! lock) v))
 
 (define (killer until)
   (when (< (monotonic-seconds) until)
     (thread-sleep! (+ 2 (* 2 (random-real))))
-    (let ((uid (list-ref robots (random-integer (length robots)))))
-      (locked (lambda () (set! kills (cons (cons uid (monotonic-seconds)) kills))))
-      (kill-and-restart! uid))
+    (kill-and-restart! (list-ref robots (random-integer (length robots))))
     (killer until)))
 
 (define (kill-and-restart! uid)
+  (locked (lambda () (set! kills (cons (cons uid (monotonic-seconds)) kills))))
   (kill-process! (locked (lambda () (cdr (assq uid pids)))))
   (thread-sleep! 1)
   (let ((pid (start-lab-aspace! lab uid)))
@@ -297,7 +296,7 @@
                              (list (eval `(lambda () (detached-component '(,tag)))
                                          (lab-environment)))
                              '(1) '(#t) 'detach #t)))
-         (outcome (guard (e (#t (display (error-message e)) (newline) 'lost))
+         (outcome (guard (e (#t (display (error-message e)) (newline) (tell-holders id) 'lost))
                     (let ((r (task-wait id 60)))
                       (cond ((symbol? r) r)
                             ((and steps? (find symbol? r)))  ; a step's not-enough-takers
@@ -305,6 +304,29 @@
                             (else (tell-failed id (if steps? (apply append r) r) began) 'failed))))))
     (if steps? (locked (lambda () (set! steps-tasks (+ steps-tasks 1)))))
     (locked (lambda () (set! detached-outcomes (cons outcome detached-outcomes))))))
+
+;; For a task the lab's lookup lost: what each member, asked directly and
+;; not through the lab-tasks subject, holds of it, at once and a second on,
+;; and which members were killed in the last ten seconds.
+(define (tell-holders id)
+  (let ((ask (eval `(lambda () (filter (lambda (e) (eq? (car e) ',id)) (handed-entries)))
+                   (lab-environment))))
+    (for-each
+     (lambda (when)
+       (display (string-append "chaos: lost " (symbol->string id) ", " when ", asked directly:"))
+       (for-each (lambda (uid)
+                   (display " ")
+                   (write (cons uid (guard (e (#t (list 'no-answer (error-message e))))
+                                      (parameterize ((remote-timeout 2))
+                                        (remote-apply (uid->aspace uid) ask))))))
+                 (append workstations robots))
+       (newline)
+       (thread-sleep! 1))
+     '("at once" "a second on"))
+    (display "chaos: killed in the ten seconds before: ")
+    (write (filter (lambda (uid) (killed-after uid (- (monotonic-seconds) 12)))
+                   (append workstations robots)))
+    (newline)))
 
 ;; Why a detached task posed at began failed, from its components'
 ;; results: each (error UID WHY), and whether the killer killed UID since.
