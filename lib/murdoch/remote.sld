@@ -11,7 +11,7 @@
           remote-error? remote-error-uid remote-error-message
           remote-timeout-error? remote-unreachable-error? remote-raised-error?
           remote-protocol-error? encap release-proxy! start-aspace!
-          hand-over-connection! release-call! var-ref var-set! display-remote undo-on-raise
+          hand-over-connection! release-call! var-ref var-set! display-remote undo-on-raise run-logged
           with-lock screen-calls!)
   (import (scheme base) (scheme write) (murdoch sys) (murdoch wire) (murdoch lab)
           (murdoch code) (murdoch remote aspace) (murdoch remote worker)

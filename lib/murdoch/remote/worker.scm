@@ -4,8 +4,9 @@
 (define (spawn thunk name)
   (thread-start! (make-guarded-thread (lambda () (run-logged thunk name)) name)))
 
-(define (run-logged thunk name)
-  (guard (e (#t (log-warn name ": " (error-message e))))
+;;> (\var{thunk}); if it raises, its error logged after \var{name}, \var{default} or #f.
+(define (run-logged thunk name . default)
+  (guard (e (#t (log-warn name ": " (error-message e)) (and (pair? default) (car default))))
     (thunk)))
 
 ;; Global: one pool for the process, which every reader hands runs to.  A

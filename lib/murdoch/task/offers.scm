@@ -224,8 +224,8 @@
     (offering-waiters-here?-set! o #f)  ; a note after it stands
     (offering-new-waiters-set! o #f)
     (offer-subjects! (and keep? 'nobody) 3)
-    (let* ((answers (answer-or "who waits for this robot" '()
-                               (lambda () (who-waits me depth))))
+    (let* ((answers (run-logged (lambda () (who-waits me depth))
+                                "who waits for this robot" '()))
            (waiting (list-sort (lambda (a b) (rank<? (wanting-rank a) (wanting-rank b)))
                                (append-map cadr answers))))
       (offering-waiters-seen-set! o (pair? waiting))

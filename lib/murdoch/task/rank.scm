@@ -262,9 +262,10 @@
   (others line-ranks-others)
   (own line-ranks-own))
 
+;; Logged, not silent, when the lab cannot be asked: docs/allocation.md.
 (define (line-ranks-now)
-  (make-line-ranks (answer-or "the other posers' line" (vector)
-                              (lambda () (others-waiting-line (others-waiting))))
+  (make-line-ranks (run-logged (lambda () (others-waiting-line (others-waiting)))
+                               "the other posers' line" (vector))
                    (list->vector (map waiter-rank (with-lock (tasks-lock) waiters)))))
 
 (define (line-ranks-length line)
@@ -346,12 +347,6 @@
         (line-posers-asked-set! (the-line) (monotonic-seconds))
         answers)
       (apply ask-these-posers (line-posers (the-line)) proc args)))
-
-;;> \var{thunk}'s look at the other posers, else \var{default}, its error
-;;> logged after \var{what}: a silent guard once hid a bug (docs/allocation.md).
-(define (answer-or what default thunk)
-  (guard (e (#t (log-warn what ": " (condition-message e)) default))
-    (thunk)))
 
 ;;> The same, asked of the posers \var{posers} alone.
 (define (ask-these-posers posers proc . args)

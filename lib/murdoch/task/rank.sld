@@ -20,7 +20,7 @@
           held-uids place-in-line line-ranks-now line-ranks-length waiting-ranks waiting-there?
           waiting-there-poser waiting-there-rank
           waiting-there-held waiting-elsewhere waiting-at-others lab-holders
-          know-poser! ask-posers answer-or wants? waiting-entries waiting-entry
+          know-poser! ask-posers wants? waiting-entries waiting-entry
           wanting-rank
           wanting-poser wanting-id
           make-try-turn try-turn? try-turn-waiter try-turn-claim try-turn-bell

@@ -270,7 +270,7 @@
     ;; task asks those of them that rank after it to give way.
     (let ((holders (list-sort (lambda (a b)
                                 (rank<? (waiting-there-rank a) (waiting-there-rank b)))
-                              (answer-or "the lab's holders" '() lab-holders)))
+                              (run-logged lab-holders "the lab's holders" '())))
           (lines-told (told-lines)))
       (if fresh?
           (remind-free! (delete-duplicates (append-map explanation-free (map cdr lines)))))
@@ -467,5 +467,5 @@
   (or (let ((ws (with-lock (tasks-lock) waiters)))
         (or (not (memq w ws)) (rank<? (waiter-rank (car ws)) (waiter-rank w))))
       (any (lambda (o) (rank<? (waiting-there-rank o) (waiter-rank w)))
-           (answer-or "the other posers' waiting tasks" '()
-                      (lambda () (waiting-at-others posed))))))
+           (run-logged (lambda () (waiting-at-others posed))
+                       "the other posers' waiting tasks" '()))))
