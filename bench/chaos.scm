@@ -307,10 +307,12 @@
 
 ;; For a task the lab's lookup lost: what each member, asked directly and
 ;; not through the lab-tasks subject, holds of it, at once and a second on,
-;; and which members were killed in the last ten seconds.
+;; and which members were killed in the ten seconds before.
 (define (tell-holders id)
   (let ((ask (eval `(lambda () (filter (lambda (e) (eq? (car e) ',id)) (handed-entries)))
-                   (lab-environment))))
+                   (lab-environment)))
+        (members (append workstations robots))
+        (since (- (monotonic-seconds) 10)))
     (for-each
      (lambda (when)
        (display (string-append "chaos: lost " (symbol->string id) ", " when ", asked directly:"))
@@ -319,13 +321,12 @@
                    (write (cons uid (guard (e (#t (list 'no-answer (error-message e))))
                                       (parameterize ((remote-timeout 2))
                                         (remote-apply (uid->aspace uid) ask))))))
-                 (append workstations robots))
+                 members)
        (newline)
        (thread-sleep! 1))
      '("at once" "a second on"))
     (display "chaos: killed in the ten seconds before: ")
-    (write (filter (lambda (uid) (killed-after uid (- (monotonic-seconds) 12)))
-                   (append workstations robots)))
+    (write (filter (lambda (uid) (killed-after uid since)) members))
     (newline)))
 
 ;; Why a detached task posed at began failed, from its components'

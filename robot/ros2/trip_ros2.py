@@ -281,8 +281,8 @@ class Base:
         self.stalled = 0
         self.goal = None
         self.turning = False                    # goto: still facing the goal
-        self.progress = None                    # (robot's ms, pose) of the last progress
-        self.still = 0                          # ... and robot's ms since, that odometry covers
+        self.progress = None                    # (robot's ms last looked, pose of the last progress)
+        self.still = 0                          # robot's ms since that progress, that odometry covers
 
     def pose(self):
         with self.robot.lock:
